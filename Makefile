@@ -1,0 +1,33 @@
+# Every target sets up what it needs: a virtual environment in .venv with the
+# package installed in editable mode (which compiles the C kernels via cffi).
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.installed
+C_SOURCES := generated/sr_generated.c generated/sr_generated.h c/sr_runtime.c c/spherical_robot.h
+
+.PHONY: install test run generate verify bench figures clean
+
+$(STAMP): pyproject.toml setup.py bindings/build_sr.py $(C_SOURCES)
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e '.[dev]'
+	touch $@
+
+install: $(STAMP)
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+run: $(STAMP)
+	$(PY) -m runtime run t-shape --out out
+
+generate: $(STAMP)
+	$(PY) -m derive
+	$(PY) -m pip install --quiet --no-deps -e .
+
+verify: $(STAMP)
+	$(PY) -m runtime verify
+
+clean:
+	rm -rf $(VENV) build out *.egg-info bindings/_sr*.so bindings/_sr.c

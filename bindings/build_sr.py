@@ -1,0 +1,53 @@
+"""cffi builder for `bindings._sr`: compiles generated/ and c/ into one extension module."""
+import pathlib
+
+import cffi
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+SOURCES = ["generated/sr_generated.c", "c/sr_runtime.c"]
+INCLUDE_DIRS = ["generated", "c"]
+
+# The double build of c/spherical_robot.h, as cffi's parser needs it (no preprocessor).
+CDEF = """
+#define SR_NPARAM 12
+#define SR_NX 35
+#define SR_NU 2
+#define SR_NV 5
+#define SR_OK 0
+#define SR_ERR_NULL 1
+#define SR_ERR_NONFINITE 2
+#define SR_ERR_NOT_ROTATION 3
+#define SR_ERR_SINGULAR 4
+#define SR_ERR_PARAM 5
+#define SR_ERR_ARG 6
+#define SR_ERR_CONSTRAINT 7
+#define SR_LIE_EULER 0
+typedef double sr_real;
+typedef struct sr_model { ...; } sr_model;
+const char *sr_status_string(int status);
+int sr_model_init(sr_model *model, const sr_real params[]);
+int sr_check_state(const sr_model *model, const sr_real x[]);
+int sr_accel(const sr_model *model, const sr_real x[], const sr_real u[], sr_real a[]);
+int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real *a, long *failed_row);
+int sr_inertia(const sr_model *model, const sr_real x[], sr_real M[]);
+int sr_rhs(const sr_model *model, const sr_real x[], const sr_real u[], sr_real f[]);
+int sr_energy(const sr_model *model, const sr_real x[], sr_real *energy);
+int sr_equilibrium_residual(const sr_model *model, const sr_real x[], sr_real res[]);
+int sr_so3_exp(const sr_real w[], sr_real R[]);
+int sr_step(const sr_model *model, int method, const sr_real x[], const sr_real u[], sr_real dt, sr_real x_next[]);
+int sr_simulate(const sr_model *model, int method, const sr_real x0[], sr_real dt, long steps,
+                const sr_real *u, sr_real *traj, long *steps_done);
+"""
+
+ffibuilder = cffi.FFI()
+ffibuilder.cdef(CDEF)
+ffibuilder.set_source(
+    "bindings._sr",
+    '#include "spherical_robot.h"',
+    sources=SOURCES,
+    include_dirs=INCLUDE_DIRS,
+    extra_compile_args=["-std=c99", "-O2"],
+)
+
+if __name__ == "__main__":
+    ffibuilder.compile(verbose=True)

@@ -1,0 +1,130 @@
+/*
+ * spherical_robot.h -- public C API of the spherical-robot kernels.
+ *
+ * Model: S. Fiori (2024), "Lie-group modeling and simulation of a spherical
+ * robot, actuated by a yoke-pendulum system, rolling over a flat surface
+ * without slipping".  The equations are derived symbolically in derive/ and
+ * emitted to generated/sr_generated.c; this header and c/sr_runtime.c add
+ * input checks, the SO(3) exponential and the time steppers.
+ *
+ * Self-contained C99: no dynamic allocation, no mutable globals, every
+ * function is re-entrant, every buffer is provided by the caller, every
+ * function returns a status code (SR_OK = 0 on success).
+ *
+ * Scalar type: sr_real is double, or float when compiled with -DSR_USE_FLOAT.
+ *
+ * Units and frames (SI throughout):
+ *   params  [SR_NPARAM] = (r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g)
+ *           r shell radius [m], m_S shell mass [kg], b, h yoke sides [m]
+ *           (b-rods along y, h-rods along x), m_b, m_h rod masses [kg],
+ *           l pendulum length [m], m_P pendulum mass [kg], g gravity [m/s^2],
+ *           k_S, k_Y, k_P physical damping [N m s/rad]: torque -k*omega.
+ *   x       [SR_NX] = 35 state entries:
+ *           x[0..8]   R_S row-major, shell frame -> inertial frame
+ *           x[9..17]  R_Y row-major, yoke relative to shell, rotation about x
+ *           x[18..26] R_P row-major, pendulum relative to yoke, rotation about y
+ *           x[27..29] q, shell centre in the inertial frame [m], q_z = r
+ *           x[30..32] w_S, shell angular velocity in the shell frame [rad/s]
+ *                     (R_S^T dR_S/dt = [[w_S]])
+ *           x[33]     w_Y, yoke speed (R_Y^T dR_Y/dt = w_Y Sigma_Y) [rad/s]
+ *           x[34]     w_P, pendulum speed (R_P^T dR_P/dt = w_P Sigma_P) [rad/s]
+ *   u       [SR_NU] = (yoke motor torque, pendulum motor torque) [N m]
+ *   nu      [SR_NV] = (w_S, w_Y, w_P); accelerations are d(nu)/dt [rad/s^2]
+ */
+#ifndef SPHERICAL_ROBOT_H
+#define SPHERICAL_ROBOT_H
+
+#include "sr_generated.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SR_NPARAM SR_GEN_NPARAM
+#define SR_NX SR_GEN_NX
+#define SR_NU SR_GEN_NU
+#define SR_NV SR_GEN_NV
+
+/* Status codes. */
+#define SR_OK 0
+#define SR_ERR_NULL 1          /* a required pointer is NULL */
+#define SR_ERR_NONFINITE 2     /* an input (or, in a simulation, the state) is NaN or infinite */
+#define SR_ERR_NOT_ROTATION 3  /* a rotation matrix is not orthonormal with det +1, R_Y is not about x or R_P not about y */
+#define SR_ERR_SINGULAR 4      /* the generalized inertia M is not positive definite */
+#define SR_ERR_PARAM 5         /* a parameter is out of its physical range */
+#define SR_ERR_ARG 6           /* another argument is invalid (dt <= 0, steps < 0, unknown method) */
+#define SR_ERR_CONSTRAINT 7    /* q_z differs from r */
+
+/* Tolerance on |R^T R - I| (entry-wise) and |det R - 1| accepted by the checks. */
+#ifdef SR_USE_FLOAT
+#define SR_ROTATION_TOL SR_C(1e-3)
+#else
+#define SR_ROTATION_TOL SR_C(1e-6)
+#endif
+
+/* Time-stepping methods. */
+#define SR_LIE_EULER 0         /* the paper's eq. (111), first order */
+
+/* Model: the parameters and the constants derived from them. Fill with sr_model_init. */
+typedef struct sr_model {
+    sr_real p[SR_NPARAM];
+    sr_real c[SR_GEN_NCONST];
+} sr_model;
+
+/* Human-readable name of a status code (static string, never NULL). */
+const char *sr_status_string(int status);
+
+/* Validate params (all finite; r, m_S, b, h, m_b, m_h, l, m_P > 0; k_S, k_Y, k_P, g >= 0;
+ * yoke half-diagonal sqrt(b^2+h^2)/2 <= r and l <= r) and fill *model.
+ * Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_PARAM. */
+int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM]);
+
+/* Full state check: finite entries, R_S orthonormal with det +1, R_Y a rotation
+ * about x, R_P a rotation about y (to SR_ROTATION_TOL), |q_z - r| <= SR_ROTATION_TOL*r.
+ * Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION or SR_ERR_CONSTRAINT. */
+int sr_check_state(const sr_model *model, const sr_real x[SR_NX]);
+
+/* Accelerations a = d(nu)/dt at state x under torques u (u may be NULL: zero torque).
+ * Cheap checks only: finiteness of x and u, |gamma| = 1 and the unit columns of R_Y, R_P
+ * that the model reads.  Returns SR_OK or an error code; a is untouched on error. */
+int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV]);
+
+/* sr_accel over n states: x is n x SR_NX, u is n x SR_NU (or NULL), a is n x SR_NV,
+ * all row-major.  Stops at the first failing row, whose index goes to *failed_row
+ * (if not NULL; -1 when all rows succeed). */
+int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
+                   sr_real *a, long *failed_row);
+
+/* Generalized inertia M (row-major 5x5): kinetic energy = 1/2 nu^T M nu [kg m^2]. */
+int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * SR_NV]);
+
+/* Right-hand side f of M d(nu)/dt = f [N m]. */
+int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NV]);
+
+/* Total energy [J]: 1/2 nu^T M nu + m_P g e_z^T (q + R_S R_Y R_P cbar_P). */
+int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy);
+
+/* Generalized gravity torques at rest (f at nu = 0, u = 0) [N m]; zero exactly at the
+ * equilibria R_S R_Y R_P e_z = +-e_z of eq. (108). */
+int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV]);
+
+/* R = Exp([[w]]) by Rodrigues' formula, with a series branch for |w| < 1e-4 rad. */
+int sr_so3_exp(const sr_real w[3], sr_real R[9]);
+
+/* One step of size dt > 0 with constant torques u (NULL: zero) from x to x_next
+ * (x_next may alias x).  method: SR_LIE_EULER. */
+int sr_step(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
+            sr_real dt, sr_real x_next[SR_NX]);
+
+/* steps steps of size dt from x0: traj[(steps+1) x SR_NX] receives x0 and every state after;
+ * u is steps x SR_NU (torque held over each step) or NULL.  On an error at step k
+ * (1-based), *steps_done = k-1 and traj holds rows 0..k-1; the state is checked for
+ * finiteness after every step. */
+int sr_simulate(const sr_model *model, int method, const sr_real x0[SR_NX], sr_real dt, long steps,
+                const sr_real *u, sr_real *traj, long *steps_done);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SPHERICAL_ROBOT_H */

@@ -1,0 +1,130 @@
+"""Equations of motion M(γ, R_Y, R_P) ν̇ = f(γ, R_Y, R_P, ν, u), derived from ℓ and ℓ_c.
+
+ν = (ω_S, ω_Y, ω_P) stacks the axial vector of Ω_S and the coordinates of
+Ω_Y = ω_Y Σ_Y and Ω_P = ω_P Σ_P.  Everything below is obtained by
+differentiating the Lagrangians of `derive.lagrangian`; nothing is copied
+from the printed formulas of Section 4.
+
+Shell (eq. 85, first line, with γ̇ and not γ in the last term; eq. 71 has γ):
+    d/dt ∂ℓ_c/∂ω_S = ∂ℓ_c/∂ω_S × ω_S + ∂ℓ/∂γ × γ + r γ̇ × ∂ℓ/∂v − k_S ω_S
+  the vector form of  d/dt ∂ℓ_c/∂Ω_S − ad*_{Ω_S} ∂ℓ_c/∂Ω_S = −γ◇∂ℓ/∂γ + r γ̇◇∂ℓ/∂v − k_S Ω_S.
+Yoke and pendulum (eqs. 78, 84):
+    d/dt ∂ℓ_c/∂ω_Y = ⟨∂ℓ_c/∂R_Y, R_Y Σ_Y⟩ + u_Y − k_Y ω_Y
+    d/dt ∂ℓ_c/∂ω_P = ⟨∂ℓ_c/∂R_P, R_P Σ_P⟩ + u_P − k_P ω_P
+The generalized forces are physical torques (pairing by the dot product of
+axial vectors, see README, "Conventions").  With ∂ℓ_c/∂ν = M ν (eq. 97):
+    M ν̇ = f := [gyroscopic, gravity, non-holonomic and applied terms] − Ṁ ν.
+"""
+import functools
+
+import sympy as sp
+
+from . import lagrangian as L
+from . import parameters as P
+from . import state as S
+
+
+def cross(a, b):
+    return a.cross(b)
+
+
+@functools.lru_cache(maxsize=None)
+def inertia():
+    """Generalized inertia M = ∂²k_c/∂ν² (5×5, symmetric; the matrix form of 𝕁, eqs. 97-99)."""
+    k_c = sp.expand(L.constrained_kinetic_energy())
+    return sp.hessian(k_c, list(S.nu)).applyfunc(sp.expand)
+
+
+@functools.lru_cache(maxsize=None)
+def momenta():
+    """∂ℓ_c/∂ν = M ν: the generalized momenta Λ of eq. (96)."""
+    return inertia() * S.nu
+
+
+def linear_momentum():
+    """∂ℓ/∂v on the constraint (eq. 90)."""
+    ell = L.reduced_lagrangian()
+    return L.constrain(sp.Matrix([sp.diff(ell, vi) for vi in S.v]))
+
+
+def gravity_gradient():
+    """∂ℓ/∂γ on the constraint (eq. 88: −m_P g R_Y R_P c̄_P)."""
+    ell = L.reduced_lagrangian()
+    return L.constrain(sp.Matrix([sp.diff(ell, gi) for gi in S.gamma]))
+
+
+def shell_forces():
+    """Right-hand side of the shell equation, before −Ṁν: K×ω + ∂ℓ/∂γ×γ + r γ̇×∂ℓ/∂v − k_S ω_S."""
+    K_S = momenta()[0:3, 0]
+    gamma_dot = -S.Omega_S * S.gamma
+    return (cross(K_S, S.w_S) + cross(gravity_gradient(), S.gamma)
+            + P.r * cross(gamma_dot, linear_momentum()) - P.k_S * S.w_S)
+
+
+def joint_force(virtual_rates, torque, damping, speed):
+    """⟨∂ℓ_c/∂R, R Σ⟩ + τ − k ω for a one-axis joint (eqs. 76-78, 82-84)."""
+    ell_c = L.reduced_constrained_lagrangian()
+    return S.directional_derivative(ell_c, virtual_rates) + torque - damping * speed
+
+
+def yoke_force():
+    zero = sp.zeros(3, 3)
+    rates = S.configuration_rates(S.R_Y * S.Sigma_Y, zero, sp.zeros(3, 1))
+    return joint_force(rates, S.u_Y, P.k_Y, S.w_Y)
+
+
+def pendulum_force():
+    zero = sp.zeros(3, 3)
+    rates = S.configuration_rates(zero, S.R_P * S.Sigma_P, sp.zeros(3, 1))
+    return joint_force(rates, S.u_P, P.k_P, S.w_P)
+
+
+def inertia_rate_times_nu():
+    """Ṁ ν along the reconstruction and advection equations."""
+    M_dot = inertia().applyfunc(lambda m: S.directional_derivative(m, S.time_rates()))
+    return M_dot * S.nu
+
+
+@functools.lru_cache(maxsize=None)
+def rhs():
+    """f with M ν̇ = f (5-vector)."""
+    forces = sp.Matrix.vstack(shell_forces(), sp.Matrix([yoke_force(), pendulum_force()]))
+    return (forces - inertia_rate_times_nu()).applyfunc(sp.expand)
+
+
+@functools.lru_cache(maxsize=None)
+def equilibrium_residual():
+    """f at ν = 0, u = 0: the conditions of eq. (106); zero exactly at the equilibria."""
+    at_rest = {s: 0 for s in list(S.nu) + list(S.u)}
+    return rhs().subs(at_rest).applyfunc(sp.simplify)
+
+
+def energy():
+    """Total energy, ½νᵀMν + m_P g e_zᵀ(q + R_S R_Y R_P c̄_P)."""
+    return sp.expand(L.total_energy())
+
+
+def pendulum_axis():
+    """R_Y R_P e_z: the pendulum shaft direction (opposite to the rod) in the shell frame."""
+    return S.R_Y * S.R_P * P.e_z()
+
+
+def check_equilibrium_set():
+    """Prove symbolically that the equilibrium residual vanishes exactly on eq. (108).
+
+    With a = R_Y R_P e_z, a unit vector, the shell residual is
+    (m_P g l / 2) a × γ and the joint residuals are its components along the
+    joint axes, so the residual is zero iff a ∥ γ, i.e. R_S R_Y R_P e_z = ±e_z.
+    Returns the list of identities checked (each simplified to 0).
+    """
+    res = equilibrium_residual()
+    a = pendulum_axis()
+    shell_torque = P.m_P * P.g * P.l / 2 * cross(a, S.gamma)
+    unit = {S.RY_c**2: 1 - S.RY_s**2, S.RP_c**2: 1 - S.RP_s**2}
+    identities = list(res[0:3, 0] - shell_torque)
+    identities.append(res[3] - shell_torque[0])                       # along the yoke axis e_x
+    identities.append(res[4] - (S.R_Y * sp.Matrix([0, 1, 0])).dot(shell_torque))  # along R_Y e_y
+    # |a × γ|² = |a|²|γ|² − (a·γ)² (eq. 1): zero iff a·γ = ±1 for unit a, γ.
+    identities.append(sp.expand(cross(a, S.gamma).dot(cross(a, S.gamma)) - (a.dot(a) * S.gamma.dot(S.gamma) - a.dot(S.gamma) ** 2)))
+    identities.append(sp.expand(a.dot(a) - 1).subs(unit))
+    return [sp.simplify(sp.expand(e).subs(unit)) for e in identities]

@@ -1,0 +1,41 @@
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 06bdad5c308858e6], SymPy 1.14.0. */
+/*
+ * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
+ * Internal to the library: use the checked API of c/spherical_robot.h.
+ * Every function returns SR_GEN_OK or SR_GEN_SINGULAR; outputs are caller-provided.
+ */
+#ifndef SR_GENERATED_H
+#define SR_GENERATED_H
+
+#ifdef SR_USE_FLOAT
+typedef float sr_real;
+#define SR_C(v) ((sr_real)(v##f))
+#define SR_GEN_PIVOT_TOL SR_C(1e-6)
+#else
+typedef double sr_real;
+#define SR_C(v) ((sr_real)(v))
+#define SR_GEN_PIVOT_TOL SR_C(1e-13)
+#endif
+
+#define SR_GEN_OK 0
+#define SR_GEN_SINGULAR 4
+#define SR_GEN_NPARAM 12
+#define SR_GEN_NCONST 12
+#define SR_GEN_NX 35
+#define SR_GEN_NU 2
+#define SR_GEN_NV 5
+
+/* Derived constants of Section 2.3 from the twelve parameters. */
+int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[12]);
+/* Generalized inertia M(γ, R_Y, R_P), row-major 5x5, kinetic energy ½νᵀMν. */
+int sr_gen_inertia(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr_real M[25]);
+/* Right-hand side f of M ν̇ = f: gyroscopic, non-holonomic, gravity, motor and friction terms. */
+int sr_gen_rhs(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real f[5]);
+/* Total energy: ½νᵀMν + m_P g e_zᵀ(q + R_S R_Y R_P c̄_P) [J]. */
+int sr_gen_energy(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr_real E[1]);
+/* f at ν = 0, u = 0 (eq. 106); zero iff R_S R_Y R_P e_z = ±e_z (eq. 108). */
+int sr_gen_equilibrium_residual(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr_real res[5]);
+/* ν̇ = (ω̇_S, ω̇_Y, ω̇_P) solving M ν̇ = f by LDLᵀ; SR_GEN_SINGULAR if a pivot is not positive. */
+int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real a[SR_GEN_NV]);
+
+#endif /* SR_GENERATED_H */
