@@ -243,17 +243,26 @@ static int lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_rea
     return SR_OK;
 }
 
+/* One step of any method; x and out may alias. */
+static int advance(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                   sr_real dt, sr_real out[SR_NX])
+{
+    switch (method) {
+    case SR_LIE_EULER: return lie_euler(model, x, u, dt, out);
+    default: return SR_ERR_ARG;
+    }
+}
+
+static int valid_method(int method) { return method == SR_LIE_EULER; }
+
 int sr_step(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
             sr_real dt, sr_real x_next[SR_NX])
 {
     int status = cheap_checks(model, x, u);
     if (status != SR_OK) return status;
     if (!x_next) return SR_ERR_NULL;
-    if (!(dt > 0) || !isfinite(dt)) return SR_ERR_ARG;
-    switch (method) {
-    case SR_LIE_EULER: return lie_euler(model, x, u ? u : zero_u, dt, x_next);
-    default: return SR_ERR_ARG;
-    }
+    if (!(dt > 0) || !isfinite(dt) || !valid_method(method)) return SR_ERR_ARG;
+    return advance(model, method, x, u ? u : zero_u, dt, x_next);
 }
 
 int sr_simulate(const sr_model *model, int method, const sr_real x0[SR_NX], sr_real dt, long steps,
@@ -265,14 +274,13 @@ int sr_simulate(const sr_model *model, int method, const sr_real x0[SR_NX], sr_r
     status = cheap_checks(model, x0, NULL);
     if (status != SR_OK) return status;
     if (!traj) return SR_ERR_NULL;
-    if (steps < 0 || !(dt > 0) || !isfinite(dt)) return SR_ERR_ARG;
-    if (method != SR_LIE_EULER) return SR_ERR_ARG;
+    if (steps < 0 || !(dt > 0) || !isfinite(dt) || !valid_method(method)) return SR_ERR_ARG;
     for (i = 0; i < SR_NX; ++i) traj[i] = x0[i];
     for (n = 0; n < steps; ++n) {
         const sr_real *x = traj + n * SR_NX;
         const sr_real *un = u ? u + n * SR_NU : zero_u;
         if (!all_finite(un, SR_NU)) return SR_ERR_NONFINITE;
-        status = lie_euler(model, x, un, dt, traj + (n + 1) * SR_NX);
+        status = advance(model, method, x, un, dt, traj + (n + 1) * SR_NX);
         if (status == SR_OK && !all_finite(traj + (n + 1) * SR_NX, SR_NX)) status = SR_ERR_NONFINITE;
         if (status != SR_OK) return status;
         if (steps_done) *steps_done = n + 1;
