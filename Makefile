@@ -4,7 +4,7 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
-C_SOURCES := generated/sr_generated.c generated/sr_generated.h c/sr_runtime.c c/spherical_robot.h
+C_SOURCES := $(wildcard generated/*.c generated/*.h c/*.c c/*.h)
 
 .PHONY: install test run generate verify bench figures clean
 

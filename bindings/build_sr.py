@@ -4,7 +4,8 @@ import pathlib
 import cffi
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-SOURCES = ["generated/sr_generated.c", "c/sr_runtime.c"]
+# Every C file of generated/ and the top level of c/ (examples and C tests live in subfolders).
+SOURCES = sorted(str(p.relative_to(ROOT)) for d in ("generated", "c") for p in (ROOT / d).glob("*.c"))
 INCLUDE_DIRS = ["generated", "c"]
 
 # The double build of c/spherical_robot.h, as cffi's parser needs it (no preprocessor).

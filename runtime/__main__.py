@@ -1,0 +1,28 @@
+"""`python -m runtime COMMAND [options]`: one module per command, each with its own `main(argv) -> int`."""
+import importlib
+import sys
+
+COMMANDS = {
+    "run": ("runtime.scenario_cli", "run a shipped scenario, a scenario file, or `all`"),
+    "verify": ("runtime.verify", "cross-check the kernels against the reference and the invariants"),
+    "convergence": ("runtime.convergence", "convergence and energy study of the integrators"),
+    "bench": ("runtime.bench", "benchmarks against the alternatives"),
+}
+
+
+def usage():
+    lines = ["usage: python -m runtime COMMAND [options]", "", "commands:"]
+    lines += [f"  {name:<12} {doc}" for name, (_, doc) in COMMANDS.items()]
+    return "\n".join(lines)
+
+
+def main(argv):
+    if not argv or argv[0] in ("-h", "--help") or argv[0] not in COMMANDS:
+        print(usage(), file=sys.stderr if argv and argv[0] not in ("-h", "--help") else sys.stdout)
+        return 0 if argv and argv[0] in ("-h", "--help") else 2
+    module = importlib.import_module(COMMANDS[argv[0]][0])
+    return module.main(argv[1:])
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
