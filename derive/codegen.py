@@ -66,13 +66,33 @@ def input_symbols(arrays):
     return {s: (a, i) for a in arrays for s, i in ARRAY_LAYOUTS[a].items()}
 
 
+def nested_in_speeds(expr):
+    """expr as Σ_j ν_j (Σ_k c_jk(config) ν_k) + (linear and constant terms).
+
+    The right-hand side is quadratic in ν; grouping its 15 monomials this way
+    lets CSE share the configuration-dependent coefficients (about half the
+    flops of the expanded polynomial).
+    """
+    speeds, inputs = list(S.nu), list(S.u)
+    poly = sp.Poly(expr, *speeds, *inputs)
+    rows, rest = {}, []
+    for powers, coeff in poly.terms():
+        coeff = sp.factor_terms(coeff)
+        factors = [v for v, k in zip(speeds, powers[:len(speeds)]) for _ in range(k)]
+        if len(factors) == 2:
+            rows.setdefault(factors[0], []).append(coeff * factors[1])
+        else:
+            rest.append(coeff * sp.Mul(*[v**k for v, k in zip(speeds + inputs, powers)]))
+    return sp.Add(*rest) + sp.Add(*[v * sp.Add(*terms) for v, terms in rows.items()])
+
+
 def upper_triangle(M):
     return tuple(M[i, j] for i in range(M.rows) for j in range(i, M.cols))
 
 
 def kernels():
     """The functions to emit."""
-    M, f = D.inertia(), D.rhs()
+    M, f = D.inertia(), D.rhs().applyfunc(nested_in_speeds)
     return (
         Kernel("constants", "Derived constants of Section 2.3 from the twelve parameters.",
                ("p",), (Output("c", tuple(P.constant_expressions()), "constants (r, l, g, m_P, m_R, j_S, j_xx, j_yy, j_P, k_S, k_Y, k_P)"),)),

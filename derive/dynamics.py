@@ -28,11 +28,29 @@ def cross(a, b):
     return a.cross(b)
 
 
+#: Generators ordered so that reduction replaces cos² by 1 − sin² and γ_x² by 1 − γ_y² − γ_z².
+_MANIFOLD_GENERATORS = (S.RY_c, S.RP_c, S.gamma[0], S.RY_s, S.RP_s, S.gamma[1], S.gamma[2])
+
+
+@functools.lru_cache(maxsize=None)
+def _unit_norm_basis():
+    """Gröbner basis of the identities every valid state satisfies: R_Y, R_P and R_S orthonormal."""
+    identities = [S.RY_c**2 + S.RY_s**2 - 1, S.RP_c**2 + S.RP_s**2 - 1, (S.gamma.T * S.gamma)[0] - 1]
+    return sp.groebner(identities, *_MANIFOLD_GENERATORS, order="grevlex")
+
+
+def on_manifold(expr):
+    """The canonical remainder of expr modulo cos² + sin² = 1 and |γ| = 1 (fewer terms, same values on valid states)."""
+    basis = _unit_norm_basis()
+    _, remainder = sp.reduced(sp.expand(expr), list(basis), *_MANIFOLD_GENERATORS, order="grevlex")
+    return sp.expand(remainder)
+
+
 @functools.lru_cache(maxsize=None)
 def inertia():
     """Generalized inertia M = ∂²k_c/∂ν² (5×5, symmetric; the matrix form of 𝕁, eqs. 97-99)."""
     k_c = sp.expand(L.constrained_kinetic_energy())
-    return sp.hessian(k_c, list(S.nu)).applyfunc(sp.expand)
+    return sp.hessian(k_c, list(S.nu)).applyfunc(on_manifold)
 
 
 @functools.lru_cache(maxsize=None)
@@ -89,7 +107,7 @@ def inertia_rate_times_nu():
 def rhs():
     """f with M ν̇ = f (5-vector)."""
     forces = sp.Matrix.vstack(shell_forces(), sp.Matrix([yoke_force(), pendulum_force()]))
-    return (forces - inertia_rate_times_nu()).applyfunc(sp.expand)
+    return (forces - inertia_rate_times_nu()).applyfunc(on_manifold)
 
 
 @functools.lru_cache(maxsize=None)
@@ -101,7 +119,7 @@ def equilibrium_residual():
 
 def energy():
     """Total energy, ½νᵀMν + m_P g e_zᵀ(q + R_S R_Y R_P c̄_P)."""
-    return sp.expand(L.total_energy())
+    return on_manifold(L.total_energy())
 
 
 def pendulum_axis():

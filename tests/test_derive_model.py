@@ -14,7 +14,17 @@ def test_inertia_is_symmetric():
 def test_kinetic_energy_is_half_nu_M_nu():
     k_c = L.constrained_kinetic_energy()
     quad = (S.nu.T * D.inertia() * S.nu)[0] / 2
-    assert sp.expand(k_c - quad) == 0
+    assert D.on_manifold(k_c - quad) == 0
+
+
+def test_reduction_on_the_manifold_keeps_values_on_valid_states():
+    k_c = L.constrained_kinetic_energy()
+    reduced = D.on_manifold(k_c)
+    point = {S.RY_c: sp.Rational(3, 5), S.RY_s: sp.Rational(4, 5), S.RP_c: sp.Rational(5, 13),
+             S.RP_s: sp.Rational(-12, 13), S.gamma[0]: sp.Rational(2, 3), S.gamma[1]: sp.Rational(-1, 3),
+             S.gamma[2]: sp.Rational(2, 3)}
+    assert sp.expand((k_c - reduced).subs(point)) == 0
+    assert reduced != sp.expand(k_c)
 
 
 def test_inertia_does_not_depend_on_speeds_or_inputs():
