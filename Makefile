@@ -29,5 +29,8 @@ generate: $(STAMP)
 verify: $(STAMP)
 	$(PY) -m runtime verify
 
+bench: $(STAMP)
+	$(PY) -m runtime bench --native
+
 clean:
 	rm -rf $(VENV) build out *.egg-info bindings/_sr*.so bindings/_sr.c

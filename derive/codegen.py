@@ -15,6 +15,7 @@ numeric literals go through SR_C() so both builds are clean under -Wall
 import dataclasses
 import hashlib
 import pathlib
+import re
 
 import sympy as sp
 from sympy.printing.c import C99CodePrinter
@@ -186,7 +187,25 @@ def signature(kernel):
     return f"int {PREFIX}{kernel.name}({', '.join(args)})"
 
 
+_TOKEN = re.compile(r"[A-Za-z_][A-Za-z_0-9]*(?:\[[0-9]+\])?|[0-9.]+(?:e[-+]?[0-9]+)?|[-+*/()<>!,]")
+
+
+def count_flops(lines):
+    """Binary + − × ÷ in the right-hand sides of C statements (unary minus is free: it folds into a subtraction)."""
+    flops = 0
+    for line in lines:
+        if "=" not in line or line.lstrip().startswith("/*"):
+            continue
+        previous = None
+        for token in _TOKEN.findall(line.split("=", 1)[1].replace("SR_C", "")):
+            if token in "+-*/" and previous is not None and (previous[0].isalnum() or previous[0] in "_.)"):
+                flops += 1
+            previous = token
+    return flops
+
+
 def emit_kernel(kernel):
+    """C text of one kernel and its flop count."""
     printer = Printer()
     exprs = [e for o in kernel.outputs for e in o.exprs]
     temporaries, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"), order="canonical")
@@ -210,7 +229,7 @@ def emit_kernel(kernel):
         body += emit_ldlt_solve(S.NV, "M", "f", "a")
     body.append("    return SR_GEN_OK;")
     doc = f"/* {kernel.doc} */"
-    return "\n".join([doc, signature(kernel), "{", *body, "}", ""])
+    return "\n".join([doc, signature(kernel), "{", *body, "}", ""]), count_flops(body)
 
 
 def provenance():
@@ -226,9 +245,10 @@ def banner():
             f"[sha256 of its sources {provenance()}], SymPy {sp.__version__}. */\n")
 
 
-def header_text(ks):
+def header_text(ks, flops):
     guard = "SR_GENERATED_H"
     protos = "\n".join(f"/* {k.doc} */\n{signature(k)};" for k in ks)
+    flop_macros = "\n".join(f"#define SR_GEN_{k.name.upper()}_FLOPS {flops[k.name]}" for k in ks)
     return f"""{banner()}/*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -255,14 +275,17 @@ typedef double sr_real;
 #define SR_GEN_NU {S.NU}
 #define SR_GEN_NV {S.NV}
 
+/* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
+{flop_macros}
+
 {protos}
 
 #endif /* {guard} */
 """
 
 
-def source_text(ks):
-    return banner() + f'#include "{HEADER_NAME}"\n\n' + "\n".join(emit_kernel(k) for k in ks)
+def source_text(emitted):
+    return banner() + f'#include "{HEADER_NAME}"\n\n' + "\n".join(text for text, _ in emitted)
 
 
 def write(out_dir):
@@ -270,7 +293,9 @@ def write(out_dir):
     out_dir = pathlib.Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     ks = kernels()
-    files = {HEADER_NAME: header_text(ks), SOURCE_NAME: source_text(ks)}
+    emitted = [emit_kernel(k) for k in ks]
+    flops = {k.name: n for k, (_, n) in zip(ks, emitted)}
+    files = {HEADER_NAME: header_text(ks, flops), SOURCE_NAME: source_text(emitted)}
     for name, text in files.items():
         tmp = out_dir / (name + ".tmp")
         tmp.write_text(text)

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources c1e1d310120b3391], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources beb838f47476483a], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -24,6 +24,14 @@ typedef double sr_real;
 #define SR_GEN_NX 35
 #define SR_GEN_NU 2
 #define SR_GEN_NV 5
+
+/* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
+#define SR_GEN_CONSTANTS_FLOPS 21
+#define SR_GEN_INERTIA_FLOPS 111
+#define SR_GEN_RHS_FLOPS 345
+#define SR_GEN_ENERGY_FLOPS 206
+#define SR_GEN_EQUILIBRIUM_RESIDUAL_FLOPS 22
+#define SR_GEN_ACCEL_FLOPS 540
 
 /* Derived constants of Section 2.3 from the twelve parameters. */
 int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[12]);

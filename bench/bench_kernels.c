@@ -1,0 +1,119 @@
+/* bench_kernels.c -- times the kernels in a C loop (no Python in the timed region).
+ *
+ * usage: bench_kernels INPUT.bin REPEATS
+ * INPUT.bin: int32 n, then params[12], states[n][35], inputs[n][2] (float64).
+ * Prints one JSON object: ns per call of each kernel (best of 5 runs of REPEATS
+ * sweeps over the n states) and the outputs for the first 8 states, which the
+ * Python driver checks against the reference before reporting any time.
+ * Built by runtime/bench.py; with -DWITH_CASADI the CasADi-generated reference
+ * (ref_accel.c, written by the driver) is timed too.
+ */
+#define _POSIX_C_SOURCE 199309L
+#include "spherical_robot.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#ifdef WITH_CASADI
+#include "ref_accel.h"
+#endif
+
+#define NMAX 4096
+#define NCHECK 8
+
+static sr_real X[NMAX][SR_NX], U[NMAX][SR_NU], OUT[NMAX][SR_NX];
+static double sink;
+
+static double now_ns(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return 1e9 * (double)t.tv_sec + (double)t.tv_nsec;
+}
+
+typedef int (*kernel_fn)(const sr_model *, int, int);
+static sr_model model;
+
+static int k_accel(const sr_model *m, int i, int arg) { (void)arg; return sr_accel(m, X[i], U[i], OUT[i]); }
+static int k_gen_accel(const sr_model *m, int i, int arg) { (void)arg; return sr_gen_accel(m->c, X[i], U[i], OUT[i]); }
+static int k_inertia(const sr_model *m, int i, int arg) { (void)arg; return sr_inertia(m, X[i], OUT[i]); }
+static int k_step(const sr_model *m, int i, int method) { return sr_step(m, method, X[i], U[i], 0.01, OUT[i]); }
+
+#ifdef WITH_CASADI
+static casadi_int iw[4096];
+static casadi_real w[65536];
+static int k_casadi(const sr_model *m, int i, int arg)
+{
+    const casadi_real *in[64];
+    casadi_real *out[64];
+    (void)m; (void)arg;
+    in[0] = X[i]; in[1] = U[i]; out[0] = OUT[i];
+    return ref_accel(in, out, iw, w, 0);
+}
+#endif
+
+static double time_kernel(kernel_fn fn, int arg, int n, int repeats, int nout, const char *name)
+{
+    double best = 1e300;
+    int run, r, i, k;
+    for (run = 0; run < 5; ++run) {
+        double t0 = now_ns(), dt;
+        for (r = 0; r < repeats; ++r)
+            for (i = 0; i < n; ++i) {
+                if (fn(&model, i, arg) != 0) { fprintf(stderr, "%s failed at state %d\n", name, i); exit(2); }
+                sink += OUT[i][0];
+            }
+        dt = (now_ns() - t0) / ((double)repeats * n);
+        if (dt < best) best = dt;
+    }
+    printf("  \"%s\": {\"ns\": %.3f, \"check\": [", name, best);
+    for (i = 0; i < NCHECK && i < n; ++i) {
+        fn(&model, i, arg);
+        printf("%s[", i ? ", " : "");
+        for (k = 0; k < nout; ++k) printf("%s%.17g", k ? ", " : "", (double)OUT[i][k]);
+        printf("]");
+    }
+    printf("]},\n");
+    return best;
+}
+
+int main(int argc, char **argv)
+{
+    FILE *f;
+    int n, repeats;
+    sr_real p[SR_NPARAM];
+    if (argc != 3) { fprintf(stderr, "usage: %s INPUT.bin REPEATS\n", argv[0]); return 2; }
+    f = fopen(argv[1], "rb");
+    if (!f || fread(&n, sizeof n, 1, f) != 1 || n < 1 || n > NMAX) { fprintf(stderr, "bad input\n"); return 2; }
+    if (fread(p, sizeof(sr_real), SR_NPARAM, f) != SR_NPARAM
+        || fread(X, sizeof(sr_real) * SR_NX, (size_t)n, f) != (size_t)n
+        || fread(U, sizeof(sr_real) * SR_NU, (size_t)n, f) != (size_t)n) { fprintf(stderr, "short input\n"); return 2; }
+    fclose(f);
+    repeats = atoi(argv[2]);
+    if (sr_model_init(&model, p) != SR_OK) { fprintf(stderr, "bad params\n"); return 2; }
+#ifdef WITH_CASADI
+    {
+        casadi_int sz_arg, sz_res, sz_iw, sz_w;
+        ref_accel_work(&sz_arg, &sz_res, &sz_iw, &sz_w);
+        if (sz_arg > 64 || sz_res > 64 || sz_iw > (casadi_int)(sizeof iw / sizeof iw[0])
+            || sz_w > (casadi_int)(sizeof w / sizeof w[0])) { fprintf(stderr, "CasADi work arrays too small\n"); return 2; }
+    }
+#endif
+    printf("{\n");
+    time_kernel(k_accel, 0, n, repeats, SR_NV, "accel");
+    time_kernel(k_gen_accel, 0, n, repeats, SR_NV, "accel_unchecked");
+    time_kernel(k_inertia, 0, n, repeats, SR_NV * SR_NV, "inertia");
+    time_kernel(k_step, SR_LIE_EULER, n, repeats, SR_NX, "step_lie_euler");
+#ifdef SR_RKMK4
+    time_kernel(k_step, SR_RKMK4, n, repeats, SR_NX, "step_rkmk4");
+#endif
+#ifdef SR_CF4
+    time_kernel(k_step, SR_CF4, n, repeats, SR_NX, "step_cf4");
+#endif
+#ifdef WITH_CASADI
+    time_kernel(k_casadi, 0, n, repeats > 10 ? repeats / 10 : 1, SR_NV, "casadi_generated_reference_accel");
+#endif
+    printf("  \"accel_flops\": %d,\n  \"sink\": %g\n}\n", SR_GEN_ACCEL_FLOPS, sink);
+    return 0;
+}
