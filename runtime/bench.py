@@ -272,7 +272,19 @@ def main(argv=None):
     def progress(msg):
         print(f"bench: {msg}", file=sys.stderr, flush=True)
 
+    try:
+        original_affinity = os.sched_getaffinity(0)
+    except (AttributeError, OSError):
+        original_affinity = None
     core = pin_to_one_core()
+    try:
+        return run(args, core, progress)
+    finally:
+        if original_affinity:
+            os.sched_setaffinity(0, original_affinity)
+
+
+def run(args, core, progress):
     rng = np.random.default_rng(0)
     params = Params.paper_simulation()
     model = Model(params)
