@@ -20,7 +20,7 @@ test: $(STAMP)
 	$(PY) -m pytest -q
 
 run: $(STAMP)
-	$(PY) -m runtime run t-shape --out out
+	$(PY) -m runtime run all --out out
 
 generate: $(STAMP)
 	$(PY) -m derive
@@ -31,6 +31,9 @@ verify: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) -m runtime bench --native
+
+figures: $(STAMP)
+	$(PY) -m runtime.figures
 
 clean:
 	rm -rf $(VENV) build out *.egg-info bindings/_sr*.so bindings/_sr.c

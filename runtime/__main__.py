@@ -7,6 +7,7 @@ COMMANDS = {
     "verify": ("runtime.verify", "cross-check the kernels against the reference and the invariants"),
     "convergence": ("runtime.convergence", "convergence and energy study of the integrators"),
     "bench": ("runtime.bench", "benchmarks against the alternatives"),
+    "figures": ("runtime.figures", "regenerate the committed figures under docs/figures/"),
 }
 
 
