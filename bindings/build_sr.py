@@ -22,7 +22,12 @@ CDEF = """
 #define SR_ERR_PARAM 5
 #define SR_ERR_ARG 6
 #define SR_ERR_CONSTRAINT 7
+#define SR_ERR_STEP_SIZE 8
+#define SR_ERR_MAX_STEPS 9
 #define SR_LIE_EULER 0
+#define SR_RKMK4 1
+#define SR_CF4 2
+#define SR_PROJECT 16
 typedef double sr_real;
 typedef struct sr_model { ...; } sr_model;
 const char *sr_status_string(int status);
@@ -38,6 +43,16 @@ int sr_so3_exp(const sr_real w[], sr_real R[]);
 int sr_step(const sr_model *model, int method, const sr_real x[], const sr_real u[], sr_real dt, sr_real x_next[]);
 int sr_simulate(const sr_model *model, int method, const sr_real x0[], sr_real dt, long steps,
                 const sr_real *u, sr_real *traj, long *steps_done);
+typedef struct sr_adaptive_stats {
+    long accepted;
+    long rejected;
+    long evaluations;
+    long rows_done;
+    sr_real h_next;
+} sr_adaptive_stats;
+int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[], sr_real dt_out,
+                         long n_out, const sr_real *u, sr_real rtol, sr_real atol, sr_real h_init,
+                         long max_steps, sr_real *traj, sr_adaptive_stats *stats);
 """
 
 ffibuilder = cffi.FFI()

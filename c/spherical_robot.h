@@ -54,6 +54,8 @@ extern "C" {
 #define SR_ERR_PARAM 5         /* a parameter is out of its physical range */
 #define SR_ERR_ARG 6           /* another argument is invalid (dt <= 0, steps < 0, unknown method) */
 #define SR_ERR_CONSTRAINT 7    /* q_z differs from r */
+#define SR_ERR_STEP_SIZE 8     /* adaptive stepping: the step size fell below the rounding level of t */
+#define SR_ERR_MAX_STEPS 9     /* adaptive stepping: more than max_steps step attempts */
 
 /* Tolerance on |R^T R - I| (entry-wise) and |det R - 1| accepted by the checks. */
 #ifdef SR_USE_FLOAT
@@ -64,6 +66,23 @@ extern "C" {
 
 /* Time-stepping methods. */
 #define SR_LIE_EULER 0         /* the paper's eq. (111), first order */
+/* Fourth-order Lie-group methods (c/sr_lie_integrators.c).  Both advance the state on
+ * SO(3) x SO(2)_x x SO(2)_y x R^3 x R^5: R_S by right multiplication with Exp of an so(3)
+ * element, R_Y and R_P by exact rotations about x and y, q and nu additively.  The torque u
+ * is held constant over the step; q is a stage variable like every other (order 4 overall).
+ * Rotations stay orthonormal to rounding (no projection). */
+#define SR_RKMK4 1             /* Runge-Kutta-Munthe-Kaas: classical RK4 tableau in the Lie
+                                  algebra with the closed-form dexp^-1 of SO(3); 4 acceleration
+                                  evaluations and 4 SO(3) exponentials per step */
+#define SR_CF4 2               /* commutator-free method of Celledoni-Marthinsen-Owren (2003):
+                                  4 stages, no dexp^-1, the update a product of 2 exponentials;
+                                  4 acceleration evaluations and 5 SO(3) exponentials per step */
+#define SR_PROJECT 16          /* flag, OR-ed into any method (e.g. SR_RKMK4 | SR_PROJECT): after
+                                  every step, one Newton-Schulz step R <- R (3I - R^T R)/2 pulls
+                                  R_S (and the cos/sin pairs of R_Y, R_P) back to the rotations.
+                                  Off by default: the methods need it only where rounding is
+                                  biased, e.g. a robot at rest for ~10^5+ steps, whose tiny
+                                  constant increments round the same way every step */
 
 /* Model: the parameters and the constants derived from them. Fill with sr_model_init. */
 typedef struct sr_model {
@@ -112,7 +131,7 @@ int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_re
 int sr_so3_exp(const sr_real w[3], sr_real R[9]);
 
 /* One step of size dt > 0 with constant torques u (NULL: zero) from x to x_next
- * (x_next may alias x).  method: SR_LIE_EULER. */
+ * (x_next may alias x).  method: SR_LIE_EULER, SR_RKMK4 or SR_CF4. */
 int sr_step(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
             sr_real dt, sr_real x_next[SR_NX]);
 
@@ -122,6 +141,37 @@ int sr_step(const sr_model *model, int method, const sr_real x[SR_NX], const sr_
  * finiteness after every step. */
 int sr_simulate(const sr_model *model, int method, const sr_real x0[SR_NX], sr_real dt, long steps,
                 const sr_real *u, sr_real *traj, long *steps_done);
+
+/* Counters of sr_simulate_adaptive. */
+typedef struct sr_adaptive_stats {
+    long accepted;    /* accepted steps */
+    long rejected;    /* rejected step attempts (error estimate above tolerance) */
+    long evaluations; /* calls of the acceleration kernel */
+    long rows_done;   /* output rows written, x0 included: traj rows 0..rows_done-1 are valid */
+    sr_real h_next;   /* step-size proposal at exit: pass it as h_init to continue a run */
+} sr_adaptive_stats;
+
+/* Adaptive RKMK4 with output on the fixed grid t_k = k*dt_out, k = 0..n_out:
+ * traj[(n_out+1) x SR_NX] receives x0 and the state at every t_k.  Steps land exactly on the
+ * grid points (no interpolation), so the torque may jump there: u is n_out x SR_NU, row k held
+ * over [t_k, t_k+1) (NULL: zero torque).
+ *   method: SR_RKMK4, optionally | SR_PROJECT.  The error estimate comes from the RK4(3) pair
+ *   with the "first same as last" stage: the 3rd-order weights (1/6, 1/3, 1/3, 0, 1/6) use the
+ *   stage at the new point, so the estimate is dt/6 (K4 - K5) in the Lie algebra and an
+ *   accepted step costs 4 acceleration evaluations (5 after a torque change).  The 4th-order
+ *   solution is propagated (local extrapolation); the global error is typically ~3 rtol.
+ * Error test (max norm): every component e_i of the estimate satisfies |e_i| <= atol + rtol*s_i,
+ * with s_i = 1 for the 5 rotation angles and s_i = max(|old_i|, |new_i|) for q and nu.
+ * Step-size control: h *= clamp(0.9 err^(-1/4), 0.2, 5) (no growth right after a rejection).
+ *   rtol, atol >= 0 with rtol + atol > 0; h_init > 0 the first trial step, or <= 0 for
+ *   min(dt_out, 0.1*tol^(1/4)) with tol = max(rtol, atol); max_steps > 0 bounds the step
+ *   attempts (accepted + rejected).  stats may be NULL.
+ * Returns SR_OK, SR_ERR_NULL, SR_ERR_ARG, SR_ERR_NONFINITE (x0 or u or the state),
+ * SR_ERR_NOT_ROTATION (x0), SR_ERR_SINGULAR, SR_ERR_STEP_SIZE or SR_ERR_MAX_STEPS; on error
+ * the valid rows are reported in stats->rows_done. */
+int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[SR_NX], sr_real dt_out,
+                         long n_out, const sr_real *u, sr_real rtol, sr_real atol, sr_real h_init,
+                         long max_steps, sr_real *traj, sr_adaptive_stats *stats);
 
 #ifdef __cplusplus
 }

@@ -1,23 +1,8 @@
 /* sr_runtime.c -- checks, SO(3) exponential and time steppers around the generated kernels.
  * Hand-written; see spherical_robot.h for the contract of every function. */
-#include "spherical_robot.h"
+#include "sr_internal.h" /* spherical_robot.h, math macros, shared helpers */
 
-#include <math.h>
 #include <stddef.h>
-
-#ifdef SR_USE_FLOAT
-#define SR_SQRT sqrtf
-#define SR_SIN sinf
-#define SR_COS cosf
-#define SR_FABS fabsf
-#else
-#define SR_SQRT sqrt
-#define SR_SIN sin
-#define SR_COS cos
-#define SR_FABS fabs
-#endif
-
-enum { RS = 0, RY = 9, RP = 18, Q = 27, W = 30 };
 
 const char *sr_status_string(int status)
 {
@@ -30,16 +15,10 @@ const char *sr_status_string(int status)
     case SR_ERR_PARAM: return "parameter out of range";
     case SR_ERR_ARG: return "invalid argument";
     case SR_ERR_CONSTRAINT: return "constraint violated (q_z != r)";
+    case SR_ERR_STEP_SIZE: return "adaptive step size below the rounding level of t";
+    case SR_ERR_MAX_STEPS: return "adaptive stepping exceeded max_steps";
     default: return "unknown status";
     }
-}
-
-static int all_finite(const sr_real *v, int n)
-{
-    int i;
-    for (i = 0; i < n; ++i)
-        if (!isfinite(v[i])) return 0;
-    return 1;
 }
 
 int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM])
@@ -59,20 +38,6 @@ int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM])
     if (params[l] > params[r]) return SR_ERR_PARAM;
     for (i = 0; i < SR_NPARAM; ++i) model->p[i] = params[i];
     return sr_gen_constants(model->p, model->c);
-}
-
-static int near(sr_real a, sr_real b) { return SR_FABS(a - b) <= SR_ROTATION_TOL; }
-
-/* The entries the kernels read: gamma = third row of R_S, cos/sin of R_Y and R_P. */
-static int cheap_checks(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU])
-{
-    const sr_real *gam = x + RS + 6;
-    if (!model || !x) return SR_ERR_NULL;
-    if (!all_finite(x, SR_NX) || (u && !all_finite(u, SR_NU))) return SR_ERR_NONFINITE;
-    if (!near(gam[0] * gam[0] + gam[1] * gam[1] + gam[2] * gam[2], 1)) return SR_ERR_NOT_ROTATION;
-    if (!near(x[RY + 4] * x[RY + 4] + x[RY + 7] * x[RY + 7], 1)) return SR_ERR_NOT_ROTATION;
-    if (!near(x[RP + 0] * x[RP + 0] + x[RP + 2] * x[RP + 2], 1)) return SR_ERR_NOT_ROTATION;
-    return SR_OK;
 }
 
 static int is_rotation(const sr_real *R)
@@ -113,7 +78,7 @@ static const sr_real zero_u[SR_NU] = {0, 0};
 
 int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV])
 {
-    int status = cheap_checks(model, x, u);
+    int status = checks(model, x, u, 0);
     if (status != SR_OK) return status;
     if (!a) return SR_ERR_NULL;
     return sr_gen_accel(model->c, x, u ? u : zero_u, a);
@@ -138,7 +103,7 @@ int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 
 int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * SR_NV])
 {
-    int status = cheap_checks(model, x, NULL);
+    int status = checks(model, x, NULL, 0);
     if (status != SR_OK) return status;
     if (!M) return SR_ERR_NULL;
     return sr_gen_inertia(model->c, x, M);
@@ -146,7 +111,7 @@ int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * 
 
 int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NV])
 {
-    int status = cheap_checks(model, x, u);
+    int status = checks(model, x, u, 0);
     if (status != SR_OK) return status;
     if (!f) return SR_ERR_NULL;
     return sr_gen_rhs(model->c, x, u ? u : zero_u, f);
@@ -154,7 +119,7 @@ int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU]
 
 int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy)
 {
-    int status = cheap_checks(model, x, NULL);
+    int status = checks(model, x, NULL, 0);
     if (status != SR_OK) return status;
     if (!energy) return SR_ERR_NULL;
     return sr_gen_energy(model->c, x, energy);
@@ -162,7 +127,7 @@ int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy)
 
 int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV])
 {
-    int status = cheap_checks(model, x, NULL);
+    int status = checks(model, x, NULL, 0);
     if (status != SR_OK) return status;
     if (!res) return SR_ERR_NULL;
     return sr_gen_equilibrium_residual(model->c, x, res);
@@ -170,20 +135,10 @@ int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_re
 
 int sr_so3_exp(const sr_real w[3], sr_real R[9])
 {
-    sr_real theta2, A, B, half, s_half;
+    sr_real theta2, A, B;
     if (!w || !R) return SR_ERR_NULL;
     theta2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-    if (theta2 < SR_C(1e-8)) {
-        /* sin(t)/t and (1 - cos t)/t^2 by their series; the next terms are below 1e-24. */
-        A = 1 - theta2 / 6 * (1 - theta2 / 20);
-        B = SR_C(0.5) * (1 - theta2 / 12 * (1 - theta2 / 30));
-    } else {
-        const sr_real theta = SR_SQRT(theta2);
-        half = SR_C(0.5) * theta;
-        s_half = SR_SIN(half);
-        A = SR_SIN(theta) / theta;
-        B = SR_C(2.0) * s_half * s_half / theta2; /* (1 - cos t)/t^2 without cancellation */
-    }
+    so3_exp_coefficients(theta2, &A, &B);
     /* R = I + A [[w]] + B [[w]]^2, with [[w]]^2 = w w^T - |w|^2 I. */
     R[0] = 1 + B * (w[0] * w[0] - theta2);
     R[4] = 1 + B * (w[1] * w[1] - theta2);
@@ -195,28 +150,6 @@ int sr_so3_exp(const sr_real w[3], sr_real R[9])
     R[5] = B * w[1] * w[2] - A * w[0];
     R[7] = B * w[1] * w[2] + A * w[0];
     return SR_OK;
-}
-
-static void matmul3(const sr_real *A, const sr_real *B, sr_real *C)
-{
-    int i, j;
-    for (i = 0; i < 3; ++i)
-        for (j = 0; j < 3; ++j)
-            C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
-}
-
-/* R <- R Exp(angle * [[e_k]]) for a rotation about axis k, keeping the exact zeros and ones. */
-static void rotate_about_axis(const sr_real *R, int k, sr_real angle, sr_real *out)
-{
-    sr_real E[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
-    const sr_real c = SR_COS(angle), s = SR_SIN(angle);
-    const int i = (k + 1) % 3, j = (k + 2) % 3; /* Exp(t[[e_k]]) rotates the (i, j) plane */
-    E[4 * k] = 1;
-    E[3 * i + i] = c;
-    E[3 * j + j] = c;
-    E[3 * i + j] = -s;
-    E[3 * j + i] = s;
-    matmul3(R, E, out);
 }
 
 static int lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
@@ -247,18 +180,27 @@ static int lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_rea
 static int advance(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
                    sr_real dt, sr_real out[SR_NX])
 {
-    switch (method) {
-    case SR_LIE_EULER: return lie_euler(model, x, u, dt, out);
+    int status;
+    switch (method & ~SR_PROJECT) {
+    case SR_LIE_EULER: status = lie_euler(model, x, u, dt, out); break;
+    case SR_RKMK4: status = sr_internal_rkmk4_step(model, x, u, dt, out); break;
+    case SR_CF4: status = sr_internal_cf4_step(model, x, u, dt, out); break;
     default: return SR_ERR_ARG;
     }
+    if (status == SR_OK && (method & SR_PROJECT)) sr_internal_project(out);
+    return status;
 }
 
-static int valid_method(int method) { return method == SR_LIE_EULER; }
+static int valid_method(int method)
+{
+    const int base = method & ~SR_PROJECT;
+    return base == SR_LIE_EULER || base == SR_RKMK4 || base == SR_CF4;
+}
 
 int sr_step(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
             sr_real dt, sr_real x_next[SR_NX])
 {
-    int status = cheap_checks(model, x, u);
+    int status = checks(model, x, u, 1);
     if (status != SR_OK) return status;
     if (!x_next) return SR_ERR_NULL;
     if (!(dt > 0) || !isfinite(dt) || !valid_method(method)) return SR_ERR_ARG;
@@ -271,7 +213,7 @@ int sr_simulate(const sr_model *model, int method, const sr_real x0[SR_NX], sr_r
     long n;
     int i, status;
     if (steps_done) *steps_done = 0;
-    status = cheap_checks(model, x0, NULL);
+    status = checks(model, x0, NULL, 1);
     if (status != SR_OK) return status;
     if (!traj) return SR_ERR_NULL;
     if (steps < 0 || !(dt > 0) || !isfinite(dt) || !valid_method(method)) return SR_ERR_ARG;

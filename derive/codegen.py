@@ -153,7 +153,10 @@ def emit_inputs(kernel, used):
 
 
 def emit_ldlt_solve(n, M_name, f_name, out_name):
-    """Unrolled LDLᵀ of a symmetric n×n matrix given as M_i_j (i ≤ j), then forward/back substitution."""
+    """Unrolled LDLᵀ of a symmetric n×n matrix given as M_i_j (i ≤ j), then forward/back substitution.
+
+    Only the n pivots are divided (1/d_j); every other division becomes a multiplication.
+    """
     def m(i, j):
         i, j = min(i, j), max(i, j)
         return f"{M_name}_{i}_{j}"
@@ -163,16 +166,17 @@ def emit_ldlt_solve(n, M_name, f_name, out_name):
         terms = "".join(f" - L_{j}_{k}*L_{j}_{k}*d_{k}" for k in range(j))
         lines.append(f"    const sr_real d_{j} = {m(j, j)}{terms};")
         lines.append(f"    if (!(d_{j} > SR_GEN_PIVOT_TOL*{m(j, j)})) return SR_GEN_SINGULAR;")
+        lines.append(f"    const sr_real inv_d_{j} = SR_C(1.0)/d_{j};")
         for i in range(j + 1, n):
             terms = "".join(f" - L_{i}_{k}*L_{j}_{k}*d_{k}" for k in range(j))
-            lines.append(f"    const sr_real L_{i}_{j} = ({m(i, j)}{terms})/d_{j};")
+            lines.append(f"    const sr_real L_{i}_{j} = ({m(i, j)}{terms})*inv_d_{j};")
     lines.append("    /* Solve L y = f, then L^T a = D^-1 y. */")
     for i in range(n):
         terms = "".join(f" - L_{i}_{k}*y_{k}" for k in range(i))
         lines.append(f"    const sr_real y_{i} = {f_name}_{i}{terms};")
     for i in reversed(range(n)):
         terms = "".join(f" - L_{k}_{i}*a_{k}" for k in range(i + 1, n))
-        lines.append(f"    const sr_real a_{i} = y_{i}/d_{i}{terms};")
+        lines.append(f"    const sr_real a_{i} = y_{i}*inv_d_{i}{terms};")
     for i in range(n):
         lines.append(f"    {out_name}[{i}] = a_{i};")
     return lines

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources beb838f47476483a], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 9072c683a807e0d4], SymPy 1.14.0. */
 #include "sr_generated.h"
 
 /* Derived constants of Section 2.3 from the twelve parameters. */
@@ -517,35 +517,40 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     /* LDL^T factorization, unrolled: M = L D L^T with unit lower-triangular L. */
     const sr_real d_0 = M_0_0;
     if (!(d_0 > SR_GEN_PIVOT_TOL*M_0_0)) return SR_GEN_SINGULAR;
-    const sr_real L_1_0 = (M_0_1)/d_0;
-    const sr_real L_2_0 = (M_0_2)/d_0;
-    const sr_real L_3_0 = (M_0_3)/d_0;
-    const sr_real L_4_0 = (M_0_4)/d_0;
+    const sr_real inv_d_0 = SR_C(1.0)/d_0;
+    const sr_real L_1_0 = (M_0_1)*inv_d_0;
+    const sr_real L_2_0 = (M_0_2)*inv_d_0;
+    const sr_real L_3_0 = (M_0_3)*inv_d_0;
+    const sr_real L_4_0 = (M_0_4)*inv_d_0;
     const sr_real d_1 = M_1_1 - L_1_0*L_1_0*d_0;
     if (!(d_1 > SR_GEN_PIVOT_TOL*M_1_1)) return SR_GEN_SINGULAR;
-    const sr_real L_2_1 = (M_1_2 - L_2_0*L_1_0*d_0)/d_1;
-    const sr_real L_3_1 = (M_1_3 - L_3_0*L_1_0*d_0)/d_1;
-    const sr_real L_4_1 = (M_1_4 - L_4_0*L_1_0*d_0)/d_1;
+    const sr_real inv_d_1 = SR_C(1.0)/d_1;
+    const sr_real L_2_1 = (M_1_2 - L_2_0*L_1_0*d_0)*inv_d_1;
+    const sr_real L_3_1 = (M_1_3 - L_3_0*L_1_0*d_0)*inv_d_1;
+    const sr_real L_4_1 = (M_1_4 - L_4_0*L_1_0*d_0)*inv_d_1;
     const sr_real d_2 = M_2_2 - L_2_0*L_2_0*d_0 - L_2_1*L_2_1*d_1;
     if (!(d_2 > SR_GEN_PIVOT_TOL*M_2_2)) return SR_GEN_SINGULAR;
-    const sr_real L_3_2 = (M_2_3 - L_3_0*L_2_0*d_0 - L_3_1*L_2_1*d_1)/d_2;
-    const sr_real L_4_2 = (M_2_4 - L_4_0*L_2_0*d_0 - L_4_1*L_2_1*d_1)/d_2;
+    const sr_real inv_d_2 = SR_C(1.0)/d_2;
+    const sr_real L_3_2 = (M_2_3 - L_3_0*L_2_0*d_0 - L_3_1*L_2_1*d_1)*inv_d_2;
+    const sr_real L_4_2 = (M_2_4 - L_4_0*L_2_0*d_0 - L_4_1*L_2_1*d_1)*inv_d_2;
     const sr_real d_3 = M_3_3 - L_3_0*L_3_0*d_0 - L_3_1*L_3_1*d_1 - L_3_2*L_3_2*d_2;
     if (!(d_3 > SR_GEN_PIVOT_TOL*M_3_3)) return SR_GEN_SINGULAR;
-    const sr_real L_4_3 = (M_3_4 - L_4_0*L_3_0*d_0 - L_4_1*L_3_1*d_1 - L_4_2*L_3_2*d_2)/d_3;
+    const sr_real inv_d_3 = SR_C(1.0)/d_3;
+    const sr_real L_4_3 = (M_3_4 - L_4_0*L_3_0*d_0 - L_4_1*L_3_1*d_1 - L_4_2*L_3_2*d_2)*inv_d_3;
     const sr_real d_4 = M_4_4 - L_4_0*L_4_0*d_0 - L_4_1*L_4_1*d_1 - L_4_2*L_4_2*d_2 - L_4_3*L_4_3*d_3;
     if (!(d_4 > SR_GEN_PIVOT_TOL*M_4_4)) return SR_GEN_SINGULAR;
+    const sr_real inv_d_4 = SR_C(1.0)/d_4;
     /* Solve L y = f, then L^T a = D^-1 y. */
     const sr_real y_0 = f_0;
     const sr_real y_1 = f_1 - L_1_0*y_0;
     const sr_real y_2 = f_2 - L_2_0*y_0 - L_2_1*y_1;
     const sr_real y_3 = f_3 - L_3_0*y_0 - L_3_1*y_1 - L_3_2*y_2;
     const sr_real y_4 = f_4 - L_4_0*y_0 - L_4_1*y_1 - L_4_2*y_2 - L_4_3*y_3;
-    const sr_real a_4 = y_4/d_4;
-    const sr_real a_3 = y_3/d_3 - L_4_3*a_4;
-    const sr_real a_2 = y_2/d_2 - L_3_2*a_3 - L_4_2*a_4;
-    const sr_real a_1 = y_1/d_1 - L_2_1*a_2 - L_3_1*a_3 - L_4_1*a_4;
-    const sr_real a_0 = y_0/d_0 - L_1_0*a_1 - L_2_0*a_2 - L_3_0*a_3 - L_4_0*a_4;
+    const sr_real a_4 = y_4*inv_d_4;
+    const sr_real a_3 = y_3*inv_d_3 - L_4_3*a_4;
+    const sr_real a_2 = y_2*inv_d_2 - L_3_2*a_3 - L_4_2*a_4;
+    const sr_real a_1 = y_1*inv_d_1 - L_2_1*a_2 - L_3_1*a_3 - L_4_1*a_4;
+    const sr_real a_0 = y_0*inv_d_0 - L_1_0*a_1 - L_2_0*a_2 - L_3_0*a_3 - L_4_0*a_4;
     a[0] = a_0;
     a[1] = a_1;
     a[2] = a_2;

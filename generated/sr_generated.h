@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources beb838f47476483a], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 9072c683a807e0d4], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -31,7 +31,7 @@ typedef double sr_real;
 #define SR_GEN_RHS_FLOPS 345
 #define SR_GEN_ENERGY_FLOPS 206
 #define SR_GEN_EQUILIBRIUM_RESIDUAL_FLOPS 22
-#define SR_GEN_ACCEL_FLOPS 540
+#define SR_GEN_ACCEL_FLOPS 545
 
 /* Derived constants of Section 2.3 from the twelve parameters. */
 int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[12]);

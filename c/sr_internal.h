@@ -1,0 +1,126 @@
+/*
+ * sr_internal.h -- helpers shared by the hand-written C files (sr_runtime.c,
+ * sr_lie_integrators.c).  Internal to the library: not part of the public API
+ * of spherical_robot.h, and not seen by the cffi bindings.
+ *
+ * Everything here is static inline (no code unless used) or a declaration of
+ * an internal stepper; no globals.
+ */
+#ifndef SR_INTERNAL_H
+#define SR_INTERNAL_H
+
+#include "spherical_robot.h"
+
+#include <float.h>
+#include <math.h>
+#include <stddef.h>
+
+#ifdef SR_USE_FLOAT
+#define SR_SQRT sqrtf
+#define SR_SIN sinf
+#define SR_COS cosf
+#define SR_FABS fabsf
+#define SR_POW powf
+#define SR_EPSILON FLT_EPSILON
+#else
+#define SR_SQRT sqrt
+#define SR_SIN sin
+#define SR_COS cos
+#define SR_FABS fabs
+#define SR_POW pow
+#define SR_EPSILON DBL_EPSILON
+#endif
+
+/* Offsets of the blocks of the state x (see spherical_robot.h). */
+enum { RS = 0, RY = 9, RP = 18, Q = 27, W = 30 };
+
+static inline int all_finite(const sr_real *v, int n)
+{
+    int i;
+    for (i = 0; i < n; ++i)
+        if (!isfinite(v[i])) return 0;
+    return 1;
+}
+
+static inline int near(sr_real a, sr_real b) { return SR_FABS(a - b) <= SR_ROTATION_TOL; }
+
+/* Indices of the state entries the generated kernels read: gamma = third row of R_S,
+ * cos/sin of R_Y and R_P, q_z (energy only) and the five speeds. */
+static const int kernel_inputs[] = {RS + 6, RS + 7, RS + 8, RY + 4, RY + 7, RP + 0, RP + 2, Q + 2,
+                                    W, W + 1, W + 2, W + 3, W + 4};
+
+/* Checks before a kernel call.  whole_state = 0: only the entries the kernels read must be
+ * finite (evaluations: accel, inertia, rhs, energy); 1: all 35 (steppers, which carry every
+ * entry into their output). */
+static inline int checks(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int whole_state)
+{
+    const sr_real *gam = x + RS + 6;
+    size_t i;
+    if (!model || !x) return SR_ERR_NULL;
+    if (whole_state) {
+        if (!all_finite(x, SR_NX)) return SR_ERR_NONFINITE;
+    } else {
+        for (i = 0; i < sizeof kernel_inputs / sizeof kernel_inputs[0]; ++i)
+            if (!isfinite(x[kernel_inputs[i]])) return SR_ERR_NONFINITE;
+    }
+    if (u && !all_finite(u, SR_NU)) return SR_ERR_NONFINITE;
+    if (!near(gam[0] * gam[0] + gam[1] * gam[1] + gam[2] * gam[2], 1)) return SR_ERR_NOT_ROTATION;
+    if (!near(x[RY + 4] * x[RY + 4] + x[RY + 7] * x[RY + 7], 1)) return SR_ERR_NOT_ROTATION;
+    if (!near(x[RP + 0] * x[RP + 0] + x[RP + 2] * x[RP + 2], 1)) return SR_ERR_NOT_ROTATION;
+    return SR_OK;
+}
+
+/* Rodrigues' coefficients A = sin(t)/t and B = (1 - cos t)/t^2 from t^2 = |w|^2, so that
+ * Exp([[w]]) = I + A [[w]] + B [[w]]^2 (sr_so3_exp; the Lie-group steppers use the same
+ * coefficients to form Exp - I directly). */
+static inline void so3_exp_coefficients(sr_real theta2, sr_real *A, sr_real *B)
+{
+    if (theta2 < SR_C(1e-8)) {
+        /* sin(t)/t and (1 - cos t)/t^2 by their series; the next terms are below 1e-24. */
+        *A = 1 - theta2 / 6 * (1 - theta2 / 20);
+        *B = SR_C(0.5) * (1 - theta2 / 12 * (1 - theta2 / 30));
+    } else {
+        const sr_real theta = SR_SQRT(theta2);
+        const sr_real s_half = SR_SIN(SR_C(0.5) * theta);
+        *A = SR_SIN(theta) / theta;
+        *B = SR_C(2.0) * s_half * s_half / theta2; /* (1 - cos t)/t^2 without cancellation */
+    }
+}
+
+/* C = A B for row-major 3x3 matrices (C must not alias A or B). */
+static inline void matmul3(const sr_real *A, const sr_real *B, sr_real *C)
+{
+    int i, j;
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j)
+            C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+}
+
+/* out = R Exp(angle * [[e_k]]) for a rotation about axis k, keeping the exact zeros and ones
+ * (out must not alias R). */
+static inline void rotate_about_axis(const sr_real *R, int k, sr_real angle, sr_real *out)
+{
+    sr_real E[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    const sr_real c = SR_COS(angle), s = SR_SIN(angle);
+    const int i = (k + 1) % 3, j = (k + 2) % 3; /* Exp(t[[e_k]]) rotates the (i, j) plane */
+    E[4 * k] = 1;
+    E[3 * i + i] = c;
+    E[3 * j + j] = c;
+    E[3 * i + j] = -s;
+    E[3 * j + i] = s;
+    matmul3(R, E, out);
+}
+
+/* One step of the Lie-group methods of sr_lie_integrators.c, without argument checks
+ * (sr_step/sr_simulate check first).  u must not be NULL; out may alias x. */
+int sr_internal_rkmk4_step(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                           sr_real dt, sr_real out[SR_NX]);
+int sr_internal_cf4_step(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                         sr_real dt, sr_real out[SR_NX]);
+
+/* The optional correction of SR_PROJECT (sr_lie_integrators.c): one Newton-Schulz step
+ * R <- R (3I - R^T R)/2 towards the nearest rotation for R_S, the same on the (cos, sin) pair
+ * of R_Y and R_P. */
+void sr_internal_project(sr_real x[SR_NX]);
+
+#endif /* SR_INTERNAL_H */

@@ -1,0 +1,1 @@
+"""Alternative implementations of the same robot, for the benchmark."""
