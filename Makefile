@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 C_SOURCES := $(wildcard generated/*.c generated/*.h c/*.c c/*.h)
 
-.PHONY: install test run generate verify bench figures clean
+.PHONY: install test run generate verify bench figures c-lib c-test clean
 
 $(STAMP): pyproject.toml setup.py bindings/build_sr.py $(C_SOURCES)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -35,5 +35,12 @@ bench: $(STAMP)
 figures: $(STAMP)
 	$(PY) -m runtime.figures
 
+c-lib:
+	$(MAKE) -C c
+
+c-test:
+	$(MAKE) -C c test sanitize
+
 clean:
+	$(MAKE) -C c clean
 	rm -rf $(VENV) build out *.egg-info bindings/_sr*.so bindings/_sr.c

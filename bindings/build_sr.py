@@ -62,7 +62,8 @@ ffibuilder.set_source(
     '#include "spherical_robot.h"',
     sources=SOURCES,
     include_dirs=INCLUDE_DIRS,
-    extra_compile_args=["-std=c99", "-O2"],
+    # No FMA contraction: the firmware example (c/examples) must reproduce the Python runs bit for bit.
+    extra_compile_args=["-std=c99", "-O2", "-ffp-contract=off"],
 )
 
 if __name__ == "__main__":

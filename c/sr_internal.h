@@ -13,7 +13,6 @@
 
 #include <float.h>
 #include <math.h>
-#include <stddef.h>
 
 #ifdef SR_USE_FLOAT
 #define SR_SQRT sqrtf
@@ -44,26 +43,14 @@ static inline int all_finite(const sr_real *v, int n)
 
 static inline int near(sr_real a, sr_real b) { return SR_FABS(a - b) <= SR_ROTATION_TOL; }
 
-/* Indices of the state entries the generated kernels read: gamma = third row of R_S,
- * cos/sin of R_Y and R_P, q_z (energy only) and the five speeds. */
-static const int kernel_inputs[] = {RS + 6, RS + 7, RS + 8, RY + 4, RY + 7, RP + 0, RP + 2, Q + 2,
-                                    W, W + 1, W + 2, W + 3, W + 4};
-
-/* Checks before a kernel call.  whole_state = 0: only the entries the kernels read must be
- * finite (evaluations: accel, inertia, rhs, energy); 1: all 35 (steppers, which carry every
- * entry into their output). */
-static inline int checks(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int whole_state)
+/* Checks before every kernel call: all of x (and u, if given) finite; gamma = third row of
+ * R_S of unit length; the cos/sin entries of R_Y and R_P of unit length.  The full structure
+ * check is sr_check_state. */
+static inline int checks(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU])
 {
     const sr_real *gam = x + RS + 6;
-    size_t i;
     if (!model || !x) return SR_ERR_NULL;
-    if (whole_state) {
-        if (!all_finite(x, SR_NX)) return SR_ERR_NONFINITE;
-    } else {
-        for (i = 0; i < sizeof kernel_inputs / sizeof kernel_inputs[0]; ++i)
-            if (!isfinite(x[kernel_inputs[i]])) return SR_ERR_NONFINITE;
-    }
-    if (u && !all_finite(u, SR_NU)) return SR_ERR_NONFINITE;
+    if (!all_finite(x, SR_NX) || (u && !all_finite(u, SR_NU))) return SR_ERR_NONFINITE;
     if (!near(gam[0] * gam[0] + gam[1] * gam[1] + gam[2] * gam[2], 1)) return SR_ERR_NOT_ROTATION;
     if (!near(x[RY + 4] * x[RY + 4] + x[RY + 7] * x[RY + 7], 1)) return SR_ERR_NOT_ROTATION;
     if (!near(x[RP + 0] * x[RP + 0] + x[RP + 2] * x[RP + 2], 1)) return SR_ERR_NOT_ROTATION;

@@ -335,7 +335,7 @@ int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[SR_
     int i, base, status;
     if (!stats) stats = &local;
     *stats = local;
-    status = checks(model, x0, NULL, 1);
+    status = checks(model, x0, NULL);
     if (status != SR_OK) return status;
     if (!traj) return SR_ERR_NULL;
     base = method & ~SR_PROJECT;

@@ -78,9 +78,10 @@ static const sr_real zero_u[SR_NU] = {0, 0};
 
 int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV])
 {
-    int status = checks(model, x, u, 0);
-    if (status != SR_OK) return status;
+    int status;
     if (!a) return SR_ERR_NULL;
+    status = checks(model, x, u);
+    if (status != SR_OK) return status;
     return sr_gen_accel(model->c, x, u ? u : zero_u, a);
 }
 
@@ -103,33 +104,37 @@ int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 
 int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * SR_NV])
 {
-    int status = checks(model, x, NULL, 0);
-    if (status != SR_OK) return status;
+    int status;
     if (!M) return SR_ERR_NULL;
+    status = checks(model, x, NULL);
+    if (status != SR_OK) return status;
     return sr_gen_inertia(model->c, x, M);
 }
 
 int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NV])
 {
-    int status = checks(model, x, u, 0);
-    if (status != SR_OK) return status;
+    int status;
     if (!f) return SR_ERR_NULL;
+    status = checks(model, x, u);
+    if (status != SR_OK) return status;
     return sr_gen_rhs(model->c, x, u ? u : zero_u, f);
 }
 
 int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy)
 {
-    int status = checks(model, x, NULL, 0);
-    if (status != SR_OK) return status;
+    int status;
     if (!energy) return SR_ERR_NULL;
+    status = checks(model, x, NULL);
+    if (status != SR_OK) return status;
     return sr_gen_energy(model->c, x, energy);
 }
 
 int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV])
 {
-    int status = checks(model, x, NULL, 0);
-    if (status != SR_OK) return status;
+    int status;
     if (!res) return SR_ERR_NULL;
+    status = checks(model, x, NULL);
+    if (status != SR_OK) return status;
     return sr_gen_equilibrium_residual(model->c, x, res);
 }
 
@@ -200,9 +205,10 @@ static int valid_method(int method)
 int sr_step(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
             sr_real dt, sr_real x_next[SR_NX])
 {
-    int status = checks(model, x, u, 1);
-    if (status != SR_OK) return status;
+    int status;
     if (!x_next) return SR_ERR_NULL;
+    status = checks(model, x, u);
+    if (status != SR_OK) return status;
     if (!(dt > 0) || !isfinite(dt) || !valid_method(method)) return SR_ERR_ARG;
     return advance(model, method, x, u ? u : zero_u, dt, x_next);
 }
@@ -213,7 +219,7 @@ int sr_simulate(const sr_model *model, int method, const sr_real x0[SR_NX], sr_r
     long n;
     int i, status;
     if (steps_done) *steps_done = 0;
-    status = checks(model, x0, NULL, 1);
+    status = checks(model, x0, NULL);
     if (status != SR_OK) return status;
     if (!traj) return SR_ERR_NULL;
     if (steps < 0 || !(dt > 0) || !isfinite(dt) || !valid_method(method)) return SR_ERR_ARG;

@@ -1,0 +1,126 @@
+/* sr_test.c -- the test runner (main), the framework's counters and the shared helpers. */
+#include "sr_test.h"
+
+#include <math.h>
+#include <stdarg.h>
+
+int sr_test_current_failures = 0;
+static int tests_passed = 0, tests_failed = 0;
+
+void sr_test_fail(const char *file, int line, const char *fmt, ...)
+{
+    va_list args;
+    ++sr_test_current_failures;
+    fprintf(stderr, "%s:%d: ", file, line);
+    va_start(args, fmt);
+    vfprintf(stderr, fmt, args);
+    va_end(args);
+    fputc('\n', stderr);
+}
+
+void sr_test_run(const char *name, void (*test)(void))
+{
+    sr_test_current_failures = 0;
+    test();
+    if (sr_test_current_failures == 0) {
+        ++tests_passed;
+    } else {
+        ++tests_failed;
+        fprintf(stderr, "FAILED %s (%d failed checks)\n", name, sr_test_current_failures);
+    }
+}
+
+int sr_test_summary(void)
+{
+    printf("%d passed, %d failed\n", tests_passed, tests_failed);
+    return tests_failed == 0 ? 0 : 1;
+}
+
+int main(void)
+{
+    printf("spherical-robot C tests, sr_real = %s\n", TEST_SCALAR_NAME);
+    suite_status();
+    suite_numerics();
+    suite_buffers();
+    suite_precision();
+    return sr_test_summary();
+}
+
+/* ---- helpers -------------------------------------------------------------------- */
+
+double rng_uniform(test_rng *rng, double lo, double hi)
+{
+    unsigned long long z = (rng->s += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    z ^= z >> 31;
+    return lo + (hi - lo) * ((double)(z >> 11) * (1.0 / 9007199254740992.0));
+}
+
+void paper_simulation_params(sr_real p[SR_NPARAM])
+{
+    /* r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g */
+    const sr_real values[SR_NPARAM] = {SR_C(0.3),  SR_C(2.0), SR_C(0.16), SR_C(0.2),
+                                       SR_C(0.5),  SR_C(2.0), SR_C(5.0),  SR_C(0.04),
+                                       SR_C(0.2),  SR_C(1.0), SR_C(0.10), SR_C(9.81)};
+    int i;
+    for (i = 0; i < SR_NPARAM; ++i) p[i] = values[i];
+}
+
+void paper_simulation_model(sr_model *model)
+{
+    sr_real p[SR_NPARAM];
+    paper_simulation_params(p);
+    CHECK_STATUS(sr_model_init(model, p), SR_OK);
+}
+
+static void set3(sr_real R[9], double a, double b, double c, double d, double e, double f,
+                 double g, double h, double i)
+{
+    R[0] = (sr_real)a; R[1] = (sr_real)b; R[2] = (sr_real)c;
+    R[3] = (sr_real)d; R[4] = (sr_real)e; R[5] = (sr_real)f;
+    R[6] = (sr_real)g; R[7] = (sr_real)h; R[8] = (sr_real)i;
+}
+
+void rot_x(double t, sr_real R[9]) { set3(R, 1, 0, 0, 0, cos(t), -sin(t), 0, sin(t), cos(t)); }
+void rot_y(double t, sr_real R[9]) { set3(R, cos(t), 0, sin(t), 0, 1, 0, -sin(t), 0, cos(t)); }
+void rot_z(double t, sr_real R[9]) { set3(R, cos(t), -sin(t), 0, sin(t), cos(t), 0, 0, 0, 1); }
+
+void make_state(sr_real x[SR_NX], double theta_Y, double theta_P, double r)
+{
+    int i;
+    for (i = 0; i < SR_NX; ++i) x[i] = 0;
+    rot_z(0.0, x);
+    rot_x(theta_Y, x + 9);
+    rot_y(theta_P, x + 18);
+    x[29] = (sr_real)r;
+}
+
+void random_state(test_rng *rng, double r, double max_speed, sr_real x[SR_NX])
+{
+    sr_real w[3];
+    int i;
+    make_state(x, rng_uniform(rng, -3.14159, 3.14159), rng_uniform(rng, -3.14159, 3.14159), r);
+    for (i = 0; i < 3; ++i) w[i] = (sr_real)rng_uniform(rng, -1.8, 1.8); /* |w| up to ~pi */
+    CHECK_STATUS(sr_so3_exp(w, x), SR_OK);
+    x[27] = (sr_real)rng_uniform(rng, -1, 1);
+    x[28] = (sr_real)rng_uniform(rng, -1, 1);
+    for (i = 30; i < 35; ++i) x[i] = (sr_real)rng_uniform(rng, -max_speed, max_speed);
+}
+
+double orthonormality_error(const sr_real R[9])
+{
+    double worst = 0, det;
+    int i, j, k;
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) {
+            double dot = 0;
+            for (k = 0; k < 3; ++k) dot += (double)R[3 * k + i] * (double)R[3 * k + j];
+            dot -= (i == j);
+            if (fabs(dot) > worst) worst = fabs(dot);
+        }
+    det = (double)R[0] * ((double)R[4] * R[8] - (double)R[5] * R[7])
+        - (double)R[1] * ((double)R[3] * R[8] - (double)R[5] * R[6])
+        + (double)R[2] * ((double)R[3] * R[7] - (double)R[4] * R[6]);
+    return fabs(det - 1) > worst ? fabs(det - 1) : worst;
+}

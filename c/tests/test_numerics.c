@@ -1,0 +1,356 @@
+/*
+ * test_numerics.c -- the numbers: the SO(3) exponential against its Taylor
+ * series, the equilibria, the consistency of M, f and the accelerations,
+ * energy conservation without friction, the rolling constraint, and
+ * determinism (aliasing, re-entrancy: no hidden state between calls).
+ */
+#include "sr_test.h"
+
+#include <math.h>
+#include <string.h>
+
+/* ---- helpers ------------------------------------------------------------------ */
+
+/* Exp([[w]]) by the Taylor series sum_k [[w]]^k / k!, in double, 60 terms. */
+static void exp_taylor(const double w[3], double E[9])
+{
+    const double W[9] = {0, -w[2], w[1], w[2], 0, -w[0], -w[1], w[0], 0};
+    double term[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, next[9];
+    int i, j, k, n;
+    memcpy(E, term, sizeof term);
+    for (n = 1; n < 60; ++n) {
+        for (i = 0; i < 3; ++i)
+            for (j = 0; j < 3; ++j) {
+                double s = 0;
+                for (k = 0; k < 3; ++k) s += term[3 * i + k] * W[3 * k + j];
+                next[3 * i + j] = s / n;
+            }
+        memcpy(term, next, sizeof term);
+        for (i = 0; i < 9; ++i) E[i] += term[i];
+    }
+}
+
+static double max_abs(const sr_real *v, int n)
+{
+    double worst = 0;
+    int i;
+    for (i = 0; i < n; ++i)
+        if (fabs((double)v[i]) > worst) worst = fabs((double)v[i]);
+    return worst;
+}
+
+static sr_real energy_of(const sr_model *m, const sr_real x[SR_NX])
+{
+    sr_real E = 0;
+    CHECK_STATUS(sr_energy(m, x, &E), SR_OK);
+    return E;
+}
+
+/* ---- the SO(3) exponential ---------------------------------------------------- */
+
+static void test_so3_exp_matches_taylor_series(void)
+{
+    /* Angles on both sides of the series branch (|w| < 1e-4) up to nearly pi. */
+    const double angles[] = {1e-12, 1e-8, 1e-5, 9.99e-5, 1.001e-4, 1e-3, 0.1, 1.0, 2.0, 3.0, 3.14159};
+    const double axes[][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.48, -0.6, 0.64}, {-0.36, 0.48, 0.8}};
+    int a, b, i;
+    for (a = 0; a < (int)(sizeof angles / sizeof angles[0]); ++a)
+        for (b = 0; b < (int)(sizeof axes / sizeof axes[0]); ++b) {
+            sr_real w[3], R[9];
+            double wd[3], E[9];
+            for (i = 0; i < 3; ++i) {
+                w[i] = (sr_real)(angles[a] * axes[b][i]);
+                wd[i] = (double)w[i]; /* the exact input the C sees */
+            }
+            CHECK_STATUS(sr_so3_exp(w, R), SR_OK);
+            exp_taylor(wd, E);
+            for (i = 0; i < 9; ++i) CHECK_NEAR(R[i], E[i], 16 * TEST_EPS);
+            CHECK(orthonormality_error(R) <= 16 * TEST_EPS);
+        }
+}
+
+static void test_so3_exp_of_zero_is_identity(void)
+{
+    const sr_real w[3] = {0, 0, 0};
+    sr_real R[9];
+    int i;
+    CHECK_STATUS(sr_so3_exp(w, R), SR_OK);
+    for (i = 0; i < 9; ++i) CHECK(R[i] == (i % 4 == 0 ? 1 : 0));
+}
+
+static void test_so3_exp_inverse_is_exp_of_minus_w(void)
+{
+    const sr_real w[3] = {SR_C(0.7), SR_C(-1.1), SR_C(0.4)}, mw[3] = {SR_C(-0.7), SR_C(1.1), SR_C(-0.4)};
+    sr_real R[9], Rm[9];
+    int i, j, k;
+    CHECK_STATUS(sr_so3_exp(w, R), SR_OK);
+    CHECK_STATUS(sr_so3_exp(mw, Rm), SR_OK);
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) {
+            double s = 0;
+            for (k = 0; k < 3; ++k) s += (double)R[3 * i + k] * (double)Rm[3 * k + j];
+            CHECK_NEAR(s, i == j, 8 * TEST_EPS);
+        }
+}
+
+/* ---- equilibria ----------------------------------------------------------------- */
+
+static void test_accel_at_identity_equilibrium_is_zero(void)
+{
+    sr_model m;
+    sr_real x[SR_NX], a[SR_NV], res[SR_NV];
+    int i;
+    paper_simulation_model(&m);
+    make_state(x, 0, 0, 0.3);
+    CHECK_STATUS(sr_accel(&m, x, NULL, a), SR_OK);
+    CHECK_STATUS(sr_equilibrium_residual(&m, x, res), SR_OK);
+    for (i = 0; i < SR_NV; ++i) {
+        CHECK(a[i] == 0);
+        CHECK(res[i] == 0);
+    }
+    /* Any heading of the shell (R_S about the vertical) is the same equilibrium. */
+    rot_z(1.234, x);
+    x[27] = SR_C(0.5);
+    x[28] = SR_C(-2.0);
+    CHECK_STATUS(sr_accel(&m, x, NULL, a), SR_OK);
+    for (i = 0; i < SR_NV; ++i) CHECK(a[i] == 0);
+}
+
+/* Eq. (108): at rest, f = 0 whenever R_S R_Y R_P e_z = e_z, e.g. a tilted shell
+ * with the yoke tilted back (R_S = rot_x(-t), R_Y = rot_x(t)). */
+static void test_tilted_equilibrium_has_zero_residual(void)
+{
+    sr_model m;
+    sr_real x[SR_NX], res[SR_NV], a[SR_NV];
+    paper_simulation_model(&m);
+    make_state(x, 0.6, 0, 0.3);
+    rot_x(-0.6, x);
+    CHECK_STATUS(sr_equilibrium_residual(&m, x, res), SR_OK);
+    CHECK(max_abs(res, SR_NV) <= 64 * TEST_EPS); /* scale: m_P g l = 2 N m */
+    CHECK_STATUS(sr_accel(&m, x, NULL, a), SR_OK);
+    CHECK(max_abs(a, SR_NV) <= 256 * TEST_EPS);
+    /* ... and not when the pendulum swings out of the vertical. */
+    rot_y(0.3, x + 18);
+    CHECK_STATUS(sr_equilibrium_residual(&m, x, res), SR_OK);
+    CHECK(max_abs(res, SR_NV) > 0.1);
+}
+
+/* ---- M, f and the accelerations ------------------------------------------------- */
+
+static void test_inertia_is_symmetric_positive_definite_and_solves_for_accel(void)
+{
+    test_rng rng = {20241122ULL};
+    sr_model m;
+    sr_real x[SR_NX], u[SR_NU], M[SR_NV * SR_NV], f[SR_NV], a[SR_NV];
+    int trial, i, j, k;
+    paper_simulation_model(&m);
+    for (trial = 0; trial < 50; ++trial) {
+        double L[SR_NV * SR_NV] = {0}, scale = 0;
+        random_state(&rng, 0.3, 3.0, x);
+        u[0] = (sr_real)rng_uniform(&rng, -0.5, 0.5);
+        u[1] = (sr_real)rng_uniform(&rng, -0.5, 0.5);
+        CHECK_STATUS(sr_inertia(&m, x, M), SR_OK);
+        CHECK_STATUS(sr_rhs(&m, x, u, f), SR_OK);
+        CHECK_STATUS(sr_accel(&m, x, u, a), SR_OK);
+        for (i = 0; i < SR_NV; ++i)
+            for (j = 0; j < SR_NV; ++j) CHECK(M[SR_NV * i + j] == M[SR_NV * j + i]);
+        /* Cholesky in double: every pivot positive. */
+        for (j = 0; j < SR_NV; ++j) {
+            double d = (double)M[SR_NV * j + j];
+            for (k = 0; k < j; ++k) d -= L[SR_NV * j + k] * L[SR_NV * j + k];
+            CHECK(d > 0);
+            if (!(d > 0)) break;
+            L[SR_NV * j + j] = sqrt(d);
+            for (i = j + 1; i < SR_NV; ++i) {
+                double s = (double)M[SR_NV * i + j];
+                for (k = 0; k < j; ++k) s -= L[SR_NV * i + k] * L[SR_NV * j + k];
+                L[SR_NV * i + j] = s / L[SR_NV * j + j];
+            }
+        }
+        /* M a = f to working precision. */
+        for (i = 0; i < SR_NV; ++i) {
+            double s = 0;
+            for (j = 0; j < SR_NV; ++j) s += fabs((double)M[SR_NV * i + j] * (double)a[j]);
+            if (s + fabs((double)f[i]) > scale) scale = s + fabs((double)f[i]);
+        }
+        for (i = 0; i < SR_NV; ++i) {
+            double s = -(double)f[i];
+            for (j = 0; j < SR_NV; ++j) s += (double)M[SR_NV * i + j] * (double)a[j];
+            CHECK(fabs(s) <= 256 * TEST_EPS * scale);
+        }
+    }
+}
+
+static void test_kinetic_energy_is_half_nu_M_nu(void)
+{
+    test_rng rng = {7ULL};
+    sr_model m;
+    sr_real x[SR_NX], rest[SR_NX], M[SR_NV * SR_NV];
+    int trial, i, j;
+    paper_simulation_model(&m);
+    for (trial = 0; trial < 20; ++trial) {
+        double T = 0;
+        random_state(&rng, 0.3, 3.0, x);
+        memcpy(rest, x, sizeof x);
+        for (i = 30; i < SR_NX; ++i) rest[i] = 0;
+        CHECK_STATUS(sr_inertia(&m, x, M), SR_OK);
+        for (i = 0; i < SR_NV; ++i)
+            for (j = 0; j < SR_NV; ++j) T += 0.5 * (double)x[30 + i] * (double)M[SR_NV * i + j] * (double)x[30 + j];
+        CHECK(T > 0);
+        CHECK_NEAR(energy_of(&m, x) - energy_of(&m, rest), T, 64 * TEST_EPS * (T + 5));
+    }
+}
+
+static void test_motor_torques_enter_f_with_unit_coefficients(void)
+{
+    test_rng rng = {11ULL};
+    sr_model m;
+    sr_real x[SR_NX], u[SR_NU] = {SR_C(0.3), SR_C(-0.2)}, f0[SR_NV], fu[SR_NV];
+    int i;
+    paper_simulation_model(&m);
+    random_state(&rng, 0.3, 2.0, x);
+    CHECK_STATUS(sr_rhs(&m, x, NULL, f0), SR_OK);
+    CHECK_STATUS(sr_rhs(&m, x, u, fu), SR_OK);
+    for (i = 0; i < 3; ++i) CHECK_NEAR(fu[i], f0[i], 16 * TEST_EPS * (1 + fabs((double)f0[i])));
+    CHECK_NEAR(fu[3] - f0[3], u[0], 16 * TEST_EPS * (1 + fabs((double)f0[3])));
+    CHECK_NEAR(fu[4] - f0[4], u[1], 16 * TEST_EPS * (1 + fabs((double)f0[4])));
+}
+
+/* ---- time stepping -------------------------------------------------------------- */
+
+/* Energy drift of a frictionless, unforced Lie-Euler run of 1 s with step dt. */
+static double frictionless_drift(double dt, double *E0)
+{
+    sr_model m;
+    sr_real p[SR_NPARAM], x[SR_NX];
+    const long steps = (long)(1.0 / dt + 0.5);
+    long n;
+    paper_simulation_params(p);
+    p[2] = p[7] = p[10] = 0; /* k_S = k_Y = k_P = 0 */
+    CHECK_STATUS(sr_model_init(&m, p), SR_OK);
+    make_state(x, 0.3, 0.5, 0.3);
+    x[30] = SR_C(0.4);
+    x[31] = SR_C(-0.3);
+    x[32] = SR_C(0.2);
+    x[33] = SR_C(0.8);
+    x[34] = SR_C(-0.5);
+    *E0 = (double)energy_of(&m, x);
+    for (n = 0; n < steps; ++n) CHECK_STATUS(sr_step(&m, SR_LIE_EULER, x, NULL, (sr_real)dt, x), SR_OK);
+    return (double)energy_of(&m, x) - *E0;
+}
+
+static void test_energy_is_conserved_without_friction_to_first_order(void)
+{
+    double E0, d1 = frictionless_drift(1e-3, &E0), d2 = frictionless_drift(5e-4, &E0);
+    /* Lie-Euler is first order: the drift is O(dt) (about 0.4 % of E here) and halves with dt. */
+    CHECK(fabs(d1) <= 5e-3 * fabs(E0));
+    CHECK(d1 / d2 > 1.8 && d1 / d2 < 2.2);
+}
+
+static void test_friction_dissipates_energy(void)
+{
+    sr_model m;
+    sr_real x[SR_NX];
+    double E0;
+    int n;
+    paper_simulation_model(&m);
+    make_state(x, 0.0, 0.8, 0.3);
+    x[30] = SR_C(1.0);
+    x[33] = SR_C(2.0);
+    E0 = (double)energy_of(&m, x);
+    for (n = 0; n < 500; ++n) CHECK_STATUS(sr_step(&m, SR_LIE_EULER, x, NULL, SR_C(0.01), x), SR_OK);
+    CHECK((double)energy_of(&m, x) < E0 - 0.01);
+}
+
+static void test_rolling_keeps_the_centre_at_height_r_and_rotations_orthonormal(void)
+{
+    test_rng rng = {3ULL};
+    sr_model m;
+    sr_real x[SR_NX], u[SR_NU] = {SR_C(0.1), SR_C(-0.1)};
+    int n;
+    paper_simulation_model(&m);
+    random_state(&rng, 0.3, 2.0, x);
+    for (n = 0; n < 2000; ++n) CHECK_STATUS(sr_step(&m, SR_LIE_EULER, x, u, SR_C(0.01), x), SR_OK);
+    CHECK_NEAR(x[29], 0.3, 1e3 * TEST_EPS);
+    CHECK(orthonormality_error(x) <= 1e3 * TEST_EPS);
+    CHECK(orthonormality_error(x + 9) <= 1e3 * TEST_EPS);
+    CHECK(orthonormality_error(x + 18) <= 1e3 * TEST_EPS);
+    CHECK_STATUS(sr_check_state(&m, x), SR_OK);
+}
+
+static void test_step_in_place_equals_step_out_of_place(void)
+{
+    test_rng rng = {5ULL};
+    sr_model m;
+    sr_real x[SR_NX], y[SR_NX], u[SR_NU] = {SR_C(0.1), SR_C(0.05)};
+    paper_simulation_model(&m);
+    random_state(&rng, 0.3, 2.0, x);
+    CHECK_STATUS(sr_step(&m, SR_LIE_EULER, x, u, SR_C(0.01), y), SR_OK);
+    CHECK_STATUS(sr_step(&m, SR_LIE_EULER, x, u, SR_C(0.01), x), SR_OK);
+    CHECK(memcmp(x, y, sizeof x) == 0);
+}
+
+static void test_simulate_equals_repeated_steps(void)
+{
+    enum { STEPS = 50 };
+    test_rng rng = {9ULL};
+    sr_model m;
+    sr_real x[SR_NX], u[STEPS * SR_NU], traj[(STEPS + 1) * SR_NX];
+    long done = -1;
+    int n;
+    paper_simulation_model(&m);
+    random_state(&rng, 0.3, 2.0, x);
+    for (n = 0; n < STEPS * SR_NU; ++n) u[n] = (sr_real)rng_uniform(&rng, -0.2, 0.2);
+    CHECK_STATUS(sr_simulate(&m, SR_LIE_EULER, x, SR_C(0.01), STEPS, u, traj, &done), SR_OK);
+    CHECK(done == STEPS);
+    CHECK(memcmp(traj, x, sizeof x) == 0);
+    for (n = 0; n < STEPS; ++n) {
+        CHECK_STATUS(sr_step(&m, SR_LIE_EULER, x, u + n * SR_NU, SR_C(0.01), x), SR_OK);
+        CHECK(memcmp(traj + (n + 1) * SR_NX, x, sizeof x) == 0);
+    }
+}
+
+/* Two models interleaved give the same bits as each run alone: no state survives a call. */
+static void test_interleaved_models_do_not_interfere(void)
+{
+    sr_model m1, m2;
+    sr_real p[SR_NPARAM], x1[SR_NX], x2[SR_NX], y1[SR_NX], y2[SR_NX];
+    const sr_real u[SR_NU] = {SR_C(0.1), SR_C(-0.1)};
+    int n;
+    paper_simulation_model(&m1);
+    paper_simulation_params(p);
+    p[9] = SR_C(3.0); /* a heavier pendulum */
+    p[2] = 0;
+    CHECK_STATUS(sr_model_init(&m2, p), SR_OK);
+    make_state(x1, 0.1, 0.2, 0.3);
+    memcpy(x2, x1, sizeof x1);
+    memcpy(y1, x1, sizeof x1);
+    memcpy(y2, x1, sizeof x1);
+    for (n = 0; n < 100; ++n) CHECK_STATUS(sr_step(&m1, SR_LIE_EULER, y1, u, SR_C(0.01), y1), SR_OK);
+    for (n = 0; n < 100; ++n) CHECK_STATUS(sr_step(&m2, SR_LIE_EULER, y2, u, SR_C(0.01), y2), SR_OK);
+    for (n = 0; n < 100; ++n) {
+        CHECK_STATUS(sr_step(&m1, SR_LIE_EULER, x1, u, SR_C(0.01), x1), SR_OK);
+        CHECK_STATUS(sr_step(&m2, SR_LIE_EULER, x2, u, SR_C(0.01), x2), SR_OK);
+    }
+    CHECK(memcmp(x1, y1, sizeof x1) == 0);
+    CHECK(memcmp(x2, y2, sizeof x2) == 0);
+    CHECK(memcmp(x1, x2, sizeof x1) != 0);
+}
+
+void suite_numerics(void)
+{
+    RUN_TEST(test_so3_exp_matches_taylor_series);
+    RUN_TEST(test_so3_exp_of_zero_is_identity);
+    RUN_TEST(test_so3_exp_inverse_is_exp_of_minus_w);
+    RUN_TEST(test_accel_at_identity_equilibrium_is_zero);
+    RUN_TEST(test_tilted_equilibrium_has_zero_residual);
+    RUN_TEST(test_inertia_is_symmetric_positive_definite_and_solves_for_accel);
+    RUN_TEST(test_kinetic_energy_is_half_nu_M_nu);
+    RUN_TEST(test_motor_torques_enter_f_with_unit_coefficients);
+    RUN_TEST(test_energy_is_conserved_without_friction_to_first_order);
+    RUN_TEST(test_friction_dissipates_energy);
+    RUN_TEST(test_rolling_keeps_the_centre_at_height_r_and_rotations_orthonormal);
+    RUN_TEST(test_step_in_place_equals_step_out_of_place);
+    RUN_TEST(test_simulate_equals_repeated_steps);
+    RUN_TEST(test_interleaved_models_do_not_interfere);
+}

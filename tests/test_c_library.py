@@ -1,0 +1,258 @@
+"""The embeddable C library on its own (issue 6), built with c/Makefile and c/CMakeLists.txt.
+
+* the C tests (c/tests/) pass in the double and the float build, and under
+  AddressSanitizer + UndefinedBehaviorSanitizer;
+* the library's objects reference no allocator and hold no mutable globals;
+* every public function returns a status code;
+* the firmware-style example (c/examples/firmware_tshape.c) prints, bit for
+  bit, the trajectory of the Python runtime for the same scenario, and its
+  float build stays within the accuracy documented in docs/embedding.md;
+* CMake builds it stand-alone and through add_subdirectory.
+
+Every build goes to a fresh directory under pytest's tmp (c/Makefile's BUILD=...)
+rather than c/build, so that concurrent test runs in one checkout cannot race
+on the same objects.  No Python is involved in building the C.
+"""
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from conftest import ROOT
+
+C_DIR = ROOT / "c"
+MAKE = shutil.which("make")
+CC = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+DT, STEPS = 0.01, 10_000
+
+# Libraries a firmware image may be asked to provide: libm and the mem* family.
+MATH = {"sin", "cos", "sincos", "tan", "asin", "acos", "atan", "atan2", "sqrt", "hypot", "exp", "log",
+        "pow", "fabs", "floor", "ceil", "fmod", "fma", "fmin", "fmax", "copysign"}
+ALLOWED_EXTERNAL = MATH | {f + "f" for f in MATH} | {"memcpy", "memset", "memmove"}
+ALLOCATORS = {"malloc", "calloc", "realloc", "free", "aligned_alloc", "posix_memalign", "memalign",
+              "valloc", "reallocarray", "strdup", "strndup"}
+# nm symbol types of writable data: initialized (d/D, small g/G), uninitialized (b/B, s/S), common, weak objects.
+MUTABLE_TYPES = set("bBdDgGsSCvV")
+
+pytestmark = pytest.mark.skipif(not (MAKE and CC), reason="needs make and a C compiler")
+
+
+def run(cmd, cwd=C_DIR, env=None, check=True):
+    result = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True)
+    if check and result.returncode != 0:
+        pytest.fail(f"{' '.join(map(str, cmd))} failed ({result.returncode}):\n"
+                    f"{result.stdout[-3000:]}\n{result.stderr[-3000:]}")
+    return result
+
+
+def make(build, *targets, env=None):
+    return run([MAKE, "-s", "-j2", f"BUILD={build}", "CFLAGS=-O2", *targets], env=env)
+
+
+@pytest.fixture(scope="module")
+def build(tmp_path_factory):
+    """c/Makefile's default target (libraries, example, C tests) plus the tools, in a fresh BUILD."""
+    out = tmp_path_factory.mktemp("c-build")
+    make(out, "all", "tools")
+    return out
+
+
+def tshape_torques():
+    """The t-shape program from the issue: step n (1-based) uses row n-1."""
+    u = np.zeros((STEPS, 2))
+    u[0:800, 0] = 0.1        # yoke +0.1 N m, steps 1-800
+    u[1599:1900, 1] = -0.1   # pendulum -0.1 N m, steps 1600-1900
+    u[2499:3000, 0] = -0.1   # yoke -0.1 N m, steps 2500-3000
+    u[3399:4500, 1] = 0.1    # pendulum +0.1 N m, steps 3400-4500
+    return u
+
+
+def read_csv(text):
+    """Header and rows of the example's CSV, every field parsed by float() (exact for %.17g)."""
+    lines = text.splitlines()
+    return lines[0].split(","), np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
+
+
+def passed_line(output):
+    last = output.strip().splitlines()[-1]
+    m = re.fullmatch(r"(\d+) passed, 0 failed", last)
+    assert m, f"unexpected last line {last!r}"
+    return int(m.group(1))
+
+
+def nm_symbols(path):
+    """(type, name) of every symbol of a library or object."""
+    out = run(["nm", str(path)]).stdout
+    return [(p[-2], p[-1]) for p in (line.split() for line in out.splitlines()) if len(p) >= 2 and ":" not in p[-1]]
+
+
+# ---- the C tests ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("program, scalar", [("sr_tests", "double"), ("sr_tests_f", "float")])
+def test_c_tests_pass(build, program, scalar):
+    out = run([build / program]).stdout
+    assert f"sr_real = {scalar}" in out
+    assert passed_line(out) >= 30
+
+
+def test_c_tests_pass_under_address_and_undefined_behaviour_sanitizers(build, tmp_path):
+    probe = tmp_path / "probe.c"
+    probe.write_text("int main(void) { return 0; }\n")
+    if run([CC, "-fsanitize=address,undefined", str(probe), "-o", str(tmp_path / "probe")],
+           check=False).returncode != 0:
+        pytest.skip("the C compiler has no AddressSanitizer/UBSan")
+    env = dict(os.environ, ASAN_OPTIONS="detect_leaks=0")  # no heap in the library; LSan needs ptrace
+    out = make(build, "sanitize", env=env).stdout
+    counts = [int(n) for n in re.findall(r"^(\d+) passed, 0 failed$", out, flags=re.M)]
+    assert len(counts) == 2 and min(counts) >= 30, out
+
+
+# ---- symbols: no allocation, no mutable globals ------------------------------------------
+
+@pytest.mark.parametrize("lib", ["libsphericalrobot.a", "libsphericalrobot_f.a"])
+def test_library_references_no_allocator_and_only_libm(build, lib):
+    symbols = nm_symbols(build / lib)
+    defined = {name for kind, name in symbols if kind != "U"}
+    external = {name for kind, name in symbols if kind == "U"} - defined
+    assert not external & ALLOCATORS, f"allocation in {lib}: {sorted(external & ALLOCATORS)}"
+    assert external <= ALLOWED_EXTERNAL, f"{lib} needs more than libm: {sorted(external - ALLOWED_EXTERNAL)}"
+
+
+@pytest.mark.parametrize("lib", ["libsphericalrobot.a", "libsphericalrobot_f.a"])
+def test_library_has_no_mutable_globals(build, lib):
+    mutable = [(kind, name) for kind, name in nm_symbols(build / lib) if kind in MUTABLE_TYPES]
+    assert not mutable, f"writable data in {lib}: {mutable}"
+    # Also unnamed data: no member may have a non-empty writable section.
+    for line in run(["size", "-A", str(build / lib)]).stdout.splitlines():
+        parts = line.split()
+        if len(parts) >= 2 and re.match(r"\.(data|bss|sdata|sbss)\b", parts[0]) \
+                and not parts[0].startswith(".data.rel.ro"):
+            assert int(parts[1]) == 0, f"{lib}: {line.strip()}"
+
+
+def test_every_public_function_returns_a_status_code():
+    text = re.sub(r"/\*.*?\*/", "", (C_DIR / "spherical_robot.h").read_text(), flags=re.S)
+    prototypes = re.findall(r"^([A-Za-z_][\w \t\*]*?)\b(sr_\w+)\s*\(", text, flags=re.M)
+    assert len(prototypes) >= 12
+    for ret, name in prototypes:
+        expected = "const char *" if name == "sr_status_string" else "int"
+        assert ret.strip() == expected.strip(), f"{name} returns {ret.strip()!r}"
+
+
+# ---- the firmware-style example ---------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def example_double(build):
+    return read_csv(run([build / "firmware_tshape"]).stdout)
+
+
+@pytest.fixture(scope="module")
+def example_float(build):
+    return read_csv(run([build / "firmware_tshape_f"]).stdout)
+
+
+def test_example_prints_time_and_the_35_state_entries(example_double):
+    header, rows = example_double
+    assert len(header) == 36 and header[0] == "t" and header[1] == "RS_00" and header[-1] == "w_P"
+    assert rows.shape == (STEPS + 1, 36)
+    assert np.array_equal(rows[:, 0], np.arange(STEPS + 1) * DT)
+
+
+def test_example_equals_the_python_runtime_bit_for_bit(example_double):
+    from runtime import Model, Params, initial_state
+
+    # initial_state() builds R_Y = rot_x(0), R_P = rot_y(0), whose -sin(0) entries are -0.0; the
+    # example starts from the identity matrices as written in C (+0.0).  Adding 0.0 turns -0.0
+    # into +0.0, so both sides start from the same bits.
+    x0 = initial_state() + 0.0
+    expected = Model(Params.paper_simulation()).simulate(x0, DT, STEPS, tshape_torques())
+    got = example_double[1][:, 1:]
+    differ = np.nonzero(got.view(np.uint64) != expected.view(np.uint64))
+    assert differ[0].size == 0, (
+        f"{differ[0].size} entries differ; first at step {differ[0][0]}, entry {differ[1][0]}: "
+        f"{got[differ][0]!r} vs {expected[differ][0]!r}")
+
+
+def test_float_example_tracks_the_double_one(example_double, example_float):
+    """Bounds about 5x the errors measured in docs/embedding.md."""
+    d, f = example_double[1], example_float[1]
+    assert f.shape == d.shape  # the float build survives all 10,000 steps
+    err = np.abs(f - d)
+    assert err[1000].max() < 2e-5      # t = 10 s
+    assert err[-1].max() < 1e-2        # t = 100 s
+    assert np.linalg.norm(err[-1, 28:31]) < 5e-3   # position after 100 s [m]
+
+
+def test_float_accelerations_agree_with_double(build):
+    a_d = np.array([[float(v) for v in line.split(",")] for line in run([build / "accel_dump"]).stdout.split()])
+    a_f = np.array([[float(v) for v in line.split(",")] for line in run([build / "accel_dump_f"]).stdout.split()])
+    assert a_d.shape == a_f.shape == (1000, 5)
+    rel = np.abs(a_f - a_d).max(axis=1) / np.abs(a_d).max(axis=1)
+    assert np.median(rel) < 1e-6 and rel.max() < 2e-5
+
+
+def test_float_accuracy_script_prints_its_tables(build):
+    out = run(["sh", "tools/float_accuracy.sh", str(build)]).stdout
+    assert "| 1000 |" in out and "| 10 |" in out and "| 100 |" in out
+
+
+# ---- CMake -----------------------------------------------------------------------------------
+
+CONSUMER_CMAKE = """cmake_minimum_required(VERSION 3.13)
+project(firmware C)
+add_subdirectory({c_dir} spherical_robot)
+add_executable(firmware main.c)
+target_link_libraries(firmware PRIVATE sphericalrobot::sphericalrobot)
+"""
+CONSUMER_MAIN = """#include "spherical_robot.h"
+#include <stdio.h>
+int main(void) {
+    const sr_real p[SR_NPARAM] = {0.3, 2, 0.16, 0.2, 0.5, 2, 5, 0.04, 0.2, 1, 0.1, 9.81};
+    sr_real x[SR_NX] = {1,0,0, 0,1,0, 0,0,1,  1,0,0, 0,1,0, 0,0,1,  1,0,0, 0,1,0, 0,0,1,  0,0,0.3};
+    const sr_real u[SR_NU] = {0.1, 0};
+    sr_model m;
+    int status = sr_model_init(&m, p);
+    if (status == SR_OK) status = sr_step(&m, SR_LIE_EULER, x, u, 0.01, x);
+    printf("%s %d\\n", sr_status_string(status), (int)sizeof(sr_real));
+    return status;
+}
+"""
+
+
+@pytest.mark.skipif(not shutil.which("cmake"), reason="needs cmake")
+@pytest.mark.parametrize("use_float", [False, True], ids=["double", "float"])
+def test_cmake_add_subdirectory(tmp_path, use_float):
+    project = tmp_path / "firmware"
+    project.mkdir()
+    (project / "CMakeLists.txt").write_text(CONSUMER_CMAKE.format(c_dir=C_DIR.as_posix()))
+    (project / "main.c").write_text(CONSUMER_MAIN)
+    build = tmp_path / "build"
+    run(["cmake", "-S", str(project), "-B", str(build), f"-DSR_USE_FLOAT={'ON' if use_float else 'OFF'}"])
+    run(["cmake", "--build", str(build), "-j2"])
+    assert run([build / "firmware"]).stdout.split() == ["ok", "4" if use_float else "8"]
+
+
+@pytest.mark.skipif(not shutil.which("cmake"), reason="needs cmake")
+def test_cmake_standalone_build_runs_the_c_tests(tmp_path):
+    run(["cmake", "-S", str(C_DIR), "-B", str(tmp_path)])
+    run(["cmake", "--build", str(tmp_path), "-j2"])
+    assert (tmp_path / "libsphericalrobot.a").exists()
+    run(["ctest", "--test-dir", str(tmp_path), "--output-on-failure"])
+
+
+# ---- documentation tools ------------------------------------------------------------------------
+
+def test_size_report_covers_every_public_function(tmp_path):
+    probe = tmp_path / "probe.c"
+    probe.write_text("int f(void) { return 0; }\n")
+    if run([CC, "-fcallgraph-info=su", "-c", str(probe), "-o", str(tmp_path / "probe.o")],
+           check=False, cwd=tmp_path).returncode != 0:
+        pytest.skip("the C compiler has no -fcallgraph-info (GCC >= 10 needed)")
+    out = run([sys.executable, "tools/size_report.py", "--cc", CC]).stdout
+    header = re.sub(r"/\*.*?\*/", "", (C_DIR / "spherical_robot.h").read_text(), flags=re.S)
+    for name in re.findall(r"^[A-Za-z_][\w \t\*]*?\b(sr_\w+)\s*\(", header, flags=re.M):
+        assert out.count(f"| `{name}` |") == 2, name  # one row per scalar type
