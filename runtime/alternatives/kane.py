@@ -79,10 +79,10 @@ PARAM_NAMES = ("r", "m_S", "k_S", "b", "h", "m_b", "m_h", "k_Y", "l", "m_P", "k_
 STATE_DIM = 35
 
 _LOCK = threading.Lock()
-_DERIVED = None  # filled once per process by _derivation()
+_DERIVED = {}  # cse flag -> derived functions, filled once per process by _derivation()
 
 
-def _derive():
+def _derive(cse=True):
     """Symbolic derivation with sympy.physics.mechanics and lambdify; returns a dict."""
     import sympy as sm
     import sympy.physics.mechanics as me
@@ -174,19 +174,18 @@ def _derive():
     M_s, F_s = M.xreplace(sub), F.xreplace(sub)
     udep_s = udep_expr.xreplace(sub)
     args = (qs, us, (u_Y, u_P), par)
-    f_MF = sm.lambdify(args, (M_s, F_s), modules="numpy", cse=True)
-    f_udep = sm.lambdify((qs, us[:5], par), udep_s, modules="numpy", cse=True)
+    f_MF = sm.lambdify(args, (M_s, F_s), modules="numpy", cse=cse)
+    f_udep = sm.lambdify((qs, us[:5], par), udep_s, modules="numpy", cse=cse)
     seconds = time.perf_counter() - t0
     return {"f_MF": f_MF, "f_udep": f_udep, "seconds": seconds, "kane_seconds": t_kane,
             "n_ops": int(sm.count_ops(M_s) + sm.count_ops(F_s))}
 
 
-def _derivation():
-    global _DERIVED
+def _derivation(cse=True):
     with _LOCK:
-        if _DERIVED is None:
-            _DERIVED = _derive()
-        return _DERIVED
+        if cse not in _DERIVED:
+            _DERIVED[cse] = _derive(cse)
+        return _DERIVED[cse]
 
 
 def euler_zyx(R_S):
@@ -205,10 +204,12 @@ class KaneModel:
     ``KaneModel(params)`` with the 12 parameters by the paper's names (a dict, or
     anything with those attributes such as ``runtime.Params``).  The symbolic
     derivation and lambdify run once per process, on the first construction;
-    ``derivation_seconds`` reports how long they took.
+    ``derivation_seconds`` reports how long they took.  ``cse=False`` lambdifies
+    with sympy's default options (no common-subexpression elimination).
     """
 
-    def __init__(self, params):
+    def __init__(self, params, cse=True):
+        self.cse = bool(cse)
         if not isinstance(params, dict):
             params = {k: getattr(params, k) for k in PARAM_NAMES}
         missing = [k for k in PARAM_NAMES if k not in params]
@@ -217,13 +218,13 @@ class KaneModel:
             raise ValueError(f"bad parameter set: missing={missing}, unknown={extra}")
         self.params = {k: float(params[k]) for k in PARAM_NAMES}
         self._p = tuple(self.params[k] for k in PARAM_NAMES)
-        d = _derivation()
+        d = _derivation(self.cse)
         self._f_MF, self._f_udep = d["f_MF"], d["f_udep"]
 
     @property
     def derivation_seconds(self) -> float:
         """Wall time of the symbolic derivation (KanesMethod) plus lambdify, once per process."""
-        return _derivation()["seconds"]
+        return _derivation(self.cse)["seconds"]
 
     @staticmethod
     def coordinates(x):
