@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 C_SOURCES := $(wildcard generated/*.c generated/*.h c/*.c c/*.h)
 
-.PHONY: install test run generate verify bench figures c-lib c-test clean
+.PHONY: install test run generate verify bench figures soak fuzz c-lib c-test clean
 
 $(STAMP): pyproject.toml setup.py bindings/build_sr.py $(C_SOURCES)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -20,7 +20,7 @@ test: $(STAMP)
 	$(PY) -m pytest -q
 
 run: $(STAMP)
-	$(PY) -m runtime run all --out out
+	$(PY) -m runtime run all --out out --force
 
 generate: $(STAMP)
 	$(PY) -m derive
@@ -34,6 +34,13 @@ bench: $(STAMP)
 
 figures: $(STAMP)
 	$(PY) -m runtime.figures
+
+soak: $(STAMP)
+	$(PY) -m runtime soak
+
+fuzz:
+	$(MAKE) -C c fuzz
+	if command -v clang >/dev/null; then $(MAKE) -C c fuzz-libfuzzer; fi
 
 c-lib:
 	$(MAKE) -C c

@@ -24,15 +24,19 @@ CDEF = """
 #define SR_ERR_CONSTRAINT 7
 #define SR_ERR_STEP_SIZE 8
 #define SR_ERR_MAX_STEPS 9
+#define SR_ERR_ENERGY 10
+#define SR_GUARD_INTERVAL 16
 #define SR_LIE_EULER 0
 #define SR_RKMK4 1
 #define SR_CF4 2
 #define SR_PROJECT 16
 typedef double sr_real;
+static const double SR_ROTATION_TOL;
 typedef struct sr_model { ...; } sr_model;
 const char *sr_status_string(int status);
 int sr_model_init(sr_model *model, const sr_real params[]);
 int sr_check_state(const sr_model *model, const sr_real x[]);
+int sr_check_state_batch(const sr_model *model, long n, const sr_real *x, long *failed_row);
 int sr_accel(const sr_model *model, const sr_real x[], const sr_real u[], sr_real a[]);
 int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real *a, long *failed_row);
 int sr_inertia(const sr_model *model, const sr_real x[], sr_real M[]);
@@ -43,6 +47,15 @@ int sr_so3_exp(const sr_real w[], sr_real R[]);
 int sr_step(const sr_model *model, int method, const sr_real x[], const sr_real u[], sr_real dt, sr_real x_next[]);
 int sr_simulate(const sr_model *model, int method, const sr_real x0[], sr_real dt, long steps,
                 const sr_real *u, sr_real *traj, long *steps_done);
+typedef struct sr_energy_guard {
+    sr_real tol;
+    int in_stretch;
+    sr_real e_start;
+    sr_real scale;
+    sr_real energy;
+} sr_energy_guard;
+int sr_simulate_guarded(const sr_model *model, int method, const sr_real x0[], sr_real dt, long steps,
+                        const sr_real *u, sr_energy_guard *guard, sr_real *traj, long *steps_done);
 typedef struct sr_adaptive_stats {
     long accepted;
     long rejected;

@@ -48,14 +48,17 @@ extern "C" {
 /* Status codes. */
 #define SR_OK 0
 #define SR_ERR_NULL 1          /* a required pointer is NULL */
-#define SR_ERR_NONFINITE 2     /* an input (or, in a simulation, the state) is NaN or infinite */
+#define SR_ERR_NONFINITE 2     /* an input is NaN or infinite, or a result overflowed (outputs are
+                                  finite whenever a function returns SR_OK) */
 #define SR_ERR_NOT_ROTATION 3  /* a rotation matrix is not orthonormal with det +1, R_Y is not about x or R_P not about y */
 #define SR_ERR_SINGULAR 4      /* the generalized inertia M is not positive definite */
 #define SR_ERR_PARAM 5         /* a parameter is out of its physical range */
 #define SR_ERR_ARG 6           /* another argument is invalid (dt <= 0, steps < 0, unknown method) */
-#define SR_ERR_CONSTRAINT 7    /* q_z differs from r */
+#define SR_ERR_CONSTRAINT 7    /* q_z differs from r by more than SR_ROTATION_TOL * r */
 #define SR_ERR_STEP_SIZE 8     /* adaptive stepping: the step size fell below the rounding level of t */
 #define SR_ERR_MAX_STEPS 9     /* adaptive stepping: more than max_steps step attempts */
+#define SR_ERR_ENERGY 10       /* sr_simulate_guarded: the energy rose without input power beyond the
+                                  guard's tolerance (see sr_energy_guard) */
 
 /* Tolerance on |R^T R - I| (entry-wise) and |det R - 1| accepted by the checks. */
 #ifdef SR_USE_FLOAT
@@ -63,6 +66,10 @@ extern "C" {
 #else
 #define SR_ROTATION_TOL SR_C(1e-6)
 #endif
+
+/* sr_simulate and sr_simulate_guarded check the whole state (sr_check_state) every
+ * SR_GUARD_INTERVAL steps and after the last step; finiteness is checked after every step. */
+#define SR_GUARD_INTERVAL 16
 
 /* Time-stepping methods. */
 #define SR_LIE_EULER 0         /* the paper's eq. (111), first order */
@@ -94,8 +101,12 @@ typedef struct sr_model {
 const char *sr_status_string(int status);
 
 /* Validate params (all finite; r, m_S, b, h, m_b, m_h, l, m_P > 0; k_S, k_Y, k_P, g >= 0;
- * yoke half-diagonal sqrt(b^2+h^2)/2 <= r and l <= r) and fill *model.
- * Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_PARAM. */
+ * yoke half-diagonal sqrt(b^2+h^2)/2 <= r and l <= r) and fill *model.  The derived
+ * constants, M and the energy at the reference state (R_S = R_Y = R_P = I, q = (0, 0, r), at
+ * rest) must be finite (else SR_ERR_PARAM: a value so large that it overflows), and M there
+ * positive definite (else SR_ERR_SINGULAR: values so small that the inertias underflow).
+ * Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE, SR_ERR_PARAM or SR_ERR_SINGULAR; *model is
+ * untouched on error. */
 int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM]);
 
 /* Full state check: finite entries, R_S orthonormal with det +1, R_Y a rotation
@@ -103,9 +114,16 @@ int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM]);
  * Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION or SR_ERR_CONSTRAINT. */
 int sr_check_state(const sr_model *model, const sr_real x[SR_NX]);
 
+/* sr_check_state over n states (x is n x SR_NX, row-major).  Stops at the first failing row,
+ * whose index goes to *failed_row (if not NULL; -1 when all rows pass). */
+int sr_check_state_batch(const sr_model *model, long n, const sr_real *x, long *failed_row);
+
 /* Accelerations a = d(nu)/dt at state x under torques u (u may be NULL: zero torque).
  * Cheap checks only: finiteness of x and u, |gamma| = 1 and the unit columns of R_Y, R_P
- * that the model reads.  Returns SR_OK or an error code; a is untouched on error. */
+ * that the model reads (call sr_check_state once for the full check).  Returns SR_OK or an
+ * error code (SR_ERR_NONFINITE also when the result overflows); a is untouched on error.
+ * The same holds for sr_inertia, sr_rhs, sr_energy and sr_equilibrium_residual: every output
+ * is either fully written and finite (SR_OK) or untouched. */
 int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV]);
 
 /* sr_accel over n states: x is n x SR_NX, u is n x SR_NU (or NULL), a is n x SR_NV,
@@ -127,20 +145,49 @@ int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy);
  * equilibria R_S R_Y R_P e_z = +-e_z of eq. (108). */
 int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV]);
 
-/* R = Exp([[w]]) by Rodrigues' formula, with a series branch for |w| < 1e-4 rad. */
+/* R = Exp([[w]]) by Rodrigues' formula, with a series branch for |w| < 1e-4 rad.
+ * SR_ERR_NONFINITE (R untouched) if w is not finite or |w|^2 overflows. */
 int sr_so3_exp(const sr_real w[3], sr_real R[9]);
 
 /* One step of size dt > 0 with constant torques u (NULL: zero) from x to x_next
- * (x_next may alias x).  method: SR_LIE_EULER, SR_RKMK4 or SR_CF4. */
+ * (x_next may alias x).  method: SR_LIE_EULER, SR_RKMK4 or SR_CF4.  x_next is written only
+ * on SR_OK (a non-finite new state gives SR_ERR_NONFINITE). */
 int sr_step(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
             sr_real dt, sr_real x_next[SR_NX]);
 
 /* steps steps of size dt from x0: traj[(steps+1) x SR_NX] receives x0 and every state after;
- * u is steps x SR_NU (torque held over each step) or NULL.  On an error at step k
- * (1-based), *steps_done = k-1 and traj holds rows 0..k-1; the state is checked for
- * finiteness after every step. */
+ * u is steps x SR_NU (torque held over each step) or NULL.  x0 gets the full check
+ * (sr_check_state).  Guards: the state is checked for finiteness after every step
+ * (SR_ERR_NONFINITE), and fully (SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT: the rotations or
+ * q_z drifted beyond SR_ROTATION_TOL) every SR_GUARD_INTERVAL steps and after the last.
+ * On an error at step k (1-based: a bad torque of step k, a failing kernel, or a guard failing
+ * on the state after step k), *steps_done = k-1 and traj rows 0..k-1 are valid; row k may have
+ * been written (with the offending state, for a guard), rows after k are untouched. */
 int sr_simulate(const sr_model *model, int method, const sr_real x0[SR_NX], sr_real dt, long steps,
                 const sr_real *u, sr_real *traj, long *steps_done);
+
+/* Energy guard of sr_simulate_guarded.  Over a torque-free stretch (steps whose torques are
+ * both exactly 0: no input power) the exact energy cannot rise, since the damping is >= 0.
+ * The guard fails the run with SR_ERR_ENERGY when, at a check (the same steps as the state
+ * checks), the energy E exceeds
+ *     E_start + tol * scale + 64 eps (|E_start| + scale),
+ * E_start being the energy at the start of the stretch and scale its kinetic energy plus
+ * m_P g l (the swing of the pendulum's potential energy); the last term absorbs rounding.
+ * A non-zero torque ends the stretch; the next torque-free step starts a new one.
+ * Set tol (< 0 disables the guard) and in_stretch = 0 before a run; to continue a run in
+ * chunks, pass the same struct again: it carries the stretch across calls. */
+typedef struct sr_energy_guard {
+    sr_real tol;      /* in: allowed rise as a fraction of scale; < 0: no energy guard */
+    int in_stretch;   /* in/out: nonzero inside a torque-free stretch */
+    sr_real e_start;  /* in/out: energy at the start of the stretch [J] */
+    sr_real scale;    /* in/out: kinetic energy at the start of the stretch + m_P g l [J] */
+    sr_real energy;   /* out: energy at the last check [J] (at the failing one on SR_ERR_ENERGY) */
+} sr_energy_guard;
+
+/* sr_simulate with the energy guard (guard may be NULL: same as sr_simulate). */
+int sr_simulate_guarded(const sr_model *model, int method, const sr_real x0[SR_NX], sr_real dt,
+                        long steps, const sr_real *u, sr_energy_guard *guard, sr_real *traj,
+                        long *steps_done);
 
 /* Counters of sr_simulate_adaptive. */
 typedef struct sr_adaptive_stats {
@@ -166,9 +213,11 @@ typedef struct sr_adaptive_stats {
  *   rtol, atol >= 0 with rtol + atol > 0; h_init > 0 the first trial step, or <= 0 for
  *   min(dt_out, 0.1*tol^(1/4)) with tol = max(rtol, atol); max_steps > 0 bounds the step
  *   attempts (accepted + rejected).  stats may be NULL.
+ * x0 gets the full check (sr_check_state).
  * Returns SR_OK, SR_ERR_NULL, SR_ERR_ARG, SR_ERR_NONFINITE (x0 or u or the state),
- * SR_ERR_NOT_ROTATION (x0), SR_ERR_SINGULAR, SR_ERR_STEP_SIZE or SR_ERR_MAX_STEPS; on error
- * the valid rows are reported in stats->rows_done. */
+ * SR_ERR_NOT_ROTATION or SR_ERR_CONSTRAINT (x0), SR_ERR_SINGULAR, SR_ERR_STEP_SIZE or
+ * SR_ERR_MAX_STEPS; on error the valid rows are reported in stats->rows_done (the rows after
+ * them are untouched). */
 int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[SR_NX], sr_real dt_out,
                          long n_out, const sr_real *u, sr_real rtol, sr_real atol, sr_real h_init,
                          long max_steps, sr_real *traj, sr_adaptive_stats *stats);

@@ -58,7 +58,10 @@ static int vector_field(const sr_model *model, const sr_real x[SR_NX], const sr_
     f[T_Q + 1] = r * (R[3] * v[0] + R[4] * v[1] + R[5] * v[2]);
     f[T_Q + 2] = 0;
     if (evaluations) ++*evaluations;
-    return sr_gen_accel(model->c, x, u, f + T_V);
+    i = sr_gen_accel(model->c, x, u, f + T_V);
+    /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
+    if (i == SR_ERR_SINGULAR && !all_finite(x, SR_NX)) return SR_ERR_NONFINITE;
+    return i;
 }
 
 /* Rounding and orthogonality.  Forming E = Exp(...) and then R E rounds the diagonal of E to
@@ -335,7 +338,7 @@ int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[SR_
     int i, base, status;
     if (!stats) stats = &local;
     *stats = local;
-    status = checks(model, x0, NULL);
+    status = sr_check_state(model, x0); /* in full, like sr_simulate */
     if (status != SR_OK) return status;
     if (!traj) return SR_ERR_NULL;
     base = method & ~SR_PROJECT;
@@ -394,15 +397,15 @@ int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[SR_
                 rejected = 1;
                 continue;
             }
+            if (method & SR_PROJECT) {
+                sr_internal_project(y); /* f(x) of the unprojected point differs by rounding only */
+            }
             if (!all_finite(y, SR_NX)) {
                 stats->h_next = h;
                 return SR_ERR_NONFINITE;
             }
             ++stats->accepted;
             for (i = 0; i < SR_NX; ++i) x[i] = y[i];
-            if (method & SR_PROJECT) {
-                sr_internal_project(x); /* f(x) of the unprojected point differs by rounding only */
-            }
             for (i = 0; i < NT; ++i) cx.f_cur[i] = f_next[i]; /* first same as last */
             cx.have_f = 1;
             fac = err > 0 ? SR_C(0.9) * SR_POW(err, expo) : SR_C(5.0);

@@ -17,16 +17,31 @@ const char *sr_status_string(int status)
     case SR_ERR_CONSTRAINT: return "constraint violated (q_z != r)";
     case SR_ERR_STEP_SIZE: return "adaptive step size below the rounding level of t";
     case SR_ERR_MAX_STEPS: return "adaptive stepping exceeded max_steps";
+    case SR_ERR_ENERGY: return "energy rose without input power beyond the guard's tolerance";
     default: return "unknown status";
     }
 }
+
+/* The reference state of sr_model_init's checks: R_S = R_Y = R_P = I, q = (0, 0, r), at rest. */
+static void reference_state(sr_real r, sr_real x[SR_NX])
+{
+    int i;
+    for (i = 0; i < SR_NX; ++i) x[i] = 0;
+    for (i = 0; i < 3; ++i) x[RS + 4 * i] = x[RY + 4 * i] = x[RP + 4 * i] = 1;
+    x[Q + 2] = r;
+}
+
+static const sr_real zero_u[SR_NU] = {0, 0};
 
 int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM])
 {
     enum { r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g };
     static const int positive[] = {r, m_S, b, h, m_b, m_h, l, m_P};
     static const int nonnegative[] = {k_S, k_Y, k_P, g};
+    sr_model m;
+    sr_real x[SR_NX], M[SR_NV * SR_NV], a[SR_NV], energy;
     size_t i;
+    int status;
     if (!model || !params) return SR_ERR_NULL;
     if (!all_finite(params, SR_NPARAM)) return SR_ERR_NONFINITE;
     for (i = 0; i < sizeof positive / sizeof positive[0]; ++i)
@@ -36,8 +51,22 @@ int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM])
     /* The yoke's corners and the pendulum's tip must fit inside the shell. */
     if (params[b] * params[b] + params[h] * params[h] > SR_C(4.0) * params[r] * params[r]) return SR_ERR_PARAM;
     if (params[l] > params[r]) return SR_ERR_PARAM;
-    for (i = 0; i < SR_NPARAM; ++i) model->p[i] = params[i];
-    return sr_gen_constants(model->p, model->c);
+    for (i = 0; i < SR_NPARAM; ++i) m.p[i] = params[i];
+    status = sr_gen_constants(m.p, m.c);
+    if (status != SR_OK) return status;
+    /* Values in range one by one can still overflow or underflow together (r = 1e200, or every
+     * length 1e-200): evaluate the model once at the reference state.  M is positive definite
+     * for any positive masses and lengths in exact arithmetic, so a failing pivot means that
+     * the inertias underflowed. */
+    if (!all_finite(m.c, SR_GEN_NCONST)) return SR_ERR_PARAM;
+    reference_state(params[r], x);
+    if (sr_gen_inertia(m.c, x, M) != SR_OK || !all_finite(M, SR_NV * SR_NV)) return SR_ERR_PARAM;
+    if (sr_gen_energy(m.c, x, &energy) != SR_OK || !isfinite(energy)) return SR_ERR_PARAM;
+    status = sr_gen_accel(m.c, x, zero_u, a);
+    if (status != SR_OK) return status; /* SR_GEN_SINGULAR == SR_ERR_SINGULAR */
+    if (!all_finite(a, SR_NV)) return SR_ERR_PARAM;
+    *model = m;
+    return SR_OK;
 }
 
 static int is_rotation(const sr_real *R)
@@ -74,15 +103,41 @@ int sr_check_state(const sr_model *model, const sr_real x[SR_NX])
     return SR_OK;
 }
 
-static const sr_real zero_u[SR_NU] = {0, 0};
+int sr_check_state_batch(const sr_model *model, long n, const sr_real *x, long *failed_row)
+{
+    long i;
+    if (failed_row) *failed_row = -1;
+    if (!model || !x) return SR_ERR_NULL;
+    if (n < 0) return SR_ERR_ARG;
+    for (i = 0; i < n; ++i) {
+        const int status = sr_check_state(model, x + i * SR_NX);
+        if (status != SR_OK) {
+            if (failed_row) *failed_row = i;
+            return status;
+        }
+    }
+    return SR_OK;
+}
+
+/* Copy n results from tmp to out when the kernel succeeded and they are all finite: outputs
+ * are either fully written and finite or untouched. */
+static int deliver(int status, const sr_real *tmp, int n, sr_real *out)
+{
+    int i;
+    if (status != SR_OK) return status;
+    if (!all_finite(tmp, n)) return SR_ERR_NONFINITE;
+    for (i = 0; i < n; ++i) out[i] = tmp[i];
+    return SR_OK;
+}
 
 int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV])
 {
     int status;
+    sr_real tmp[SR_NV];
     if (!a) return SR_ERR_NULL;
     status = checks(model, x, u);
     if (status != SR_OK) return status;
-    return sr_gen_accel(model->c, x, u ? u : zero_u, a);
+    return deliver(sr_gen_accel(model->c, x, u ? u : zero_u, tmp), tmp, SR_NV, a);
 }
 
 int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
@@ -105,46 +160,49 @@ int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * SR_NV])
 {
     int status;
+    sr_real tmp[SR_NV * SR_NV];
     if (!M) return SR_ERR_NULL;
     status = checks(model, x, NULL);
     if (status != SR_OK) return status;
-    return sr_gen_inertia(model->c, x, M);
+    return deliver(sr_gen_inertia(model->c, x, tmp), tmp, SR_NV * SR_NV, M);
 }
 
 int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NV])
 {
     int status;
+    sr_real tmp[SR_NV];
     if (!f) return SR_ERR_NULL;
     status = checks(model, x, u);
     if (status != SR_OK) return status;
-    return sr_gen_rhs(model->c, x, u ? u : zero_u, f);
+    return deliver(sr_gen_rhs(model->c, x, u ? u : zero_u, tmp), tmp, SR_NV, f);
 }
 
 int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy)
 {
     int status;
+    sr_real tmp;
     if (!energy) return SR_ERR_NULL;
     status = checks(model, x, NULL);
     if (status != SR_OK) return status;
-    return sr_gen_energy(model->c, x, energy);
+    return deliver(sr_gen_energy(model->c, x, &tmp), &tmp, 1, energy);
 }
 
 int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV])
 {
     int status;
+    sr_real tmp[SR_NV];
     if (!res) return SR_ERR_NULL;
     status = checks(model, x, NULL);
     if (status != SR_OK) return status;
-    return sr_gen_equilibrium_residual(model->c, x, res);
+    return deliver(sr_gen_equilibrium_residual(model->c, x, tmp), tmp, SR_NV, res);
 }
 
-int sr_so3_exp(const sr_real w[3], sr_real R[9])
+/* R = Exp([[w]]) = I + A [[w]] + B [[w]]^2, with [[w]]^2 = w w^T - |w|^2 I (no checks). */
+static void so3_exp(const sr_real w[3], sr_real R[9])
 {
-    sr_real theta2, A, B;
-    if (!w || !R) return SR_ERR_NULL;
-    theta2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    sr_real A, B;
+    const sr_real theta2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
     so3_exp_coefficients(theta2, &A, &B);
-    /* R = I + A [[w]] + B [[w]]^2, with [[w]]^2 = w w^T - |w|^2 I. */
     R[0] = 1 + B * (w[0] * w[0] - theta2);
     R[4] = 1 + B * (w[1] * w[1] - theta2);
     R[8] = 1 + B * (w[2] * w[2] - theta2);
@@ -154,7 +212,15 @@ int sr_so3_exp(const sr_real w[3], sr_real R[9])
     R[6] = B * w[0] * w[2] - A * w[1];
     R[5] = B * w[1] * w[2] - A * w[0];
     R[7] = B * w[1] * w[2] + A * w[0];
-    return SR_OK;
+}
+
+int sr_so3_exp(const sr_real w[3], sr_real R[9])
+{
+    sr_real tmp[9];
+    if (!w || !R) return SR_ERR_NULL;
+    if (!all_finite(w, 3)) return SR_ERR_NONFINITE;
+    so3_exp(w, tmp);
+    return deliver(SR_OK, tmp, 9, R); /* |w|^2 may overflow */
 }
 
 static int lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
@@ -166,7 +232,7 @@ static int lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_rea
     int i, status = sr_gen_accel(model->c, x, u, a);
     if (status != SR_OK) return status;
     for (i = 0; i < 3; ++i) w_dt[i] = dt * w[i];
-    sr_so3_exp(w_dt, E);
+    so3_exp(w_dt, E);
     matmul3(R, E, x_new + RS);
     rotate_about_axis(x + RY, 0, dt * x[W + 3], x_new + RY);
     rotate_about_axis(x + RP, 1, dt * x[W + 4], x_new + RP);
@@ -206,32 +272,98 @@ int sr_step(const sr_model *model, int method, const sr_real x[SR_NX], const sr_
             sr_real dt, sr_real x_next[SR_NX])
 {
     int status;
+    sr_real tmp[SR_NX];
     if (!x_next) return SR_ERR_NULL;
     status = checks(model, x, u);
     if (status != SR_OK) return status;
     if (!(dt > 0) || !isfinite(dt) || !valid_method(method)) return SR_ERR_ARG;
-    return advance(model, method, x, u ? u : zero_u, dt, x_next);
+    return deliver(advance(model, method, x, u ? u : zero_u, dt, tmp), tmp, SR_NX, x_next);
+}
+
+/* Kinetic energy 1/2 nu^T M nu and total energy of x (both finite, else SR_ERR_NONFINITE). */
+static int energies(const sr_model *model, const sr_real x[SR_NX], sr_real *kinetic, sr_real *total)
+{
+    sr_real rest[SR_NX], potential;
+    int i, status;
+    for (i = 0; i < SR_NX; ++i) rest[i] = i < W ? x[i] : 0;
+    status = sr_gen_energy(model->c, x, total);
+    if (status == SR_OK) status = sr_gen_energy(model->c, rest, &potential);
+    if (status != SR_OK) return status;
+    *kinetic = *total - potential;
+    return isfinite(*total) && isfinite(*kinetic) ? SR_OK : SR_ERR_NONFINITE;
+}
+
+/* The energy guard at row n of a run (the state x after n steps of this call); step_u is the
+ * torque of the step that starts at x (NULL after the last step), prev_u that of the step that
+ * ended there (NULL at row 0).  Opens a stretch at the start of a torque-free step, closes it
+ * at a powered one, and compares the energy with the stretch's start at the check rows. */
+static int energy_guard(const sr_model *model, sr_energy_guard *guard, const sr_real x[SR_NX],
+                        const sr_real *prev_u, const sr_real *step_u, int check_row)
+{
+    const sr_real *p = model->p;
+    sr_real kinetic, total;
+    int status;
+    if (!guard || !(guard->tol >= 0)) return SR_OK;
+    if (prev_u && (prev_u[0] != 0 || prev_u[1] != 0)) guard->in_stretch = 0;
+    if (guard->in_stretch && check_row) {
+        sr_real limit;
+        status = sr_gen_energy(model->c, x, &total);
+        if (status != SR_OK) return status;
+        if (!isfinite(total)) return SR_ERR_NONFINITE;
+        guard->energy = total;
+        limit = guard->e_start + guard->tol * guard->scale
+              + 64 * SR_EPSILON * (SR_FABS(guard->e_start) + guard->scale);
+        if (total > limit) return SR_ERR_ENERGY;
+    }
+    if (!guard->in_stretch && step_u && step_u[0] == 0 && step_u[1] == 0) {
+        status = energies(model, x, &kinetic, &total);
+        if (status != SR_OK) return status;
+        guard->in_stretch = 1;
+        guard->e_start = guard->energy = total;
+        guard->scale = kinetic + p[9] * p[11] * p[8]; /* + m_P g l */
+    }
+    return SR_OK;
+}
+
+int sr_simulate_guarded(const sr_model *model, int method, const sr_real x0[SR_NX], sr_real dt,
+                        long steps, const sr_real *u, sr_energy_guard *guard, sr_real *traj,
+                        long *steps_done)
+{
+    long n;
+    int i, status;
+    if (steps_done) *steps_done = 0;
+    status = sr_check_state(model, x0);
+    if (status != SR_OK) return status;
+    if (!traj) return SR_ERR_NULL;
+    if (steps < 0 || !(dt > 0) || !isfinite(dt) || !valid_method(method)) return SR_ERR_ARG;
+    if (guard && guard->tol == guard->tol && !isfinite(guard->tol)) return SR_ERR_ARG; /* +-inf */
+    for (i = 0; i < SR_NX; ++i) traj[i] = x0[i];
+    for (n = 0; n < steps; ++n) {
+        const sr_real *x = traj + n * SR_NX;
+        sr_real *next = traj + (n + 1) * SR_NX;
+        const sr_real *un = u ? u + n * SR_NU : zero_u;
+        const int check_row = (n + 1) % SR_GUARD_INTERVAL == 0 || n + 1 == steps;
+        if (!all_finite(un, SR_NU)) return SR_ERR_NONFINITE;
+        if (n == 0) { /* open a stretch at x0 (or continue the caller's) */
+            status = energy_guard(model, guard, x, NULL, un, 0);
+            if (status != SR_OK) return status;
+        }
+        status = advance(model, method, x, un, dt, next);
+        if (status == SR_OK && !all_finite(next, SR_NX)) status = SR_ERR_NONFINITE;
+        if (status == SR_OK && check_row) status = sr_check_state(model, next);
+        if (status == SR_OK) {
+            const sr_real *u_next = n + 1 < steps ? (u ? u + (n + 1) * SR_NU : zero_u) : NULL;
+            if (u_next && !all_finite(u_next, SR_NU)) u_next = NULL; /* reported at step n + 2 */
+            status = energy_guard(model, guard, next, un, u_next, check_row);
+        }
+        if (status != SR_OK) return status;
+        if (steps_done) *steps_done = n + 1;
+    }
+    return SR_OK;
 }
 
 int sr_simulate(const sr_model *model, int method, const sr_real x0[SR_NX], sr_real dt, long steps,
                 const sr_real *u, sr_real *traj, long *steps_done)
 {
-    long n;
-    int i, status;
-    if (steps_done) *steps_done = 0;
-    status = checks(model, x0, NULL);
-    if (status != SR_OK) return status;
-    if (!traj) return SR_ERR_NULL;
-    if (steps < 0 || !(dt > 0) || !isfinite(dt) || !valid_method(method)) return SR_ERR_ARG;
-    for (i = 0; i < SR_NX; ++i) traj[i] = x0[i];
-    for (n = 0; n < steps; ++n) {
-        const sr_real *x = traj + n * SR_NX;
-        const sr_real *un = u ? u + n * SR_NU : zero_u;
-        if (!all_finite(un, SR_NU)) return SR_ERR_NONFINITE;
-        status = advance(model, method, x, un, dt, traj + (n + 1) * SR_NX);
-        if (status == SR_OK && !all_finite(traj + (n + 1) * SR_NX, SR_NX)) status = SR_ERR_NONFINITE;
-        if (status != SR_OK) return status;
-        if (steps_done) *steps_done = n + 1;
-    }
-    return SR_OK;
+    return sr_simulate_guarded(model, method, x0, dt, steps, u, NULL, traj, steps_done);
 }

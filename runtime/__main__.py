@@ -8,6 +8,7 @@ COMMANDS = {
     "convergence": ("runtime.convergence", "convergence and energy study of the integrators"),
     "bench": ("runtime.bench", "benchmarks against the alternatives"),
     "figures": ("runtime.figures", "regenerate the committed figures under docs/figures/"),
+    "soak": ("runtime.soak", "10^7 steps from random states: constraint and energy drift (not a unit test)"),
 }
 
 

@@ -5,6 +5,7 @@ from bindings._sr import ffi, lib
 
 from .params import Params
 from .state import NU, NV, NX
+from .validation import ROTATION_TOL, check_finite, check_states, describe_state, project_state, real_array
 
 #: Integrator names accepted by `Model.step`, `Model.simulate` and scenario files.
 #: lie-euler: eq. (111), order 1.  rkmk4: Runge–Kutta–Munthe-Kaas (RK4 tableau in the Lie
@@ -14,6 +15,19 @@ from .state import NU, NV, NX
 #: long runs at rest, where rounding drifts the same way every step.
 METHODS = {"lie-euler": lib.SR_LIE_EULER, "rkmk4": lib.SR_RKMK4, "cf4": lib.SR_CF4,
            "rkmk4-projected": lib.SR_RKMK4 | lib.SR_PROJECT, "cf4-projected": lib.SR_CF4 | lib.SR_PROJECT}
+
+#: Default of `Model.simulate(energy_tol=...)`: the energy may rise over a torque-free stretch
+#: by at most this fraction of the stretch's energy scale (kinetic energy at its start + m_P g l)
+#: before the run is stopped (SR_ERR_ENERGY).  The exact flow never gains energy without input
+#: (damping >= 0).  Measured (docs/robustness.md): the shipped scenarios gain at most 0.0018 of
+#: the scale with Lie–Euler at dt = 0.01 s, 0.25 at dt = 0.05 s, RKMK4 nothing; frictionless
+#: Lie–Euler gains 0.14 in 100 s at dt = 0.001 s, 2.0 at dt = 0.01 s, 19 at dt = 0.1 s.
+#: Half the scale gained from nowhere (the pendulum could swing up half its range by itself)
+#: means the results are no longer physics: stop there.
+ENERGY_TOL = 0.5
+
+#: Steps per C call of `Model.simulate` (between calls the progress callback runs).
+CHUNK_STEPS = 2000
 
 _STATUS_HINTS = {
     lib.SR_ERR_NONFINITE: "contains NaN or infinity",
@@ -25,24 +39,40 @@ _STATUS_HINTS = {
 
 
 class KernelError(ValueError):
-    """A C kernel returned an error status."""
+    """A C kernel returned an error status (`.status`, one of the SR_* codes of c/spherical_robot.h).
 
-    def __init__(self, field, status, detail=""):
+    The message names the argument (`field`) and the rule; `message`, when given, replaces the
+    generic text built from the status.
+    """
+
+    def __init__(self, field, status, detail="", message=None):
         self.status = status
-        hint = _STATUS_HINTS.get(status, ffi.string(lib.sr_status_string(status)).decode())
-        super().__init__(f"{field}: {hint}{detail}")
+        self.field = field
+        if message is None:
+            hint = _STATUS_HINTS.get(status, ffi.string(lib.sr_status_string(status)).decode())
+            message = f"{field}: {hint}{detail}"
+        super().__init__(message)
+
+
+class SimulationStopped(KernelError):
+    """`Model.simulate` stopped before the end: the state became non-finite, drifted off the
+    constraints, or gained energy without input (see docs/robustness.md).
+
+    Attributes: `step` (1-based number of the step whose result failed), `time` (its start
+    time, (step − 1)·dt), `trajectory` (the rows 0..step−1 computed before it, all valid),
+    `state` (the offending state after `step`, or None if it was never formed), `status`.
+    """
+
+    def __init__(self, status, step, dt, trajectory, state, reason):
+        self.step, self.time, self.trajectory, self.state = step, (step - 1) * dt, trajectory, state
+        super().__init__("x", status, message=(
+            f"x: simulation stopped at step {step} (t = {self.time:.6g} → {step * dt:.6g} s): {reason}; "
+            f"the {len(trajectory)} rows computed before it are in the exception's .trajectory"))
 
 
 def _double_array(value, field, shape_tail):
-    """`value` as a C-contiguous float64 array whose trailing shape is `shape_tail`."""
-    try:
-        arr = np.ascontiguousarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{field}: expected an array of real numbers ({exc})") from None
-    if arr.shape[arr.ndim - len(shape_tail):] != shape_tail or arr.ndim > len(shape_tail) + 1:
-        want = " or ".join(str(s) for s in [shape_tail, ("B",) + shape_tail])
-        raise ValueError(f"{field}: expected shape {want}, got {arr.shape}")
-    return arr
+    """`value` as a C-contiguous float64 array whose trailing shape is `shape_tail` (see validation.real_array)."""
+    return real_array(value, field, shape_tail)
 
 
 def _ptr(arr):
@@ -56,8 +86,21 @@ def _method(method):
         raise ValueError(f"method: unknown integrator {method!r}; choose one of {sorted(METHODS)}") from None
 
 
+_PARAM_MESSAGES = {
+    lib.SR_ERR_SINGULAR: "params: the generalized inertia M is not positive definite at the reference "
+                         "state (masses or lengths so small that the inertias underflow)",
+    lib.SR_ERR_PARAM: "params: the model overflows at the reference state (masses, lengths or g so "
+                      "large that M or the energy is not finite)",
+}
+
+
 class Model:
-    """The spherical robot with parameters `params` (default: `Params()`, Section 5.2 as printed)."""
+    """The spherical robot with parameters `params` (default: `Params()`, Section 5.2 as printed).
+
+    Every method validates its input in full (c/spherical_robot.h, `sr_check_state`; the rules
+    are in runtime/validation.py) and raises ValueError naming the argument, the entry and the
+    rule; `KernelError` (a ValueError) carries the C status code.
+    """
 
     def __init__(self, params=None):
         self.params = Params() if params is None else params
@@ -67,15 +110,30 @@ class Model:
         self._model = ffi.new("sr_model *")
         status = lib.sr_model_init(self._model, _ptr(self._p))
         if status != lib.SR_OK:
-            raise KernelError("params", status)
+            raise KernelError("params", status, message=_PARAM_MESSAGES.get(status))
+
+    def project(self, x):
+        """The nearest valid state to x (35,) or (B, 35): see `runtime.validation.project_state`."""
+        return project_state(x, self.params.r)
 
     # -- single-state kernels -------------------------------------------------
-    def _state_and_input(self, x, u):
-        x = _double_array(x, "x", (NX,))
-        u = np.zeros(x.shape[:-1] + (NU,)) if u is None else _double_array(u, "u", (NU,))
+    def _valid_states(self, x, name="x", batch=True):
+        x = real_array(x, name, (NX,), batch=batch)
+        check_states(self._model, x, self.params.r, name)
+        return x
+
+    def _input(self, u, x, name="u"):
+        if u is None:
+            return np.zeros(x.shape[:-1] + (NU,))
+        u = real_array(u, name, (NU,))
         if u.shape[:-1] != x.shape[:-1]:
-            raise ValueError(f"u: shape {u.shape} does not match x of shape {x.shape}")
-        return x, u
+            raise ValueError(f"{name}: shape {u.shape} does not match x of shape {x.shape}")
+        check_finite(u, name)
+        return u
+
+    def _state_and_input(self, x, u, batch=True):
+        x = self._valid_states(x, batch=batch)
+        return x, self._input(u, x)
 
     def accel(self, x, u=None):
         """ν̇ = (ω̇_S, ω̇_Y, ω̇_P): shape (5,) for x (35,), or (B, 5) for x (B, 35); u (2,) / (B, 2) or None."""
@@ -91,9 +149,7 @@ class Model:
         return out
 
     def _single(self, fn, x, n, field="x"):
-        x = _double_array(x, field, (NX,))
-        if x.ndim != 1:
-            raise ValueError(f"{field}: expected shape ({NX},), got {x.shape}")
+        x = self._valid_states(x, field, batch=False)
         out = np.empty(n)
         self._check(field, fn(self._model, _ptr(x), _ptr(out)))
         return out
@@ -104,9 +160,7 @@ class Model:
 
     def rhs(self, x, u=None):
         """f (5,) with M ν̇ = f."""
-        x, u = self._state_and_input(x, u)
-        if x.ndim != 1:
-            raise ValueError(f"x: expected shape ({NX},), got {x.shape}")
+        x, u = self._state_and_input(x, u, batch=False)
         out = np.empty(NV)
         self._check("x", lib.sr_rhs(self._model, _ptr(x), _ptr(u), _ptr(out)))
         return out
@@ -122,53 +176,95 @@ class Model:
     # -- time stepping ----------------------------------------------------------
     def step(self, x, u=None, dt=0.01, method="lie-euler"):
         """One step of `method` with torques u held constant; returns the new state (35,)."""
-        x, u = self._state_and_input(x, u)
-        if x.ndim != 1:
-            raise ValueError(f"x: expected shape ({NX},), got {x.shape}")
+        x, u = self._state_and_input(x, u, batch=False)
         dt = self._dt(dt)
         out = np.empty(NX)
-        self._check("x", lib.sr_step(self._model, _method(method), _ptr(x), _ptr(u), dt, _ptr(out)))
+        self._check("x", lib.sr_step(self._model, _method(method), _ptr(x), _ptr(u), dt, _ptr(out)),
+                    ": the step's result overflowed (dt too large for this state?)")
         return out
 
-    def simulate(self, x0, dt, steps, u=None, method="lie-euler"):
+    def simulate(self, x0, dt, steps, u=None, method="lie-euler", energy_tol=ENERGY_TOL, progress=None):
         """Trajectory (steps+1, 35) from x0.
 
         u: None (zero torque), an array (steps, 2) whose row n−1 acts on step n
         (from t = (n−1)·dt to n·dt), or a callable u(t, x) -> (2,) evaluated at
         the start of every step (a feedback controller).
+
+        Guards (docs/robustness.md): the run stops with `SimulationStopped` (a
+        KernelError, hence a ValueError) naming the step and the time when the
+        state becomes non-finite (checked every step), when R_S, R_Y, R_P or q_z
+        drift beyond ROTATION_TOL (every SR_GUARD_INTERVAL = 16 steps and at the
+        end), or when, over a stretch of zero torque, the energy rises by more
+        than `energy_tol` times the stretch's energy scale (its kinetic energy at
+        the start + m_P g l; checked with the same interval; None disables).  The
+        exception's `.trajectory` holds the rows computed before the failure.
+        `progress(done, steps)` is called every CHUNK_STEPS steps.
         """
-        x0 = _double_array(x0, "x0", (NX,))
-        if x0.ndim != 1:
-            raise ValueError(f"x0: expected shape ({NX},), got {x0.shape}")
+        x0 = self._valid_states(x0, "x0", batch=False)
         dt = self._dt(dt)
         if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 0:
             raise ValueError(f"steps: expected a non-negative integer, got {steps!r}")
+        steps = int(steps)
         code = _method(method)
-        traj = np.empty((steps + 1, NX))
+        guard = ffi.new("sr_energy_guard *")
+        guard.tol = self._energy_tol(energy_tol)
+        # NaN-filled, so that a row C never wrote (a step that failed before forming its state) shows.
+        traj = np.full((steps + 1, NX), np.nan)
         if callable(u):
-            return self._simulate_feedback(x0, dt, steps, u, code, traj)
+            return self._simulate_feedback(x0, dt, steps, u, code, traj, guard)
         if u is not None:
-            u = _double_array(u, "u", (NU,))
+            u = real_array(u, "u", (NU,))
             if u.shape != (steps, NU):
                 raise ValueError(f"u: expected shape ({steps}, {NU}) for {steps} steps, got {u.shape}")
-            if not np.all(np.isfinite(u)):
-                raise ValueError("u: contains NaN or infinity")
-        done = ffi.new("long *")
-        status = lib.sr_simulate(self._model, code, _ptr(x0), dt, steps,
-                                 ffi.NULL if u is None else _ptr(u), _ptr(traj), done)
-        self._check_simulation(status, done[0], dt)
-        return traj
+            check_finite(u, "u")
+        traj[0] = x0
+        done = 0
+        while True:   # chunks of CHUNK_STEPS; the guard struct carries the energy stretch across them
+            n = min(CHUNK_STEPS, steps - done)
+            self._guarded_run(code, dt, n, None if u is None else u[done:done + n], guard, traj, done)
+            done += n
+            if progress is not None:
+                progress(done, steps)
+            if done >= steps:
+                return traj
 
-    def _simulate_feedback(self, x0, dt, steps, control, code, traj):
+    def _guarded_run(self, code, dt, n, u, guard, traj, first):
+        """`n` steps from traj[first] into traj[first..first+n] by sr_simulate_guarded; raises SimulationStopped."""
+        done = ffi.new("long *")
+        status = lib.sr_simulate_guarded(self._model, code, _ptr(traj[first]), dt, n,
+                                         ffi.NULL if u is None else _ptr(u), guard,
+                                         _ptr(traj[first:first + n + 1]), done)
+        if status != lib.SR_OK:
+            step = first + done[0] + 1
+            state = traj[step].copy() if step < len(traj) and not np.isnan(traj[step]).all() else None
+            raise SimulationStopped(status, step, dt, traj[:step].copy(), state,
+                                    self._stop_reason(status, state, guard))
+
+    def _stop_reason(self, status, state, guard):
+        if status == lib.SR_ERR_ENERGY:
+            rise = guard.energy - guard.e_start
+            return (f"the energy rose without input power from {guard.e_start:.6g} J to {guard.energy:.6g} J "
+                    f"(+{rise:.3g} J = {rise / guard.scale if guard.scale > 0 else float('inf'):.3g} × the "
+                    f"energy scale {guard.scale:.3g} J, tolerance energy_tol = {guard.tol:g}); the time step "
+                    f"is too large for this method, or pass energy_tol=None to measure the drift")
+        if state is not None and status in (lib.SR_ERR_NONFINITE, lib.SR_ERR_NOT_ROTATION, lib.SR_ERR_CONSTRAINT):
+            described = describe_state(state, self.params.r, "x")
+            if described is not None:
+                what = described[len("x: "):].split("; Model.project")[0]
+                kind = "became non-finite" if status == lib.SR_ERR_NONFINITE else "drifted off the constraints"
+                return f"the state {kind}: {what}"
+        if status == lib.SR_ERR_NONFINITE:
+            return "the state or an intermediate result became non-finite"
+        return ffi.string(lib.sr_status_string(status)).decode()
+
+    def _simulate_feedback(self, x0, dt, steps, control, code, traj, guard):
         traj[0] = x0
         for n in range(steps):
-            un = _double_array(control(n * dt, traj[n].copy()), "u(t, x)", (NU,))
-            if un.ndim != 1:
-                raise ValueError(f"u(t, x): expected shape ({NU},), got {un.shape}")
-            status = lib.sr_step(self._model, code, _ptr(traj[n]), _ptr(un), dt, _ptr(traj[n + 1]))
-            if status == lib.SR_OK and not np.all(np.isfinite(traj[n + 1])):
-                status = lib.SR_ERR_NONFINITE
-            self._check_simulation(status, n, dt)
+            un = real_array(control(n * dt, traj[n].copy()), "u(t, x)", (NU,), batch=False)
+            if not np.all(np.isfinite(un)):
+                raise ValueError(f"u(t, x): returned {un.tolist()} at t = {n * dt:g} s (step {n + 1}), "
+                                 f"expected finite torques")
+            self._guarded_run(code, dt, 1, un.reshape(1, NU), guard, traj, n)
         return traj
 
     def simulate_adaptive(self, x0, t_end, dt_out, rtol=1e-8, atol=1e-10, u=None, method="rkmk4",
@@ -190,9 +286,7 @@ class Model:
         With return_stats=True, returns (traj, stats) where stats is a dict of
         accepted, rejected, evaluations (acceleration calls) and h_next.
         """
-        x0 = _double_array(x0, "x0", (NX,))
-        if x0.ndim != 1:
-            raise ValueError(f"x0: expected shape ({NX},), got {x0.shape}")
+        x0 = self._valid_states(x0, "x0", batch=False)
         try:
             dt_out = float(dt_out)
         except (TypeError, ValueError):
@@ -258,8 +352,7 @@ class Model:
                 if u.shape != (n_out, NU):
                     raise ValueError(f"u: expected shape ({n_out}, {NU}) for {n_out} output intervals, "
                                      f"got {u.shape}")
-                if not np.all(np.isfinite(u)):
-                    raise ValueError("u: contains NaN or infinity")
+                check_finite(u, "u")
             run(x0, n_out, u, 0.0, traj, 0)
         return (traj, totals) if return_stats else traj
 
@@ -275,11 +368,17 @@ class Model:
         return dt
 
     @staticmethod
-    def _check(field, status):
-        if status != lib.SR_OK:
-            raise KernelError(field, status)
+    def _energy_tol(energy_tol):
+        if energy_tol is None:
+            return -1.0
+        if isinstance(energy_tol, bool) or not isinstance(energy_tol, (int, float, np.integer, np.floating)) \
+                or not (np.isfinite(energy_tol) and energy_tol >= 0):
+            raise ValueError(f"energy_tol: expected None or a non-negative finite number, got {energy_tol!r}")
+        return float(energy_tol)
 
     @staticmethod
-    def _check_simulation(status, done, dt):
+    def _check(field, status, detail=""):
         if status != lib.SR_OK:
-            raise KernelError("x", status, f" at step {done + 1} (t = {done * dt:g} s)")
+            if status == lib.SR_ERR_NONFINITE:   # inputs were checked before: the result overflowed
+                raise KernelError(field, status, message=f"{field}: the result is not finite (overflow){detail}")
+            raise KernelError(field, status)

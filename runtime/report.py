@@ -356,10 +356,34 @@ def write_gif(result, target, seconds=GIF_SECONDS, fps=GIF_FPS, frames=None, pro
 
 
 # -- everything for one run --------------------------------------------------------------------
+#: Files a stopped run writes instead of the outputs (marked by name: never mistaken for a full run).
+PARTIAL_FILES = ("trajectory.partial.csv", "summary.partial.json")
+
+#: Every file name a run may write into its folder: a folder holding any of them "holds outputs".
+OUTPUT_FILES = ("trajectory.csv", *FIGURES, "robot.gif", "summary.json", *PARTIAL_FILES)
+
+
+def existing_outputs(folder):
+    """The OUTPUT_FILES already present in `folder` (sorted; empty if the folder does not exist)."""
+    folder = pathlib.Path(folder)
+    return sorted(name for name in OUTPUT_FILES if (folder / name).exists())
+
+
+def remove_stale(folder, keep):
+    """Delete the OUTPUT_FILES in `folder` that are not in `keep` (paths just written), so that the
+    folder holds only what the latest run produced.  Nothing else in the folder is touched."""
+    keep = {pathlib.Path(k).name for k in keep}
+    for name in OUTPUT_FILES:
+        if name not in keep:
+            with contextlib.suppress(FileNotFoundError):
+                (pathlib.Path(folder) / name).unlink()
+
+
 def write_outputs(result, folder, gif=True, progress=None):
     """Write trajectory.csv, the FIGURES, robot.gif (if `gif`) and summary.json (last) into `folder`.
 
     `progress(what, done, total)` reports the GIF's frames.  Returns the paths written.
+    Whether an existing folder may be overwritten is the caller's decision (the CLI's --force).
     """
     started = time.perf_counter()
     folder = pathlib.Path(folder)
@@ -379,3 +403,19 @@ def write_outputs(result, folder, gif=True, progress=None):
     written.append(folder / "summary.json")
     write_summary(summary(result, timings), written[-1])
     return written
+
+
+def write_partial_outputs(result, folder, stopped):
+    """What a run stopped by a guard computed: trajectory.partial.csv (the valid rows, same columns as
+    trajectory.csv) and summary.partial.json (the summary of those rows, plus "stopped": step, time
+    and reason).  No figures.  `stopped` is the runtime.model.SimulationStopped exception."""
+    folder = pathlib.Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    csv_path, summary_path = (folder / name for name in PARTIAL_FILES)
+    write_csv(result, csv_path)
+    info = summary(result)
+    info["steps_computed"] = len(result.trajectory) - 1
+    info["stopped"] = {"step": stopped.step, "time_s": stopped.time, "status": stopped.status,
+                       "reason": str(stopped)}
+    write_summary(info, summary_path)
+    return [csv_path, summary_path]

@@ -23,10 +23,11 @@ import tomllib
 import numpy as np
 
 from . import model as _model_module
-from .model import Model
+from .model import Model, SimulationStopped
 from .params import NAMES as PARAM_NAMES
 from .params import Params
 from .state import IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NU, NX, rot_x, rot_y
+from .validation import ROTATION_TOL, describe_state
 
 #: The paper's simulations in the order of Section 5.3 (`run all` runs them in this order).
 PAPER_SCENARIOS = ("tilted-pendulum", "tilted-yoke", "t-shape")
@@ -34,12 +35,9 @@ PAPER_SCENARIOS = ("tilted-pendulum", "tilted-yoke", "t-shape")
 #: Named parameter sets a scenario may start from (`[params] preset = ...`).
 PRESETS = {"paper": Params.paper, "paper_simulation": Params.paper_simulation}
 
-#: Orthonormality tolerance for matrices given in a file: the kernels' own
-#: (SR_ROTATION_TOL in c/spherical_robot.h, double precision).
-ROTATION_TOL = 1e-6
-
-#: Steps simulated per call into C; between calls the progress callback runs.
-CHUNK_STEPS = 2000
+#: Largest number of steps of a run: the trajectory is held in memory (35 float64 a row, so
+#: 10^7 steps take 2.8 GB).  A larger `steps` (or duration / dt) is an error, not a MemoryError.
+MAX_STEPS = 10_000_000
 
 _TOP_KEYS = {"description", "dt", "steps", "duration", "method", "params", "initial", "torque"}
 _INITIAL_KEYS = {"theta_Y", "theta_P", "R_S", "R_Y", "R_P", "q", "w_S", "w_Y", "w_P"}
@@ -156,6 +154,10 @@ def load_scenario(name_or_path):
             data = tomllib.load(f)
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"{path}: not valid TOML ({exc})") from None
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{path}: not valid TOML (not UTF-8 text: {exc.reason} at byte {exc.start})") from None
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot read the file ({exc.strerror or exc})") from None
     return parse_scenario(data, source=str(path), name=path.stem)
 
 
@@ -175,6 +177,10 @@ def parse_scenario(data, source="<scenario>", name="scenario"):
         steps = _whole_steps(_positive_real(data["duration"], f"{source}: duration"), dt, f"{source}: duration")
     method = _method_name(data.get("method", "lie-euler"), f"{source}: method")
     x0 = _parse_initial(data.get("initial", {}), params, source)
+    # The kernels' own check of the assembled state, in case a rule is not mirrored above.
+    problem = describe_state(x0, params.r, "x0")
+    if problem is not None:
+        raise ValueError(f"{source}: initial: {problem}")
     torques = _parse_torques(data.get("torque", []), dt, steps, source)
     return Scenario(name=name, source=source, params=params, x0=x0, dt=dt, steps=steps,
                     method=method, torques=torques, description=description)
@@ -192,9 +198,11 @@ def _parse_params(table, source):
         raise ValueError(f"{where}.preset: unknown preset {_show(preset)}; choose one of {sorted(PRESETS)}")
     overrides = {key: _real(value, f"{where}.{key}") for key, value in table.items() if key != "preset"}
     try:
-        return PRESETS[preset](**overrides)
+        params = PRESETS[preset](**overrides)
+        Model(params)                  # C's checks too: M positive definite, no overflow
     except ValueError as exc:          # Params names the parameter ("Params.r: must be > 0")
         raise ValueError(f"{where}: {exc}") from None
+    return params
 
 
 def _parse_initial(table, params, source):
@@ -240,6 +248,9 @@ def _parse_torques(windows, dt, steps, source):
             if not 0 <= t_from < t_to:
                 raise ValueError(f"{where}.from_time, to_time: need 0 <= from_time < to_time, "
                                  f"got [{t_from:g}, {t_to:g})")
+            if t_from >= steps * dt:
+                raise ValueError(f"{where}.from_time: {t_from:g} s is at or past the end of the run "
+                                 f"({steps * dt:g} s): the window would select no step")
         else:
             first = _step_count(_require(table, "from_step", where), f"{where}.from_step")
             last = _step_count(_require(table, "to_step", where), f"{where}.to_step")
@@ -297,11 +308,17 @@ def _step_count(value, where):
         raise ValueError(f"{where}: expected a whole number, got {_show(value)}")
     if value < 1:
         raise ValueError(f"{where}: must be >= 1, got {value}")
+    if value > MAX_STEPS:
+        raise ValueError(f"{where}: {value} is more than MAX_STEPS = {MAX_STEPS} (the trajectory is kept in memory)")
     return value
 
 
 def _whole_steps(duration, dt, where):
-    steps = round(duration / dt)
+    ratio = duration / dt
+    if not ratio <= MAX_STEPS + 0.5:
+        raise ValueError(f"{where}: {duration:g} s at dt = {dt:g} s is more than MAX_STEPS = {MAX_STEPS} steps "
+                         f"(the trajectory is kept in memory)")
+    steps = round(ratio)
     if steps < 1 or abs(steps * dt - duration) > 1e-9 * max(duration, dt):
         raise ValueError(f"{where}: the duration {duration:g} s is not a whole number of steps of dt = {dt:g} s")
     return steps
@@ -328,39 +345,46 @@ def _rotation(table, key, where, axis):
                                                                  for row in value)):
         raise ValueError(f"{where}: expected a 3×3 matrix as a list of 3 rows of 3 numbers, got {_show(value)}")
     R = np.array([[_real(v, f"{where}[{i}][{j}]") for j, v in enumerate(row)] for i, row in enumerate(value)])
-    if np.max(np.abs(R.T @ R - np.eye(3))) > ROTATION_TOL or np.linalg.det(R) < 0:
-        raise ValueError(f"{where}: not a rotation matrix (needs RᵀR = I to {ROTATION_TOL:g} and det R = +1)")
-    if axis is not None:
-        e = np.eye(3)[axis]
-        if np.max(np.abs(R[axis] - e)) > ROTATION_TOL or np.max(np.abs(R[:, axis] - e)) > ROTATION_TOL:
-            name = "xy"[axis]
-            raise ValueError(f"{where}: must be a rotation about the {name} axis "
-                             f"(row and column {axis + 1} equal to e_{name}); or give theta_{key[-1]}")
+    if axis is not None:               # the kernels' rule: row and column `axis` exactly e_axis
+        name = "xy"[axis]
+        for i in range(3):
+            for a, b in ((axis, i), (i, axis)):
+                want = 1.0 if i == axis else 0.0
+                if R[a, b] != want:
+                    raise ValueError(f"{where}[{a}][{b}]: must be exactly {want:g}: {key} is a rotation about "
+                                     f"the {name} axis (row and column {axis + 1} equal to e_{name}); "
+                                     f"or give theta_{key[-1]}")
+    gram = R.T @ R - np.eye(3)
+    defect, det = float(np.abs(gram).max()), float(np.linalg.det(R))
+    if det < 0 or defect > ROTATION_TOL or abs(det - 1) > ROTATION_TOL:
+        raise ValueError(f"{where}: not a rotation matrix (needs RᵀR = I and det R = +1 to {ROTATION_TOL:g}; "
+                         f"got max |RᵀR − I| = {defect:.3g}, det R = {det:.6g})")
     return R
 
 
 # -- running ------------------------------------------------------------------------------
 def run_scenario(scenario, progress=None):
-    """Simulate `scenario`; `progress(done_steps, total_steps)` is called between chunks.
+    """Simulate `scenario`; `progress(done_steps, total_steps)` is called every few thousand steps.
 
-    The loop stays in C: `Model.simulate` runs CHUNK_STEPS steps per call, each
-    chunk starting from the last state of the one before (identical to a
-    single call, since a step depends only on the state and the torque).
+    The loop stays in C (`Model.simulate`, with its guards).  If a guard stops the
+    run, the `SimulationStopped` exception propagates with `.result`: a `Result`
+    holding the rows computed before the failing step (see docs/robustness.md).
     """
     started = time.perf_counter()
     model = Model(scenario.params)
     steps = scenario.steps
     torques = scenario.torque_at_step_starts(steps + 1)
-    trajectory = np.empty((steps + 1, NX))
-    trajectory[0] = scenario.x0
-    done = 0
-    while done < steps:
-        n = min(CHUNK_STEPS, steps - done)
-        trajectory[done:done + n + 1] = model.simulate(trajectory[done], scenario.dt, n,
-                                                       torques[done:done + n], method=scenario.method)
-        done += n
-        if progress is not None:
-            progress(done, steps)
+    try:
+        trajectory = model.simulate(scenario.x0, scenario.dt, steps, torques[:steps], method=scenario.method,
+                                    progress=progress)
+    except SimulationStopped as exc:
+        rows = len(exc.trajectory)
+        exc.result = _result(model, scenario, exc.trajectory, torques[:rows], started)
+        raise
+    return _result(model, scenario, trajectory, torques, started)
+
+
+def _result(model, scenario, trajectory, torques, started):
     energy = np.array([model.energy(x) for x in trajectory])
-    return Result(scenario=scenario, time=np.arange(steps + 1) * scenario.dt, trajectory=trajectory,
+    return Result(scenario=scenario, time=np.arange(len(trajectory)) * scenario.dt, trajectory=trajectory,
                   torques=torques, energy=energy, wall_time_s=time.perf_counter() - started)

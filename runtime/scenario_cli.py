@@ -1,9 +1,21 @@
-"""`python -m runtime run SCENARIO [--out DIR] [--method M] [--dt DT] [--steps N] [--no-gif]`.
+"""`python -m runtime run SCENARIO [--out DIR] [--method M] [--dt DT] [--steps N] [--no-gif] [--force]`.
 
 SCENARIO is a shipped name (see `--help`), a path to a TOML scenario file
 (format: docs/scenarios.md), or `all` for the paper's three simulations.
 Each scenario writes into OUT/<name>/ (see runtime/report.py for the files).
-Exit status: 0 on success, 2 on a bad argument or scenario file.
+
+A folder that already holds outputs of a run (any of report.OUTPUT_FILES) is
+not overwritten unless --force is given; with --force, the output files of
+the earlier run that this run does not rewrite are deleted, so the folder
+never mixes two runs.  Other files in the folder are never touched.
+
+If a guard stops the simulation (docs/robustness.md), the rows computed
+before the failing step go to trajectory.partial.csv and summary.partial.json
+(with the step, time and reason), and no figures are drawn.
+
+Exit status: 0 on success; 2 on a bad argument or scenario file, or an output
+folder that holds outputs (without --force); 3 when a simulation was stopped
+by a guard (partial outputs written).
 """
 import argparse
 import pathlib
@@ -11,8 +23,8 @@ import sys
 import time
 
 from . import report
-from .model import KernelError
-from .scenario import PAPER_SCENARIOS, load_scenario, run_scenario, shipped_scenarios
+from .model import KernelError, SimulationStopped
+from .scenario import PAPER_SCENARIOS, load_scenario, run_scenario, scenario_path, shipped_scenarios
 
 
 class Progress:
@@ -69,20 +81,33 @@ def build_parser():
     parser.add_argument("--steps", type=int, help="number of steps, overriding the file's")
     parser.add_argument("--no-gif", dest="gif", action="store_false", help="skip the animation (the slow part)")
     parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    parser.add_argument("--force", "--overwrite", dest="force", action="store_true",
+                        help="overwrite an output folder that already holds the outputs of a run")
     return parser
+
+
+class Stopped(Exception):
+    """A run stopped by a simulation guard; the partial outputs are written (exit status 3)."""
 
 
 def run_one(name_or_path, args):
     """Load, override, simulate and write one scenario; returns its summary dict."""
     scenario = load_scenario(name_or_path).with_overrides(dt=args.dt, steps=args.steps, method=args.method)
     folder = args.out / scenario.name
+    check_output_folder(folder, args.force)
     progress = Progress(scenario.name, delay=float("inf") if args.quiet else 1.0)
     try:
         result = run_scenario(scenario, progress=lambda done, total: progress("simulate", done, total))
+    except SimulationStopped as exc:  # a guard fired: keep what was computed, clearly marked
+        written = report.write_partial_outputs(exc.result, folder, exc)
+        report.remove_stale(folder, written)
+        raise Stopped(f"{scenario.source}: {exc}; wrote the {len(exc.trajectory)} valid rows to "
+                      f"{written[0]} and {written[1].name}") from None
     except KernelError as exc:        # the state left the model's domain: say which scenario
         raise ValueError(f"{scenario.source}: simulation failed: {exc}") from None
     progress.restart()
     written = report.write_outputs(result, folder, gif=args.gif, progress=progress)
+    report.remove_stale(folder, written)
     summary = report.summary(result)
     if not args.quiet:
         x, y = summary["final_position_m"]
@@ -92,15 +117,33 @@ def run_one(name_or_path, args):
     return summary
 
 
+def check_output_folder(folder, force):
+    """Refuse (ValueError) a folder that already holds outputs of a run, unless `force`."""
+    existing = report.existing_outputs(folder)
+    if existing and not force:
+        raise ValueError(f"{folder}: already holds the outputs of a run ({', '.join(existing)}); "
+                         f"pass --force to overwrite them, or choose another --out")
+
+
 def main(argv):
     args = build_parser().parse_args(argv)
     names = list(PAPER_SCENARIOS) if args.scenario == "all" else [args.scenario]
-    for name in names:
-        try:
+    try:
+        # Every folder is checked before the first run, so `all` does not stop half-way.
+        for name in names:
+            check_output_folder(args.out / scenario_path(name).stem, args.force)
+        for name in names:
             run_one(name, args)
-        except ValueError as exc:
-            print(f"error: {exc}", file=sys.stderr)
-            return 2
+    except Stopped as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 3
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:            # unwritable --out, disk full, ...
+        print(f"error: {exc.filename or args.out}: cannot write the outputs ({exc.strerror or exc})",
+              file=sys.stderr)
+        return 2
     return 0
 
 

@@ -233,6 +233,14 @@ theta_P = 0.5
     (VALID + "[[torque]]\nfrom_step = 1\nto_time = 2.0\nu_P = 1.0\n", "torque[1]", "not both"),
     (VALID + "[[torque]]\nfrom_time = 1.0\nu_P = 1.0\n", "torque[1]: to_time", "missing"),
     ("dt = 0.01\nsteps = \n", "", "not valid TOML"),
+    # issue 8: the kernels' rules, resource limits, windows that select nothing
+    (VALID + "R_Y = [[1, 0, 1e-9], [0, 1, 0], [0, 0, 1]]\n", "initial.R_Y[0][2]", "must be exactly 0"),
+    (VALID + "R_S = [[1, 0, 0], [0, 1, 0], [0, 0, 1.00001]]\n", "initial.R_S", "max |RᵀR − I| = 2e-05"),
+    (VALID.replace("steps = 10", "steps = 100000000"), "steps", "MAX_STEPS"),
+    (VALID.replace("steps = 10", "duration = 1e9"), "duration", "MAX_STEPS"),
+    (VALID + "[[torque]]\nfrom_time = 0.1\nto_time = 0.2\nu_P = 1.0\n", "torque[1].from_time", "past the end"),
+    (VALID.replace('preset = "paper"', 'preset = "paper"\nr = 1e-200\nb = 1e-200\nh = 1e-200\nl = 1e-200'),
+     "params", "not positive definite"),
 ])
 def test_invalid_files_name_the_file_the_key_and_the_problem(tmp_path, text, key, what):
     path = tmp_path / "bad.toml"
@@ -380,3 +388,10 @@ def test_gif_is_an_animation_with_the_requested_frames(tmp_path, results):
         assert gif.format == "GIF" and gif.n_frames == 4
     assert seen and set(seen) == {4}
     assert [p.name for p in tmp_path.iterdir()] == ["robot.gif"]
+
+
+def test_a_file_that_is_not_utf8_is_named(tmp_path):
+    path = tmp_path / "latin1.toml"
+    path.write_bytes(b"description = 'caf\xe9'\ndt = 0.01\nsteps = 10\n")
+    with pytest.raises(ValueError, match=r"latin1.toml: not valid TOML \(not UTF-8 text"):
+        load_scenario(path)

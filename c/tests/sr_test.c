@@ -43,6 +43,7 @@ int main(void)
     suite_numerics();
     suite_buffers();
     suite_precision();
+    suite_guards();
     return sr_test_summary();
 }
 

@@ -65,6 +65,7 @@ void suite_status(void);
 void suite_numerics(void);
 void suite_buffers(void);
 void suite_precision(void);
+void suite_guards(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 

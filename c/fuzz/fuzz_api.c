@@ -1,0 +1,319 @@
+/*
+ * fuzz_api.c -- fuzz target for every public entry point of the spherical-robot library.
+ *
+ * LLVMFuzzerTestOneInput turns the input bytes into parameters, a state, torques, a time
+ * step, a method and small step counts, calls every function of spherical_robot.h and
+ * checks its contract (abort() on a violation, so libFuzzer and the plain driver both
+ * report it with the input that caused it):
+ *
+ *   - the status is one of the codes the header documents for that function;
+ *   - whenever the status is SR_OK, every output is finite;
+ *   - outputs are fully written on SR_OK and untouched on error (single-state kernels,
+ *     sr_step, sr_model_init), or written exactly up to the documented row (simulations);
+ *   - nothing is written outside the output buffers: every buffer is surrounded by canary
+ *     zones that are checked after each call (and ASan sees any access beyond them).
+ *
+ * The bytes are read as a sequence of choices, each falling back to a valid value when
+ * the input runs out: most fields stay valid and a few are perturbed (slightly, wildly,
+ * or replaced by raw bits: NaN, infinities, subnormals, huge values), so the fuzzer gets
+ * past the first check and exercises the steppers.  Built two ways (c/Makefile):
+ *   make fuzz            plain C driver (fuzz/driver.c), gcc or clang, ASan + UBSan
+ *   make fuzz-libfuzzer  clang -fsanitize=fuzzer,address,undefined
+ */
+#include "spherical_robot.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define GUARD 8             /* canary reals on each side of an output */
+#define CANARY 0xA5      /* byte pattern of the model before sr_model_init */
+#define MAX_STEPS 6         /* largest step count of a fuzzed simulation */
+#define MAX_OUT ((MAX_STEPS + 1) * SR_NX)
+
+typedef struct reader {
+    const uint8_t *p;
+    size_t n;
+} reader;
+
+static unsigned read_u8(reader *r)
+{
+    if (r->n == 0) return 0;
+    --r->n;
+    return *r->p++;
+}
+
+static double read_raw(reader *r)
+{
+    uint64_t bits = 0;
+    double v;
+    int i;
+    for (i = 0; i < 8; ++i) bits = (bits << 8) | read_u8(r);
+    memcpy(&v, &bits, sizeof v);
+    return v;
+}
+
+/* A value for a field whose valid value is `valid`: usually valid, sometimes perturbed. */
+static sr_real pick(reader *r, double valid)
+{
+    static const double special[] = {0.0, -0.0, 1e-300, 1e300, 1e-30, 1e30, 4.9e-324, -1.0,
+                                     1.0 + 1e-7, 1.0 - 1e-7, 1e-7, 2.0};
+    const unsigned c = read_u8(r);
+    switch (c % 16) {
+    case 12: return (sr_real)(valid * (1.0 + ((double)read_u8(r) - 128.0) * 1e-9)); /* slightly off */
+    case 13: return (sr_real)(valid + ((double)read_u8(r) - 128.0) / 16.0);        /* off */
+    case 14: return (sr_real)read_raw(r);                                            /* any bits */
+    case 15: {
+        const unsigned k = read_u8(r);
+        if (k % 16 == 12) return (sr_real)NAN;
+        if (k % 16 == 13) return (sr_real)INFINITY;
+        if (k % 16 == 14) return (sr_real)-INFINITY;
+        if (k % 16 == 15) return (sr_real)-valid;
+        return (sr_real)special[k % 12];
+    }
+    default: return (sr_real)valid;
+    }
+}
+
+static double unit(reader *r) { return ((double)read_u8(r) - 128.0) / 128.0; } /* [-1, 1) */
+
+/* ---- canary-guarded output buffers -----------------------------------------------------
+ * The canary is a signalling NaN with a fixed payload: never a valid output (outputs are finite
+ * on SR_OK), and not what arithmetic produces (quiet NaNs), so "untouched" is unambiguous even
+ * when the fuzzer feeds the canary's bytes as input. */
+#ifdef SR_USE_FLOAT
+typedef uint32_t canary_bits;
+static const canary_bits CANARY_BITS = 0x7FA5A5A5u;
+#else
+typedef uint64_t canary_bits;
+static const canary_bits CANARY_BITS = 0x7FF4A5A5A5A5A5A5ull;
+#endif
+
+typedef struct guarded {
+    sr_real buf[GUARD + MAX_OUT + GUARD];
+    int n;
+} guarded;
+
+static sr_real *arm(guarded *g, int n)
+{
+    size_t i;
+    for (i = 0; i < sizeof g->buf / sizeof g->buf[0]; ++i) memcpy(&g->buf[i], &CANARY_BITS, sizeof(sr_real));
+    g->n = n;
+    return g->buf + GUARD;
+}
+
+static int is_canary(const sr_real *v) { return memcmp(v, &CANARY_BITS, sizeof *v) == 0; }
+
+static void fail(const char *fn, int status, const char *what)
+{
+    fprintf(stderr, "fuzz: contract violated by %s (status %d, %s): %s\n", fn, status, sr_status_string(status),
+            what);
+    abort();
+}
+
+/* Guards intact; outputs [0, written) written (finite if `finite`), [written, n) untouched. */
+static void expect(const char *fn, int status, const guarded *g, int written, int finite)
+{
+    int i;
+    for (i = 0; i < GUARD; ++i)
+        if (!is_canary(g->buf + i) || !is_canary(g->buf + GUARD + g->n + i)) fail(fn, status, "wrote outside its buffer");
+    for (i = 0; i < g->n; ++i) {
+        const sr_real v = g->buf[GUARD + i];
+        if (i < written && is_canary(&g->buf[GUARD + i])) fail(fn, status, "left an output unwritten");
+        if (i < written && finite && !isfinite(v)) fail(fn, status, "returned a non-finite output");
+        if (i >= written && !is_canary(&g->buf[GUARD + i])) fail(fn, status, "wrote an output it documents as untouched");
+    }
+}
+
+/* status must be one of the `n` codes in `allowed`. */
+static void expect_status(const char *fn, int status, const int *allowed, int n)
+{
+    int i;
+    for (i = 0; i < n; ++i)
+        if (status == allowed[i]) return;
+    fail(fn, status, "undocumented status code");
+}
+#define EXPECT_STATUS(fn, status, ...)                                                   \
+    do {                                                                                 \
+        const int allowed_[] = {__VA_ARGS__};                                            \
+        expect_status(fn, status, allowed_, (int)(sizeof allowed_ / sizeof allowed_[0])); \
+    } while (0)
+
+/* ---- the fuzzed inputs --------------------------------------------------------------------- */
+static void read_params(reader *r, sr_real p[SR_NPARAM])
+{
+    /* r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g: Section 5.2 with doubled damping */
+    static const double base[SR_NPARAM] = {0.3, 2.0, 0.16, 0.2, 0.5, 2.0, 5.0, 0.04, 0.2, 1.0, 0.10, 9.81};
+    int i;
+    for (i = 0; i < SR_NPARAM; ++i) p[i] = pick(r, base[i]);
+}
+
+static void rot_axis(int k, double t, sr_real R[9])
+{
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    int m;
+    for (m = 0; m < 9; ++m) R[m] = 0;
+    R[4 * k] = 1;
+    R[4 * i] = R[4 * j] = (sr_real)cos(t);
+    R[3 * i + j] = (sr_real)-sin(t);
+    R[3 * j + i] = (sr_real)sin(t);
+}
+
+/* A valid state built from the bytes (any attitude, joint angles, speeds up to ~20 rad/s),
+ * then each entry possibly perturbed. */
+static void read_state(reader *r, sr_real radius, sr_real x[SR_NX])
+{
+    sr_real w[3];
+    const double speed = 20.0 * fabs(unit(r));
+    int i;
+    for (i = 0; i < 3; ++i) w[i] = (sr_real)(3.2 * unit(r));
+    if (sr_so3_exp(w, x) != SR_OK) abort();
+    rot_axis(0, 3.2 * unit(r), x + 9);
+    rot_axis(1, 3.2 * unit(r), x + 18);
+    x[27] = (sr_real)unit(r);
+    x[28] = (sr_real)unit(r);
+    x[29] = isfinite(radius) ? radius : SR_C(0.3);
+    for (i = 30; i < SR_NX; ++i) x[i] = (sr_real)(speed * unit(r));
+    for (i = 0; i < SR_NX; ++i) x[i] = pick(r, (double)x[i]);
+}
+
+/* ---- the target ------------------------------------------------------------------------------ */
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    reader rd = {data, size};
+    sr_model model, fallback;
+    sr_real p[SR_NPARAM], x[SR_NX], x2[2 * SR_NX], u[MAX_STEPS * SR_NU], dt;
+    const sr_real *u_or_null;
+    static guarded g; /* static: too large for some stacks, and the harness is single-threaded */
+    long done, row;
+    int status, method, steps, i;
+
+    /* sr_model_init: untouched on error */
+    read_params(&rd, p);
+    memset(&model, CANARY, sizeof model);
+    status = sr_model_init(&model, p);
+    EXPECT_STATUS("sr_model_init", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_PARAM, SR_ERR_SINGULAR);
+    if (status != SR_OK) {
+        const unsigned char *b = (const unsigned char *)&model;
+        for (i = 0; i < (int)sizeof model; ++i)
+            if (b[i] != CANARY) fail("sr_model_init", status, "wrote the model on error");
+        for (i = 0; i < SR_NPARAM; ++i) p[i] = (sr_real)((const double[]){0.3, 2, 0.16, 0.2, 0.5, 2, 5, 0.04, 0.2, 1, 0.1, 9.81})[i];
+        if (sr_model_init(&fallback, p) != SR_OK) abort();
+        model = fallback; /* keep fuzzing the state paths */
+    } else {
+        for (i = 0; i < SR_GEN_NCONST; ++i)
+            if (!isfinite(model.c[i])) fail("sr_model_init", status, "non-finite constant with SR_OK");
+    }
+
+    read_state(&rd, model.p[0], x);
+    for (i = 0; i < MAX_STEPS * SR_NU; ++i) u[i] = pick(&rd, 0.3 * unit(&rd));
+    u_or_null = read_u8(&rd) % 4 == 3 ? NULL : u;
+    dt = pick(&rd, 0.002 + 0.05 * fabs(unit(&rd)));
+    method = (int)(read_u8(&rd) % 3);
+    {
+        const unsigned c = read_u8(&rd);
+        if (c % 2) method |= SR_PROJECT;
+        if (c % 32 == 31) method = (int)(c * 12345u); /* an unknown method */
+    }
+    steps = (int)(read_u8(&rd) % (MAX_STEPS + 2)) - 1; /* -1 .. MAX_STEPS */
+
+    status = sr_check_state(&model, x);
+    EXPECT_STATUS("sr_check_state", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+
+    /* single-state kernels: all or nothing, finite on SR_OK */
+    status = sr_accel(&model, x, u_or_null, arm(&g, SR_NV));
+    EXPECT_STATUS("sr_accel", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_SINGULAR);
+    expect("sr_accel", status, &g, status == SR_OK ? SR_NV : 0, 1);
+    status = sr_rhs(&model, x, u_or_null, arm(&g, SR_NV));
+    EXPECT_STATUS("sr_rhs", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION);
+    expect("sr_rhs", status, &g, status == SR_OK ? SR_NV : 0, 1);
+    status = sr_inertia(&model, x, arm(&g, SR_NV * SR_NV));
+    EXPECT_STATUS("sr_inertia", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION);
+    expect("sr_inertia", status, &g, status == SR_OK ? SR_NV * SR_NV : 0, 1);
+    status = sr_energy(&model, x, arm(&g, 1));
+    EXPECT_STATUS("sr_energy", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION);
+    expect("sr_energy", status, &g, status == SR_OK ? 1 : 0, 1);
+    status = sr_equilibrium_residual(&model, x, arm(&g, SR_NV));
+    EXPECT_STATUS("sr_equilibrium_residual", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION);
+    expect("sr_equilibrium_residual", status, &g, status == SR_OK ? SR_NV : 0, 1);
+    status = sr_so3_exp(x + 30, arm(&g, 9));
+    EXPECT_STATUS("sr_so3_exp", status, SR_OK, SR_ERR_NONFINITE);
+    expect("sr_so3_exp", status, &g, status == SR_OK ? 9 : 0, 1);
+
+    /* batches: two rows, the second a copy of x with one more perturbation */
+    memcpy(x2, x, sizeof x);
+    memcpy(x2 + SR_NX, x, sizeof x);
+    i = (int)(read_u8(&rd) % SR_NX);
+    x2[SR_NX + i] = pick(&rd, (double)x2[SR_NX + i]);
+    status = sr_accel_batch(&model, 2, x2, u_or_null, arm(&g, 2 * SR_NV), &row);
+    EXPECT_STATUS("sr_accel_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_SINGULAR);
+    if ((status == SR_OK) != (row == -1) || row < -1 || row > 1) fail("sr_accel_batch", status, "bad failed_row");
+    expect("sr_accel_batch", status, &g, status == SR_OK ? 2 * SR_NV : (int)row * SR_NV, 1);
+    status = sr_check_state_batch(&model, 2, x2, &row);
+    EXPECT_STATUS("sr_check_state_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+    if ((status == SR_OK) != (row == -1) || row < -1 || row > 1) fail("sr_check_state_batch", status, "bad failed_row");
+
+    /* one step: all or nothing */
+    status = sr_step(&model, method, x, u_or_null, dt, arm(&g, SR_NX));
+    EXPECT_STATUS("sr_step", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_SINGULAR, SR_ERR_ARG);
+    expect("sr_step", status, &g, status == SR_OK ? SR_NX : 0, 1);
+
+    /* simulations: rows 0..steps_done valid; nothing past row steps_done + 1 */
+    {
+        sr_energy_guard guard;
+        const int rows = steps >= 0 ? steps + 1 : 1;
+        int pass;
+        for (pass = 0; pass < 2; ++pass) {
+            const char *fn = pass ? "sr_simulate_guarded" : "sr_simulate";
+            memset(&guard, 0, sizeof guard);
+            guard.tol = pick(&rd, 0.5);
+            done = -7;
+            status = pass ? sr_simulate_guarded(&model, method, x, dt, steps, u_or_null, &guard, arm(&g, rows * SR_NX), &done)
+                          : sr_simulate(&model, method, x, dt, steps, u_or_null, arm(&g, rows * SR_NX), &done);
+            EXPECT_STATUS(fn, status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_SINGULAR, SR_ERR_ARG,
+                          SR_ERR_CONSTRAINT, SR_ERR_ENERGY);
+            if (status == SR_ERR_ENERGY && !pass) fail(fn, status, "energy guard without a guard");
+            if (status == SR_OK) {
+                if (done != steps) fail(fn, status, "steps_done != steps on success");
+                expect(fn, status, &g, rows * SR_NX, 1);
+            } else {
+                if (done < 0 || done > (steps > 0 ? steps - 1 : 0))
+                    fail(fn, status, "steps_done out of range on error");
+                /* rows 0..done valid (finite), row done + 1 may be written, the rest untouched */
+                for (i = 0; i < GUARD; ++i)
+                    if (!is_canary(g.buf + i) || !is_canary(g.buf + GUARD + g.n + i)) fail(fn, status, "wrote outside its buffer");
+                if (done > 0) /* x0 and every state that passed the finiteness check */
+                    for (i = 0; i < (int)(done + 1) * SR_NX; ++i)
+                        if (!isfinite(g.buf[GUARD + i])) fail(fn, status, "a valid row is not finite");
+                for (i = (int)(done + 2) * SR_NX; i < rows * SR_NX; ++i)
+                    if (!is_canary(g.buf + GUARD + i)) fail(fn, status, "wrote past the failing row");
+            }
+        }
+    }
+
+    /* adaptive: small limits */
+    {
+        sr_adaptive_stats st;
+        const long n_out = (long)(read_u8(&rd) % (MAX_STEPS + 1));
+        const sr_real rtol = pick(&rd, 1e-6), atol = pick(&rd, 1e-9), h0 = pick(&rd, 0.0);
+        const long max_steps = (long)(read_u8(&rd) % 64);
+        const int amethod = read_u8(&rd) % 4 == 0 ? method : SR_RKMK4 | (method & SR_PROJECT);
+        status = sr_simulate_adaptive(&model, amethod, x, dt, n_out, u_or_null, rtol, atol, h0, max_steps,
+                                      arm(&g, (int)(n_out + 1) * SR_NX), &st);
+        EXPECT_STATUS("sr_simulate_adaptive", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_SINGULAR,
+                      SR_ERR_ARG, SR_ERR_CONSTRAINT, SR_ERR_STEP_SIZE, SR_ERR_MAX_STEPS);
+        if (st.rows_done < 0 || st.rows_done > n_out + 1) fail("sr_simulate_adaptive", status, "rows_done out of range");
+        if (status == SR_OK && st.rows_done != n_out + 1) fail("sr_simulate_adaptive", status, "rows_done short on success");
+        expect("sr_simulate_adaptive", status, &g, (int)st.rows_done * SR_NX, 1);
+    }
+
+    /* NULL pointers */
+    EXPECT_STATUS("sr_accel(NULL)", sr_accel(&model, x, u, NULL), SR_ERR_NULL);
+    EXPECT_STATUS("sr_check_state(NULL)", sr_check_state(NULL, x), SR_ERR_NULL);
+    return 0;
+}
