@@ -162,7 +162,12 @@ int sr_step(const sr_model *model, int method, const sr_real x[SR_NX], const sr_
  * q_z drifted beyond SR_ROTATION_TOL) every SR_GUARD_INTERVAL steps and after the last.
  * On an error at step k (1-based: a bad torque of step k, a failing kernel, or a guard failing
  * on the state after step k), *steps_done = k-1 and traj rows 0..k-1 are valid; row k may have
- * been written (with the offending state, for a guard), rows after k are untouched. */
+ * been written (with the offending state, for a guard), rows after k are untouched.
+ * Rounding: for SR_RKMK4 and SR_CF4 the update x + increment is Kahan-compensated across the
+ * steps of one call (a resting robot's constant sub-ulp increments would otherwise round the
+ * same way every step and grow |R^T R - I| linearly), so sr_simulate may differ from repeated
+ * sr_step calls in the last bits; SR_LIE_EULER is the paper's plain eq. (111) in both.  The
+ * compensation needs IEEE arithmetic: do not compile with -ffast-math. */
 int sr_simulate(const sr_model *model, int method, const sr_real x0[SR_NX], sr_real dt, long steps,
                 const sr_real *u, sr_real *traj, long *steps_done);
 

@@ -99,11 +99,13 @@ static inline void rotate_about_axis(const sr_real *R, int k, sr_real angle, sr_
 }
 
 /* One step of the Lie-group methods of sr_lie_integrators.c, without argument checks
- * (sr_step/sr_simulate check first).  u must not be NULL; out may alias x. */
+ * (sr_step/sr_simulate check first).  u must not be NULL; out may alias x.  comp: NULL for a
+ * single step, or the running Kahan compensation of a simulation (SR_NX entries, zero at its
+ * start), updated only when the step succeeds. */
 int sr_internal_rkmk4_step(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                           sr_real dt, sr_real out[SR_NX]);
+                           sr_real dt, sr_real *comp, sr_real out[SR_NX]);
 int sr_internal_cf4_step(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                         sr_real dt, sr_real out[SR_NX]);
+                         sr_real dt, sr_real *comp, sr_real out[SR_NX]);
 
 /* The optional correction of SR_PROJECT (sr_lie_integrators.c): one Newton-Schulz step
  * R <- R (3I - R^T R)/2 towards the nearest rotation for R_S, the same on the (cos, sin) pair

@@ -72,12 +72,11 @@ static int vector_field(const sr_model *model, const sr_real x[SR_NX], const sr_
  * R <- R + R D: the remaining rounding is that of one addition per entry, which does not
  * repeat from step to step. */
 
-/* out = R Exp([[w]]) = R + R (A [[w]] + B [[w]]^2), with the coefficients of sr_so3_exp. */
-static void so3_right_multiply_exp(const sr_real R[9], const sr_real w[3], sr_real out[9])
+/* D = Exp([[w]]) - I = A [[w]] + B [[w]]^2, with the coefficients of sr_so3_exp. */
+static void so3_exp_minus_identity(const sr_real w[3], sr_real D[9])
 {
     const sr_real x2 = w[0] * w[0], y2 = w[1] * w[1], z2 = w[2] * w[2];
-    sr_real A, B, D[9], RD[9];
-    int i;
+    sr_real A, B;
     so3_exp_coefficients(x2 + y2 + z2, &A, &B);
     /* [[w]]^2 = w w^T - |w|^2 I, its diagonal written without cancellation. */
     D[0] = -B * (y2 + z2);
@@ -89,36 +88,72 @@ static void so3_right_multiply_exp(const sr_real R[9], const sr_real w[3], sr_re
     D[6] = B * w[0] * w[2] - A * w[1];
     D[5] = B * w[1] * w[2] - A * w[0];
     D[7] = B * w[1] * w[2] + A * w[0];
-    matmul3(R, D, RD);
-    for (i = 0; i < 9; ++i) out[i] = R[i] + RD[i];
 }
 
-/* out = R Exp(angle [[e_k]]) for R a rotation about axis k (0 = x, 1 = y): only the (i, j)
- * plane changes, by R + R (Exp - I) with cos(angle) - 1 = -2 sin^2(angle/2); the other
- * entries of R (exact zeros and ones) are copied. */
-static void axis_right_multiply_exp(const sr_real R[9], int k, sr_real angle, sr_real out[9])
+/* delta = R Exp(angle [[e_k]]) - R for R a rotation about axis k (0 = x, 1 = y): only the
+ * (i, j) plane changes, by R (Exp - I) with cos(angle) - 1 = -2 sin^2(angle/2); the other
+ * entries (exact zeros and ones) get a zero increment. */
+static void axis_increment(const sr_real R[9], int k, sr_real angle, sr_real delta[9])
 {
     const sr_real sh = SR_SIN(SR_C(0.5) * angle);
     const sr_real cm1 = SR_C(-2.0) * sh * sh, s = SR_SIN(angle);
     const int i = (k + 1) % 3, j = (k + 2) % 3; /* Exp(t[[e_k]]) rotates the (i, j) plane */
     int m;
-    for (m = 0; m < 9; ++m) out[m] = R[m];
+    for (m = 0; m < 9; ++m) delta[m] = 0;
     for (m = 0; m < 3; ++m) { /* row m: (R_mi, R_mj) <- (R_mi, R_mj) [[c, -s], [s, c]] */
         const sr_real a = R[3 * m + i], b = R[3 * m + j];
-        out[3 * m + i] = a + (a * cm1 + b * s);
-        out[3 * m + j] = b + (b * cm1 - a * s);
+        delta[3 * m + i] = a * cm1 + b * s;
+        delta[3 * m + j] = b * cm1 - a * s;
+    }
+}
+
+/* delta = x . exp(th1) . exp(th2) - x, written as increments (th2 may be NULL: one exponential).
+ * On SO(3): R (E1 E2 - I) = R (D1 + D2 + D1 D2) with D = E - I; the one-axis rotations and the
+ * vector parts add their arguments. */
+static void increment(const sr_real x[SR_NX], const sr_real th1[NT], const sr_real *th2, sr_real delta[SR_NX])
+{
+    sr_real D[9];
+    int i;
+    so3_exp_minus_identity(th1 + T_S, D);
+    if (th2) {
+        sr_real D2[9], D12[9];
+        so3_exp_minus_identity(th2 + T_S, D2);
+        matmul3(D, D2, D12);
+        for (i = 0; i < 9; ++i) D[i] = D[i] + D2[i] + D12[i];
+    }
+    matmul3(x + RS, D, delta + RS);
+    axis_increment(x + RY, 0, th1[T_Y] + (th2 ? th2[T_Y] : 0), delta + RY);
+    axis_increment(x + RP, 1, th1[T_P] + (th2 ? th2[T_P] : 0), delta + RP);
+    for (i = 0; i < 3; ++i) delta[Q + i] = th1[T_Q + i] + (th2 ? th2[T_Q + i] : 0);
+    for (i = 0; i < SR_NV; ++i) delta[W + i] = th1[T_V + i] + (th2 ? th2[T_V + i] : 0);
+}
+
+/* out = x + delta.  With comp (a running compensation, zero at the start of a simulation)
+ * the sum is Kahan-compensated: the low-order bits that one addition loses are carried to
+ * the next step instead of being rounded the same way at every step, which keeps |R^T R - I|
+ * at the rounding level even when a resting robot's increments stay constant and below one
+ * ulp of the entries near 1 (the stagnation that otherwise grows |R^T R - I| linearly). */
+static void apply(const sr_real x[SR_NX], const sr_real delta[SR_NX], sr_real *comp, sr_real out[SR_NX])
+{
+    int i;
+    if (!comp) {
+        for (i = 0; i < SR_NX; ++i) out[i] = x[i] + delta[i];
+        return;
+    }
+    for (i = 0; i < SR_NX; ++i) {
+        const sr_real y = delta[i] - comp[i];
+        const sr_real t = x[i] + y;
+        comp[i] = (t - x[i]) - y;
+        out[i] = t;
     }
 }
 
 /* out = x . exp(th) (see the top of the file); out must not alias x. */
 static void act(const sr_real x[SR_NX], const sr_real th[NT], sr_real out[SR_NX])
 {
-    int i;
-    so3_right_multiply_exp(x + RS, th + T_S, out + RS);
-    axis_right_multiply_exp(x + RY, 0, th[T_Y], out + RY);
-    axis_right_multiply_exp(x + RP, 1, th[T_P], out + RP);
-    for (i = 0; i < 3; ++i) out[Q + i] = x[Q + i] + th[T_Q + i];
-    for (i = 0; i < SR_NV; ++i) out[W + i] = x[W + i] + th[T_V + i];
+    sr_real delta[SR_NX];
+    increment(x, th, NULL, delta);
+    apply(x, delta, NULL, out);
 }
 
 /* k = dexp^{-1}_{-th}(f): the so(3) block gets the closed form above (series below
@@ -166,7 +201,7 @@ static void combine(int n, const sr_real *coef, const sr_real (*K)[NT], sr_real 
  * K[0] = f(x) must be filled by the caller (the adaptive driver reuses it); K[1..3] and theta
  * (the final Theta) are outputs.  out must not alias x. */
 static int rkmk4_core(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
-                      sr_real K[4][NT], sr_real theta[NT], sr_real out[SR_NX], long *evaluations)
+                      sr_real K[4][NT], sr_real theta[NT], sr_real *comp, sr_real out[SR_NX], long *evaluations)
 {
     static const sr_real a_diag[3] = {SR_C(0.5), SR_C(0.5), SR_C(1.0)}; /* a_{i+1,i} */
     const sr_real b[4] = {h / 6, h / 3, h / 3, h / 6};
@@ -180,7 +215,8 @@ static int rkmk4_core(const sr_model *model, const sr_real x[SR_NX], const sr_re
         dexpinv(th, K[s], K[s]);
     }
     combine(4, b, (const sr_real(*)[NT])K, theta);
-    act(x, theta, out);
+    increment(x, theta, NULL, y);
+    apply(x, y, comp, out);
     return SR_OK;
 }
 
@@ -190,11 +226,11 @@ static int rkmk4_core(const sr_model *model, const sr_real x[SR_NX], const sr_re
  *     x_new = x . exp(h/12 (3F1 + 2F2 + 2F3 - F4)) . exp(h/12 (-F1 + 2F2 + 2F3 + 3F4)).
  * No dexp^-1; on the abelian factors this is the classical RK4.  out must not alias x. */
 static int cf4_core(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
-                    sr_real out[SR_NX], long *evaluations)
+                    sr_real *comp, sr_real out[SR_NX], long *evaluations)
 {
     const sr_real beta1[4] = {h / 4, h / 6, h / 6, -h / 12};
     const sr_real beta2[4] = {-h / 12, h / 6, h / 6, h / 4};
-    sr_real F[4][NT], th[NT], Y2[SR_NX], Y[SR_NX];
+    sr_real F[4][NT], th[NT], th2[NT], Y2[SR_NX], Y[SR_NX];
     int i, status;
     status = vector_field(model, x, u, F[0], evaluations);
     if (status != SR_OK) return status;
@@ -211,31 +247,36 @@ static int cf4_core(const sr_model *model, const sr_real x[SR_NX], const sr_real
     status = vector_field(model, Y, u, F[3], evaluations);
     if (status != SR_OK) return status;
     combine(4, beta1, (const sr_real(*)[NT])F, th);
-    act(x, th, Y);
-    combine(4, beta2, (const sr_real(*)[NT])F, th);
-    act(Y, th, out);
+    combine(4, beta2, (const sr_real(*)[NT])F, th2);
+    increment(x, th, th2, Y);  /* both exponentials as one increment of x */
+    apply(x, Y, comp, out);
     return SR_OK;
 }
 
 int sr_internal_rkmk4_step(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                           sr_real dt, sr_real out[SR_NX])
+                           sr_real dt, sr_real *comp, sr_real out[SR_NX])
 {
-    sr_real K[4][NT], theta[NT], y[SR_NX];
+    sr_real K[4][NT], theta[NT], y[SR_NX], c[SR_NX];
     int i, status = vector_field(model, x, u, K[0], NULL);
     if (status != SR_OK) return status;
-    status = rkmk4_core(model, x, u, dt, K, theta, y, NULL);
+    if (comp) for (i = 0; i < SR_NX; ++i) c[i] = comp[i];
+    status = rkmk4_core(model, x, u, dt, K, theta, comp ? c : NULL, y, NULL);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NX; ++i) out[i] = y[i];
+    if (comp) for (i = 0; i < SR_NX; ++i) comp[i] = c[i];
     return SR_OK;
 }
 
 int sr_internal_cf4_step(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                         sr_real dt, sr_real out[SR_NX])
+                         sr_real dt, sr_real *comp, sr_real out[SR_NX])
 {
-    sr_real y[SR_NX];
-    int i, status = cf4_core(model, x, u, dt, y, NULL);
+    sr_real y[SR_NX], c[SR_NX];
+    int i, status;
+    if (comp) for (i = 0; i < SR_NX; ++i) c[i] = comp[i];
+    status = cf4_core(model, x, u, dt, comp ? c : NULL, y, NULL);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NX; ++i) out[i] = y[i];
+    if (comp) for (i = 0; i < SR_NX; ++i) comp[i] = c[i];
     return SR_OK;
 }
 
@@ -317,7 +358,7 @@ static int trial_step(adaptive_ctx *cx, const sr_real x[SR_NX], const sr_real u[
         cx->have_f = 1;
     }
     for (i = 0; i < NT; ++i) K[0][i] = cx->f_cur[i];
-    status = rkmk4_core(cx->model, x, u, h, K, theta, y, &cx->st->evaluations);
+    status = rkmk4_core(cx->model, x, u, h, K, theta, NULL, y, &cx->st->evaluations);
     if (status != SR_OK) return status;
     /* Fifth stage at the new point ("first same as last"): K5 = dexpinv(Theta, f(y)). */
     status = vector_field(cx->model, y, u, f_next, &cx->st->evaluations);

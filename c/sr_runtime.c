@@ -247,18 +247,22 @@ static int lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_rea
     return SR_OK;
 }
 
-/* One step of any method; x and out may alias. */
+/* One step of any method; x and out may alias.  comp: NULL, or a simulation's running
+ * compensation for the fourth-order methods (Lie-Euler stays the paper's plain eq. (111)). */
 static int advance(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                   sr_real dt, sr_real out[SR_NX])
+                   sr_real dt, sr_real *comp, sr_real out[SR_NX])
 {
-    int status;
+    int i, status;
     switch (method & ~SR_PROJECT) {
     case SR_LIE_EULER: status = lie_euler(model, x, u, dt, out); break;
-    case SR_RKMK4: status = sr_internal_rkmk4_step(model, x, u, dt, out); break;
-    case SR_CF4: status = sr_internal_cf4_step(model, x, u, dt, out); break;
+    case SR_RKMK4: status = sr_internal_rkmk4_step(model, x, u, dt, comp, out); break;
+    case SR_CF4: status = sr_internal_cf4_step(model, x, u, dt, comp, out); break;
     default: return SR_ERR_ARG;
     }
-    if (status == SR_OK && (method & SR_PROJECT)) sr_internal_project(out);
+    if (status == SR_OK && (method & SR_PROJECT)) {
+        sr_internal_project(out);
+        if (comp) for (i = 0; i < Q; ++i) comp[i] = 0; /* the projection moved the rotations */
+    }
     return status;
 }
 
@@ -277,7 +281,7 @@ int sr_step(const sr_model *model, int method, const sr_real x[SR_NX], const sr_
     status = checks(model, x, u);
     if (status != SR_OK) return status;
     if (!(dt > 0) || !isfinite(dt) || !valid_method(method)) return SR_ERR_ARG;
-    return deliver(advance(model, method, x, u ? u : zero_u, dt, tmp), tmp, SR_NX, x_next);
+    return deliver(advance(model, method, x, u ? u : zero_u, dt, NULL, tmp), tmp, SR_NX, x_next);
 }
 
 /* Kinetic energy 1/2 nu^T M nu and total energy of x (both finite, else SR_ERR_NONFINITE). */
@@ -331,6 +335,7 @@ int sr_simulate_guarded(const sr_model *model, int method, const sr_real x0[SR_N
 {
     long n;
     int i, status;
+    sr_real comp[SR_NX] = {0}; /* Kahan compensation carried across the steps of this call */
     if (steps_done) *steps_done = 0;
     status = sr_check_state(model, x0);
     if (status != SR_OK) return status;
@@ -348,7 +353,7 @@ int sr_simulate_guarded(const sr_model *model, int method, const sr_real x0[SR_N
             status = energy_guard(model, guard, x, NULL, un, 0);
             if (status != SR_OK) return status;
         }
-        status = advance(model, method, x, un, dt, next);
+        status = advance(model, method, x, un, dt, comp, next);
         if (status == SR_OK && !all_finite(next, SR_NX)) status = SR_ERR_NONFINITE;
         if (status == SR_OK && check_row) status = sr_check_state(model, next);
         if (status == SR_OK) {
