@@ -77,6 +77,8 @@ def real_array(value, name, shape_tail, batch=True):
 
 def check_finite(arr, name, entry_names=None):
     """Raise ValueError naming the first NaN or infinite entry of `arr` ("u[3, 1] is nan")."""
+    if np.isfinite(arr).all():        # the common case, without building the index list
+        return
     bad = np.argwhere(~np.isfinite(arr))
     if bad.size:
         index = tuple(int(i) for i in bad[0])
