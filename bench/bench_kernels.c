@@ -2,7 +2,7 @@
  *
  * usage: bench_kernels INPUT.bin REPEATS
  * INPUT.bin: int32 n, then params[12], states[n][35], inputs[n][2] (float64).
- * Prints one JSON object: ns per call of each kernel (best of 5 runs of REPEATS
+ * Prints one JSON object: ns per call of each kernel (best of 11 runs of REPEATS
  * sweeps over the n states) and the outputs for the first 8 states, which the
  * Python driver checks against the reference before reporting any time.
  * Built by runtime/bench.py; with -DWITH_CASADI the CasADi-generated reference
@@ -57,7 +57,7 @@ static double time_kernel(kernel_fn fn, int arg, int n, int repeats, int nout, c
 {
     double best = 1e300;
     int run, r, i, k;
-    for (run = 0; run < 5; ++run) {
+    for (run = 0; run < 11; ++run) {
         double t0 = now_ns(), dt;
         for (r = 0; r < repeats; ++r)
             for (i = 0; i < n; ++i) {
