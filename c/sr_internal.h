@@ -74,6 +74,25 @@ static inline void so3_exp_coefficients(sr_real theta2, sr_real *A, sr_real *B)
     }
 }
 
+/* D = Exp([[w]]) - I = A [[w]] + B [[w]]^2, the one formula behind
+ * sr_so3_exp and the steppers (small entries keep full relative precision). */
+static inline void so3_exp_minus_identity(const sr_real w[3], sr_real D[9])
+{
+    const sr_real x2 = w[0] * w[0], y2 = w[1] * w[1], z2 = w[2] * w[2];
+    sr_real A, B;
+    so3_exp_coefficients(x2 + y2 + z2, &A, &B);
+    /* [[w]]^2 = w w^T - |w|^2 I, its diagonal written without cancellation. */
+    D[0] = -B * (y2 + z2);
+    D[4] = -B * (x2 + z2);
+    D[8] = -B * (x2 + y2);
+    D[1] = B * w[0] * w[1] - A * w[2];
+    D[3] = B * w[0] * w[1] + A * w[2];
+    D[2] = B * w[0] * w[2] + A * w[1];
+    D[6] = B * w[0] * w[2] - A * w[1];
+    D[5] = B * w[1] * w[2] - A * w[0];
+    D[7] = B * w[1] * w[2] + A * w[0];
+}
+
 /* C = A B for row-major 3x3 matrices (C must not alias A or B). */
 static inline void matmul3(const sr_real *A, const sr_real *B, sr_real *C)
 {

@@ -72,24 +72,6 @@ static int vector_field(const sr_model *model, const sr_real x[SR_NX], const sr_
  * R <- R + R D: the remaining rounding is that of one addition per entry, which does not
  * repeat from step to step. */
 
-/* D = Exp([[w]]) - I = A [[w]] + B [[w]]^2, with the coefficients of sr_so3_exp. */
-static void so3_exp_minus_identity(const sr_real w[3], sr_real D[9])
-{
-    const sr_real x2 = w[0] * w[0], y2 = w[1] * w[1], z2 = w[2] * w[2];
-    sr_real A, B;
-    so3_exp_coefficients(x2 + y2 + z2, &A, &B);
-    /* [[w]]^2 = w w^T - |w|^2 I, its diagonal written without cancellation. */
-    D[0] = -B * (y2 + z2);
-    D[4] = -B * (x2 + z2);
-    D[8] = -B * (x2 + y2);
-    D[1] = B * w[0] * w[1] - A * w[2];
-    D[3] = B * w[0] * w[1] + A * w[2];
-    D[2] = B * w[0] * w[2] + A * w[1];
-    D[6] = B * w[0] * w[2] - A * w[1];
-    D[5] = B * w[1] * w[2] - A * w[0];
-    D[7] = B * w[1] * w[2] + A * w[0];
-}
-
 /* delta = R Exp(angle [[e_k]]) - R for R a rotation about axis k (0 = x, 1 = y): only the
  * (i, j) plane changes, by R (Exp - I) with cos(angle) - 1 = -2 sin^2(angle/2); the other
  * entries (exact zeros and ones) get a zero increment. */

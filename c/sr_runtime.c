@@ -197,21 +197,12 @@ int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_re
     return deliver(sr_gen_equilibrium_residual(model->c, x, tmp), tmp, SR_NV, res);
 }
 
-/* R = Exp([[w]]) = I + A [[w]] + B [[w]]^2, with [[w]]^2 = w w^T - |w|^2 I (no checks). */
+/* R = Exp([[w]]) = I + (Exp([[w]]) - I) (no checks). */
 static void so3_exp(const sr_real w[3], sr_real R[9])
 {
-    sr_real A, B;
-    const sr_real theta2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-    so3_exp_coefficients(theta2, &A, &B);
-    R[0] = 1 + B * (w[0] * w[0] - theta2);
-    R[4] = 1 + B * (w[1] * w[1] - theta2);
-    R[8] = 1 + B * (w[2] * w[2] - theta2);
-    R[1] = B * w[0] * w[1] - A * w[2];
-    R[3] = B * w[0] * w[1] + A * w[2];
-    R[2] = B * w[0] * w[2] + A * w[1];
-    R[6] = B * w[0] * w[2] - A * w[1];
-    R[5] = B * w[1] * w[2] - A * w[0];
-    R[7] = B * w[1] * w[2] + A * w[0];
+    int i;
+    so3_exp_minus_identity(w, R);
+    for (i = 0; i < 9; i += 4) R[i] += 1;
 }
 
 int sr_so3_exp(const sr_real w[3], sr_real R[9])
