@@ -40,6 +40,27 @@
 extern "C" {
 #endif
 
+/* The float build has symbol names of its own (suffix _f): code compiled with SR_USE_FLOAT
+ * against the double library, or the reverse, fails at link time instead of misreading every
+ * buffer, and one program can link both builds. */
+#ifdef SR_USE_FLOAT
+#define sr_status_string sr_status_string_f
+#define sr_model_init sr_model_init_f
+#define sr_check_state sr_check_state_f
+#define sr_check_state_batch sr_check_state_batch_f
+#define sr_accel sr_accel_f
+#define sr_accel_batch sr_accel_batch_f
+#define sr_inertia sr_inertia_f
+#define sr_rhs sr_rhs_f
+#define sr_energy sr_energy_f
+#define sr_equilibrium_residual sr_equilibrium_residual_f
+#define sr_so3_exp sr_so3_exp_f
+#define sr_step sr_step_f
+#define sr_simulate sr_simulate_f
+#define sr_simulate_guarded sr_simulate_guarded_f
+#define sr_simulate_adaptive sr_simulate_adaptive_f
+#endif
+
 #define SR_NPARAM SR_GEN_NPARAM
 #define SR_NX SR_GEN_NX
 #define SR_NU SR_GEN_NU

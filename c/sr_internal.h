@@ -117,6 +117,12 @@ static inline void rotate_about_axis(const sr_real *R, int k, sr_real angle, sr_
     matmul3(R, E, out);
 }
 
+#ifdef SR_USE_FLOAT /* float symbols carry _f, as in spherical_robot.h */
+#define sr_internal_rkmk4_step sr_internal_rkmk4_step_f
+#define sr_internal_cf4_step sr_internal_cf4_step_f
+#define sr_internal_project sr_internal_project_f
+#endif
+
 /* One step of the Lie-group methods of sr_lie_integrators.c, without argument checks
  * (sr_step/sr_simulate check first).  u must not be NULL; out may alias x.  comp: NULL for a
  * single step, or the running Kahan compensation of a simulation (SR_NX entries, zero at its

@@ -253,6 +253,7 @@ def header_text(ks, flops):
     guard = "SR_GENERATED_H"
     protos = "\n".join(f"/* {k.doc} */\n{signature(k)};" for k in ks)
     flop_macros = "\n".join(f"#define SR_GEN_{k.name.upper()}_FLOPS {flops[k.name]}" for k in ks)
+    float_names = "\n".join(f"#define {PREFIX}{k.name} {PREFIX}{k.name}_f" for k in ks)
     return f"""{banner()}/*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -281,6 +282,11 @@ typedef double sr_real;
 
 /* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
 {flop_macros}
+
+/* The float build's symbols carry _f, so a float/double mismatch fails at link time. */
+#ifdef SR_USE_FLOAT
+{float_names}
+#endif
 
 {protos}
 

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 9072c683a807e0d4], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 05adb89524a99154], SymPy 1.14.0. */
 #include "sr_generated.h"
 
 /* Derived constants of Section 2.3 from the twelve parameters. */

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 9072c683a807e0d4], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 05adb89524a99154], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -32,6 +32,16 @@ typedef double sr_real;
 #define SR_GEN_ENERGY_FLOPS 206
 #define SR_GEN_EQUILIBRIUM_RESIDUAL_FLOPS 22
 #define SR_GEN_ACCEL_FLOPS 545
+
+/* The float build's symbols carry _f, so a float/double mismatch fails at link time. */
+#ifdef SR_USE_FLOAT
+#define sr_gen_constants sr_gen_constants_f
+#define sr_gen_inertia sr_gen_inertia_f
+#define sr_gen_rhs sr_gen_rhs_f
+#define sr_gen_energy sr_gen_energy_f
+#define sr_gen_equilibrium_residual sr_gen_equilibrium_residual_f
+#define sr_gen_accel sr_gen_accel_f
+#endif
 
 /* Derived constants of Section 2.3 from the twelve parameters. */
 int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[12]);

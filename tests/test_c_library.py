@@ -256,3 +256,14 @@ def test_size_report_covers_every_public_function(tmp_path):
     header = re.sub(r"/\*.*?\*/", "", (C_DIR / "spherical_robot.h").read_text(), flags=re.S)
     for name in re.findall(r"^[A-Za-z_][\w \t\*]*?\b(sr_\w+)\s*\(", header, flags=re.M):
         assert out.count(f"| `{name}` |") == 2, name  # one row per scalar type
+
+
+@pytest.mark.parametrize("app_scalar, lib_name", [("float", "libsphericalrobot.a"), ("double", "libsphericalrobot_f.a")])
+def test_a_float_double_mismatch_fails_at_link_time(build, tmp_path, app_scalar, lib_name):
+    """The float build's symbols carry _f: mixing the builds cannot link (and misread buffers)."""
+    flags = ["-DSR_USE_FLOAT"] if app_scalar == "float" else []
+    out = run([CC, "-std=c99", *flags, f"-I{C_DIR}", f"-I{ROOT / 'generated'}",
+               str(C_DIR / "examples" / "firmware_tshape.c"), str(build / lib_name), "-lm",
+               "-o", str(tmp_path / "mixed")], check=False)
+    assert out.returncode != 0
+    assert "undefined reference" in out.stderr + out.stdout

@@ -178,14 +178,16 @@ def report(cc, cflags, nm, size_tool):
                 objs = compile_variant(cc, cflags, opt, scalar == "float", out_dir)
                 lib = Library(objs, nm)
                 totals[(scalar, opt)] = berkeley_totals(size_tool, objs)
+                suffix = "_f" if scalar == "float" else ""   # the float build's symbols carry _f
                 for fn in publics:
-                    if fn in lib.nodes:
-                        rows[(scalar, opt, fn)] = lib.row(fn)
+                    if fn + suffix in lib.nodes:
+                        rows[(scalar, opt, fn)] = lib.row(fn + suffix)
                 # Global functions outside the public API: the generated kernels, internal steppers.
                 for title in lib.nodes:
-                    if ":" not in title and title not in publics:
-                        internals[title] = True
-                        rows[(scalar, opt, title)] = lib.row(title)
+                    name = title[:-len(suffix)] if suffix and title.endswith(suffix) else title
+                    if ":" not in title and name not in publics:
+                        internals[name] = True
+                        rows[(scalar, opt, name)] = lib.row(title)
     version = subprocess.run([cc, "--version"], capture_output=True, text=True).stdout.splitlines()[0]
     lines = [
         f"Compiler: `{version}`, flags `{' '.join(['-std=c99', '-ffp-contract=off', *cflags])}` "
