@@ -62,3 +62,21 @@ def test_verify_command_prints_a_table_and_exits_zero():
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stdout + out.stderr
     assert "cross-check accel" in out.stdout and "0 failed" in out.stdout
+
+
+def test_rhs_and_equilibrium_residual_equal_M_times_the_reference_accel(rng):
+    """f = M ν̇ with M and ν̇ from the independent reference; at rest and without torque, f is the residual."""
+    from runtime import Params
+    from runtime.reference import ReferenceModel
+    from runtime.sampling import random_inputs, random_state
+    params = Params.paper_simulation()
+    model, ref = Model(params), ReferenceModel(params.as_dict())
+    for _ in range(50):
+        x, u = random_state(rng, params), random_inputs(rng, 1)[0]
+        expected = ref.inertia(x) @ ref.accel(x, u)
+        assert np.allclose(model.rhs(x, u), expected, rtol=1e-11, atol=1e-11 * np.abs(expected).max())
+        rest = x.copy()
+        rest[30:35] = 0
+        expected = ref.inertia(rest) @ ref.accel(rest, np.zeros(2))
+        assert np.allclose(model.equilibrium_residual(rest), expected, rtol=1e-11,
+                           atol=1e-11 * np.abs(expected).max())
