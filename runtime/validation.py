@@ -23,6 +23,8 @@ bool (True is not a number of radians), object, strings, dates, ragged lists.
 Instead of failing, a nearly valid state can be pulled onto the constraints
 explicitly with `project_state(x, r)` (or `Model.project(x)`).
 """
+import math
+
 import numpy as np
 
 from bindings._sr import ffi, lib
@@ -77,7 +79,10 @@ def real_array(value, name, shape_tail, batch=True):
 
 def check_finite(arr, name, entry_names=None):
     """Raise ValueError naming the first NaN or infinite entry of `arr` ("u[3, 1] is nan")."""
-    if np.isfinite(arr).all():        # the common case, without building the index list
+    if arr.size <= 16:                 # the common case, cheapest per call for small arrays
+        if all(math.isfinite(v) for v in arr.flat):
+            return
+    elif np.isfinite(arr).all():
         return
     bad = np.argwhere(~np.isfinite(arr))
     if bad.size:
@@ -139,8 +144,7 @@ def describe_state(x, r, name="x"):
 def check_states(model_ptr, x, r, name="x"):
     """Run sr_check_state (x of shape (35,)) or sr_check_state_batch ((B, 35)); on failure raise
     KernelError with the detailed message of `describe_state` (the failing row named "x[i]")."""
-    from .model import KernelError            # model imports this module
-    ptr = ffi.cast("double *", ffi.from_buffer(x))
+    ptr = ffi.from_buffer("double[]", x)
     if x.ndim == 1:
         status, row, row_name, state = lib.sr_check_state(model_ptr, ptr), None, name, x
     else:
@@ -151,6 +155,7 @@ def check_states(model_ptr, x, r, name="x"):
         state = x[row] if row >= 0 else None
     if status == lib.SR_OK:
         return
+    from .model import KernelError            # model imports this module
     message = describe_state(state, r, row_name) if state is not None else None
     raise KernelError(row_name, status, message=message)
 
