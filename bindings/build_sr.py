@@ -1,4 +1,5 @@
 """cffi builder for `bindings._sr`: compiles generated/ and c/ into one extension module."""
+import os
 import pathlib
 
 import cffi
@@ -68,6 +69,11 @@ int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[], 
                          long max_steps, sr_real *traj, sr_adaptive_stats *stats);
 """
 
+# Portable -O2 by default; SR_NATIVE=1 at install time (`SR_NATIVE=1 pip install -e .`) adds
+# -march=native for this machine's vector units (the firmware example then matches the Python
+# runs only if it is built with the same flag).
+NATIVE = ["-march=native"] if os.environ.get("SR_NATIVE") == "1" else []
+
 ffibuilder = cffi.FFI()
 ffibuilder.cdef(CDEF)
 ffibuilder.set_source(
@@ -76,7 +82,7 @@ ffibuilder.set_source(
     sources=SOURCES,
     include_dirs=INCLUDE_DIRS,
     # No FMA contraction: the firmware example (c/examples) must reproduce the Python runs bit for bit.
-    extra_compile_args=["-std=c99", "-O2", "-ffp-contract=off"],
+    extra_compile_args=["-std=c99", "-O2", "-ffp-contract=off", *NATIVE],
 )
 
 if __name__ == "__main__":
