@@ -215,47 +215,49 @@ def _torque_shading(ax, result):
             ax.axvspan(t[start], t[min(stop, len(t) - 1)], color=color, alpha=0.12, lw=0)
 
 
+def _time_figure(result, size):
+    """A figure against time with the motor windows shaded; the caller draws, then `_finish_time_axes`."""
+    fig, ax = plt.subplots(figsize=size, layout="constrained")
+    _torque_shading(ax, result)
+    return fig, ax
+
+
+def _finish_time_axes(ax, result, ylabel, what, legend=True):
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3)
+    if legend:
+        ax.legend(fontsize=8)
+    ax.set_title(_title(result, what), fontsize=10)
+
+
 def inclinations_figure(result, size=(6.0, 3.6)):
     """θ_Y (yoke relative to the shell) and θ_P (pendulum relative to the yoke) against time (Figs. 3, 7).
 
     The angles are unwrapped (continuous through ±π), so a joint that turns
     over shows as a ramp rather than a saw-tooth.
     """
-    fig, ax = plt.subplots(figsize=size, layout="constrained")
-    _torque_shading(ax, result)
+    fig, ax = _time_figure(result, size)
     ax.plot(result.time, np.unwrap(yoke_angle(result.trajectory)), label="yoke rel. to shell θ_Y")
     ax.plot(result.time, np.unwrap(pendulum_angle(result.trajectory)), label="pendulum rel. to yoke θ_P")
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel("angle [rad]")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    ax.set_title(_title(result, "relative inclinations"), fontsize=10)
+    _finish_time_axes(ax, result, "angle [rad]", "relative inclinations")
     return fig
 
 
 def absolute_inclinations_figure(result, size=(6.0, 3.6)):
     """Yoke plane normal and pendulum shaft against the vertical (Fig. 5)."""
     yoke, pendulum = absolute_inclinations(result.trajectory)
-    fig, ax = plt.subplots(figsize=size, layout="constrained")
-    _torque_shading(ax, result)
+    fig, ax = _time_figure(result, size)
     ax.plot(result.time, yoke, label="yoke plane normal vs vertical")
     ax.plot(result.time, pendulum, "--", label="pendulum shaft vs vertical")
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel("angle [rad]")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    ax.set_title(_title(result, "absolute inclinations"), fontsize=10)
+    _finish_time_axes(ax, result, "angle [rad]", "absolute inclinations")
     return fig
 
 
 def energy_figure(result, size=(6.0, 3.6)):
-    fig, ax = plt.subplots(figsize=size, layout="constrained")
-    _torque_shading(ax, result)
+    fig, ax = _time_figure(result, size)
     ax.plot(result.time, result.energy, color="k")
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel("E [J]")
-    ax.grid(alpha=0.3)
-    ax.set_title(_title(result, "kinetic + potential energy"), fontsize=10)
+    _finish_time_axes(ax, result, "E [J]", "kinetic + potential energy", legend=False)
     return fig
 
 
