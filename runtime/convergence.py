@@ -66,46 +66,14 @@ def scenarios():
     }
 
 
-def _project(x):
-    """Nearest rotations (polar factor of R_S; normalised cos/sin pairs of R_Y, R_P)."""
-    y = x.copy()
-    U, _, Vt = np.linalg.svd(x[0:9].reshape(3, 3))
-    y[0:9] = (U @ Vt).ravel()
-    for base, (ci, si) in ((9, (4, 7)), (18, (0, 2))):
-        c, s = x[base + ci], x[base + si]
-        n = np.hypot(c, s)
-        R = np.eye(3)
-        if base == 9:
-            R[1, 1], R[1, 2], R[2, 1], R[2, 2] = c / n, -s / n, s / n, c / n
-        else:
-            R[0, 0], R[0, 2], R[2, 0], R[2, 2] = c / n, s / n, -s / n, c / n
-        y[base:base + 9] = R.ravel()
-    return y
-
-
 def scipy_reference(model, x0, u, t_end, rtol=1e-13):
-    """DOP853 on the 35 entries (R' = R Ω, q' = r R_S (ω_S × γ), ν' = accel), or None without scipy."""
+    """DOP853 on the 35 entries (runtime.verify.integrate), or None without scipy."""
     try:
-        from scipy.integrate import solve_ivp
+        import scipy.integrate  # noqa: F401
     except ImportError:
         return None
-    sx, sy = np.array([[0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]]), np.array([[0, 0, 1.0], [0, 0, 0], [-1.0, 0, 0]])
-
-    def rhs(_t, x):
-        xp = _project(x)
-        R_S, R_Y, R_P = (x[i:i + 9].reshape(3, 3) for i in (0, 9, 18))
-        w = x[30:33]
-        hat = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
-        dx = np.empty(35)
-        dx[0:9] = (R_S @ hat).ravel()
-        dx[9:18] = (x[33] * R_Y @ sx).ravel()
-        dx[18:27] = (x[34] * R_P @ sy).ravel()
-        dx[27:30] = model.params.r * xp[0:9].reshape(3, 3) @ np.cross(w, xp[6:9])
-        dx[30:35] = model.accel(xp, u)
-        return dx
-
-    sol = solve_ivp(rhs, (0.0, t_end), x0, method="DOP853", rtol=rtol, atol=rtol * 1e-2)
-    return sol.y[:, -1]
+    from .verify import integrate
+    return integrate(model, x0, t_end, u=u, rtol=rtol, atol=rtol * 1e-2).y[:, -1]
 
 
 def error_table(model, log):

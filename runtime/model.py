@@ -287,18 +287,8 @@ class Model:
         accepted, rejected, evaluations (acceleration calls) and h_next.
         """
         x0 = self._valid_states(x0, "x0", batch=False)
-        try:
-            dt_out = float(dt_out)
-        except (TypeError, ValueError):
-            raise ValueError(f"dt_out: expected a positive number, got {dt_out!r}") from None
-        if not (dt_out > 0 and np.isfinite(dt_out)):
-            raise ValueError(f"dt_out: expected a positive finite number, got {dt_out!r}")
-        try:
-            t_end = float(t_end)
-        except (TypeError, ValueError):
-            raise ValueError(f"t_end: expected a non-negative number, got {t_end!r}") from None
-        if not (t_end >= 0 and np.isfinite(t_end)):
-            raise ValueError(f"t_end: expected a non-negative finite number, got {t_end!r}")
+        dt_out = self._dt(dt_out, "dt_out")
+        t_end = self._dt(t_end, "t_end", allow_zero=True)
         n_out = int(round(t_end / dt_out))
         if abs(n_out * dt_out - t_end) > 1e-9 * max(t_end, dt_out):
             raise ValueError(f"t_end: must be a whole multiple of dt_out = {dt_out:g}, got {t_end:g}")
@@ -358,14 +348,16 @@ class Model:
 
     # -- helpers ------------------------------------------------------------------
     @staticmethod
-    def _dt(dt):
+    def _dt(value, name="dt", allow_zero=False):
+        """A time argument as a float: finite and positive (or non-negative with allow_zero)."""
+        kind = "non-negative" if allow_zero else "positive"
         try:
-            dt = float(dt)
+            value = float(value)
         except (TypeError, ValueError):
-            raise ValueError(f"dt: expected a positive number, got {dt!r}") from None
-        if not (dt > 0 and np.isfinite(dt)):
-            raise ValueError(f"dt: expected a positive finite number, got {dt!r}")
-        return dt
+            raise ValueError(f"{name}: expected a {kind} number, got {value!r}") from None
+        if not (np.isfinite(value) and (value >= 0 if allow_zero else value > 0)):
+            raise ValueError(f"{name}: expected a {kind} finite number, got {value!r}")
+        return value
 
     @staticmethod
     def _energy_tol(energy_tol):

@@ -29,7 +29,7 @@ import numpy as np
 
 from bindings._sr import ffi, lib
 
-from .state import NX
+from .state import NX, rot_x, rot_y
 
 #: Tolerance of the state checks, exported from C (SR_ROTATION_TOL): entries of RᵀR − I,
 #: det R − 1, and |q_z − r| / r.
@@ -186,8 +186,7 @@ def project_state(x, r):
         RY, RP = row[9:18].reshape(3, 3), row[18:27].reshape(3, 3)
         ty = np.arctan2(RY[2, 1] - RY[1, 2], RY[1, 1] + RY[2, 2])
         tp = np.arctan2(RP[0, 2] - RP[2, 0], RP[0, 0] + RP[2, 2])
-        cy, sy, cp, sp = np.cos(ty), np.sin(ty), np.cos(tp), np.sin(tp)
-        row[9:18] = (1.0, 0.0, 0.0, 0.0, cy, -sy, 0.0, sy, cy)
-        row[18:27] = (cp, 0.0, sp, 0.0, 1.0, 0.0, -sp, 0.0, cp)
+        row[9:18] = rot_x(ty).ravel()
+        row[18:27] = rot_y(tp).ravel()
         row[29] = r
     return out

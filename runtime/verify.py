@@ -25,6 +25,7 @@ from .model import Model
 from .params import Params
 from .sampling import random_inputs, random_params, random_state
 from .state import initial_state, rot_x, rot_y, rot_z
+from .validation import project_state
 
 
 @dataclasses.dataclass
@@ -56,23 +57,13 @@ def expm_so3(w):
     return np.eye(3) + np.sin(t) * K + (1 - np.cos(t)) * K @ K
 
 
-def project(x):
-    """Nearest valid state: R_S by polar decomposition, R_Y and R_P rebuilt from their angles.
-
-    The dynamics live on SO(3)³; a Runge–Kutta integrator in ℝ³⁵ evaluates
-    stages slightly off it, so the vector field is extended by projection.
-    """
-    y = np.array(x, dtype=float)
-    U, _, Vt = np.linalg.svd(y[0:9].reshape(3, 3))
-    y[0:9] = (U @ Vt).ravel()
-    y[9:18] = rot_x(np.arctan2(y[16], y[13])).ravel()
-    y[18:27] = rot_y(np.arctan2(y[20], y[18])).ravel()
-    return y
-
-
 def state_derivative(model, x, u=None):
-    """ẋ for the whole 35-vector: Ṙ_S = R_S⟦ω_S⟧, Ṙ_Y = R_Y ω_Y Σ_Y, Ṙ_P = R_P ω_P Σ_P, q̇ = r R_S(ω_S × γ), ν̇."""
-    xp = project(x)
+    """ẋ for the whole 35-vector: Ṙ_S = R_S⟦ω_S⟧, Ṙ_Y = R_Y ω_Y Σ_Y, Ṙ_P = R_P ω_P Σ_P, q̇ = r R_S(ω_S × γ), ν̇.
+
+    The dynamics live on SO(3)³; a Runge–Kutta integrator in ℝ³⁵ evaluates stages slightly
+    off it, so the vector field is extended by projection (`project_state`).
+    """
+    xp = project_state(x, model.params.r)
     R_S, R_Y, R_P = (xp[i:i + 9].reshape(3, 3) for i in (0, 9, 18))
     w = xp[30:33]
     d = np.empty(35)
@@ -85,6 +76,7 @@ def state_derivative(model, x, u=None):
 
 
 def integrate(model, x0, t_end, u=None, rtol=1e-12, atol=1e-12, dense=False):
+    """solve_ivp (DOP853) on the 35 entries with `state_derivative`: the independent tight-tolerance solution."""
     from scipy.integrate import solve_ivp
     return solve_ivp(lambda t, x: state_derivative(model, x, u), (0.0, t_end), x0, method="DOP853",
                      rtol=rtol, atol=atol, first_step=1e-4, dense_output=dense)
@@ -130,7 +122,7 @@ def energy_conservation(n_runs=3, seed=1, t_end=20.0):
         x0 = random_state(rng, model.params, max_speed=3.0)
         sol = integrate(model, x0, t_end)
         E0 = model.energy(x0)
-        drift = max(abs(model.energy(project(x)) - E0) for x in sol.y.T)
+        drift = max(abs(model.energy(project_state(x, model.params.r)) - E0) for x in sol.y.T)
         if drift / abs(E0) > worst[1]:
             worst = (drift, drift / abs(E0))
     return CheckResult(f"energy conserved without friction ({n_runs} runs, {t_end:g} s)", *worst, 1e-9)
@@ -191,7 +183,7 @@ def rolling_constraint(seed=3, t_end=2.0):
     worst = (0.0, 0.0)
     h = 1e-4
     for t in np.linspace(0.1, t_end - 0.1, 40):
-        x = project(sol.sol(t))
+        x = project_state(sol.sol(t), params.r)
         q_dot = (sol.sol(t + h)[27:30] - sol.sol(t - h)[27:30]) / (2 * h)
         R_dot = (sol.sol(t + h)[0:9] - sol.sol(t - h)[0:9]).reshape(3, 3) / (2 * h)
         R_S = x[0:9].reshape(3, 3)
