@@ -58,13 +58,15 @@ int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM])
      * length 1e-200): evaluate the model once at the reference state.  M is positive definite
      * for any positive masses and lengths in exact arithmetic, so a failing pivot means that
      * the inertias underflowed. */
-    if (!all_finite(m.c, SR_GEN_NCONST)) return SR_ERR_PARAM;
+    if (!all_finite(m.c, SR_GEN_NCONST_NAMED)) return SR_ERR_PARAM;
     reference_state(params[r], x);
     if (sr_gen_inertia(m.c, x, M) != SR_OK || !all_finite(M, SR_NV * SR_NV)) return SR_ERR_PARAM;
-    if (sr_gen_energy(m.c, x, &energy) != SR_OK || !isfinite(energy)) return SR_ERR_PARAM;
     status = sr_gen_accel(m.c, x, zero_u, a);
     if (status != SR_OK) return status; /* SR_GEN_SINGULAR == SR_ERR_SINGULAR */
-    if (!all_finite(a, SR_NV)) return SR_ERR_PARAM;
+    /* After the pivots, so that inertias that underflow to zero (and whose reciprocals among the
+     * pooled constants are infinite) are reported as singular. */
+    if (!all_finite(m.c, SR_GEN_NCONST) || !all_finite(a, SR_NV)) return SR_ERR_PARAM;
+    if (sr_gen_energy(m.c, x, &energy) != SR_OK || !isfinite(energy)) return SR_ERR_PARAM;
     *model = m;
     return SR_OK;
 }

@@ -4,9 +4,11 @@ Each kernel is (name, inputs, outputs): inputs are the arrays it reads
 (`p` parameters, `c` constants, `x` state, `u` input), outputs are named
 arrays of SymPy expressions.  All kernels of a file share nothing at run
 time; within a kernel common subexpressions are eliminated by SymPy's CSE.
-`accel` additionally solves M ν̇ = f with an unrolled LDLᵀ factorization
-(M is symmetric positive definite, so no pivoting is needed and no square
-root is taken).
+`rhs` and `accel` evaluate f in the body-by-body form of
+`derive.newton_euler`, after proving it equal to `dynamics.rhs`; `accel`
+additionally solves M ν̇ = f, joint accelerations first (see
+`emit_joint_first_solve`: M is symmetric positive definite, so no pivoting
+is needed and no square root is taken).
 
 The scalar type is `sr_real` (double, or float with -DSR_USE_FLOAT), and
 numeric literals go through SR_C() so both builds are clean under -Wall
@@ -21,8 +23,10 @@ import sympy as sp
 from sympy.printing.c import C99CodePrinter
 
 from . import dynamics as D
+from . import newton_euler as NE
 from . import parameters as P
 from . import state as S
+from . import yoke_frame as YF
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 HEADER_NAME = "sr_generated.h"
@@ -35,6 +39,7 @@ class Output:
     name: str
     exprs: tuple
     doc: str
+    local_names: tuple = ()   # set: assigned to these C locals (for the solve) instead of the output array
 
 
 @dataclasses.dataclass(frozen=True)
@@ -43,7 +48,7 @@ class Kernel:
     doc: str
     inputs: tuple          # subset of ("p", "c", "x", "u"), in argument order
     outputs: tuple         # Output instances, written in this order
-    solve: bool = False    # outputs are (M upper triangle, f); write ν̇ = M⁻¹ f instead
+    solve: bool = False    # outputs are the locals of joint_first_system; write ν̇ = M⁻¹ f instead
 
 
 INPUT_DOCS = {
@@ -54,48 +59,93 @@ INPUT_DOCS = {
 }
 
 
-ARRAY_LAYOUTS = {
-    "p": {s: i for i, s in enumerate(P.PARAMETERS)},
-    "c": {s: i for i, s in enumerate(P.CONSTANTS)},
-    "x": S.STATE_LAYOUT,
-    "u": S.INPUT_LAYOUT,
-}
+def array_layouts(constants):
+    """Symbol -> index for each input array; `constants` is the full constants array (named, then pooled)."""
+    return {
+        "p": {s: i for i, s in enumerate(P.PARAMETERS)},
+        "c": {s: i for i, s in enumerate(constants)},
+        "x": S.STATE_LAYOUT,
+        "u": S.INPUT_LAYOUT,
+    }
 
 
-def input_symbols(arrays):
+def input_symbols(arrays, layouts):
     """Symbol -> (array, index) for the arrays a kernel reads."""
-    return {s: (a, i) for a in arrays for s, i in ARRAY_LAYOUTS[a].items()}
+    return {s: (a, i) for a in arrays for s, i in layouts[a].items()}
 
 
-def nested_in_speeds(expr):
-    """expr as Σ_j ν_j (Σ_k c_jk(config) ν_k) + (linear and constant terms).
+class ConstantPool:
+    """Parameter-only subexpressions of the kernels, moved into sr_gen_constants.
 
-    The right-hand side is quadratic in ν; grouping its 15 monomials this way
-    lets CSE share the configuration-dependent coefficients (about half the
-    flops of the expanded polynomial).
+    A product like l·m_P·r/2 or a sum like j_P + j_S + j_xx depends on the
+    parameters alone, so it is computed once per model (in the constants array
+    after the twelve named constants) instead of once per call.  Names k_0,
+    k_1, ... are given in order of first appearance, so generation stays
+    deterministic.
     """
-    speeds, inputs = list(S.nu), list(S.u)
-    poly = sp.Poly(expr, *speeds, *inputs)
-    rows, rest = {}, []
-    for powers, coeff in poly.terms():
-        coeff = sp.factor_terms(coeff)
-        factors = [v for v, k in zip(speeds, powers[:len(speeds)]) for _ in range(k)]
-        if len(factors) == 2:
-            rows.setdefault(factors[0], []).append(coeff * factors[1])
-        else:
-            rest.append(coeff * sp.Mul(*[v**k for v, k in zip(speeds + inputs, powers)]))
-    return sp.Add(*rest) + sp.Add(*[v * sp.Add(*terms) for v, terms in rows.items()])
+
+    def __init__(self, base):
+        self.base = frozenset(base)
+        self.table = {}            # expression -> symbol, in insertion order
+
+    def _name(self, expr):
+        if expr.is_Atom:
+            return expr
+        if expr.could_extract_minus_sign():
+            return -self._name(-expr)
+        if expr not in self.table:
+            self.table[expr] = sp.Symbol(f"k_{len(self.table)}", real=True)
+        return self.table[expr]
+
+    def hoist(self, expr):
+        """expr with its maximal parameter-only subexpressions replaced by pool symbols."""
+        if expr.is_Atom:
+            return expr
+        if expr.free_symbols <= self.base:
+            return self._name(expr)
+        if expr.is_Add or expr.is_Mul:
+            const = [a for a in expr.args if a.free_symbols <= self.base]
+            rest = [self.hoist(a) for a in expr.args if not a.free_symbols <= self.base]
+            return expr.func(self._name(expr.func(*const)), *rest) if const else expr.func(*rest)
+        return expr.func(*[self.hoist(a) for a in expr.args])
+
+    def symbols(self):
+        return tuple(self.table.values())
+
+    def expressions(self):
+        return tuple(self.table)
 
 
 def upper_triangle(M):
     return tuple(M[i, j] for i in range(M.rows) for j in range(i, M.cols))
 
 
+def proven(name, residuals):
+    if any(r != 0 for r in residuals):
+        raise ValueError(f"{name}: the evaluated form differs from the derivation: {residuals}")
+
+
+def fast_rhs():
+    """f in the body-by-body form, after checking it against the Euler–Poincaré derivation."""
+    proven("newton_euler", NE.check_equal_to_rhs())
+    return NE.rhs()
+
+
+def accel_system():
+    """M and f in the yoke frame, evaluated at the shell-frame state (after the proof of `yoke_frame`)."""
+    proven("newton_euler", NE.check_equal_to_rhs())
+    proven("yoke_frame", YF.check_equivalence())
+    sub = YF.from_shell_frame()
+    return joint_first_system(YF.inertia().xreplace(sub), YF.rhs().xreplace(sub))
+
+
 def kernels():
     """The functions to emit."""
-    M, f = D.inertia(), D.rhs().applyfunc(nested_in_speeds)
+    M, f = D.inertia(), fast_rhs()
     return (
-        Kernel("constants", "Derived constants of Section 2.3 from the twelve parameters.",
+        Kernel("constants", "Derived constants of Section 2.3 from the twelve parameters, c[0..11] ="
+               " (r, l, g, m_P, m_R, j_S, j_xx, j_yy, j_P, k_S, k_Y, k_P), then the parameter-only"
+               " subexpressions of the kernels, computed once per model:",
                ("p",), (Output("c", tuple(P.constant_expressions()), "constants (r, l, g, m_P, m_R, j_S, j_xx, j_yy, j_P, k_S, k_Y, k_P)"),)),
         Kernel("inertia", "Generalized inertia M(γ, R_Y, R_P), row-major 5x5, kinetic energy ½νᵀMν.",
                ("c", "x"), (Output("M", tuple(M), "M, row-major 5x5"),)),
@@ -105,8 +155,8 @@ def kernels():
                ("c", "x"), (Output("E", (D.energy(),), "energy"),)),
         Kernel("equilibrium_residual", "f at ν = 0, u = 0 (eq. 106); zero iff R_S R_Y R_P e_z = ±e_z (eq. 108).",
                ("c", "x"), (Output("res", tuple(D.equilibrium_residual()), "residual"),)),
-        Kernel("accel", "ν̇ = (ω̇_S, ω̇_Y, ω̇_P) solving M ν̇ = f by LDLᵀ; SR_GEN_SINGULAR if a pivot is not positive.",
-               ("c", "x", "u"), (Output("M", upper_triangle(M), "M"), Output("f", tuple(f), "f")), solve=True),
+        Kernel("accel", "ν̇ = (ω̇_S, ω̇_Y, ω̇_P) solving M ν̇ = f, joints first; SR_GEN_SINGULAR if M is not positive definite.",
+               ("c", "x", "u"), accel_system(), solve=True),
     )
 
 
@@ -140,8 +190,8 @@ def emit_assignments(printer, assignments, declare):
     return lines
 
 
-def emit_inputs(kernel, used):
-    table = input_symbols(kernel.inputs)
+def emit_inputs(kernel, used, layouts):
+    table = input_symbols(kernel.inputs, layouts)
     missing = [s for s in used if s not in table]
     if missing:
         raise ValueError(f"kernel {kernel.name} uses symbols outside its inputs: {missing}")
@@ -152,33 +202,75 @@ def emit_inputs(kernel, used):
     return lines
 
 
-def emit_ldlt_solve(n, M_name, f_name, out_name):
-    """Unrolled LDLᵀ of a symmetric n×n matrix given as M_i_j (i ≤ j), then forward/back substitution.
+def joint_first_system(M, f):
+    """M ν̇ = f with the joint accelerations eliminated: the outputs of the `accel` kernel.
 
-    Only the n pivots are divided (1/d_j); every other division becomes a multiplication.
+    M = [A B; Bᵀ D] with A the 3×3 shell block and D = diag(M_33, M_44): the
+    yoke and pendulum rates do not couple (M_34 = 0 identically, asserted
+    here).  The shell accelerations solve S ω̇_S = g with the Schur complement
+    S = M_33 (A − B D⁻¹ Bᵀ) and g = M_33 (f_S − B D⁻¹ f_J); the factor M_33
+    keeps every division out of S and g (D⁻¹ M_33 = diag(1, M_33/M_44), and
+    1/M_44 = 1/j_P is a per-model constant), so the only division on the
+    critical path is 1/det S in `emit_shell_solve`.  Then
+    ω̇_J = D⁻¹ (f_J − Bᵀ ω̇_S).  These are symbolic, so CSE and the constant
+    pool see them together with M and f.
     """
-    def m(i, j):
-        i, j = min(i, j), max(i, j)
-        return f"{M_name}_{i}_{j}"
+    if sp.simplify(M[3, 4]) != 0:
+        raise ValueError("joint-first solve needs M_34 = 0: the yoke and pendulum rates couple")
+    A, B, d3, d4 = M[0:3, 0:3], M[0:3, 3:5], M[3, 3], M[4, 4]
+    ratio = d3 / d4
+    S_ = d3 * A - B[:, 0] * B[:, 0].T - ratio * B[:, 1] * B[:, 1].T
+    g_ = d3 * f[0:3, 0] - B[:, 0] * f[3] - ratio * B[:, 1] * f[4]
+    return (
+        Output("S", upper_triangle(S_), "M_33 times the Schur complement, upper triangle", ("S_0_0", "S_0_1", "S_0_2", "S_1_1", "S_1_2", "S_2_2")),
+        Output("g", tuple(g_), "M_33 times the reduced right-hand side", ("g_0", "g_1", "g_2")),
+        Output("B", tuple(B), "shell-joint coupling, row-major 3x2", ("B_0_3", "B_0_4", "B_1_3", "B_1_4", "B_2_3", "B_2_4")),
+        Output("fJ", (f[3], f[4]), "joint right-hand sides", ("f_3", "f_4")),
+        Output("D", (d3, d4, 1 / d3, 1 / d4), "joint inertias and their reciprocals", ("M_3_3", "M_4_4", "inv_d_3", "inv_d_4")),
+        Output("Mdiag", (M[0, 0], M[1, 1], M[2, 2]), "diagonal of A, the scale of the pivot tests", ("M_0_0", "M_1_1", "M_2_2")),
+    )
 
-    lines = ["    /* LDL^T factorization, unrolled: M = L D L^T with unit lower-triangular L. */"]
-    for j in range(n):
-        terms = "".join(f" - L_{j}_{k}*L_{j}_{k}*d_{k}" for k in range(j))
-        lines.append(f"    const sr_real d_{j} = {m(j, j)}{terms};")
-        lines.append(f"    if (!(d_{j} > SR_GEN_PIVOT_TOL*{m(j, j)})) return SR_GEN_SINGULAR;")
-        lines.append(f"    const sr_real inv_d_{j} = SR_C(1.0)/d_{j};")
-        for i in range(j + 1, n):
-            terms = "".join(f" - L_{i}_{k}*L_{j}_{k}*d_{k}" for k in range(j))
-            lines.append(f"    const sr_real L_{i}_{j} = ({m(i, j)}{terms})*inv_d_{j};")
-    lines.append("    /* Solve L y = f, then L^T a = D^-1 y. */")
-    for i in range(n):
-        terms = "".join(f" - L_{i}_{k}*y_{k}" for k in range(i))
-        lines.append(f"    const sr_real y_{i} = {f_name}_{i}{terms};")
-    for i in reversed(range(n)):
-        terms = "".join(f" - L_{k}_{i}*a_{k}" for k in range(i + 1, n))
-        lines.append(f"    const sr_real a_{i} = y_{i}*inv_d_{i}{terms};")
-    for i in range(n):
-        lines.append(f"    {out_name}[{i}] = a_{i};")
+
+def emit_shell_solve(printer, out_name, rotation):
+    """C for the rest of `joint_first_system`: S by its adjugate, then the joint accelerations.
+
+    The shell accelerations come out in the frame of the system (the yoke
+    frame, see `derive.yoke_frame`) and are written as `rotation` times them.
+
+    M is positive definite iff M_33, M_44 and the leading minors of S are
+    positive; as in an LDLᵀ, each pivot of S/M_33 must exceed SR_GEN_PIVOT_TOL
+    times M's diagonal entry (S's pivots are M_33 times those of the Schur
+    complement).  1/M_33 is formed before the test of M_33; a zero or
+    negative M_33 gives an infinity or a wrong sign that is never used.
+    """
+    shell = (0, 1, 2)
+
+    def s(i, j):
+        return f"S_{min(i, j)}_{max(i, j)}"
+
+    lines = ["    /* M positive definite: the joint block, then the leading minors of S (C = adj S, symmetric). */",
+             "    if (!(M_3_3 > 0 && M_4_4 > 0)) return SR_GEN_SINGULAR;"]
+    for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)):
+        p, q = [k for k in shell if k != i], [k for k in shell if k != j]
+        sign = "" if (i + j) % 2 == 0 else "-"
+        lines.append(f"    const sr_real C_{i}_{j} = {sign}({s(p[0], q[0])}*{s(p[1], q[1])} - {s(p[1], q[0])}*{s(p[0], q[1])});")
+    lines += [
+        "    const sr_real det_S = S_0_0*C_0_0 + S_0_1*C_0_1 + S_0_2*C_0_2;",
+        "    if (!(S_0_0 > SR_GEN_PIVOT_TOL*M_0_0*M_3_3)) return SR_GEN_SINGULAR;",
+        "    if (!(C_2_2 > SR_GEN_PIVOT_TOL*M_1_1*M_3_3*S_0_0)) return SR_GEN_SINGULAR;",
+        "    if (!(det_S > SR_GEN_PIVOT_TOL*M_2_2*M_3_3*C_2_2)) return SR_GEN_SINGULAR;",
+        "    const sr_real inv_det_S = SR_C(1.0)/det_S;",
+    ]
+    for i in shell:
+        terms = " + ".join(f"C_{min(i, j)}_{max(i, j)}*g_{j}" for j in shell)
+        lines.append(f"    const sr_real a_{i} = ({terms})*inv_det_S;")
+    for k in (3, 4):
+        terms = "".join(f" - B_{i}_{k}*a_{i}" for i in shell)
+        lines.append(f"    const sr_real a_{k} = (f_{k}{terms})*inv_d_{k};")
+    a = sp.symbols("a_0:5", real=True)
+    shell_out = rotation * sp.Matrix(a[0:3])
+    for i, value in enumerate(list(shell_out) + list(a[3:5])):
+        lines.append(f"    {out_name}[{i}] = {printer.doprint(value)};")
     return lines
 
 
@@ -187,7 +279,7 @@ def signature(kernel):
     if kernel.solve:
         args.append("sr_real a[SR_GEN_NV]")
     else:
-        args += [f"sr_real {o.name}[{len(o.exprs)}]" for o in kernel.outputs]
+        args += [f"sr_real {o.name}[{'SR_GEN_NCONST' if o.name == 'c' else len(o.exprs)}]" for o in kernel.outputs]
     return f"int {PREFIX}{kernel.name}({', '.join(args)})"
 
 
@@ -208,29 +300,24 @@ def count_flops(lines):
     return flops
 
 
-def emit_kernel(kernel):
+def emit_kernel(kernel, layouts):
     """C text of one kernel and its flop count."""
     printer = Printer()
     exprs = [e for o in kernel.outputs for e in o.exprs]
     temporaries, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"), order="canonical")
     used = set().union(*(e.free_symbols for e in exprs)) if exprs else set()
-    body = emit_inputs(kernel, used)
+    body = emit_inputs(kernel, used, layouts)
     body += emit_assignments(printer, temporaries, declare=True)
     k = 0
     for out in kernel.outputs:
         values = reduced[k:k + len(out.exprs)]
         k += len(out.exprs)
-        if kernel.solve:
-            if out.name == "M":
-                n = S.NV
-                names = [f"M_{i}_{j}" for i in range(n) for j in range(i, n)]
-            else:
-                names = [f"f_{i}" for i in range(len(values))]
-            body += emit_assignments(printer, zip(names, values), declare=True)
+        if out.local_names:
+            body += emit_assignments(printer, zip(out.local_names, values), declare=True)
         else:
             body += [f"    {out.name}[{i}] = {printer.doprint(v)};" for i, v in enumerate(values)]
     if kernel.solve:
-        body += emit_ldlt_solve(S.NV, "M", "f", "a")
+        body += emit_shell_solve(printer, "a", S.R_Y)
     body.append("    return SR_GEN_OK;")
     doc = f"/* {kernel.doc} */"
     return "\n".join([doc, signature(kernel), "{", *body, "}", ""]), count_flops(body)
@@ -249,7 +336,7 @@ def banner():
             f"[sha256 of its sources {provenance()}], SymPy {sp.__version__}. */\n")
 
 
-def header_text(ks, flops):
+def header_text(ks, flops, n_constants):
     guard = "SR_GENERATED_H"
     protos = "\n".join(f"/* {k.doc} */\n{signature(k)};" for k in ks)
     flop_macros = "\n".join(f"#define SR_GEN_{k.name.upper()}_FLOPS {flops[k.name]}" for k in ks)
@@ -275,7 +362,8 @@ typedef double sr_real;
 #define SR_GEN_OK 0
 #define SR_GEN_SINGULAR 4
 #define SR_GEN_NPARAM {len(P.PARAMETERS)}
-#define SR_GEN_NCONST {len(P.CONSTANTS)}
+#define SR_GEN_NCONST {n_constants}
+#define SR_GEN_NCONST_NAMED {len(P.CONSTANTS)}
 #define SR_GEN_NX {S.NX}
 #define SR_GEN_NU {S.NU}
 #define SR_GEN_NV {S.NV}
@@ -298,14 +386,41 @@ def source_text(emitted):
     return banner() + f'#include "{HEADER_NAME}"\n\n' + "\n".join(text for text, _ in emitted)
 
 
+def pool_constants(ks):
+    """The kernels with their parameter-only subexpressions moved into the constants kernel.
+
+    Returns (kernels, constants): `constants` is the layout of the constants
+    array, the twelve named constants of `parameters.CONSTANTS` first.
+    """
+    pool = ConstantPool(P.CONSTANTS)
+
+    def hoisted(kernel):
+        if "c" not in kernel.inputs:
+            return kernel
+        outputs = tuple(dataclasses.replace(o, exprs=tuple(pool.hoist(e) for e in o.exprs)) for o in kernel.outputs)
+        return dataclasses.replace(kernel, outputs=outputs)
+
+    ks = tuple(hoisted(k) for k in ks)
+    in_parameters = dict(zip(P.CONSTANTS, P.constant_expressions()))
+    pooled = tuple(e.xreplace(in_parameters) for e in pool.expressions())
+    first = len(P.CONSTANTS)
+    listing = "".join(f"\n *   c[{first + i}] {k} = {sp.sstr(e)}"
+                      for i, (k, e) in enumerate(zip(pool.symbols(), pool.expressions())))
+    constants = tuple(P.constant_expressions()) + pooled
+    ks = tuple(dataclasses.replace(k, doc=k.doc + listing, outputs=(dataclasses.replace(k.outputs[0], exprs=constants),))
+               if k.name == "constants" else k for k in ks)
+    return ks, tuple(P.CONSTANTS) + pool.symbols()
+
+
 def write(out_dir):
     """The one place that writes files: generated/sr_generated.{{h,c}}."""
     out_dir = pathlib.Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    ks = kernels()
-    emitted = [emit_kernel(k) for k in ks]
+    ks, constants = pool_constants(kernels())
+    layouts = array_layouts(constants)
+    emitted = [emit_kernel(k, layouts) for k in ks]
     flops = {k.name: n for k, (_, n) in zip(ks, emitted)}
-    files = {HEADER_NAME: header_text(ks, flops), SOURCE_NAME: source_text(emitted)}
+    files = {HEADER_NAME: header_text(ks, flops, len(constants)), SOURCE_NAME: source_text(emitted)}
     for name, text in files.items():
         tmp = out_dir / (name + ".tmp")
         tmp.write_text(text)

@@ -3,7 +3,9 @@ import sympy as sp
 
 from derive import dynamics as D
 from derive import lagrangian as L
+from derive import newton_euler as NE
 from derive import state as S
+from derive import yoke_frame as YF
 
 
 def test_inertia_is_symmetric():
@@ -48,3 +50,22 @@ def test_equilibrium_check_can_fail():
     a = D.pendulum_axis()
     wrong = sp.expand(res[0] - 2 * D.cross(a, S.gamma)[0])
     assert wrong != 0
+
+
+def test_body_by_body_rhs_equals_the_euler_poincare_rhs():
+    assert NE.check_equal_to_rhs() == [0] * 5
+
+
+def test_body_by_body_check_can_fail():
+    """A wrong sign on one body's gyroscopic torque does not reduce to zero."""
+    wrong = NE.rhs()[0] + 2 * NE.yoke_bias_torque()[0]
+    assert D.on_manifold(sp.expand(wrong - D.rhs()[0])) != 0
+
+
+def test_yoke_frame_forms_equal_the_shell_frame_forms():
+    assert YF.check_equivalence() == [0] * 30
+
+
+def test_yoke_and_pendulum_rates_do_not_couple():
+    """M_34 = 0 is what lets the accel kernel eliminate the joint accelerations first."""
+    assert D.inertia()[3, 4] == 0

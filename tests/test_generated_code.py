@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import pytest
+import sympy as sp
 
 from conftest import ROOT
 
@@ -47,3 +48,31 @@ def test_c_compiles_cleanly_as_c99(scalar, source, tmp_path):
     cc = shutil.which("cc") or shutil.which("gcc")
     flags = WARNINGS + ["-O2", "-Igenerated", "-Ic"] + (["-DSR_USE_FLOAT"] if scalar == "float" else [])
     subprocess.run([cc, *flags, "-c", source, "-o", str(tmp_path / "out.o")], cwd=ROOT, check=True)
+
+
+def test_constant_pool_moves_parameter_only_subexpressions_out_of_the_kernels():
+    from derive import parameters as P
+    from derive.codegen import ConstantPool
+    from derive.state import gamma
+    pool = ConstantPool(P.CONSTANTS)
+    expr = P.l * P.m_P * P.r / 2 * gamma[0] - P.l * P.m_P * P.r / 2 * gamma[1] + P.j_P + P.j_S
+    hoisted = pool.hoist(expr)
+    assert hoisted.free_symbols <= {gamma[0], gamma[1], *pool.symbols()}
+    assert len(pool.symbols()) == 2          # l m_P r / 2 (once, for both signs) and j_P + j_S
+    back = hoisted.xreplace(dict(zip(pool.symbols(), pool.expressions())))
+    assert sp.expand(back - expr) == 0
+
+
+def test_joint_first_solve_refuses_coupled_joints():
+    from derive import dynamics as D
+    from derive.codegen import joint_first_system
+    M = D.inertia().copy()
+    M[3, 4] = M[4, 3] = sp.Symbol("c34")
+    with pytest.raises(ValueError, match="M_34"):
+        joint_first_system(M, D.rhs())
+
+
+def test_code_generation_refuses_an_unproven_form():
+    from derive.codegen import proven
+    with pytest.raises(ValueError, match="differs from the derivation"):
+        proven("test", [0, sp.Symbol("x")])
