@@ -2,8 +2,8 @@
  *
  * usage: bench_kernels INPUT.bin REPEATS
  * INPUT.bin: int32 n, then params[12], states[n][35], inputs[n][2] (float64).
- * Prints one JSON object: ns per call of each kernel (best of 11 runs of REPEATS
- * sweeps over the n states) and the outputs for the first 8 states, which the
+ * Prints one JSON object: ns per call of each kernel (best of 11 rounds, each kernel timed
+ * once per round over REPEATS sweeps of the n states, after a 0.3 s warm-up) and the outputs for the first 8 states, which the
  * Python driver checks against the reference before reporting any time.
  * Built by runtime/bench.py; with -DWITH_CASADI the CasADi-generated reference
  * (ref_accel.c, written by the driver) is timed too.
@@ -53,29 +53,54 @@ static int k_casadi(const sr_model *m, int i, int arg)
 }
 #endif
 
-static double time_kernel(kernel_fn fn, int arg, int n, int repeats, int nout, const char *name)
+typedef struct {
+    kernel_fn fn;
+    int arg, nout, repeat_divisor;
+    const char *name;
+    double best;
+} bench_case;
+
+/* One timed sweep: `repeats` passes over the n states, ns per call. */
+static double sweep(const bench_case *c, int n, int repeats)
 {
-    double best = 1e300;
-    int run, r, i, k;
-    for (run = 0; run < 11; ++run) {
-        double t0 = now_ns(), dt;
-        for (r = 0; r < repeats; ++r)
-            for (i = 0; i < n; ++i) {
-                if (fn(&model, i, arg) != 0) { fprintf(stderr, "%s failed at state %d\n", name, i); exit(2); }
-                sink += OUT[i][0];
-            }
-        dt = (now_ns() - t0) / ((double)repeats * n);
-        if (dt < best) best = dt;
-    }
-    printf("  \"%s\": {\"ns\": %.3f, \"check\": [", name, best);
+    double t0 = now_ns();
+    int r, i, reps = repeats / c->repeat_divisor > 0 ? repeats / c->repeat_divisor : 1;
+    for (r = 0; r < reps; ++r)
+        for (i = 0; i < n; ++i) {
+            if (c->fn(&model, i, c->arg) != 0) { fprintf(stderr, "%s failed at state %d\n", c->name, i); exit(2); }
+            sink += OUT[i][0];
+        }
+    return (now_ns() - t0) / ((double)reps * n);
+}
+
+static void print_case(const bench_case *c, int n)
+{
+    int i, k;
+    printf("  \"%s\": {\"ns\": %.3f, \"check\": [", c->name, c->best);
     for (i = 0; i < NCHECK && i < n; ++i) {
-        fn(&model, i, arg);
+        c->fn(&model, i, c->arg);
         printf("%s[", i ? ", " : "");
-        for (k = 0; k < nout; ++k) printf("%s%.17g", k ? ", " : "", (double)OUT[i][k]);
+        for (k = 0; k < c->nout; ++k) printf("%s%.17g", k ? ", " : "", (double)OUT[i][k]);
         printf("]");
     }
     printf("]},\n");
-    return best;
+}
+
+/* Warm up (clock and caches) for at least 0.3 s, then 11 rounds that time every kernel once
+ * each, round robin, so that a change of clock speed during the run affects all of them alike;
+ * the best round of each kernel is reported. */
+static void time_all(bench_case *cases, int ncases, int n, int repeats)
+{
+    double start = now_ns();
+    int round, k;
+    while (now_ns() - start < 3e8)
+        for (k = 0; k < ncases; ++k) sweep(&cases[k], n, 1);
+    for (k = 0; k < ncases; ++k) cases[k].best = 1e300;
+    for (round = 0; round < 11; ++round)
+        for (k = 0; k < ncases; ++k) {
+            double dt = sweep(&cases[k], n, repeats);
+            if (dt < cases[k].best) cases[k].best = dt;
+        }
 }
 
 int main(int argc, char **argv)
@@ -100,20 +125,24 @@ int main(int argc, char **argv)
             || sz_w > (casadi_int)(sizeof w / sizeof w[0])) { fprintf(stderr, "CasADi work arrays too small\n"); return 2; }
     }
 #endif
-    printf("{\n");
-    time_kernel(k_accel, 0, n, repeats, SR_NV, "accel");
-    time_kernel(k_gen_accel, 0, n, repeats, SR_NV, "accel_unchecked");
-    time_kernel(k_inertia, 0, n, repeats, SR_NV * SR_NV, "inertia");
-    time_kernel(k_step, SR_LIE_EULER, n, repeats, SR_NX, "step_lie_euler");
-#ifdef SR_RKMK4
-    time_kernel(k_step, SR_RKMK4, n, repeats, SR_NX, "step_rkmk4");
-#endif
-#ifdef SR_CF4
-    time_kernel(k_step, SR_CF4, n, repeats, SR_NX, "step_cf4");
-#endif
+    {
+        bench_case cases[] = {
+            {k_accel, 0, SR_NV, 1, "accel", 0},
+            {k_gen_accel, 0, SR_NV, 1, "accel_unchecked", 0},
+            {k_inertia, 0, SR_NV * SR_NV, 1, "inertia", 0},
+            {k_step, SR_LIE_EULER, SR_NX, 1, "step_lie_euler", 0},
+            {k_step, SR_RKMK4, SR_NX, 1, "step_rkmk4", 0},
+            {k_step, SR_CF4, SR_NX, 1, "step_cf4", 0},
 #ifdef WITH_CASADI
-    time_kernel(k_casadi, 0, n, repeats > 10 ? repeats / 10 : 1, SR_NV, "casadi_generated_reference_accel");
+            {k_casadi, 0, SR_NV, 10, "casadi_generated_reference_accel", 0},
 #endif
+        };
+        const int ncases = (int)(sizeof cases / sizeof cases[0]);
+        int k;
+        time_all(cases, ncases, n, repeats);
+        printf("{\n");
+        for (k = 0; k < ncases; ++k) print_case(&cases[k], n);
+    }
     printf("  \"accel_flops\": %d,\n  \"sink\": %g\n}\n", SR_GEN_ACCEL_FLOPS, sink);
     return 0;
 }

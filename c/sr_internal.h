@@ -33,9 +33,21 @@
 /* Offsets of the blocks of the state x (see spherical_robot.h). */
 enum { RS = 0, RY = 9, RP = 18, Q = 27, W = 30 };
 
+/* A NaN or an infinity anywhere makes the sum non-finite, so one test of the sum (four partial
+ * sums, to keep the chain of additions short) clears the common case; a sum that is not finite
+ * (a bad entry, or finite entries whose sum overflowed) is decided entry by entry. */
 static inline int all_finite(const sr_real *v, int n)
 {
+    sr_real s0 = 0, s1 = 0, s2 = 0, s3 = 0;
     int i;
+    for (i = 0; i + 4 <= n; i += 4) {
+        s0 += v[i];
+        s1 += v[i + 1];
+        s2 += v[i + 2];
+        s3 += v[i + 3];
+    }
+    for (; i < n; ++i) s0 += v[i];
+    if (isfinite((s0 + s1) + (s2 + s3))) return 1;
     for (i = 0; i < n; ++i)
         if (!isfinite(v[i])) return 0;
     return 1;

@@ -103,11 +103,25 @@ class ConstantPool:
             return expr
         if expr.free_symbols <= self.base:
             return self._name(expr)
+        if expr.is_Add:
+            expr = self._collect(expr)
+            if not expr.is_Add:
+                return self.hoist(expr)
         if expr.is_Add or expr.is_Mul:
             const = [a for a in expr.args if a.free_symbols <= self.base]
             rest = [self.hoist(a) for a in expr.args if not a.free_symbols <= self.base]
             return expr.func(self._name(expr.func(*const)), *rest) if const else expr.func(*rest)
         return expr.func(*[self.hoist(a) for a in expr.args])
+
+    def _collect(self, add):
+        """c₁ m + c₂ m -> (c₁ + c₂) m for terms with the same non-constant factor m (one product instead of two)."""
+        groups = {}
+        for term in add.args:
+            const, var = term.as_independent(*(term.free_symbols - self.base), as_Add=False)
+            groups.setdefault(var, []).append(const)
+        if all(len(c) == 1 for c in groups.values()):
+            return add
+        return sp.Add(*[sp.Add(*consts) * var for var, consts in groups.items()])
 
     def symbols(self):
         return tuple(self.table.values())
@@ -231,11 +245,12 @@ def joint_first_system(M, f):
     )
 
 
-def emit_shell_solve(printer, out_name, rotation):
+def emit_shell_solve(printer, out_name, rotation, zero):
     """C for the rest of `joint_first_system`: S by its adjugate, then the joint accelerations.
 
     The shell accelerations come out in the frame of the system (the yoke
     frame, see `derive.yoke_frame`) and are written as `rotation` times them.
+    Couplings named in `zero` are identically zero and left out.
 
     M is positive definite iff M_33, M_44 and the leading minors of S are
     positive; as in an LDLᵀ, each pivot of S/M_33 must exceed SR_GEN_PIVOT_TOL
@@ -265,7 +280,7 @@ def emit_shell_solve(printer, out_name, rotation):
         terms = " + ".join(f"C_{min(i, j)}_{max(i, j)}*g_{j}" for j in shell)
         lines.append(f"    const sr_real a_{i} = ({terms})*inv_det_S;")
     for k in (3, 4):
-        terms = "".join(f" - B_{i}_{k}*a_{i}" for i in shell)
+        terms = "".join(f" - B_{i}_{k}*a_{i}" for i in shell if f"B_{i}_{k}" not in zero)
         lines.append(f"    const sr_real a_{k} = (f_{k}{terms})*inv_d_{k};")
     a = sp.symbols("a_0:5", real=True)
     shell_out = rotation * sp.Matrix(a[0:3])
@@ -308,16 +323,17 @@ def emit_kernel(kernel, layouts):
     used = set().union(*(e.free_symbols for e in exprs)) if exprs else set()
     body = emit_inputs(kernel, used, layouts)
     body += emit_assignments(printer, temporaries, declare=True)
-    k = 0
+    k, zero = 0, set()
     for out in kernel.outputs:
         values = reduced[k:k + len(out.exprs)]
         k += len(out.exprs)
         if out.local_names:
-            body += emit_assignments(printer, zip(out.local_names, values), declare=True)
+            zero |= {n for n, v in zip(out.local_names, values) if v == 0}
+            body += emit_assignments(printer, [(n, v) for n, v in zip(out.local_names, values) if v != 0], declare=True)
         else:
             body += [f"    {out.name}[{i}] = {printer.doprint(v)};" for i, v in enumerate(values)]
     if kernel.solve:
-        body += emit_shell_solve(printer, "a", S.R_Y)
+        body += emit_shell_solve(printer, "a", S.R_Y, zero)
     body.append("    return SR_GEN_OK;")
     doc = f"/* {kernel.doc} */"
     return "\n".join([doc, signature(kernel), "{", *body, "}", ""]), count_flops(body)
