@@ -33,10 +33,9 @@
 /* Offsets of the blocks of the state x (see spherical_robot.h). */
 enum { RS = 0, RY = 9, RP = 18, Q = 27, W = 30 };
 
-/* A NaN or an infinity anywhere makes the sum non-finite, so one test of the sum (four partial
- * sums, to keep the chain of additions short) clears the common case; a sum that is not finite
- * (a bad entry, or finite entries whose sum overflowed) is decided entry by entry. */
-static inline int all_finite(const sr_real *v, int n)
+/* Sum in four lanes (a short chain of additions, which compilers vectorize).  A NaN or an
+ * infinity anywhere makes the sum non-finite; so can finite entries that overflow. */
+static inline sr_real lane_sum(const sr_real *v, int n)
 {
     sr_real s0 = 0, s1 = 0, s2 = 0, s3 = 0;
     int i;
@@ -47,7 +46,14 @@ static inline int all_finite(const sr_real *v, int n)
         s3 += v[i + 3];
     }
     for (; i < n; ++i) s0 += v[i];
-    if (isfinite((s0 + s1) + (s2 + s3))) return 1;
+    return (s0 + s1) + (s2 + s3);
+}
+
+/* One test of the sum clears the common case; otherwise entry by entry. */
+static inline int all_finite(const sr_real *v, int n)
+{
+    int i;
+    if (isfinite(lane_sum(v, n))) return 1;
     for (i = 0; i < n; ++i)
         if (!isfinite(v[i])) return 0;
     return 1;
@@ -61,7 +67,17 @@ static inline int near(sr_real a, sr_real b) { return SR_FABS(a - b) <= SR_ROTAT
 static inline int checks(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU])
 {
     const sr_real *gam = x + RS + 6;
+    sr_real sum, worst, defect;
     if (!model || !x) return SR_ERR_NULL;
+    /* Fast path, one branch: the sum of all entries finite and the largest unit-length defect
+     * within tolerance (a NaN fails both tests).  Anything else is sorted out below, in order. */
+    sum = lane_sum(x, SR_NX) + (u ? u[0] + u[1] : 0);
+    worst = SR_FABS(gam[0] * gam[0] + gam[1] * gam[1] + gam[2] * gam[2] - 1);
+    defect = SR_FABS(x[RY + 4] * x[RY + 4] + x[RY + 7] * x[RY + 7] - 1);
+    worst = defect > worst ? defect : worst;
+    defect = SR_FABS(x[RP + 0] * x[RP + 0] + x[RP + 2] * x[RP + 2] - 1);
+    worst = defect > worst ? defect : worst;
+    if (isfinite(sum) && worst <= SR_ROTATION_TOL) return SR_OK;
     if (!all_finite(x, SR_NX) || (u && !all_finite(u, SR_NU))) return SR_ERR_NONFINITE;
     if (!near(gam[0] * gam[0] + gam[1] * gam[1] + gam[2] * gam[2], 1)) return SR_ERR_NOT_ROTATION;
     if (!near(x[RY + 4] * x[RY + 4] + x[RY + 7] * x[RY + 7], 1)) return SR_ERR_NOT_ROTATION;

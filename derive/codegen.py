@@ -49,6 +49,7 @@ class Kernel:
     inputs: tuple          # subset of ("p", "c", "x", "u"), in argument order
     outputs: tuple         # Output instances, written in this order
     solve: bool = False    # outputs are the locals of joint_first_system; write ν̇ = M⁻¹ f instead
+    definitions: tuple = ()  # (symbol, expression) intermediates the outputs use (newton_euler.Program)
 
 
 INPUT_DOCS = {
@@ -139,23 +140,31 @@ def proven(name, residuals):
         raise ValueError(f"{name}: the evaluated form differs from the derivation: {residuals}")
 
 
-def fast_rhs():
-    """f in the body-by-body form, after checking it against the Euler–Poincaré derivation."""
+def rhs_program():
+    """f body by body in the shell frame: (definitions, f), after the proof of `newton_euler`."""
     proven("newton_euler", NE.check_equal_to_rhs())
-    return NE.rhs()
+    p, f = NE.program()
+    return tuple(p.definitions), f
 
 
-def accel_system():
-    """M and f in the yoke frame, evaluated at the shell-frame state (after the proof of `yoke_frame`)."""
+def accel_program():
+    """(definitions, outputs of joint_first_system) in the yoke frame, at the shell-frame state.
+
+    After the proofs of `newton_euler` and `yoke_frame`.
+    """
     proven("newton_euler", NE.check_equal_to_rhs())
     proven("yoke_frame", YF.check_equivalence())
     sub = YF.from_shell_frame()
-    return joint_first_system(YF.inertia().xreplace(sub), YF.rhs().xreplace(sub))
+    p, f = YF.program()
+    definitions = tuple((symbol, value.xreplace(sub)) for symbol, value in p.definitions)
+    return definitions, joint_first_system(YF.inertia().xreplace(sub), f.xreplace(sub))
 
 
 def kernels():
     """The functions to emit."""
-    M, f = D.inertia(), fast_rhs()
+    M = D.inertia()
+    rhs_definitions, f = rhs_program()
+    accel_definitions, accel_outputs = accel_program()
     return (
         Kernel("constants", "Derived constants of Section 2.3 from the twelve parameters, c[0..11] ="
                " (r, l, g, m_P, m_R, j_S, j_xx, j_yy, j_P, k_S, k_Y, k_P), then the parameter-only"
@@ -164,13 +173,13 @@ def kernels():
         Kernel("inertia", "Generalized inertia M(γ, R_Y, R_P), row-major 5x5, kinetic energy ½νᵀMν.",
                ("c", "x"), (Output("M", tuple(M), "M, row-major 5x5"),)),
         Kernel("rhs", "Right-hand side f of M ν̇ = f: gyroscopic, non-holonomic, gravity, motor and friction terms.",
-               ("c", "x", "u"), (Output("f", tuple(f), "f"),)),
+               ("c", "x", "u"), (Output("f", tuple(f), "f"),), definitions=rhs_definitions),
         Kernel("energy", "Total energy: ½νᵀMν + m_P g e_zᵀ(q + R_S R_Y R_P c̄_P) [J].",
                ("c", "x"), (Output("E", (D.energy(),), "energy"),)),
         Kernel("equilibrium_residual", "f at ν = 0, u = 0 (eq. 106); zero iff R_S R_Y R_P e_z = ±e_z (eq. 108).",
                ("c", "x"), (Output("res", tuple(D.equilibrium_residual()), "residual"),)),
         Kernel("accel", "ν̇ = (ω̇_S, ω̇_Y, ω̇_P) solving M ν̇ = f, joints first; SR_GEN_SINGULAR if M is not positive definite.",
-               ("c", "x", "u"), accel_system(), solve=True),
+               ("c", "x", "u"), accel_outputs, solve=True, definitions=accel_definitions),
     )
 
 
@@ -315,14 +324,35 @@ def count_flops(lines):
     return flops
 
 
+def dependency_order(nodes, roots):
+    """The (symbol, expression) nodes the roots need, each after the nodes it uses (depth first, roots in order)."""
+    definition = dict(nodes)
+    rank = {symbol: i for i, (symbol, _) in enumerate(nodes)}
+    done, order = set(), []
+
+    def visit(expr):
+        for symbol in sorted(expr.free_symbols & definition.keys(), key=rank.get):
+            if symbol not in done:
+                done.add(symbol)
+                visit(definition[symbol])
+                order.append((symbol, definition[symbol]))
+
+    for root in roots:
+        visit(root)
+    return order
+
+
 def emit_kernel(kernel, layouts):
     """C text of one kernel and its flop count."""
     printer = Printer()
-    exprs = [e for o in kernel.outputs for e in o.exprs]
+    defined = [symbol for symbol, _ in kernel.definitions]
+    exprs = [value for _, value in kernel.definitions] + [e for o in kernel.outputs for e in o.exprs]
     temporaries, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"), order="canonical")
-    used = set().union(*(e.free_symbols for e in exprs)) if exprs else set()
+    definitions, reduced = list(zip(defined, reduced[:len(defined)])), reduced[len(defined):]
+    used = set().union(*(e.free_symbols for e in exprs)) - set(defined) if exprs else set()
     body = emit_inputs(kernel, used, layouts)
-    body += emit_assignments(printer, temporaries, declare=True)
+    nodes = temporaries + definitions
+    body += emit_assignments(printer, dependency_order(nodes, [s for s, _ in nodes] + reduced), declare=True)
     k, zero = 0, set()
     for out in kernel.outputs:
         values = reduced[k:k + len(out.exprs)]
@@ -331,7 +361,7 @@ def emit_kernel(kernel, layouts):
             zero |= {n for n, v in zip(out.local_names, values) if v == 0}
             body += emit_assignments(printer, [(n, v) for n, v in zip(out.local_names, values) if v != 0], declare=True)
         else:
-            body += [f"    {out.name}[{i}] = {printer.doprint(v)};" for i, v in enumerate(values)]
+            body += emit_assignments(printer, [(f"{out.name}[{i}]", v) for i, v in enumerate(values)], declare=False)
     if kernel.solve:
         body += emit_shell_solve(printer, "a", S.R_Y, zero)
     body.append("    return SR_GEN_OK;")
@@ -414,7 +444,8 @@ def pool_constants(ks):
         if "c" not in kernel.inputs:
             return kernel
         outputs = tuple(dataclasses.replace(o, exprs=tuple(pool.hoist(e) for e in o.exprs)) for o in kernel.outputs)
-        return dataclasses.replace(kernel, outputs=outputs)
+        definitions = tuple((symbol, pool.hoist(value)) for symbol, value in kernel.definitions)
+        return dataclasses.replace(kernel, outputs=outputs, definitions=definitions)
 
     ks = tuple(hoisted(k) for k in ks)
     in_parameters = dict(zip(P.CONSTANTS, P.constant_expressions()))

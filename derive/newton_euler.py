@@ -4,94 +4,116 @@
 non-holonomic Euler–Poincaré equations (eqs. 78, 84, 85).  Expanded into
 monomials it costs about 345 flops.  The same vector, written as d'Alembert's
 principle for the three bodies about the shell centre O (Newton–Euler about a
-moving point), costs about 200, because it keeps the angular velocities and
-accelerations of the bodies as intermediate vectors.  `check_equal_to_rhs`
-proves the two forms equal modulo the unit-norm identities; `make generate`
-runs that proof before it emits this form.
+moving point), costs 169 (104 in the yoke frame, see `derive.yoke_frame`),
+because the angular velocities and accelerations of the bodies are kept as
+named intermediates (`Program`).  `check_equal_to_rhs` proves the two forms
+equal modulo the unit-norm identities; `make generate` runs that proof
+before it emits this form.
 
-All vectors are in the shell frame.  Body quantities about O:
+Body quantities about O, in the frame where the yoke's attitude is R_Y:
 
     shell      mass at O (all of m_R, the rolling mass), inertia j_S I, angular velocity ω_S
-    yoke       inertia I_Y = R_Y J_Y R_Yᵀ with J_Y = tr(Ĵ_Y) I − Ĵ_Y, angular velocity ω_S + ω_Y e_x
+    yoke       inertia I_Y = R_Y J_Y R_Yᵀ with J_Y = tr(Ĵ_Y) I − Ĵ_Y, angular velocity ω_y = ω_S + ω_Y e_x
     pendulum   first moment h = m_P ξ (ξ = R_Y R_P c̄_P), inertia about O
                I_O = j_P (I − a aᵀ) (the standard tensor of Ĵ_P) with a = R_Y R_P e_z,
-               angular velocity ω_p = ω_S + ω_Y e_x + ω_P e, e = R_Y e_y (eq. 29)
+               angular velocity ω_p = ω_y + ω_P e, e = R_Y e_y (eq. 29)
 
 The acceleration of O is r ω̇_S × γ (no velocity-dependent part: q̈ = r R_S ω̇_S × e_z
 since Ω_S ω_S = 0), and gravity enters as an upward acceleration g γ of O.
 With ν̇ = 0 the inertial forces and torques about O reduce to their bias
 parts, and f = (applied generalized forces) − (projections of the bias onto
-the partial velocities ∂v_O/∂ν = r(· × γ), ∂ω_Y/∂ν = (I, e_x, 0),
+the partial velocities ∂v_O/∂ν = r(· × γ), ∂ω_y/∂ν = (I, e_x, 0),
 ∂ω_p/∂ν = (I, e_x, e)).
 """
 import sympy as sp
 
 from . import dynamics as D
-from . import lagrangian as L
 from . import parameters as P
 from . import state as S
 
 _e_x = sp.Matrix([1, 0, 0])
 
 
-def joint_axis():
-    """e = R_Y e_y: the pendulum's rotation axis in the shell frame."""
-    return S.R_Y * sp.Matrix([0, 1, 0])
+class Program:
+    """A straight-line program: named intermediate quantities in order of definition.
+
+    Kept as symbols, the body quantities (ω_y, α_P, τ_Y, ...) are computed
+    once and shared, which CSE alone does not recover once SymPy has
+    distributed the constants into nested vector expressions (120 flops for
+    f in the yoke frame instead of 104).  `inline` substitutes them back.
+    """
+
+    def __init__(self):
+        self.definitions = []      # (symbol, expression), each using only earlier symbols
+
+    def let(self, name, value):
+        """A symbol (or a vector of symbols) standing for value; atoms and zeros are used as they are."""
+        if isinstance(value, sp.MatrixBase):
+            return sp.Matrix([self.let(f"{name}_{'xyz'[i]}", v) for i, v in enumerate(value)])
+        value = sp.sympify(value)
+        if value.is_Atom:
+            return value
+        symbol = sp.Symbol(name, real=True)
+        self.definitions.append((symbol, value))
+        return symbol
+
+    def inline(self, exprs):
+        """exprs with every defined symbol replaced by its definition."""
+        exprs = sp.Matrix(exprs)
+        for symbol, value in reversed(self.definitions):
+            exprs = exprs.xreplace({symbol: value})
+        return exprs
 
 
-def shaft():
-    """a = R_Y R_P e_z: the pendulum's shaft direction; ξ = −(l/2) a."""
-    return S.R_Y * S.R_P * P.e_z()
+def joint_axis(R_Y):
+    """e = R_Y e_y: the pendulum's rotation axis."""
+    return R_Y * sp.Matrix([0, 1, 0])
 
 
-def joint_velocity():
-    """ω_Y e_x + ω_P e: the pendulum's angular velocity relative to the shell."""
-    return S.w_Y * _e_x + S.w_P * joint_axis()
+def shaft(R_Y):
+    """a = R_Y R_P e_z: the pendulum's shaft direction; its centre of mass is ξ = c̄_P,z a = −(l/2) a."""
+    return R_Y * S.R_P * P.e_z()
 
 
-def yoke_inertia(x):
+def yoke_inertia(R_Y, x):
     """I_Y x = R_Y J_Y R_Yᵀ x, with J_Y = tr(Ĵ_Y) I − Ĵ_Y the standard tensor of Ĵ_Y (Section 2.3)."""
     J_Y = P.Jhat_Y().trace() * sp.eye(3) - P.Jhat_Y()
-    return S.R_Y * (J_Y * (S.R_Y.T * x))
+    return R_Y * (J_Y * (R_Y.T * x))
 
 
-def yoke_bias_torque():
-    """I_Y α_Y + ω_y × I_Y ω_y at ν̇ = 0, where α_Y = ω_Y ω_S × e_x."""
-    w_y = S.w_S + S.w_Y * _e_x
-    return yoke_inertia(S.w_Y * S.w_S.cross(_e_x)) + w_y.cross(yoke_inertia(w_y))
+def program(R_Y=S.R_Y):
+    """f body by body as a straight-line program; returns (program, f).
 
-
-def pendulum_bias_acceleration():
-    """α_P at ν̇ = 0: ω_S × (ω_Y e_x + ω_P e) + ω_Y ω_P e_x × e."""
-    return S.w_S.cross(joint_velocity()) + S.w_Y * S.w_P * _e_x.cross(joint_axis())
-
-
-def pendulum_bias_torque():
-    """I_O α_P + ω_p × I_O ω_p + h × g γ at ν̇ = 0, with I_O = j_P(I − a aᵀ).
-
-    ω_p × I_O ω_p = −j_P (a·ω_p) ω_p × a, since ω_p × ω_p = 0.
+    Vectors are in the frame in which the yoke's attitude is R_Y: the shell
+    frame (the default), or the yoke frame with R_Y = I (`derive.yoke_frame`).
     """
-    a, alpha = shaft(), pendulum_bias_acceleration()
-    w_p = S.w_S + joint_velocity()
-    h = P.m_P * L.pendulum_centre()
-    return P.j_P * (alpha - a * a.dot(alpha)) - P.j_P * a.dot(w_p) * w_p.cross(a) + P.g * h.cross(S.gamma)
-
-
-def pendulum_bias_force():
-    """α_P × h + ω_p × (ω_p × h): the pendulum's bias force (the rolling mass's m_R g γ is parallel to γ and drops)."""
-    alpha = pendulum_bias_acceleration()
-    w_p = S.w_S + joint_velocity()
-    h = P.m_P * L.pendulum_centre()
-    return alpha.cross(h) + w_p.cross(w_p.cross(h))
+    p = Program()
+    w, e, a = S.w_S, joint_axis(R_Y), p.let("a", shaft(R_Y))
+    w_y = p.let("w_y", w + S.w_Y * _e_x)                                   # yoke angular velocity
+    w_p = p.let("w_p", w_y + S.w_P * e)                                    # pendulum angular velocity (eq. 29)
+    # Bias angular accelerations (ν̇ = 0): α_Y = ω_Y ω × e_x, α_P = ω × (ω_Y e_x + ω_P e) + ω_Y ω_P e_x × e.
+    alpha_P = p.let("alpha_P", w.cross(S.w_Y * _e_x + S.w_P * e) + S.w_Y * S.w_P * _e_x.cross(e))
+    # Yoke: I_Y α_Y + ω_y × I_Y ω_y.
+    tau_Y = p.let("tau_Y", yoke_inertia(R_Y, S.w_Y * w.cross(_e_x)) + w_y.cross(yoke_inertia(R_Y, w_y)))
+    # Pendulum about O, I_O = j_P (I − a aᵀ), first moment h = m_P ξ = κ a:
+    # I_O α_P + ω_p × I_O ω_p + h × g γ, with ω_p × I_O ω_p = −j_P (a·ω_p) ω_p × a.
+    kappa = P.m_P * P.cbar_P()[2]
+    a_alpha, a_w = p.let("a_alpha", a.dot(alpha_P)), p.let("a_w", a.dot(w_p))
+    w_x_a = p.let("w_x_a", w_p.cross(a))
+    tau_P = p.let("tau_P", P.j_P * (alpha_P - a_alpha * a) - P.j_P * a_w * w_x_a + P.g * kappa * a.cross(S.gamma))
+    # Pendulum bias force α_P × h + ω_p × (ω_p × h); the rolling mass's m_R g γ is parallel to γ and drops.
+    F = p.let("F", kappa * (alpha_P.cross(a) + w_p.cross(w_x_a)))
+    T = p.let("T", tau_Y + tau_P)
+    shell = -P.k_S * w - (P.r * S.gamma.cross(F) + T)
+    yoke = S.u_Y - P.k_Y * S.w_Y - _e_x.dot(T)
+    pendulum = S.u_P - P.k_P * S.w_P - e.dot(tau_P)
+    return p, sp.Matrix([*shell, yoke, pendulum])
 
 
 def rhs():
-    """f of M ν̇ = f, body by body (equal to `dynamics.rhs()` on valid states)."""
-    tau_Y, tau_P = yoke_bias_torque(), pendulum_bias_torque()
-    shell = -P.k_S * S.w_S - (P.r * S.gamma.cross(pendulum_bias_force()) + tau_Y + tau_P)
-    yoke = S.u_Y - P.k_Y * S.w_Y - _e_x.dot(tau_Y + tau_P)
-    pendulum = S.u_P - P.k_P * S.w_P - joint_axis().dot(tau_P)
-    return sp.Matrix([*shell, yoke, pendulum])
+    """f of M ν̇ = f, body by body, as one expression (equal to `dynamics.rhs()` on valid states)."""
+    p, f = program()
+    return p.inline(f)
 
 
 def check_equal_to_rhs():

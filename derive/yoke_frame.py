@@ -34,9 +34,15 @@ def inertia():
     return D.inertia().xreplace(_IDENTITY)
 
 
+def program():
+    """f(γ', I, R_P, ν') body by body, as a straight-line program (γ and ω_S standing for γ', ω')."""
+    return NE.program(sp.eye(3))
+
+
 def rhs():
-    """f(γ', I, R_P, ν'): the body-by-body right-hand side in the yoke frame, γ and ω_S standing for γ', ω'."""
-    return NE.rhs().xreplace(_IDENTITY)
+    """f(γ', I, R_P, ν'): the body-by-body right-hand side in the yoke frame, as one expression."""
+    p, f = program()
+    return p.inline(f)
 
 
 def from_shell_frame():
