@@ -16,6 +16,7 @@ numeric literals go through SR_C() so both builds are clean under -Wall
 """
 import dataclasses
 import hashlib
+import heapq
 import pathlib
 import re
 
@@ -184,7 +185,7 @@ def kernels():
 
 
 class Printer(C99CodePrinter):
-    """C99 with sr_real literals and integer powers as products."""
+    """C99 numeric literals as sr_real: SR_C(0.5), SR_C(2.0) (the Scheduler prints everything else)."""
 
     def _print_Rational(self, expr):
         return f"SR_C({float(expr)!r})"
@@ -195,21 +196,109 @@ class Printer(C99CodePrinter):
     def _print_Integer(self, expr):
         return f"SR_C({int(expr)}.0)" if abs(int(expr)) > 1 else str(int(expr))
 
-    def _print_Pow(self, expr):
-        base, exp = expr.as_base_exp()
-        if exp.is_Integer and 1 < exp <= 6:
-            factor = self.parenthesize(base, 100)
-            return "(" + "*".join([factor] * int(exp)) + ")"
-        if exp == -1:
-            return f"SR_C(1.0)/{self.parenthesize(base, 100)}"
-        raise ValueError(f"unsupported power in generated code: {expr}")
+
+class Scheduler:
+    """Prints sums and products as trees that combine the earliest-ready operands first.
+
+    C evaluates a + b + c + d as ((a + b) + c) + d, and without -ffast-math
+    the compiler may not reassociate, so the shape of each printed expression
+    fixes its critical path.  Combining, like a Huffman code, the two
+    operands that are ready first, by a simple latency model (3 cycles per
+    addition or multiplication, 13 per division), shortens the chains of
+    dependent operations.  `ready` maps each local already assigned to the
+    modelled cycle at which its value is available; inputs are ready at 0.
+    """
+    ADD, MUL, DIV = 3, 3, 13
+
+    def __init__(self, printer):
+        self.printer = printer
+        self.ready = {}
+
+    def assign(self, name, expr):
+        """C text of expr, and note when `name` will be ready."""
+        text, time, negative = self._operand(sp.sympify(expr))
+        self.ready[str(name)] = time
+        if _balanced(text):
+            text = text[1:-1]
+        return f"-({text})" if negative and not text.isidentifier() else f"-{text}" if negative else text
+
+    def _operand(self, expr):
+        """(C text, ready time, negated?) for expr."""
+        if expr.is_Symbol:
+            return expr.name, self.ready.get(expr.name, 0), False
+        if expr.is_Number:
+            return self.printer.doprint(abs(expr)), 0, bool(expr < 0)
+        if expr.is_Add:
+            terms = []
+            for term in expr.args:
+                if term.could_extract_minus_sign():
+                    text, time, negative = self._operand(-term)
+                    terms.append((text, time, not negative))
+                else:
+                    terms.append(self._operand(term))
+            return self._combine(terms, self.ADD, additive=True)
+        if expr.is_Mul or expr.is_Pow:
+            coeff, rest = expr.as_coeff_Mul()
+            negative = bool(coeff < 0)
+            factors = [(self.printer.doprint(abs(coeff)), 0)] if abs(coeff) != 1 else []
+            divisors = []
+            for factor in sp.Mul.make_args(rest):
+                base, exp = factor.as_base_exp()
+                if not (exp.is_Integer and 0 < abs(exp) <= 6):
+                    base, exp = factor, sp.Integer(1)
+                if exp == 1 and not (base.is_Symbol or base.is_Add or base.is_Number):
+                    raise ValueError(f"unsupported expression in generated code: {factor}")
+                text, time, neg = self._operand(base)
+                negative ^= neg and exp % 2 == 1
+                (factors if exp > 0 else divisors).extend([(text, time)] * abs(int(exp)))
+            text, time, _ = self._combine([(x, t, False) for x, t in factors], self.MUL) if factors else ("SR_C(1.0)", 0, False)
+            if divisors:
+                den, den_time, _ = self._combine([(x, t, False) for x, t in divisors], self.MUL)
+                text, time = f"({text}/{den})", max(time, den_time) + self.DIV
+            return text, time, negative
+        raise ValueError(f"unsupported expression in generated code: {expr}")
+
+    @staticmethod
+    def _combine(operands, latency, additive=False):
+        """Combine the two earliest-ready operands until one is left; returns (text, time, negated?)."""
+        heap = [(t, i, x, n) for i, (x, t, n) in enumerate(operands)]
+        heapq.heapify(heap)
+        count = len(heap)
+        while len(heap) > 1:
+            t1, _, x1, n1 = heapq.heappop(heap)
+            t2, _, x2, n2 = heapq.heappop(heap)
+            if not additive:
+                x, n = f"({x1}*{x2})", False
+            elif n1 == n2:
+                x, n = f"({x1} + {x2})", n1
+            elif n2:
+                x, n = f"({x1} - {x2})", False
+            else:
+                x, n = f"({x2} - {x1})", False
+            heapq.heappush(heap, (max(t1, t2) + latency, count, x, n))
+            count += 1
+        t, _, x, n = heap[0]
+        return x, t, n
 
 
-def emit_assignments(printer, assignments, declare):
+def _balanced(text):
+    """True if text is one parenthesized group."""
+    if not (text.startswith("(") and text.endswith(")")):
+        return False
+    depth = 0
+    for i, ch in enumerate(text):
+        depth += ch == "("
+        depth -= ch == ")"
+        if depth == 0 and i < len(text) - 1:
+            return False
+    return True
+
+
+def emit_assignments(scheduler, assignments, declare):
     lines = []
     for name, expr in assignments:
         prefix = "const sr_real " if declare else ""
-        lines.append(f"    {prefix}{name} = {printer.doprint(expr)};")
+        lines.append(f"    {prefix}{name} = {scheduler.assign(name, expr)};")
     return lines
 
 
@@ -231,70 +320,65 @@ def joint_first_system(M, f):
     M = [A B; Bᵀ D] with A the 3×3 shell block and D = diag(M_33, M_44): the
     yoke and pendulum rates do not couple (M_34 = 0 identically, asserted
     here).  The shell accelerations solve S ω̇_S = g with the Schur complement
-    S = M_33 (A − B D⁻¹ Bᵀ) and g = M_33 (f_S − B D⁻¹ f_J); the factor M_33
-    keeps every division out of S and g (D⁻¹ M_33 = diag(1, M_33/M_44), and
-    1/M_44 = 1/j_P is a per-model constant), so the only division on the
-    critical path is 1/det S in `emit_shell_solve`.  Then
-    ω̇_J = D⁻¹ (f_J − Bᵀ ω̇_S).  These are symbolic, so CSE and the constant
+    S = A − β Bᵀ, g = f_S − β f_J, β = B D⁻¹ (1/M_44 = 1/j_P is a per-model
+    constant, and 1/M_33 is ready early, off the critical path); then
+    ω̇_J = D⁻¹ f_J − βᵀ ω̇_S.  These are symbolic, so CSE and the constant
     pool see them together with M and f.
     """
     if sp.simplify(M[3, 4]) != 0:
         raise ValueError("joint-first solve needs M_34 = 0: the yoke and pendulum rates couple")
     A, B, d3, d4 = M[0:3, 0:3], M[0:3, 3:5], M[3, 3], M[4, 4]
-    ratio = d3 / d4
-    S_ = d3 * A - B[:, 0] * B[:, 0].T - ratio * B[:, 1] * B[:, 1].T
-    g_ = d3 * f[0:3, 0] - B[:, 0] * f[3] - ratio * B[:, 1] * f[4]
+    beta = B * sp.diag(1 / d3, 1 / d4)
+    S_ = A - beta * B.T
+    g_ = f[0:3, 0] - beta * f[3:5, 0]
     return (
-        Output("S", upper_triangle(S_), "M_33 times the Schur complement, upper triangle", ("S_0_0", "S_0_1", "S_0_2", "S_1_1", "S_1_2", "S_2_2")),
-        Output("g", tuple(g_), "M_33 times the reduced right-hand side", ("g_0", "g_1", "g_2")),
-        Output("B", tuple(B), "shell-joint coupling, row-major 3x2", ("B_0_3", "B_0_4", "B_1_3", "B_1_4", "B_2_3", "B_2_4")),
-        Output("fJ", (f[3], f[4]), "joint right-hand sides", ("f_3", "f_4")),
-        Output("D", (d3, d4, 1 / d3, 1 / d4), "joint inertias and their reciprocals", ("M_3_3", "M_4_4", "inv_d_3", "inv_d_4")),
+        Output("S", upper_triangle(S_), "Schur complement, upper triangle", ("S_0_0", "S_0_1", "S_0_2", "S_1_1", "S_1_2", "S_2_2")),
+        Output("g", tuple(g_), "reduced right-hand side", ("g_0", "g_1", "g_2")),
+        Output("beta", tuple(beta), "B D^-1, row-major 3x2", ("beta_0_3", "beta_0_4", "beta_1_3", "beta_1_4", "beta_2_3", "beta_2_4")),
+        Output("fD", (f[3] / d3, f[4] / d4), "D^-1 f_J", ("fD_3", "fD_4")),
+        Output("D", (d3, d4), "joint inertias", ("M_3_3", "M_4_4")),
         Output("Mdiag", (M[0, 0], M[1, 1], M[2, 2]), "diagonal of A, the scale of the pivot tests", ("M_0_0", "M_1_1", "M_2_2")),
     )
 
 
-def emit_shell_solve(printer, out_name, rotation, zero):
-    """C for the rest of `joint_first_system`: S by its adjugate, then the joint accelerations.
-
-    The shell accelerations come out in the frame of the system (the yoke
-    frame, see `derive.yoke_frame`) and are written as `rotation` times them.
-    Couplings named in `zero` are identically zero and left out.
+def emit_shell_solve(scheduler, out_name, rotation, zero):
+    """C for the rest of `joint_first_system`: S ω̇' = g by the adjugate of S, then the joints.
 
     M is positive definite iff M_33, M_44 and the leading minors of S are
-    positive; as in an LDLᵀ, each pivot of S/M_33 must exceed SR_GEN_PIVOT_TOL
-    times M's diagonal entry (S's pivots are M_33 times those of the Schur
-    complement).  1/M_33 is formed before the test of M_33; a zero or
-    negative M_33 gives an infinity or a wrong sign that is never used.
+    positive; as in an LDLᵀ, each pivot must exceed SR_GEN_PIVOT_TOL times
+    M's diagonal entry.  1/M_33 is formed before its test: a zero or
+    negative M_33 gives an infinity or a wrong sign that is never used.  The
+    shell accelerations come out in the frame of the system (the yoke frame,
+    see `derive.yoke_frame`) and are written as `rotation` times them.
+    Couplings named in `zero` are identically zero and left out.
     """
-    shell = (0, 1, 2)
+    def sym(name):
+        return sp.Symbol(name, real=True)
 
-    def s(i, j):
-        return f"S_{min(i, j)}_{max(i, j)}"
+    S_ = sp.Matrix(3, 3, lambda i, j: sym(f"S_{min(i, j)}_{max(i, j)}"))
+    C_ = S_.adjugate()
+    C = sp.Matrix(3, 3, lambda i, j: sym(f"C_{min(i, j)}_{max(i, j)}"))
+    g, a = sp.Matrix([sym(f"g_{i}") for i in range(3)]), [sym(f"a_{i}") for i in range(5)]
+    beta = sp.Matrix(3, 2, lambda i, k: 0 if f"beta_{i}_{k + 3}" in zero else sym(f"beta_{i}_{k + 3}"))
 
-    lines = ["    /* M positive definite: the joint block, then the leading minors of S (C = adj S, symmetric). */",
+    def let(name, value):
+        return f"    const sr_real {name} = {scheduler.assign(name, value)};"
+
+    lines = ["    /* M positive definite: the joint block, then the leading minors of S; C = adj S (symmetric). */",
              "    if (!(M_3_3 > 0 && M_4_4 > 0)) return SR_GEN_SINGULAR;"]
-    for i, j in ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)):
-        p, q = [k for k in shell if k != i], [k for k in shell if k != j]
-        sign = "" if (i + j) % 2 == 0 else "-"
-        lines.append(f"    const sr_real C_{i}_{j} = {sign}({s(p[0], q[0])}*{s(p[1], q[1])} - {s(p[1], q[0])}*{s(p[0], q[1])});")
+    lines += [let(f"C_{i}_{j}", C_[i, j]) for i in range(3) for j in range(i, 3)]
     lines += [
-        "    const sr_real det_S = S_0_0*C_0_0 + S_0_1*C_0_1 + S_0_2*C_0_2;",
-        "    if (!(S_0_0 > SR_GEN_PIVOT_TOL*M_0_0*M_3_3)) return SR_GEN_SINGULAR;",
-        "    if (!(C_2_2 > SR_GEN_PIVOT_TOL*M_1_1*M_3_3*S_0_0)) return SR_GEN_SINGULAR;",
-        "    if (!(det_S > SR_GEN_PIVOT_TOL*M_2_2*M_3_3*C_2_2)) return SR_GEN_SINGULAR;",
-        "    const sr_real inv_det_S = SR_C(1.0)/det_S;",
+        let("det_S", (S_.row(0) * C.col(0))[0]),
+        "    if (!(S_0_0 > SR_GEN_PIVOT_TOL*M_0_0)) return SR_GEN_SINGULAR;",
+        "    if (!(C_2_2 > SR_GEN_PIVOT_TOL*M_1_1*S_0_0)) return SR_GEN_SINGULAR;",
+        "    if (!(det_S > SR_GEN_PIVOT_TOL*M_2_2*C_2_2)) return SR_GEN_SINGULAR;",
+        let("inv_det_S", 1 / sym("det_S")),
     ]
-    for i in shell:
-        terms = " + ".join(f"C_{min(i, j)}_{max(i, j)}*g_{j}" for j in shell)
-        lines.append(f"    const sr_real a_{i} = ({terms})*inv_det_S;")
-    for k in (3, 4):
-        terms = "".join(f" - B_{i}_{k}*a_{i}" for i in shell if f"B_{i}_{k}" not in zero)
-        lines.append(f"    const sr_real a_{k} = (f_{k}{terms})*inv_d_{k};")
-    a = sp.symbols("a_0:5", real=True)
+    lines += [let(f"a_{i}", (C.row(i) * g)[0] * sym("inv_det_S")) for i in range(3)]
+    lines += [let(f"a_{k + 3}", sym(f"fD_{k + 3}") - (beta.col(k).T * sp.Matrix(a[0:3]))[0]) for k in range(2)]
     shell_out = rotation * sp.Matrix(a[0:3])
-    for i, value in enumerate(list(shell_out) + list(a[3:5])):
-        lines.append(f"    {out_name}[{i}] = {printer.doprint(value)};")
+    for i, value in enumerate(list(shell_out) + a[3:5]):
+        lines.append(f"    {out_name}[{i}] = {scheduler.assign(f'{out_name}[{i}]', value)};")
     return lines
 
 
@@ -344,7 +428,7 @@ def dependency_order(nodes, roots):
 
 def emit_kernel(kernel, layouts):
     """C text of one kernel and its flop count."""
-    printer = Printer()
+    scheduler = Scheduler(Printer())
     defined = [symbol for symbol, _ in kernel.definitions]
     exprs = [value for _, value in kernel.definitions] + [e for o in kernel.outputs for e in o.exprs]
     temporaries, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"), order="canonical")
@@ -352,18 +436,18 @@ def emit_kernel(kernel, layouts):
     used = set().union(*(e.free_symbols for e in exprs)) - set(defined) if exprs else set()
     body = emit_inputs(kernel, used, layouts)
     nodes = temporaries + definitions
-    body += emit_assignments(printer, dependency_order(nodes, [s for s, _ in nodes] + reduced), declare=True)
+    body += emit_assignments(scheduler, dependency_order(nodes, [s for s, _ in nodes] + reduced), declare=True)
     k, zero = 0, set()
     for out in kernel.outputs:
         values = reduced[k:k + len(out.exprs)]
         k += len(out.exprs)
         if out.local_names:
             zero |= {n for n, v in zip(out.local_names, values) if v == 0}
-            body += emit_assignments(printer, [(n, v) for n, v in zip(out.local_names, values) if v != 0], declare=True)
+            body += emit_assignments(scheduler, [(n, v) for n, v in zip(out.local_names, values) if v != 0], declare=True)
         else:
-            body += emit_assignments(printer, [(f"{out.name}[{i}]", v) for i, v in enumerate(values)], declare=False)
+            body += emit_assignments(scheduler, [(f"{out.name}[{i}]", v) for i, v in enumerate(values)], declare=False)
     if kernel.solve:
-        body += emit_shell_solve(printer, "a", S.R_Y, zero)
+        body += emit_shell_solve(scheduler, "a", S.R_Y, zero)
     body.append("    return SR_GEN_OK;")
     doc = f"/* {kernel.doc} */"
     return "\n".join([doc, signature(kernel), "{", *body, "}", ""]), count_flops(body)

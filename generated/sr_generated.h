@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 0c42d93c015bdd8b], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources f77794da1f9f3fce], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -32,7 +32,7 @@ typedef double sr_real;
 #define SR_GEN_RHS_FLOPS 169
 #define SR_GEN_ENERGY_FLOPS 167
 #define SR_GEN_EQUILIBRIUM_RESIDUAL_FLOPS 19
-#define SR_GEN_ACCEL_FLOPS 270
+#define SR_GEN_ACCEL_FLOPS 269
 
 /* The float build's symbols carry _f, so a float/double mismatch fails at link time. */
 #ifdef SR_USE_FLOAT
