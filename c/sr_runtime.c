@@ -73,12 +73,11 @@ int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM])
 
 static int is_rotation(const sr_real *R)
 {
-    int i, j, k;
+    int i, j;
     sr_real det;
-    for (i = 0; i < 3; ++i)
-        for (j = 0; j < 3; ++j) {
-            sr_real dot = 0;
-            for (k = 0; k < 3; ++k) dot += R[3 * k + i] * R[3 * k + j];
+    for (i = 0; i < 3; ++i) /* RᵀR is symmetric: its upper triangle decides */
+        for (j = i; j < 3; ++j) {
+            const sr_real dot = R[i] * R[j] + R[3 + i] * R[3 + j] + R[6 + i] * R[6 + j];
             if (!near(dot, i == j ? 1 : 0)) return 0;
         }
     det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6])
@@ -86,13 +85,19 @@ static int is_rotation(const sr_real *R)
     return near(det, 1);
 }
 
-/* Rotation about axis k (0 = x, 1 = y): the entries outside the k-plane are exact. */
+/* Rotation about axis k (0 = x, 1 = y): the entries outside the k-plane are exact, so the
+ * columns in the plane, (c, s) and (-s', c') on rows p, q, decide: unit length, orthogonal,
+ * determinant c c' + s s' = 1. */
 static int is_axis_rotation(const sr_real *R, int k)
 {
+    const int p = k == 0 ? 1 : 0, q = k == 2 ? 1 : 2;
     int i;
     for (i = 0; i < 3; ++i)
         if (R[3 * k + i] != (i == k ? 1 : 0) || R[3 * i + k] != (i == k ? 1 : 0)) return 0;
-    return is_rotation(R);
+    return near(R[3 * p + p] * R[3 * p + p] + R[3 * q + p] * R[3 * q + p], 1)
+        && near(R[3 * p + q] * R[3 * p + q] + R[3 * q + q] * R[3 * q + q], 1)
+        && near(R[3 * p + p] * R[3 * p + q] + R[3 * q + p] * R[3 * q + q], 0)
+        && near(R[3 * p + p] * R[3 * q + q] - R[3 * p + q] * R[3 * q + p], 1);
 }
 
 int sr_check_state(const sr_model *model, const sr_real x[SR_NX])
