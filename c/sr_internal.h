@@ -30,6 +30,11 @@
 #define SR_EPSILON DBL_EPSILON
 #endif
 
+/* The generated kernels' status codes are the library's: their results pass through. */
+#if SR_GEN_OK != SR_OK || SR_GEN_NONFINITE != SR_ERR_NONFINITE || SR_GEN_SINGULAR != SR_ERR_SINGULAR
+#error "generated status codes differ from spherical_robot.h"
+#endif
+
 /* Offsets of the blocks of the state x (see spherical_robot.h). */
 enum { RS = 0, RY = 9, RP = 18, Q = 27, W = 30 };
 

@@ -60,13 +60,13 @@ int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM])
      * the inertias underflowed. */
     if (!all_finite(m.c, SR_GEN_NCONST_NAMED)) return SR_ERR_PARAM;
     reference_state(params[r], x);
-    if (sr_gen_inertia(m.c, x, M) != SR_OK || !all_finite(M, SR_NV * SR_NV)) return SR_ERR_PARAM;
+    if (sr_gen_inertia(m.c, x, M) != SR_OK) return SR_ERR_PARAM;
     status = sr_gen_accel(m.c, x, zero_u, a);
-    if (status != SR_OK) return status; /* SR_GEN_SINGULAR == SR_ERR_SINGULAR */
+    if (status == SR_GEN_SINGULAR) return SR_ERR_SINGULAR;
     /* After the pivots, so that inertias that underflow to zero (and whose reciprocals among the
      * pooled constants are infinite) are reported as singular. */
-    if (!all_finite(m.c, SR_GEN_NCONST) || !all_finite(a, SR_NV)) return SR_ERR_PARAM;
-    if (sr_gen_energy(m.c, x, &energy) != SR_OK || !isfinite(energy)) return SR_ERR_PARAM;
+    if (status != SR_OK || !all_finite(m.c, SR_GEN_NCONST)) return SR_ERR_PARAM;
+    if (sr_gen_energy(m.c, x, &energy) != SR_OK) return SR_ERR_PARAM;
     *model = m;
     return SR_OK;
 }
@@ -126,8 +126,10 @@ int sr_check_state_batch(const sr_model *model, long n, const sr_real *x, long *
     return SR_OK;
 }
 
-/* Copy n results from tmp to out when the kernel succeeded and they are all finite: outputs
- * are either fully written and finite or untouched. */
+/* Copy n results from tmp to out when the computation succeeded and they are all finite:
+ * outputs are either fully written and finite or untouched.  (The generated kernels do the
+ * same themselves: they write only on SR_GEN_OK, and return SR_GEN_NONFINITE, equal to
+ * SR_ERR_NONFINITE, when a result is not finite.) */
 static int deliver(int status, const sr_real *tmp, int n, sr_real *out)
 {
     int i;
@@ -140,11 +142,10 @@ static int deliver(int status, const sr_real *tmp, int n, sr_real *out)
 int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV])
 {
     int status;
-    sr_real tmp[SR_NV];
     if (!a) return SR_ERR_NULL;
     status = checks(model, x, u);
     if (status != SR_OK) return status;
-    return deliver(sr_gen_accel(model->c, x, u ? u : zero_u, tmp), tmp, SR_NV, a);
+    return sr_gen_accel(model->c, x, u ? u : zero_u, a);
 }
 
 int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
@@ -167,41 +168,37 @@ int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * SR_NV])
 {
     int status;
-    sr_real tmp[SR_NV * SR_NV];
     if (!M) return SR_ERR_NULL;
     status = checks(model, x, NULL);
     if (status != SR_OK) return status;
-    return deliver(sr_gen_inertia(model->c, x, tmp), tmp, SR_NV * SR_NV, M);
+    return sr_gen_inertia(model->c, x, M);
 }
 
 int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NV])
 {
     int status;
-    sr_real tmp[SR_NV];
     if (!f) return SR_ERR_NULL;
     status = checks(model, x, u);
     if (status != SR_OK) return status;
-    return deliver(sr_gen_rhs(model->c, x, u ? u : zero_u, tmp), tmp, SR_NV, f);
+    return sr_gen_rhs(model->c, x, u ? u : zero_u, f);
 }
 
 int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy)
 {
     int status;
-    sr_real tmp;
     if (!energy) return SR_ERR_NULL;
     status = checks(model, x, NULL);
     if (status != SR_OK) return status;
-    return deliver(sr_gen_energy(model->c, x, &tmp), &tmp, 1, energy);
+    return sr_gen_energy(model->c, x, energy);
 }
 
 int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV])
 {
     int status;
-    sr_real tmp[SR_NV];
     if (!res) return SR_ERR_NULL;
     status = checks(model, x, NULL);
     if (status != SR_OK) return status;
-    return deliver(sr_gen_equilibrium_residual(model->c, x, tmp), tmp, SR_NV, res);
+    return sr_gen_equilibrium_residual(model->c, x, res);
 }
 
 /* R = Exp([[w]]) = I + (Exp([[w]]) - I) (no checks). */

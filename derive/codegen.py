@@ -51,6 +51,7 @@ class Kernel:
     outputs: tuple         # Output instances, written in this order
     solve: bool = False    # outputs are the locals of joint_first_system; write ν̇ = M⁻¹ f instead
     definitions: tuple = ()  # (symbol, expression) intermediates the outputs use (newton_euler.Program)
+    finite_or_untouched: bool = True  # write the outputs only if all are finite, else return SR_GEN_NONFINITE
 
 
 INPUT_DOCS = {
@@ -170,7 +171,7 @@ def kernels():
         Kernel("constants", "Derived constants of Section 2.3 from the twelve parameters, c[0..11] ="
                " (r, l, g, m_P, m_R, j_S, j_xx, j_yy, j_P, k_S, k_Y, k_P), then the parameter-only"
                " subexpressions of the kernels, computed once per model:",
-               ("p",), (Output("c", tuple(P.constant_expressions()), "constants (r, l, g, m_P, m_R, j_S, j_xx, j_yy, j_P, k_S, k_Y, k_P)"),)),
+               ("p",), (Output("c", tuple(P.constant_expressions()), "constants (r, l, g, m_P, m_R, j_S, j_xx, j_yy, j_P, k_S, k_Y, k_P)"),), finite_or_untouched=False),
         Kernel("inertia", "Generalized inertia M(γ, R_Y, R_P), row-major 5x5, kinetic energy ½νᵀMν.",
                ("c", "x"), (Output("M", tuple(M), "M, row-major 5x5"),)),
         Kernel("rhs", "Right-hand side f of M ν̇ = f: gyroscopic, non-holonomic, gravity, motor and friction terms.",
@@ -377,8 +378,28 @@ def emit_shell_solve(scheduler, out_name, rotation, zero):
     lines += [let(f"a_{i}", (C.row(i) * g)[0] * sym("inv_det_S")) for i in range(3)]
     lines += [let(f"a_{k + 3}", sym(f"fD_{k + 3}") - (beta.col(k).T * sp.Matrix(a[0:3]))[0]) for k in range(2)]
     shell_out = rotation * sp.Matrix(a[0:3])
-    for i, value in enumerate(list(shell_out) + a[3:5]):
-        lines.append(f"    {out_name}[{i}] = {scheduler.assign(f'{out_name}[{i}]', value)};")
+    return lines, [(f"{out_name}[{i}]", value) for i, value in enumerate(list(shell_out) + a[3:5])]
+
+
+def emit_results(scheduler, results, finite_or_untouched):
+    """Assign the outputs; with `finite_or_untouched`, only after checking that all are finite.
+
+    One test of their sum clears the common case (a NaN or an infinity makes
+    it non-finite); a sum that is not finite is decided value by value, so
+    finite values whose sum overflows still pass.  The caller's arrays are
+    written last, so they may alias the inputs.
+    """
+    if not finite_or_untouched:
+        return [f"    {target} = {scheduler.assign(target, value)};" for target, value in results]
+    names = [f"out_{i}" for i in range(len(results))]
+    lines = [f"    const sr_real {n} = {scheduler.assign(n, value)};" for n, (_, value) in zip(names, results)]
+    each = " && ".join(f"isfinite({n})" for n in names)
+    if len(names) == 1:
+        lines.append(f"    if (!{each}) return SR_GEN_NONFINITE;")
+    else:
+        lines.append(f"    const sr_real out_sum = {scheduler.assign('out_sum', sp.Add(*sp.symbols(names, real=True)))};")
+        lines.append(f"    if (!isfinite(out_sum) && !({each})) return SR_GEN_NONFINITE;")
+    lines += [f"    {target} = {n};" for n, (target, _) in zip(names, results)]
     return lines
 
 
@@ -437,7 +458,7 @@ def emit_kernel(kernel, layouts):
     body = emit_inputs(kernel, used, layouts)
     nodes = temporaries + definitions
     body += emit_assignments(scheduler, dependency_order(nodes, [s for s, _ in nodes] + reduced), declare=True)
-    k, zero = 0, set()
+    k, zero, results = 0, set(), []
     for out in kernel.outputs:
         values = reduced[k:k + len(out.exprs)]
         k += len(out.exprs)
@@ -445,9 +466,11 @@ def emit_kernel(kernel, layouts):
             zero |= {n for n, v in zip(out.local_names, values) if v == 0}
             body += emit_assignments(scheduler, [(n, v) for n, v in zip(out.local_names, values) if v != 0], declare=True)
         else:
-            body += emit_assignments(scheduler, [(f"{out.name}[{i}]", v) for i, v in enumerate(values)], declare=False)
+            results += [(f"{out.name}[{i}]", v) for i, v in enumerate(values)]
     if kernel.solve:
-        body += emit_shell_solve(scheduler, "a", S.R_Y, zero)
+        lines, results = emit_shell_solve(scheduler, "a", S.R_Y, zero)
+        body += lines
+    body += emit_results(scheduler, results, kernel.finite_or_untouched)
     body.append("    return SR_GEN_OK;")
     doc = f"/* {kernel.doc} */"
     return "\n".join([doc, signature(kernel), "{", *body, "}", ""]), count_flops(body)
@@ -474,7 +497,9 @@ def header_text(ks, flops, n_constants):
     return f"""{banner()}/*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
- * Every function returns SR_GEN_OK or SR_GEN_SINGULAR; outputs are caller-provided.
+ * Every function returns SR_GEN_OK, SR_GEN_NONFINITE (a result is not finite) or, for accel,
+ * SR_GEN_SINGULAR; outputs are caller-provided and written only on SR_GEN_OK (sr_gen_constants:
+ * always, the caller checks them).
  */
 #ifndef {guard}
 #define {guard}
@@ -490,6 +515,7 @@ typedef double sr_real;
 #endif
 
 #define SR_GEN_OK 0
+#define SR_GEN_NONFINITE 2
 #define SR_GEN_SINGULAR 4
 #define SR_GEN_NPARAM {len(P.PARAMETERS)}
 #define SR_GEN_NCONST {n_constants}
@@ -513,7 +539,7 @@ typedef double sr_real;
 
 
 def source_text(emitted):
-    return banner() + f'#include "{HEADER_NAME}"\n\n' + "\n".join(text for text, _ in emitted)
+    return banner() + f'#include "{HEADER_NAME}"\n\n#include <math.h>\n\n' + "\n".join(text for text, _ in emitted)
 
 
 def pool_constants(ks):

@@ -1,5 +1,7 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources f77794da1f9f3fce], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 8e8f8d7465338a8b], SymPy 1.14.0. */
 #include "sr_generated.h"
+
+#include <math.h>
 
 /* Derived constants of Section 2.3 from the twelve parameters, c[0..11] = (r, l, g, m_P, m_R, j_S, j_xx, j_yy, j_P, k_S, k_Y, k_P), then the parameter-only subexpressions of the kernels, computed once per model:
  *   c[12] k_0 = m_R*r**2
@@ -146,31 +148,58 @@ int sr_gen_inertia(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], s
     const sr_real t25 = ((RY_11*j_P) - t16) - (RY_11*t24);
     const sr_real t26 = -t14;
     const sr_real t27 = (t9 + (gamma_y*t11)) - (RY_21*t24);
-    M[0] = ((k_2 + t0) + (t1 + t3)) - (t4 + t5);
-    M[1] = t13;
-    M[2] = t15;
-    M[3] = t18;
-    M[4] = t19;
-    M[5] = t13;
-    M[6] = ((k_6 - t0) - (t20 + t5)) - t22;
-    M[7] = t23;
-    M[8] = t12;
-    M[9] = t25;
-    M[10] = t15;
-    M[11] = t23;
-    M[12] = ((k_7 + t3) - t20) + ((t4 - t1) + t22);
-    M[13] = t26;
-    M[14] = t27;
-    M[15] = t18;
-    M[16] = t12;
-    M[17] = t26;
-    M[18] = -t17;
-    M[19] = 0;
-    M[20] = t19;
-    M[21] = t25;
-    M[22] = t27;
-    M[23] = 0;
-    M[24] = j_P;
+    const sr_real out_0 = ((k_2 + t0) + (t1 + t3)) - (t4 + t5);
+    const sr_real out_1 = t13;
+    const sr_real out_2 = t15;
+    const sr_real out_3 = t18;
+    const sr_real out_4 = t19;
+    const sr_real out_5 = t13;
+    const sr_real out_6 = ((k_6 - t0) - (t20 + t5)) - t22;
+    const sr_real out_7 = t23;
+    const sr_real out_8 = t12;
+    const sr_real out_9 = t25;
+    const sr_real out_10 = t15;
+    const sr_real out_11 = t23;
+    const sr_real out_12 = ((k_7 + t3) - t20) + ((t4 - t1) + t22);
+    const sr_real out_13 = t26;
+    const sr_real out_14 = t27;
+    const sr_real out_15 = t18;
+    const sr_real out_16 = t12;
+    const sr_real out_17 = t26;
+    const sr_real out_18 = -t17;
+    const sr_real out_19 = 0;
+    const sr_real out_20 = t19;
+    const sr_real out_21 = t25;
+    const sr_real out_22 = t27;
+    const sr_real out_23 = 0;
+    const sr_real out_24 = j_P;
+    const sr_real out_sum = (((((out_24 + (out_19 + out_23)) + out_13) + (out_16 + out_17)) + out_12) + (((out_18 + out_8) + out_0) + (out_11 + out_15))) + (((out_3 + out_6) + (out_7 + (out_1 + out_10))) + (((out_14 + out_2) + (out_20 + out_21)) + ((out_22 + out_4) + (out_5 + out_9))));
+    if (!isfinite(out_sum) && !(isfinite(out_0) && isfinite(out_1) && isfinite(out_2) && isfinite(out_3) && isfinite(out_4) && isfinite(out_5) && isfinite(out_6) && isfinite(out_7) && isfinite(out_8) && isfinite(out_9) && isfinite(out_10) && isfinite(out_11) && isfinite(out_12) && isfinite(out_13) && isfinite(out_14) && isfinite(out_15) && isfinite(out_16) && isfinite(out_17) && isfinite(out_18) && isfinite(out_19) && isfinite(out_20) && isfinite(out_21) && isfinite(out_22) && isfinite(out_23) && isfinite(out_24))) return SR_GEN_NONFINITE;
+    M[0] = out_0;
+    M[1] = out_1;
+    M[2] = out_2;
+    M[3] = out_3;
+    M[4] = out_4;
+    M[5] = out_5;
+    M[6] = out_6;
+    M[7] = out_7;
+    M[8] = out_8;
+    M[9] = out_9;
+    M[10] = out_10;
+    M[11] = out_11;
+    M[12] = out_12;
+    M[13] = out_13;
+    M[14] = out_14;
+    M[15] = out_15;
+    M[16] = out_16;
+    M[17] = out_17;
+    M[18] = out_18;
+    M[19] = out_19;
+    M[20] = out_20;
+    M[21] = out_21;
+    M[22] = out_22;
+    M[23] = out_23;
+    M[24] = out_24;
     return SR_GEN_OK;
 }
 
@@ -238,11 +267,18 @@ int sr_gen_rhs(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const
     const sr_real T_x = tau_Y_x + tau_P_x;
     const sr_real T_y = tau_Y_y + tau_P_y;
     const sr_real T_z = tau_Y_z + tau_P_z;
-    f[0] = -(T_x + ((w_Sx*k_S) + (r*((gamma_y*F_z) - (gamma_z*F_y)))));
-    f[1] = -(T_y + ((w_Sy*k_S) + (r*((gamma_z*F_x) - (gamma_x*F_z)))));
-    f[2] = -(T_z + ((w_Sz*k_S) + (r*((gamma_x*F_y) - (gamma_y*F_x)))));
-    f[3] = (u_Y - (w_Y*k_Y)) - T_x;
-    f[4] = ((u_P - (w_P*k_P)) - (RY_11*tau_P_y)) - (RY_21*tau_P_z);
+    const sr_real out_0 = -(T_x + ((w_Sx*k_S) + (r*((gamma_y*F_z) - (gamma_z*F_y)))));
+    const sr_real out_1 = -(T_y + ((w_Sy*k_S) + (r*((gamma_z*F_x) - (gamma_x*F_z)))));
+    const sr_real out_2 = -(T_z + ((w_Sz*k_S) + (r*((gamma_x*F_y) - (gamma_y*F_x)))));
+    const sr_real out_3 = (u_Y - (w_Y*k_Y)) - T_x;
+    const sr_real out_4 = ((u_P - (w_P*k_P)) - (RY_11*tau_P_y)) - (RY_21*tau_P_z);
+    const sr_real out_sum = (out_2 + out_3) + (out_4 + (out_0 + out_1));
+    if (!isfinite(out_sum) && !(isfinite(out_0) && isfinite(out_1) && isfinite(out_2) && isfinite(out_3) && isfinite(out_4))) return SR_GEN_NONFINITE;
+    f[0] = out_0;
+    f[1] = out_1;
+    f[2] = out_2;
+    f[3] = out_3;
+    f[4] = out_4;
     return SR_GEN_OK;
 }
 
@@ -322,7 +358,9 @@ int sr_gen_energy(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr
     const sr_real t43 = t11*t12;
     const sr_real t44 = RY_21*w_Sy;
     const sr_real t45 = w_P*t40;
-    E[0] = (((((t17*(w_P*(RP_02*RY_11))) + (t19*(w_P*(RY_21*gamma_z)))) + (((k_16*q_z) + (k_4*t0)) + ((k_11*t1) + (t10*t8)))) - (((t21*(k_0*t14)) + (t37*(k_18*t2))) + (((gamma_y*w_Sy)*t23) + (t39*(k_18*t3))))) + (((((k_12*t2) + (k_13*t3)) + ((k_14*t4) + (t6*t7))) + (((t8*t9) + (w_P*(k_15*w_P))) - ((t11*t6) + (k_9*t5)))) + (((t34 + (t0*t31)) - (t9*t45)) - ((t10*t45) + (t35*t34))))) + ((((((t1*t31) + (t14*t13)) + ((t15*t17) + (t18*t19))) + (((k_5*t20) + (t25*t26)) + ((t26*t27) + (t28*t29)))) + ((((t28*t30) + (t3*t31)) + ((t3*t36) + (t37*t38))) + (((t39*t38) - (t0*t41)) - ((t0*t43) + (t1*t33))))) + (((((t9*(t12*t14)) - (t4*t33)) + ((t33*(t2*t35)) - (t21*(t10*t12)))) - (((t27*t42) + (t44*t29)) + ((t3*t40) + (t44*t30)))) - ((((t1*t43) + (t21*t13)) + ((t18*t23) + (t2*t36))) + (((t2*t40) + (t2*t43)) + ((t20*t41) + (t25*t42))))));
+    const sr_real out_0 = (((((t17*(w_P*(RP_02*RY_11))) + (t19*(w_P*(RY_21*gamma_z)))) + (((k_16*q_z) + (k_4*t0)) + ((k_11*t1) + (t10*t8)))) - (((t21*(k_0*t14)) + (t37*(k_18*t2))) + (((gamma_y*w_Sy)*t23) + (t39*(k_18*t3))))) + (((((k_12*t2) + (k_13*t3)) + ((k_14*t4) + (t6*t7))) + (((t8*t9) + (w_P*(k_15*w_P))) - ((t11*t6) + (k_9*t5)))) + (((t34 + (t0*t31)) - (t9*t45)) - ((t10*t45) + (t35*t34))))) + ((((((t1*t31) + (t14*t13)) + ((t15*t17) + (t18*t19))) + (((k_5*t20) + (t25*t26)) + ((t26*t27) + (t28*t29)))) + ((((t28*t30) + (t3*t31)) + ((t3*t36) + (t37*t38))) + (((t39*t38) - (t0*t41)) - ((t0*t43) + (t1*t33))))) + (((((t9*(t12*t14)) - (t4*t33)) + ((t33*(t2*t35)) - (t21*(t10*t12)))) - (((t27*t42) + (t44*t29)) + ((t3*t40) + (t44*t30)))) - ((((t1*t43) + (t21*t13)) + ((t18*t23) + (t2*t36))) + (((t2*t40) + (t2*t43)) + ((t20*t41) + (t25*t42))))));
+    if (!isfinite(out_0)) return SR_GEN_NONFINITE;
+    E[0] = out_0;
     return SR_GEN_OK;
 }
 
@@ -341,11 +379,18 @@ int sr_gen_equilibrium_residual(const sr_real c[SR_GEN_NCONST], const sr_real x[
     const sr_real t1 = RP_02*gamma_z;
     const sr_real t2 = RP_00*gamma_x;
     const sr_real t3 = RP_02*gamma_y;
-    res[0] = t0;
-    res[1] = k_9*((RY_11*t2) - t1);
-    res[2] = k_9*(t3 + (RY_21*t2));
-    res[3] = t0;
-    res[4] = k_9*((t2 + (RY_21*t3)) - (RY_11*t1));
+    const sr_real out_0 = t0;
+    const sr_real out_1 = k_9*((RY_11*t2) - t1);
+    const sr_real out_2 = k_9*(t3 + (RY_21*t2));
+    const sr_real out_3 = t0;
+    const sr_real out_4 = k_9*((t2 + (RY_21*t3)) - (RY_11*t1));
+    const sr_real out_sum = (out_1 + out_2) + ((out_0 + out_3) + out_4);
+    if (!isfinite(out_sum) && !(isfinite(out_0) && isfinite(out_1) && isfinite(out_2) && isfinite(out_3) && isfinite(out_4))) return SR_GEN_NONFINITE;
+    res[0] = out_0;
+    res[1] = out_1;
+    res[2] = out_2;
+    res[3] = out_3;
+    res[4] = out_4;
     return SR_GEN_OK;
 }
 
@@ -485,10 +530,17 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     const sr_real a_2 = ((C_2_2*g_2) + ((g_1*C_1_2) + (C_0_2*g_0)))*inv_det_S;
     const sr_real a_3 = (fD_3 - (beta_0_3*a_0)) - (beta_2_3*a_2);
     const sr_real a_4 = (fD_4 - (beta_0_4*a_0)) - ((beta_1_4*a_1) + (beta_2_4*a_2));
-    a[0] = a_0;
-    a[1] = (RY_11*a_1) - (RY_21*a_2);
-    a[2] = (RY_11*a_2) + (RY_21*a_1);
-    a[3] = a_3;
-    a[4] = a_4;
+    const sr_real out_0 = a_0;
+    const sr_real out_1 = (RY_11*a_1) - (RY_21*a_2);
+    const sr_real out_2 = (RY_11*a_2) + (RY_21*a_1);
+    const sr_real out_3 = a_3;
+    const sr_real out_4 = a_4;
+    const sr_real out_sum = (out_2 + out_3) + (out_4 + (out_0 + out_1));
+    if (!isfinite(out_sum) && !(isfinite(out_0) && isfinite(out_1) && isfinite(out_2) && isfinite(out_3) && isfinite(out_4))) return SR_GEN_NONFINITE;
+    a[0] = out_0;
+    a[1] = out_1;
+    a[2] = out_2;
+    a[3] = out_3;
+    a[4] = out_4;
     return SR_GEN_OK;
 }

@@ -1,8 +1,10 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources f77794da1f9f3fce], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 8e8f8d7465338a8b], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
- * Every function returns SR_GEN_OK or SR_GEN_SINGULAR; outputs are caller-provided.
+ * Every function returns SR_GEN_OK, SR_GEN_NONFINITE (a result is not finite) or, for accel,
+ * SR_GEN_SINGULAR; outputs are caller-provided and written only on SR_GEN_OK (sr_gen_constants:
+ * always, the caller checks them).
  */
 #ifndef SR_GENERATED_H
 #define SR_GENERATED_H
@@ -18,6 +20,7 @@ typedef double sr_real;
 #endif
 
 #define SR_GEN_OK 0
+#define SR_GEN_NONFINITE 2
 #define SR_GEN_SINGULAR 4
 #define SR_GEN_NPARAM 12
 #define SR_GEN_NCONST 35
@@ -28,11 +31,11 @@ typedef double sr_real;
 
 /* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
 #define SR_GEN_CONSTANTS_FLOPS 60
-#define SR_GEN_INERTIA_FLOPS 90
-#define SR_GEN_RHS_FLOPS 169
+#define SR_GEN_INERTIA_FLOPS 114
+#define SR_GEN_RHS_FLOPS 173
 #define SR_GEN_ENERGY_FLOPS 167
-#define SR_GEN_EQUILIBRIUM_RESIDUAL_FLOPS 19
-#define SR_GEN_ACCEL_FLOPS 269
+#define SR_GEN_EQUILIBRIUM_RESIDUAL_FLOPS 23
+#define SR_GEN_ACCEL_FLOPS 273
 
 /* The float build's symbols carry _f, so a float/double mismatch fails at link time. */
 #ifdef SR_USE_FLOAT
