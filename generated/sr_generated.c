@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 8e8f8d7465338a8b], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources b1702b96f5367e45], SymPy 1.14.0. */
 #include "sr_generated.h"
 
 #include <math.h>
@@ -134,18 +134,18 @@ int sr_gen_inertia(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], s
     const sr_real t11 = RP_00*k_3;
     const sr_real t12 = (t10*t9) - (t11*(RY_21*gamma_x));
     const sr_real t13 = t12 + (t7 - (gamma_y*t8));
-    const sr_real t14 = (t10*(RY_11*j_P)) - ((RP_00*RY_11)*(gamma_x*k_3));
-    const sr_real t15 = ((k_3*(RP_02*gamma_z)) - (gamma_z*t8)) - t14;
+    const sr_real t14 = RY_11*((j_P*t10) - (k_3*(RP_00*gamma_x)));
+    const sr_real t15 = (gamma_z*((RP_02*k_3) - t8)) - t14;
     const sr_real t16 = gamma_z*t11;
     const sr_real t17 = t4 - k_4;
     const sr_real t18 = (((RP_00*RY_21)*(gamma_y*k_3)) - t17) - (RY_11*t16);
     const sr_real t19 = (t6*(RY_21*gamma_z)) + (RY_11*t7);
     const sr_real t20 = k_1*(RP_02*gamma_x);
     const sr_real t21 = RY_21*RY_21;
-    const sr_real t22 = (k_5*t21) - (t21*t4);
-    const sr_real t23 = (((RP_00*RY_11)*(gamma_y*k_3)) - (RY_21*t16)) + (((k_5*(RY_11*RY_21)) - (k_0*(gamma_y*gamma_z))) - ((RY_11*RY_21)*t4));
+    const sr_real t22 = t21*(k_5 - t4);
+    const sr_real t23 = (RY_11*((k_3*(RP_00*gamma_y)) + (RY_21*(k_5 - t4)))) - ((k_0*(gamma_y*gamma_z)) + (RY_21*t16));
     const sr_real t24 = gamma_x*t6;
-    const sr_real t25 = ((RY_11*j_P) - t16) - (RY_11*t24);
+    const sr_real t25 = (RY_11*(j_P - t24)) - t16;
     const sr_real t26 = -t14;
     const sr_real t27 = (t9 + (gamma_y*t11)) - (RY_21*t24);
     const sr_real out_0 = ((k_2 + t0) + (t1 + t3)) - (t4 + t5);
@@ -173,7 +173,7 @@ int sr_gen_inertia(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], s
     const sr_real out_22 = t27;
     const sr_real out_23 = 0;
     const sr_real out_24 = j_P;
-    const sr_real out_sum = (((((out_24 + (out_19 + out_23)) + out_13) + (out_16 + out_17)) + out_12) + (((out_18 + out_8) + out_0) + (out_11 + out_15))) + (((out_3 + out_6) + (out_7 + (out_1 + out_10))) + (((out_14 + out_2) + (out_20 + out_21)) + ((out_22 + out_4) + (out_5 + out_9))));
+    const sr_real out_sum = (((out_21 + out_3) + (out_6 + out_9)) + (((out_1 + out_13) + (out_14 + out_17)) + ((out_20 + out_22) + (out_4 + out_5)))) + ((out_11 + out_7) + (((((out_24 + (out_19 + out_23)) + out_16) + (out_18 + out_8)) + out_12) + ((out_0 + out_10) + (out_15 + out_2))));
     if (!isfinite(out_sum) && !(isfinite(out_0) && isfinite(out_1) && isfinite(out_2) && isfinite(out_3) && isfinite(out_4) && isfinite(out_5) && isfinite(out_6) && isfinite(out_7) && isfinite(out_8) && isfinite(out_9) && isfinite(out_10) && isfinite(out_11) && isfinite(out_12) && isfinite(out_13) && isfinite(out_14) && isfinite(out_15) && isfinite(out_16) && isfinite(out_17) && isfinite(out_18) && isfinite(out_19) && isfinite(out_20) && isfinite(out_21) && isfinite(out_22) && isfinite(out_23) && isfinite(out_24))) return SR_GEN_NONFINITE;
     M[0] = out_0;
     M[1] = out_1;
@@ -249,8 +249,8 @@ int sr_gen_rhs(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const
     const sr_real a_w = (a_z*w_p_z) + ((RP_02*w_y_x) + (a_y*w_p_y));
     const sr_real t11 = j_P*a_w;
     const sr_real alpha_P_x = (w_Sy*(RY_21*w_P)) - (w_Sz*t0);
-    const sr_real alpha_P_y = ((w_Sz*w_Y) - (w_Sx*t1)) - (w_Y*t1);
-    const sr_real alpha_P_z = (w_Y*t0) + ((w_Sx*t0) - t2);
+    const sr_real alpha_P_y = (w_Sz*w_Y) - (t1*(w_Sx + w_Y));
+    const sr_real alpha_P_z = (t0*(w_Sx + w_Y)) - t2;
     const sr_real tau_Y_x = (w_Sy*t5) - (w_Sz*t6);
     const sr_real tau_Y_y = ((w_Sz*t7) + (RY_11*t9)) - ((RY_21*t10) + (w_y_x*t5));
     const sr_real tau_Y_z = ((RY_11*t10) - (w_Sy*t7)) + ((RY_21*t9) + (w_y_x*t6));
@@ -261,18 +261,18 @@ int sr_gen_rhs(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const
     const sr_real tau_P_x = (j_P*(alpha_P_x - (RP_02*a_alpha))) - ((k_9*((gamma_z*a_y) - (gamma_y*a_z))) + (w_x_a_x*t11));
     const sr_real tau_P_y = (j_P*(alpha_P_y - (a_y*a_alpha))) - ((k_9*((gamma_x*a_z) - (RP_02*gamma_z))) + (w_x_a_y*t11));
     const sr_real tau_P_z = (j_P*(alpha_P_z - (a_z*a_alpha))) - ((k_9*((RP_02*gamma_y) - (gamma_x*a_y))) + (w_x_a_z*t11));
-    const sr_real F_x = -(k_10*(((a_z*alpha_P_y) + (w_p_y*w_x_a_z)) - ((a_y*alpha_P_z) + (w_p_z*w_x_a_y))));
+    const sr_real F_x = -(k_10*(((a_z*alpha_P_y) - (a_y*alpha_P_z)) + ((w_p_y*w_x_a_z) - (w_p_z*w_x_a_y))));
     const sr_real F_y = -(k_10*(((RP_02*alpha_P_z) - (a_z*alpha_P_x)) + ((w_p_z*w_x_a_x) - (w_y_x*w_x_a_z))));
-    const sr_real F_z = -(k_10*(((a_y*alpha_P_x) + (w_y_x*w_x_a_y)) - ((RP_02*alpha_P_y) + (w_p_y*w_x_a_x))));
+    const sr_real F_z = -(k_10*(((a_y*alpha_P_x) - (RP_02*alpha_P_y)) + ((w_y_x*w_x_a_y) - (w_p_y*w_x_a_x))));
     const sr_real T_x = tau_Y_x + tau_P_x;
     const sr_real T_y = tau_Y_y + tau_P_y;
     const sr_real T_z = tau_Y_z + tau_P_z;
-    const sr_real out_0 = -(T_x + ((w_Sx*k_S) + (r*((gamma_y*F_z) - (gamma_z*F_y)))));
-    const sr_real out_1 = -(T_y + ((w_Sy*k_S) + (r*((gamma_z*F_x) - (gamma_x*F_z)))));
-    const sr_real out_2 = -(T_z + ((w_Sz*k_S) + (r*((gamma_x*F_y) - (gamma_y*F_x)))));
+    const sr_real out_0 = -((r*((gamma_y*F_z) - (gamma_z*F_y))) + ((w_Sx*k_S) + T_x));
+    const sr_real out_1 = -((r*((gamma_z*F_x) - (gamma_x*F_z))) + ((w_Sy*k_S) + T_y));
+    const sr_real out_2 = -((r*((gamma_x*F_y) - (gamma_y*F_x))) + ((w_Sz*k_S) + T_z));
     const sr_real out_3 = (u_Y - (w_Y*k_Y)) - T_x;
     const sr_real out_4 = ((u_P - (w_P*k_P)) - (RY_11*tau_P_y)) - (RY_21*tau_P_z);
-    const sr_real out_sum = (out_2 + out_3) + (out_4 + (out_0 + out_1));
+    const sr_real out_sum = (out_1 + out_2) + (out_4 + (out_3 + out_0));
     if (!isfinite(out_sum) && !(isfinite(out_0) && isfinite(out_1) && isfinite(out_2) && isfinite(out_3) && isfinite(out_4))) return SR_GEN_NONFINITE;
     f[0] = out_0;
     f[1] = out_1;
@@ -358,7 +358,7 @@ int sr_gen_energy(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr
     const sr_real t43 = t11*t12;
     const sr_real t44 = RY_21*w_Sy;
     const sr_real t45 = w_P*t40;
-    const sr_real out_0 = (((((t17*(w_P*(RP_02*RY_11))) + (t19*(w_P*(RY_21*gamma_z)))) + (((k_16*q_z) + (k_4*t0)) + ((k_11*t1) + (t10*t8)))) - (((t21*(k_0*t14)) + (t37*(k_18*t2))) + (((gamma_y*w_Sy)*t23) + (t39*(k_18*t3))))) + (((((k_12*t2) + (k_13*t3)) + ((k_14*t4) + (t6*t7))) + (((t8*t9) + (w_P*(k_15*w_P))) - ((t11*t6) + (k_9*t5)))) + (((t34 + (t0*t31)) - (t9*t45)) - ((t10*t45) + (t35*t34))))) + ((((((t1*t31) + (t14*t13)) + ((t15*t17) + (t18*t19))) + (((k_5*t20) + (t25*t26)) + ((t26*t27) + (t28*t29)))) + ((((t28*t30) + (t3*t31)) + ((t3*t36) + (t37*t38))) + (((t39*t38) - (t0*t41)) - ((t0*t43) + (t1*t33))))) + (((((t9*(t12*t14)) - (t4*t33)) + ((t33*(t2*t35)) - (t21*(t10*t12)))) - (((t27*t42) + (t44*t29)) + ((t3*t40) + (t44*t30)))) - ((((t1*t43) + (t21*t13)) + ((t18*t23) + (t2*t36))) + (((t2*t40) + (t2*t43)) + ((t20*t41) + (t25*t42))))));
+    const sr_real out_0 = (((t3*((t36 - t40) + ((k_13 + t31) - (k_18*t39)))) + (w_P*(((RY_21*gamma_z)*t19) + ((k_15*w_P) + ((RP_02*RY_11)*t17))))) + (((((k_16*q_z) - (k_9*t5)) - ((gamma_y*w_Sy)*t23)) + (t0*((k_4 + t31) - (t41 + t43)))) + ((t1*((k_11 + t31) - (t33 + t43))) + (t10*((t8 - (t12*t21)) - t45))))) + ((((t14*((t13 + (t12*t9)) - (k_0*t21))) + (t9*(t8 - t45))) + (((t18*(t19 - t23)) + (t20*(k_5 - t41))) + ((t25*(t26 - t42)) + (t27*(t26 - t42))))) + ((((t28*(t29 + t30)) + ((1 - t35)*t34)) + ((t4*(k_14 - t33)) - (t44*(t29 + t30)))) + ((((t15*t17) + (t38*(t37 + t39))) + ((t6*(t7 - t11)) - (t21*t13))) + (t2*(((t35*t33) - (k_18*t37)) + ((k_12 - t36) - (t40 + t43)))))));
     if (!isfinite(out_0)) return SR_GEN_NONFINITE;
     E[0] = out_0;
     return SR_GEN_OK;
@@ -473,7 +473,7 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     const sr_real t33 = (u_P - (w_P*k_P)) - tau_P_y;
     const sr_real tau_Y_x = t1*(j_xx*t0);
     const sr_real alpha_P_x = -(w_P*t1);
-    const sr_real alpha_P_z = ((w_P*w_Sx) + (w_P*w_Y)) - t3;
+    const sr_real alpha_P_z = (w_P*(w_Sx + w_Y)) - t3;
     const sr_real a_alpha = (RP_02*alpha_P_x) + (RP_00*alpha_P_z);
     const sr_real w_p_y = w_P + t0;
     const sr_real w_x_a_x = RP_00*w_p_y;
@@ -482,7 +482,7 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     const sr_real t34 = (u_Y - (w_Y*k_Y)) - T_x;
     const sr_real t35 = k_21*t23;
     const sr_real t36 = t27*t14;
-    const sr_real tau_Y_y = (j_yy*t2) - (t1*(j_yy*w_y_x));
+    const sr_real tau_Y_y = j_yy*(t2 - (w_y_x*t1));
     const sr_real tau_Y_z = -((t0*(k_22*w_y_x)) + (k_8*t3));
     const sr_real w_x_a_z = -(RP_02*w_p_y);
     const sr_real tau_P_z = (j_P*(alpha_P_z - (RP_00*a_alpha))) - ((RP_02*t6) + (w_x_a_z*t4));
@@ -492,10 +492,10 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     const sr_real T_y = tau_Y_y + tau_P_y;
     const sr_real T_z = tau_Y_z + tau_P_z;
     const sr_real S_0_0 = (((k_2 + t18) - (t10*t19)) - (t9 + t21)) - ((t16*t16)*t14);
-    const sr_real S_0_1 = (((RP_02*k_3)*t5) - (t22*t5)) - (t24*t23);
-    const sr_real S_0_2 = ((((RP_02*k_3)*t7) - (t26 + (t22*t7))) - (t25*t19)) - (t27*t28);
+    const sr_real S_0_1 = (t5*((RP_02*k_3) - t22)) - (t24*t23);
+    const sr_real S_0_2 = (((t7*((RP_02*k_3) - t22)) - t26) - (t25*t19)) - (t27*t28);
     const sr_real S_1_1 = -(t30 + (t23*(k_21*t23)));
-    const sr_real S_1_2 = (((RP_00*k_3)*t5) - (t7*(k_0*t5))) - (t31*t23);
+    const sr_real S_1_2 = (t5*((RP_00*k_3) - (k_0*t7))) - (t31*t23);
     const sr_real S_2_2 = (((k_7 - t29) - t32) - ((RP_00*RP_00)*t19)) - ((t27*t27)*t14);
     const sr_real g_0 = -((t28*t34) + ((r*((t5*F_z) - (t7*F_y))) + (((w_Sx*k_S) + (t24*t33)) + T_x)));
     const sr_real g_1 = -(((t35*t33) + ((k_S*t0) + T_y)) + (r*((t7*F_x) - (gamma_x*F_z))));

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 8e8f8d7465338a8b], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources b1702b96f5367e45], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -31,11 +31,11 @@ typedef double sr_real;
 
 /* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
 #define SR_GEN_CONSTANTS_FLOPS 60
-#define SR_GEN_INERTIA_FLOPS 114
-#define SR_GEN_RHS_FLOPS 173
-#define SR_GEN_ENERGY_FLOPS 167
+#define SR_GEN_INERTIA_FLOPS 107
+#define SR_GEN_RHS_FLOPS 171
+#define SR_GEN_ENERGY_FLOPS 136
 #define SR_GEN_EQUILIBRIUM_RESIDUAL_FLOPS 23
-#define SR_GEN_ACCEL_FLOPS 273
+#define SR_GEN_ACCEL_FLOPS 268
 
 /* The float build's symbols carry _f, so a float/double mismatch fails at link time. */
 #ifdef SR_USE_FLOAT
