@@ -6,8 +6,11 @@ Measured on one pinned core:
     and the CasADi-generated C of the independent reference model;
   from Python: ns per call of Model.accel, the NumPy transcription of the
     paper's formulas, the CasADi reference, the sympy.physics.mechanics
-    (KanesMethod) model lambdified; batch accel over 10⁶ states; the
-    10,000-step t-shape scenario end to end for every method.
+    (KanesMethod) model lambdified; batch accel over 10⁶ states, and for the
+    alternatives over their own batch paths (CasADi's Function.map, the
+    lambdified Kane model on arrays); the 10,000-step t-shape scenario end to
+    end for every method, and for every alternative as the paper's Lie–Euler
+    method in a Python loop around its accel.
 Every alternative's numbers are compared with ours before its time is
 reported; the bench exits non-zero only when a kernel gives wrong numbers.
 Results: a table on stdout and JSON under bench/results/.
@@ -15,6 +18,7 @@ Results: a table on stdout and JSON under bench/results/.
 import argparse
 import datetime
 import json
+import math
 import os
 import pathlib
 import platform
@@ -91,6 +95,50 @@ def t_shape_program(steps=10_000):
     return u
 
 
+def _so3_exp(wx, wy, wz):
+    """Exp([[w]]) by Rodrigues' formula."""
+    theta2 = wx * wx + wy * wy + wz * wz
+    if theta2 < 1e-16:
+        a, b = 1.0 - theta2 / 6, 0.5 - theta2 / 24
+    else:
+        theta = math.sqrt(theta2)
+        a, b = math.sin(theta) / theta, (1 - math.cos(theta)) / theta2
+    K = np.array([[0.0, -wz, wy], [wz, 0.0, -wx], [-wy, wx, 0.0]])
+    return np.eye(3) + a * K + b * (K @ K)
+
+
+def _rotation_about(axis, angle):
+    c, s = math.cos(angle), math.sin(angle)
+    if axis == 0:
+        return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def lie_euler_loop(accel, x0, dt, u_prog, r):
+    """The t-shape run of an alternative: the paper's Lie–Euler method (Section 5) in a Python loop.
+
+    What a user of that alternative would write around its `accel(x, u)`:
+    x <- x . exp(dt f(x)) with R_S <- R_S Exp(dt [[w_S]]), R_Y <- R_Y Exp(dt w_Y [[e_x]]),
+    R_P <- R_P Exp(dt w_P [[e_y]]), q <- q + dt r R_S (w_S x gamma), nu <- nu + dt accel(x, u).
+    Returns the final state (compared with our C Lie–Euler run before its time counts).
+    """
+    x = np.array(x0, dtype=float)
+    for u in u_prog:
+        R_S = x[0:9].reshape(3, 3)
+        wx, wy, wz = x[30:33]
+        gx, gy, gz = x[6:9]
+        v = R_S @ np.array([wy * gz - wz * gy, wz * gx - wx * gz, wx * gy - wy * gx])
+        nu_dot = accel(x, u)
+        new = np.empty_like(x)
+        new[0:9] = (R_S @ _so3_exp(dt * wx, dt * wy, dt * wz)).ravel()
+        new[9:18] = (x[9:18].reshape(3, 3) @ _rotation_about(0, dt * x[33])).ravel()
+        new[18:27] = (x[18:27].reshape(3, 3) @ _rotation_about(1, dt * x[34])).ravel()
+        new[27], new[28], new[29] = x[27] + dt * r * v[0], x[28] + dt * r * v[1], x[29]
+        new[30:35] = x[30:35] + dt * nu_dot
+        x = new
+    return x
+
+
 # -- the C loop ---------------------------------------------------------------------------------
 def casadi_reference_c(params, build):
     """The independent reference's accel as one CasADi Function, through CasADi's code generator."""
@@ -157,7 +205,7 @@ def check_harness(result, model, X, U):
 
 
 # -- Python-side timings -------------------------------------------------------------------------
-def python_timings(model, X, U, batch_size, progress, with_kane=True):
+def python_timings(model, X, U, batch_size, progress, with_kane=True, loop_steps=10_000):
     from .paper_formulas import PaperModel
     from .reference import ReferenceModel
     out = {}
@@ -210,6 +258,34 @@ def python_timings(model, X, U, batch_size, progress, with_kane=True):
             model.simulate(x0, 0.01, 10_000, u_prog, method=method)
             best = min(best, time.perf_counter() - start)
         out[f"t_shape_{method}_ms"] = best * 1e3
+
+    batches = [("CasADi reference, Function.map", ref.accel_batch, 2_000)]
+    if with_kane:
+        batches.append(("KanesMethod lambdify(cse=True) on arrays", kane.accel_batch, 100_000))
+    out["alternative_batch_ns_per_state"] = {}
+    for name, accel_batch, n in batches:
+        progress(f"batch accel, {name}, {n:,} states")
+        n = min(n, batch_size)
+        check_close(f"batch accel, {name}", accel_batch(XB[:len(X)], UB[:len(X)]), AB[:len(X)], 1e-8)
+        chunk = 10_000
+        start = time.perf_counter()
+        for i in range(0, n, chunk):
+            accel_batch(XB[i:min(i + chunk, n)], UB[i:min(i + chunk, n)])
+        out["alternative_batch_ns_per_state"][name] = (time.perf_counter() - start) / n * 1e9
+
+    alternatives = [("ours: Model.accel", model.accel), ("NumPy paper formulas", paper.accel),
+                    ("CasADi reference from Python", ref.accel)]
+    if with_kane:
+        alternatives.append(("KanesMethod lambdify(cse=True)", kane.accel))
+    expected = model.simulate(x0, 0.01, loop_steps, u_prog[:loop_steps], method="lie-euler")[-1]
+    out["lie_euler_loop_steps"] = loop_steps
+    out["lie_euler_loop_ms"] = {}
+    for name, accel in alternatives:
+        progress(f"t-shape, {loop_steps:,} Lie-Euler steps in a Python loop around {name}")
+        start = time.perf_counter()
+        final = lie_euler_loop(accel, x0, 0.01, u_prog[:loop_steps], model.params.r)
+        out["lie_euler_loop_ms"][name] = (time.perf_counter() - start) * 1e3
+        check_close(f"t-shape in a Python loop around {name}", final, expected, 1e-8)
     return out
 
 
@@ -233,6 +309,9 @@ def format_report(res):
         row("accel, checked API, -march=native (C loop)", res["c_loop_native"]["accel"]["ns"])
     row("Model.accel, one call from Python", py["python_model_accel_ns"])
     row(f"Model.accel batch of {py['batch_size']:,}, per state", py["python_batch_accel_ns_per_state"])
+    for name, ns in py.get("alternative_batch_ns_per_state", {}).items():
+        rows.append((f"batch accel, {name}, per state", f"{ns:,.1f} ns",
+                     f"{ns / py['python_batch_accel_ns_per_state']:,.0f}x our batch"))
     row("NumPy, the paper's matrix formulas, per call", py["numpy_paper_accel_ns"])
     row("CasADi reference from Python, per call", py["casadi_python_accel_ns"])
     if "kane_lambdified_accel_ns" in py:
@@ -242,6 +321,11 @@ def format_report(res):
     for key, value in py.items():
         if key.startswith("t_shape_"):
             rows.append((f"t-shape 10,000 steps, {key[8:-3]}, end to end", f"{value:.2f} ms", ""))
+    if "lie_euler_loop_ms" in py:
+        ours_le = py["t_shape_lie-euler_ms"] * py["lie_euler_loop_steps"] / 10_000
+        for name, ms in py["lie_euler_loop_ms"].items():
+            rows.append((f"t-shape {py['lie_euler_loop_steps']:,} steps, Lie-Euler in a Python loop, {name}",
+                         f"{ms:,.1f} ms", f"{ms / ours_le:,.0f}x our lie-euler"))
     widths = [max(len(r[i]) for r in rows) for i in range(3)]
     lines = ["  ".join(cell.ljust(w) if i == 0 else cell.rjust(w) for i, (cell, w) in enumerate(zip(r, widths)))
              for r in rows]
@@ -271,10 +355,14 @@ def main(argv=None):
     parser.add_argument("--batch", type=int, default=1_000_000, help="states in the Python batch accel")
     parser.add_argument("--native", action="store_true", help="also build the C loop with -march=native")
     parser.add_argument("--no-kane", action="store_true", help="skip the sympy.physics.mechanics baseline")
+    parser.add_argument("--loop-steps", type=int, default=10_000,
+                        help="steps of the alternatives' t-shape run in a Python Lie-Euler loop (<= 10,000)")
     parser.add_argument("--out", type=pathlib.Path, default=RESULTS)
     args = parser.parse_args(argv)
     if not 1 <= args.states <= 4096:
         parser.error("--states: must be between 1 and 4096")
+    if not 1 <= args.loop_steps <= 10_000:
+        parser.error("--loop-steps: must be between 1 and 10,000")
 
     def progress(msg):
         print(f"bench: {msg}", file=sys.stderr, flush=True)
@@ -310,7 +398,8 @@ def run(args, core, progress):
                 exe = build_harness(build, native=True, with_casadi=False)
                 result["c_loop_native"] = run_harness(exe, params, X, U, args.repeats)
                 check_harness(result["c_loop_native"], model, X, U)
-        result["python"] = python_timings(model, X, U, args.batch, progress, with_kane=not args.no_kane)
+        result["python"] = python_timings(model, X, U, args.batch, progress, with_kane=not args.no_kane,
+                                          loop_steps=args.loop_steps)
     except WrongNumbers as exc:
         print(f"bench: WRONG NUMBERS: {exc}", file=sys.stderr)
         return 1

@@ -318,6 +318,23 @@ class ReferenceModel:
         wS_dot = np.asarray(J) @ sdd + np.asarray(b0).reshape(-1)
         return np.concatenate([wS_dot, sdd[3:5]])
 
+    def accel_batch(self, X, U) -> np.ndarray:
+        """`accel` for states and inputs in rows, shape (n, 5): the CasADi functions mapped over
+        the batch (`Function.map`, what a CasADi user would do) and one batched solve."""
+        X, U = np.asarray(X, dtype=float), np.asarray(U, dtype=float)
+        if X.ndim != 2 or X.shape[1] != STATE_DIM or U.shape != (len(X), 2):
+            raise ValueError(f"states and inputs must have shapes (n, {STATE_DIM}) and (n, 2), "
+                             f"got {X.shape} and {U.shape}")
+        n = len(X)
+        K, rhs = self._f_kkt.map(n)(X.T, U.T)
+        J, b0 = self._f_conv.map(n)(X.T)
+        m = K.size1()
+        K = np.asarray(K).reshape(m, n, m).transpose(1, 0, 2)
+        sdd = np.linalg.solve(K, np.asarray(rhs).T[..., None])[:, :7, 0]
+        J = np.asarray(J).reshape(3, n, 7).transpose(1, 0, 2)
+        wS_dot = np.einsum("nij,nj->ni", J, sdd) + np.asarray(b0).T
+        return np.concatenate([wS_dot, sdd[:, 3:5]], axis=1)
+
     def inertia(self, x) -> np.ndarray:
         """5x5 mass matrix M(x) with kinetic energy = 1/2 nu^T M nu on the constraint."""
         return np.asarray(self._f_inertia(self._state(x)))

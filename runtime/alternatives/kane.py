@@ -177,8 +177,20 @@ def _derive(cse=True):
     f_MF = sm.lambdify(args, (M_s, F_s), modules="numpy", cse=cse)
     f_udep = sm.lambdify((qs, us[:5], par), udep_s, modules="numpy", cse=cse)
     seconds = time.perf_counter() - t0
-    return {"f_MF": f_MF, "f_udep": f_udep, "seconds": seconds, "kane_seconds": t_kane,
-            "n_ops": int(sm.count_ops(M_s) + sm.count_ops(F_s))}
+    # The same expressions lambdified for arrays of states (accel_batch): entries that do
+    # not depend on the state (the zeros of M and F) are broadcast to the batch.
+    batch = [{"array": _broadcast_array}, "numpy"]
+    f_MF_batch = sm.lambdify(args, (M_s, F_s), modules=batch, cse=cse)
+    f_udep_batch = sm.lambdify((qs, us[:5], par), udep_s, modules=batch, cse=cse)
+    return {"f_MF": f_MF, "f_udep": f_udep, "f_MF_batch": f_MF_batch, "f_udep_batch": f_udep_batch,
+            "seconds": seconds, "kane_seconds": t_kane, "n_ops": int(sm.count_ops(M_s) + sm.count_ops(F_s))}
+
+
+def _broadcast_array(rows):
+    """numpy.array of a nested list whose entries are arrays of one batch shape or scalars."""
+    entries = [e for row in rows for e in row]
+    shape = np.broadcast_shapes(*(np.shape(e) for e in entries))
+    return np.array([[np.broadcast_to(e, shape) for e in row] for row in rows])
 
 
 def _derivation(cse=True):
@@ -249,3 +261,32 @@ class KaneModel:
         """(d omega_S/dt (shell frame, 3), d omega_Y/dt, d omega_P/dt), shape (5,)."""
         M, F = self.mass_matrix_forcing(x, u)
         return np.linalg.solve(M, F)[:5]
+
+    @staticmethod
+    def coordinates_batch(X):
+        """`coordinates` for states in rows, vectorized: (7 coordinate arrays, 5 speed arrays)."""
+        X = np.asarray(X, dtype=float)
+        if X.ndim != 2 or X.shape[1] != STATE_DIM:
+            raise ValueError(f"states must have shape (n, {STATE_DIM}), got {X.shape}")
+        c = np.hypot(X[:, 0], X[:, 3])
+        theta = np.arctan2(-X[:, 6], c)
+        lock = c < 1e-12
+        psi = np.where(lock, 0.0, np.arctan2(X[:, 3], X[:, 0]))
+        phi = np.where(lock, np.arctan2(-X[:, 5], X[:, 4]), np.arctan2(X[:, 7], X[:, 8]))
+        th_Y = np.arctan2(X[:, 9 + 7], X[:, 9 + 4])
+        th_P = np.arctan2(X[:, 18 + 2], X[:, 18 + 0])
+        return (psi, theta, phi, th_Y, th_P, X[:, 27], X[:, 28]), tuple(X[:, 30 + i] for i in range(5))
+
+    def accel_batch(self, X, U) -> np.ndarray:
+        """`accel` for states and inputs in rows, shape (n, 5): the lambdified code on arrays
+        (what a NumPy user would do with a batch) and one batched solve."""
+        d = _derivation(self.cse)
+        qv, w = self.coordinates_batch(X)
+        U = np.asarray(U, dtype=float)
+        if U.shape != (len(qv[0]), 2):
+            raise ValueError(f"inputs must have shape ({len(qv[0])}, 2), got {U.shape}")
+        udep = d["f_udep_batch"](qv, w, self._p).reshape(2, -1)
+        M, F = d["f_MF_batch"](qv, w + (udep[0], udep[1]), (U[:, 0], U[:, 1]), self._p)
+        M = np.moveaxis(M.reshape(7, 7, -1), -1, 0)
+        F = np.moveaxis(F.reshape(7, -1), -1, 0)
+        return np.linalg.solve(M, F[..., None])[:, :5, 0]
