@@ -78,3 +78,23 @@ def test_derivation_is_cached_and_params_checked(models):
     assert km.derivation_seconds > 0
     with pytest.raises(ValueError):
         KaneModel({"r": 0.3})
+
+
+def test_accel_batch_agrees_with_accel_state_by_state(models, rng):
+    km, _ = models
+    p = Params.paper_simulation()
+    lock = initial_state(R_S=rot_z(0.7) @ rot_y(np.pi / 2) @ rot_x(-1.1), w_S=(0.3, -0.2, 0.5), r=p.r)
+    X = np.array([random_state(rng, p) for _ in range(5)] + [lock])
+    U = rng.uniform(-1.0, 1.0, size=(6, 2))
+    A = km.accel_batch(X, U)
+    assert A.shape == (6, 5)
+    for x, u, a in zip(X, U, A):
+        assert _rel(a, km.accel(x, u)) < 1e-13
+
+
+def test_accel_batch_names_a_wrong_shape(models):
+    km, _ = models
+    with pytest.raises(ValueError, match="states must have shape"):
+        km.accel_batch(np.zeros((3, 34)), np.zeros((3, 2)))
+    with pytest.raises(ValueError, match="inputs must have shape"):
+        km.accel_batch(np.zeros((3, 35)), np.zeros((2, 2)))
