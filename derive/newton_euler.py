@@ -101,10 +101,12 @@ def program(R_Y=S.R_Y):
     a_alpha, a_w = p.let("a_alpha", a.dot(alpha_P)), p.let("a_w", a.dot(w_p))
     w_x_a = p.let("w_x_a", w_p.cross(a))
     tau_P = p.let("tau_P", P.j_P * (alpha_P - a_alpha * a) - P.j_P * a_w * w_x_a + P.g * kappa * a.cross(S.gamma))
-    # Pendulum bias force α_P × h + ω_p × (ω_p × h); the rolling mass's m_R g γ is parallel to γ and drops.
-    F = p.let("F", kappa * (alpha_P.cross(a) + w_p.cross(w_x_a)))
+    # Pendulum bias force α_P × h + ω_p × (ω_p × h) = κ b, with b = α_P × a + ω_p × (ω_p × a) the bias
+    # acceleration of the shaft point a (κ stays outside, where it joins r in one per-model constant);
+    # the rolling mass's m_R g γ is parallel to γ and drops.
+    b = p.let("b", alpha_P.cross(a) + w_p.cross(w_x_a))
     T = p.let("T", tau_Y + tau_P)
-    shell = -P.k_S * w - (P.r * S.gamma.cross(F) + T)
+    shell = -P.k_S * w - (P.r * kappa * S.gamma.cross(b) + T)
     yoke = S.u_Y - P.k_Y * S.w_Y - _e_x.dot(T)
     pendulum = S.u_P - P.k_P * S.w_P - e.dot(tau_P)
     return p, sp.Matrix([*shell, yoke, pendulum])

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources b1702b96f5367e45], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources a07af9a72a44d236], SymPy 1.14.0. */
 #include "sr_generated.h"
 
 #include <math.h>
@@ -14,19 +14,18 @@
  *   c[19] k_7 = j_S + j_xx + j_yy + m_R*r**2
  *   c[20] k_8 = j_xx + j_yy
  *   c[21] k_9 = g*l*m_P/2
- *   c[22] k_10 = l*m_P/2
- *   c[23] k_11 = j_P/2 + j_S/2 + j_xx/2
- *   c[24] k_12 = j_P/2 + j_S/2 + j_yy/2 + m_R*r**2/2
- *   c[25] k_13 = j_S/2 + j_xx/2 + j_yy/2 + m_R*r**2/2
- *   c[26] k_14 = j_P/2 + j_xx/2
- *   c[27] k_15 = j_P/2
- *   c[28] k_16 = g*m_P
- *   c[29] k_17 = j_P/2 - j_xx/2
- *   c[30] k_18 = m_R*r**2/2
- *   c[31] k_19 = l**2*m_P**2*r**2/(4*j_P)
- *   c[32] k_20 = l*m_P*r/(2*j_P)
- *   c[33] k_21 = 1/j_P
- *   c[34] k_22 = j_xx - j_yy */
+ *   c[22] k_10 = j_P/2 + j_S/2 + j_xx/2
+ *   c[23] k_11 = j_P/2 + j_S/2 + j_yy/2 + m_R*r**2/2
+ *   c[24] k_12 = j_S/2 + j_xx/2 + j_yy/2 + m_R*r**2/2
+ *   c[25] k_13 = j_P/2 + j_xx/2
+ *   c[26] k_14 = j_P/2
+ *   c[27] k_15 = g*m_P
+ *   c[28] k_16 = j_P/2 - j_xx/2
+ *   c[29] k_17 = m_R*r**2/2
+ *   c[30] k_18 = l**2*m_P**2*r**2/(4*j_P)
+ *   c[31] k_19 = l*m_P*r/(2*j_P)
+ *   c[32] k_20 = 1/j_P
+ *   c[33] k_21 = j_xx - j_yy */
 int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[SR_GEN_NCONST])
 {
     const sr_real r = p[0];
@@ -51,18 +50,17 @@ int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[SR_GEN_NCONST])
     const sr_real t7 = m_P*t6;
     const sr_real t8 = SR_C(0.3333333333333333)*t7;
     const sr_real t9 = t1*t0;
-    const sr_real t10 = l*m_P;
-    const sr_real t11 = r*t10;
-    const sr_real t12 = t4 + t8;
-    const sr_real t13 = t3 + t9;
-    const sr_real t14 = t4 + t5;
-    const sr_real t15 = g*m_P;
-    const sr_real t16 = SR_C(0.3333333333333333)*t2;
-    const sr_real t17 = SR_C(0.16666666666666666)*t7;
-    const sr_real t18 = SR_C(0.5)*t4;
-    const sr_real t19 = t17 + t18;
-    const sr_real t20 = SR_C(0.5)*t9;
-    const sr_real t21 = t20 + (t16 + (SR_C(0.5)*t5));
+    const sr_real t10 = r*(l*m_P);
+    const sr_real t11 = t4 + t8;
+    const sr_real t12 = t3 + t9;
+    const sr_real t13 = t4 + t5;
+    const sr_real t14 = g*m_P;
+    const sr_real t15 = SR_C(0.3333333333333333)*t2;
+    const sr_real t16 = SR_C(0.16666666666666666)*t7;
+    const sr_real t17 = SR_C(0.5)*t4;
+    const sr_real t18 = t16 + t17;
+    const sr_real t19 = SR_C(0.5)*t9;
+    const sr_real t20 = t19 + (t15 + (SR_C(0.5)*t5));
     c[0] = r;
     c[1] = l;
     c[2] = g;
@@ -76,28 +74,27 @@ int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[SR_GEN_NCONST])
     c[10] = k_Y;
     c[11] = k_P;
     c[12] = t9;
-    c[13] = t11;
-    c[14] = t3 + t12;
-    c[15] = SR_C(0.5)*t11;
-    c[16] = t12;
+    c[13] = t10;
+    c[14] = t3 + t11;
+    c[15] = SR_C(0.5)*t10;
+    c[16] = t11;
     c[17] = (t6*(SR_C(0.3333333333333333)*m_P)) - t4;
-    c[18] = (t5 + t8) + t13;
-    c[19] = t14 + t13;
-    c[20] = t14;
-    c[21] = t15*(SR_C(0.5)*l);
-    c[22] = SR_C(0.5)*t10;
-    c[23] = t16 + t19;
-    c[24] = t17 + t21;
-    c[25] = t18 + t21;
-    c[26] = t19;
-    c[27] = t17;
-    c[28] = t15;
-    c[29] = (t6*(SR_C(0.16666666666666666)*m_P)) - t18;
-    c[30] = t20;
-    c[31] = t1*(SR_C(0.75)*m_P);
-    c[32] = (SR_C(1.5)*r)/l;
-    c[33] = SR_C(3.0)/(m_P*t6);
-    c[34] = t4 - t5;
+    c[18] = (t5 + t8) + t12;
+    c[19] = t13 + t12;
+    c[20] = t13;
+    c[21] = t14*(SR_C(0.5)*l);
+    c[22] = t15 + t18;
+    c[23] = t16 + t20;
+    c[24] = t17 + t20;
+    c[25] = t18;
+    c[26] = t16;
+    c[27] = t14;
+    c[28] = (t6*(SR_C(0.16666666666666666)*m_P)) - t17;
+    c[29] = t19;
+    c[30] = t1*(SR_C(0.75)*m_P);
+    c[31] = (SR_C(1.5)*r)/l;
+    c[32] = SR_C(3.0)/(m_P*t6);
+    c[33] = t4 - t5;
     return SR_GEN_OK;
 }
 
@@ -206,16 +203,15 @@ int sr_gen_inertia(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], s
 /* Right-hand side f of M ν̇ = f: gyroscopic, non-holonomic, gravity, motor and friction terms. */
 int sr_gen_rhs(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real f[5])
 {
-    const sr_real r = c[0];
     const sr_real j_xx = c[6];
     const sr_real j_yy = c[7];
     const sr_real j_P = c[8];
     const sr_real k_S = c[9];
     const sr_real k_Y = c[10];
     const sr_real k_P = c[11];
+    const sr_real k_3 = c[15];
     const sr_real k_8 = c[20];
     const sr_real k_9 = c[21];
-    const sr_real k_10 = c[22];
     const sr_real gamma_x = x[6];
     const sr_real gamma_y = x[7];
     const sr_real gamma_z = x[8];
@@ -261,18 +257,18 @@ int sr_gen_rhs(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const
     const sr_real tau_P_x = (j_P*(alpha_P_x - (RP_02*a_alpha))) - ((k_9*((gamma_z*a_y) - (gamma_y*a_z))) + (w_x_a_x*t11));
     const sr_real tau_P_y = (j_P*(alpha_P_y - (a_y*a_alpha))) - ((k_9*((gamma_x*a_z) - (RP_02*gamma_z))) + (w_x_a_y*t11));
     const sr_real tau_P_z = (j_P*(alpha_P_z - (a_z*a_alpha))) - ((k_9*((RP_02*gamma_y) - (gamma_x*a_y))) + (w_x_a_z*t11));
-    const sr_real F_x = -(k_10*(((a_z*alpha_P_y) - (a_y*alpha_P_z)) + ((w_p_y*w_x_a_z) - (w_p_z*w_x_a_y))));
-    const sr_real F_y = -(k_10*(((RP_02*alpha_P_z) - (a_z*alpha_P_x)) + ((w_p_z*w_x_a_x) - (w_y_x*w_x_a_z))));
-    const sr_real F_z = -(k_10*(((a_y*alpha_P_x) - (RP_02*alpha_P_y)) + ((w_y_x*w_x_a_y) - (w_p_y*w_x_a_x))));
+    const sr_real b_x = ((a_z*alpha_P_y) - (a_y*alpha_P_z)) + ((w_p_y*w_x_a_z) - (w_p_z*w_x_a_y));
+    const sr_real b_y = ((RP_02*alpha_P_z) - (a_z*alpha_P_x)) + ((w_p_z*w_x_a_x) - (w_y_x*w_x_a_z));
+    const sr_real b_z = ((a_y*alpha_P_x) - (RP_02*alpha_P_y)) + ((w_y_x*w_x_a_y) - (w_p_y*w_x_a_x));
     const sr_real T_x = tau_Y_x + tau_P_x;
     const sr_real T_y = tau_Y_y + tau_P_y;
     const sr_real T_z = tau_Y_z + tau_P_z;
-    const sr_real out_0 = -((r*((gamma_y*F_z) - (gamma_z*F_y))) + ((w_Sx*k_S) + T_x));
-    const sr_real out_1 = -((r*((gamma_z*F_x) - (gamma_x*F_z))) + ((w_Sy*k_S) + T_y));
-    const sr_real out_2 = -((r*((gamma_x*F_y) - (gamma_y*F_x))) + ((w_Sz*k_S) + T_z));
+    const sr_real out_0 = ((k_3*((gamma_y*b_z) - (gamma_z*b_y))) - (w_Sx*k_S)) - T_x;
+    const sr_real out_1 = ((k_3*((gamma_z*b_x) - (gamma_x*b_z))) - (w_Sy*k_S)) - T_y;
+    const sr_real out_2 = ((k_3*((gamma_x*b_y) - (gamma_y*b_x))) - (w_Sz*k_S)) - T_z;
     const sr_real out_3 = (u_Y - (w_Y*k_Y)) - T_x;
     const sr_real out_4 = ((u_P - (w_P*k_P)) - (RY_11*tau_P_y)) - (RY_21*tau_P_z);
-    const sr_real out_sum = (out_1 + out_2) + (out_4 + (out_3 + out_0));
+    const sr_real out_sum = (out_2 + out_3) + (out_4 + (out_0 + out_1));
     if (!isfinite(out_sum) && !(isfinite(out_0) && isfinite(out_1) && isfinite(out_2) && isfinite(out_3) && isfinite(out_4))) return SR_GEN_NONFINITE;
     f[0] = out_0;
     f[1] = out_1;
@@ -291,6 +287,7 @@ int sr_gen_energy(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr
     const sr_real k_4 = c[16];
     const sr_real k_5 = c[17];
     const sr_real k_9 = c[21];
+    const sr_real k_10 = c[22];
     const sr_real k_11 = c[23];
     const sr_real k_12 = c[24];
     const sr_real k_13 = c[25];
@@ -298,7 +295,6 @@ int sr_gen_energy(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr
     const sr_real k_15 = c[27];
     const sr_real k_16 = c[28];
     const sr_real k_17 = c[29];
-    const sr_real k_18 = c[30];
     const sr_real gamma_x = x[6];
     const sr_real gamma_y = x[7];
     const sr_real gamma_z = x[8];
@@ -345,12 +341,12 @@ int sr_gen_energy(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr
     const sr_real t30 = t12*(gamma_x*w_Y);
     const sr_real t31 = t12*t7;
     const sr_real t32 = RP_02*RP_02;
-    const sr_real t33 = k_15*t32;
+    const sr_real t33 = k_14*t32;
     const sr_real t34 = t3*t33;
     const sr_real t35 = RY_21*RY_21;
-    const sr_real t36 = k_17*t35;
+    const sr_real t36 = k_16*t35;
     const sr_real t37 = gamma_y*gamma_y;
-    const sr_real t38 = k_18*t1;
+    const sr_real t38 = k_17*t1;
     const sr_real t39 = gamma_z*gamma_z;
     const sr_real t40 = k_3*t5;
     const sr_real t41 = j_P*t32;
@@ -358,7 +354,7 @@ int sr_gen_energy(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr
     const sr_real t43 = t11*t12;
     const sr_real t44 = RY_21*w_Sy;
     const sr_real t45 = w_P*t40;
-    const sr_real out_0 = (((t3*((t36 - t40) + ((k_13 + t31) - (k_18*t39)))) + (w_P*(((RY_21*gamma_z)*t19) + ((k_15*w_P) + ((RP_02*RY_11)*t17))))) + (((((k_16*q_z) - (k_9*t5)) - ((gamma_y*w_Sy)*t23)) + (t0*((k_4 + t31) - (t41 + t43)))) + ((t1*((k_11 + t31) - (t33 + t43))) + (t10*((t8 - (t12*t21)) - t45))))) + ((((t14*((t13 + (t12*t9)) - (k_0*t21))) + (t9*(t8 - t45))) + (((t18*(t19 - t23)) + (t20*(k_5 - t41))) + ((t25*(t26 - t42)) + (t27*(t26 - t42))))) + ((((t28*(t29 + t30)) + ((1 - t35)*t34)) + ((t4*(k_14 - t33)) - (t44*(t29 + t30)))) + ((((t15*t17) + (t38*(t37 + t39))) + ((t6*(t7 - t11)) - (t21*t13))) + (t2*(((t35*t33) - (k_18*t37)) + ((k_12 - t36) - (t40 + t43)))))));
+    const sr_real out_0 = (((t3*((t36 - t40) + ((k_12 + t31) - (k_17*t39)))) + (w_P*(((RY_21*gamma_z)*t19) + ((k_14*w_P) + ((RP_02*RY_11)*t17))))) + (((((k_15*q_z) - (k_9*t5)) - ((gamma_y*w_Sy)*t23)) + (t0*((k_4 + t31) - (t41 + t43)))) + ((t1*((k_10 + t31) - (t33 + t43))) + (t10*((t8 - (t12*t21)) - t45))))) + ((((t14*((t13 + (t12*t9)) - (k_0*t21))) + (t9*(t8 - t45))) + (((t18*(t19 - t23)) + (t20*(k_5 - t41))) + ((t25*(t26 - t42)) + (t27*(t26 - t42))))) + ((((t28*(t29 + t30)) + ((1 - t35)*t34)) + ((t4*(k_13 - t33)) - (t44*(t29 + t30)))) + ((((t15*t17) + (t38*(t37 + t39))) + ((t6*(t7 - t11)) - (t21*t13))) + (t2*(((t35*t33) - (k_17*t37)) + ((k_11 - t36) - (t40 + t43)))))));
     if (!isfinite(out_0)) return SR_GEN_NONFINITE;
     E[0] = out_0;
     return SR_GEN_OK;
@@ -397,7 +393,6 @@ int sr_gen_equilibrium_residual(const sr_real c[SR_GEN_NCONST], const sr_real x[
 /* ν̇ = (ω̇_S, ω̇_Y, ω̇_P) solving M ν̇ = f, joints first; SR_GEN_SINGULAR if M is not positive definite. */
 int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real a[SR_GEN_NV])
 {
-    const sr_real r = c[0];
     const sr_real j_xx = c[6];
     const sr_real j_yy = c[7];
     const sr_real j_P = c[8];
@@ -413,11 +408,10 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     const sr_real k_7 = c[19];
     const sr_real k_8 = c[20];
     const sr_real k_9 = c[21];
-    const sr_real k_10 = c[22];
+    const sr_real k_18 = c[30];
     const sr_real k_19 = c[31];
     const sr_real k_20 = c[32];
     const sr_real k_21 = c[33];
-    const sr_real k_22 = c[34];
     const sr_real gamma_x = x[6];
     const sr_real gamma_y = x[7];
     const sr_real gamma_z = x[8];
@@ -453,19 +447,19 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     const sr_real t16 = -(t12 + t15);
     const sr_real t17 = t5*t5;
     const sr_real t18 = k_0*t17;
-    const sr_real t19 = k_19*t17;
+    const sr_real t19 = k_18*t17;
     const sr_real t20 = t7*(k_0*t7);
     const sr_real t21 = t11 - t20;
     const sr_real t22 = gamma_x*k_0;
     const sr_real t23 = (j_P - (k_3*(RP_02*gamma_x))) - t15;
-    const sr_real t24 = (RP_02*k_20)*t5;
+    const sr_real t24 = (RP_02*k_19)*t5;
     const sr_real t25 = RP_00*RP_02;
     const sr_real t26 = (j_P*t25) - (k_3*(RP_00*gamma_x));
     const sr_real t27 = -t26;
     const sr_real t28 = t16*t14;
     const sr_real t29 = k_1*(RP_02*gamma_x);
     const sr_real t30 = t9 + ((t29 - k_6) + t18);
-    const sr_real t31 = (RP_00*k_20)*t5;
+    const sr_real t31 = (RP_00*k_19)*t5;
     const sr_real t32 = t20 - t11;
     const sr_real alpha_P_y = t2;
     const sr_real w_x_a_y = (RP_02*t1) - (RP_00*w_y_x);
@@ -480,33 +474,33 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     const sr_real tau_P_x = ((RP_00*t6) - (w_x_a_x*t4)) + (j_P*(alpha_P_x - (RP_02*a_alpha)));
     const sr_real T_x = tau_Y_x + tau_P_x;
     const sr_real t34 = (u_Y - (w_Y*k_Y)) - T_x;
-    const sr_real t35 = k_21*t23;
+    const sr_real t35 = k_20*t23;
     const sr_real t36 = t27*t14;
     const sr_real tau_Y_y = j_yy*(t2 - (w_y_x*t1));
-    const sr_real tau_Y_z = -((t0*(k_22*w_y_x)) + (k_8*t3));
+    const sr_real tau_Y_z = -((t0*(k_21*w_y_x)) + (k_8*t3));
     const sr_real w_x_a_z = -(RP_02*w_p_y);
     const sr_real tau_P_z = (j_P*(alpha_P_z - (RP_00*a_alpha))) - ((RP_02*t6) + (w_x_a_z*t4));
-    const sr_real F_x = -(k_10*(((RP_00*alpha_P_y) + (w_p_y*w_x_a_z)) - (t1*w_x_a_y)));
-    const sr_real F_y = -(k_10*(((t1*w_x_a_x) - (RP_00*alpha_P_x)) + ((RP_02*alpha_P_z) - (w_y_x*w_x_a_z))));
-    const sr_real F_z = -(k_10*(((w_y_x*w_x_a_y) - (RP_02*alpha_P_y)) - (w_p_y*w_x_a_x)));
+    const sr_real b_x = ((RP_00*alpha_P_y) + (w_p_y*w_x_a_z)) - (t1*w_x_a_y);
+    const sr_real b_y = ((t1*w_x_a_x) - (RP_00*alpha_P_x)) + ((RP_02*alpha_P_z) - (w_y_x*w_x_a_z));
+    const sr_real b_z = ((w_y_x*w_x_a_y) - (RP_02*alpha_P_y)) - (w_p_y*w_x_a_x);
     const sr_real T_y = tau_Y_y + tau_P_y;
     const sr_real T_z = tau_Y_z + tau_P_z;
     const sr_real S_0_0 = (((k_2 + t18) - (t10*t19)) - (t9 + t21)) - ((t16*t16)*t14);
     const sr_real S_0_1 = (t5*((RP_02*k_3) - t22)) - (t24*t23);
     const sr_real S_0_2 = (((t7*((RP_02*k_3) - t22)) - t26) - (t25*t19)) - (t27*t28);
-    const sr_real S_1_1 = -(t30 + (t23*(k_21*t23)));
+    const sr_real S_1_1 = -(t30 + (t23*(k_20*t23)));
     const sr_real S_1_2 = (t5*((RP_00*k_3) - (k_0*t7))) - (t31*t23);
     const sr_real S_2_2 = (((k_7 - t29) - t32) - ((RP_00*RP_00)*t19)) - ((t27*t27)*t14);
-    const sr_real g_0 = -((t28*t34) + ((r*((t5*F_z) - (t7*F_y))) + (((w_Sx*k_S) + (t24*t33)) + T_x)));
-    const sr_real g_1 = -(((t35*t33) + ((k_S*t0) + T_y)) + (r*((t7*F_x) - (gamma_x*F_z))));
-    const sr_real g_2 = -((t36*t34) + ((r*((gamma_x*F_y) - (t5*F_x))) + (((k_S*t1) + (t31*t33)) + T_z)));
+    const sr_real g_0 = (((k_3*((t5*b_z) - (t7*b_y))) - ((w_Sx*k_S) + (t24*t33))) - T_x) - (t28*t34);
+    const sr_real g_1 = (k_3*((t7*b_x) - (gamma_x*b_z))) - ((t35*t33) + ((k_S*t0) + T_y));
+    const sr_real g_2 = (((k_3*((gamma_x*b_y) - (t5*b_x))) - ((k_S*t1) + (t31*t33))) - T_z) - (t36*t34);
     const sr_real beta_0_3 = t28;
     const sr_real beta_0_4 = t24;
     const sr_real beta_1_4 = t35;
     const sr_real beta_2_3 = t36;
     const sr_real beta_2_4 = t31;
     const sr_real fD_3 = t14*t34;
-    const sr_real fD_4 = k_21*t33;
+    const sr_real fD_4 = k_20*t33;
     const sr_real M_3_3 = t13;
     const sr_real M_4_4 = j_P;
     const sr_real M_0_0 = (k_2 + t18) + (t32 - t9);
