@@ -160,7 +160,8 @@ def accel_program():
     sub = YF.from_shell_frame()
     p, f = YF.program()
     definitions = tuple((symbol, value.xreplace(sub)) for symbol, value in p.definitions)
-    return definitions, joint_first_system(YF.inertia().xreplace(sub), f.xreplace(sub))
+    solve_definitions, outputs = joint_first_system(YF.inertia().xreplace(sub), f.xreplace(sub))
+    return definitions + solve_definitions, outputs
 
 
 def kernels():
@@ -354,33 +355,39 @@ def emit_inputs(kernel, used, layouts):
 
 
 def joint_first_system(M, f):
-    """M ν̇ = f with the joint accelerations eliminated: the outputs of the `accel` kernel.
+    """M ν̇ = f with the joint accelerations eliminated: (definitions, outputs) of the `accel` kernel.
 
     M = [A B; Bᵀ D] with A the 3×3 shell block and D = diag(M_33, M_44): the
     yoke and pendulum rates do not couple (M_34 = 0 identically, asserted
     here).  The shell accelerations solve S ω̇_S = g with the Schur complement
     S = A − β Bᵀ, g = f_S − β f_J, β = B D⁻¹ (1/M_44 = 1/j_P is a per-model
     constant, and 1/M_33 is ready early, off the critical path); then
-    ω̇_J = D⁻¹ f_J − βᵀ ω̇_S.  These are symbolic, so CSE and the constant
-    pool see them together with M and f.
+    ω̇_J = D⁻¹ f_J − βᵀ ω̇_S.  The entries of β are definitions (named
+    `beta_i_k`; those of zero entries of B are left out), so that each term
+    of β Bᵀ costs one multiplication, not the two of B_ik B_jk / d_k.  All of
+    it is symbolic, so CSE and the constant pool see it together with M and f.
     """
     if sp.simplify(M[3, 4]) != 0:
         raise ValueError("joint-first solve needs M_34 = 0: the yoke and pendulum rates couple")
-    A, B, d3, d4 = M[0:3, 0:3], M[0:3, 3:5], M[3, 3], M[4, 4]
-    beta = B * sp.diag(1 / d3, 1 / d4)
+    A, B, d = M[0:3, 0:3], M[0:3, 3:5], (M[3, 3], M[4, 4])
+    definitions, beta = [], sp.zeros(3, 2)
+    for i in range(3):
+        for k in range(2):
+            if sp.expand(B[i, k]) != 0:
+                beta[i, k] = sp.Symbol(f"beta_{i}_{k + 3}", real=True)
+                definitions.append((beta[i, k], B[i, k] / d[k]))
     S_ = A - beta * B.T
     g_ = f[0:3, 0] - beta * f[3:5, 0]
-    return (
+    return tuple(definitions), (
         Output("S", upper_triangle(S_), "Schur complement, upper triangle", ("S_0_0", "S_0_1", "S_0_2", "S_1_1", "S_1_2", "S_2_2")),
         Output("g", tuple(g_), "reduced right-hand side", ("g_0", "g_1", "g_2")),
-        Output("beta", tuple(beta), "B D^-1, row-major 3x2", ("beta_0_3", "beta_0_4", "beta_1_3", "beta_1_4", "beta_2_3", "beta_2_4")),
-        Output("fD", (f[3] / d3, f[4] / d4), "D^-1 f_J", ("fD_3", "fD_4")),
-        Output("D", (d3, d4), "joint inertias", ("M_3_3", "M_4_4")),
+        Output("fD", (f[3] / d[0], f[4] / d[1]), "D^-1 f_J", ("fD_3", "fD_4")),
+        Output("D", d, "joint inertias", ("M_3_3", "M_4_4")),
         Output("Mdiag", (M[0, 0], M[1, 1], M[2, 2]), "diagonal of A, the scale of the pivot tests", ("M_0_0", "M_1_1", "M_2_2")),
     )
 
 
-def emit_shell_solve(scheduler, out_name, rotation, zero):
+def emit_shell_solve(scheduler, out_name, rotation, defined):
     """C for the rest of `joint_first_system`: S ω̇' = g by the adjugate of S, then the joints.
 
     M is positive definite iff M_33, M_44 and the leading minors of S are
@@ -389,7 +396,7 @@ def emit_shell_solve(scheduler, out_name, rotation, zero):
     negative M_33 gives an infinity or a wrong sign that is never used.  The
     shell accelerations come out in the frame of the system (the yoke frame,
     see `derive.yoke_frame`) and are written as `rotation` times them.
-    Couplings named in `zero` are identically zero and left out.
+    Couplings β_ik not among the `defined` names are identically zero and left out.
     """
     def sym(name):
         return sp.Symbol(name, real=True)
@@ -398,7 +405,7 @@ def emit_shell_solve(scheduler, out_name, rotation, zero):
     C_ = S_.adjugate()
     C = sp.Matrix(3, 3, lambda i, j: sym(f"C_{min(i, j)}_{max(i, j)}"))
     g, a = sp.Matrix([sym(f"g_{i}") for i in range(3)]), [sym(f"a_{i}") for i in range(5)]
-    beta = sp.Matrix(3, 2, lambda i, k: 0 if f"beta_{i}_{k + 3}" in zero else sym(f"beta_{i}_{k + 3}"))
+    beta = sp.Matrix(3, 2, lambda i, k: sym(f"beta_{i}_{k + 3}") if f"beta_{i}_{k + 3}" in defined else 0)
 
     def let(name, value):
         return f"    const sr_real {name} = {scheduler.assign(name, value)};"
@@ -496,17 +503,16 @@ def emit_kernel(kernel, layouts):
     body = emit_inputs(kernel, used, layouts)
     nodes = temporaries + definitions
     body += emit_assignments(scheduler, dependency_order(nodes, [s for s, _ in nodes] + reduced), declare=True)
-    k, zero, results = 0, set(), []
+    k, results = 0, []
     for out in kernel.outputs:
         values = reduced[k:k + len(out.exprs)]
         k += len(out.exprs)
         if out.local_names:
-            zero |= {n for n, v in zip(out.local_names, values) if v == 0}
-            body += emit_assignments(scheduler, [(n, v) for n, v in zip(out.local_names, values) if v != 0], declare=True)
+            body += emit_assignments(scheduler, list(zip(out.local_names, values)), declare=True)
         else:
             results += [(f"{out.name}[{i}]", v) for i, v in enumerate(values)]
     if kernel.solve:
-        lines, results = emit_shell_solve(scheduler, "a", S.R_Y, zero)
+        lines, results = emit_shell_solve(scheduler, "a", S.R_Y, {s.name for s in defined})
         body += lines
     body += emit_results(scheduler, results, kernel.finite_or_untouched)
     body.append("    return SR_GEN_OK;")

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources a07af9a72a44d236], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 0c19854e5b5e3289], SymPy 1.14.0. */
 #include "sr_generated.h"
 
 #include <math.h>
@@ -22,10 +22,9 @@
  *   c[27] k_15 = g*m_P
  *   c[28] k_16 = j_P/2 - j_xx/2
  *   c[29] k_17 = m_R*r**2/2
- *   c[30] k_18 = l**2*m_P**2*r**2/(4*j_P)
- *   c[31] k_19 = l*m_P*r/(2*j_P)
- *   c[32] k_20 = 1/j_P
- *   c[33] k_21 = j_xx - j_yy */
+ *   c[30] k_18 = 1/j_P
+ *   c[31] k_19 = j_xx - j_yy
+ *   c[32] k_20 = l*m_P*r/(2*j_P) */
 int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[SR_GEN_NCONST])
 {
     const sr_real r = p[0];
@@ -91,10 +90,9 @@ int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[SR_GEN_NCONST])
     c[27] = t14;
     c[28] = (t6*(SR_C(0.16666666666666666)*m_P)) - t17;
     c[29] = t19;
-    c[30] = t1*(SR_C(0.75)*m_P);
-    c[31] = (SR_C(1.5)*r)/l;
-    c[32] = SR_C(3.0)/(m_P*t6);
-    c[33] = t4 - t5;
+    c[30] = SR_C(3.0)/(m_P*t6);
+    c[31] = t4 - t5;
+    c[32] = (SR_C(1.5)*r)/l;
     return SR_GEN_OK;
 }
 
@@ -411,7 +409,6 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     const sr_real k_18 = c[30];
     const sr_real k_19 = c[31];
     const sr_real k_20 = c[32];
-    const sr_real k_21 = c[33];
     const sr_real gamma_x = x[6];
     const sr_real gamma_y = x[7];
     const sr_real gamma_z = x[8];
@@ -436,35 +433,27 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     const sr_real t5 = (RY_11*gamma_y) + (RY_21*gamma_z);
     const sr_real t6 = k_9*t5;
     const sr_real t7 = (RY_11*gamma_z) - (RY_21*gamma_y);
-    const sr_real t8 = RP_00*t7;
-    const sr_real t9 = k_1*t8;
-    const sr_real t10 = RP_02*RP_02;
-    const sr_real t11 = j_P*t10;
-    const sr_real t12 = t11 - k_4;
-    const sr_real t13 = -t12;
-    const sr_real t14 = SR_C(1.0)/t13;
-    const sr_real t15 = k_3*t8;
-    const sr_real t16 = -(t12 + t15);
-    const sr_real t17 = t5*t5;
-    const sr_real t18 = k_0*t17;
-    const sr_real t19 = k_18*t17;
-    const sr_real t20 = t7*(k_0*t7);
-    const sr_real t21 = t11 - t20;
-    const sr_real t22 = gamma_x*k_0;
-    const sr_real t23 = (j_P - (k_3*(RP_02*gamma_x))) - t15;
-    const sr_real t24 = (RP_02*k_19)*t5;
-    const sr_real t25 = RP_00*RP_02;
-    const sr_real t26 = (j_P*t25) - (k_3*(RP_00*gamma_x));
-    const sr_real t27 = -t26;
-    const sr_real t28 = t16*t14;
-    const sr_real t29 = k_1*(RP_02*gamma_x);
-    const sr_real t30 = t9 + ((t29 - k_6) + t18);
-    const sr_real t31 = (RP_00*k_19)*t5;
-    const sr_real t32 = t20 - t11;
-    const sr_real alpha_P_y = t2;
-    const sr_real w_x_a_y = (RP_02*t1) - (RP_00*w_y_x);
-    const sr_real tau_P_y = ((j_P*alpha_P_y) - (k_9*((RP_00*gamma_x) - (RP_02*t7)))) - (w_x_a_y*t4);
-    const sr_real t33 = (u_P - (w_P*k_P)) - tau_P_y;
+    const sr_real t8 = RP_02*(j_P*RP_02);
+    const sr_real t9 = t8 - k_4;
+    const sr_real t10 = -t9;
+    const sr_real t11 = SR_C(1.0)/t10;
+    const sr_real t12 = RP_00*t7;
+    const sr_real t13 = k_3*t12;
+    const sr_real t14 = -(t9 + t13);
+    const sr_real t15 = k_20*t5;
+    const sr_real t16 = RP_02*k_3;
+    const sr_real t17 = (j_P - (gamma_x*t16)) - t13;
+    const sr_real t18 = RP_00*((RP_02*j_P) - (gamma_x*k_3));
+    const sr_real t19 = -t18;
+    const sr_real t20 = k_1*t12;
+    const sr_real t21 = t5*(k_0*t5);
+    const sr_real t22 = t7*(k_0*t7);
+    const sr_real t23 = t8 - t22;
+    const sr_real t24 = gamma_x*k_0;
+    const sr_real t25 = (RP_00*k_3)*t5;
+    const sr_real t26 = k_1*(RP_02*gamma_x);
+    const sr_real t27 = t21 + ((t26 - k_6) + t20);
+    const sr_real t28 = t22 - t8;
     const sr_real tau_Y_x = t1*(j_xx*t0);
     const sr_real alpha_P_x = -(w_P*t1);
     const sr_real alpha_P_z = (w_P*(w_Sx + w_Y)) - t3;
@@ -473,11 +462,13 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     const sr_real w_x_a_x = RP_00*w_p_y;
     const sr_real tau_P_x = ((RP_00*t6) - (w_x_a_x*t4)) + (j_P*(alpha_P_x - (RP_02*a_alpha)));
     const sr_real T_x = tau_Y_x + tau_P_x;
-    const sr_real t34 = (u_Y - (w_Y*k_Y)) - T_x;
-    const sr_real t35 = k_20*t23;
-    const sr_real t36 = t27*t14;
+    const sr_real t29 = (u_Y - (w_Y*k_Y)) - T_x;
+    const sr_real alpha_P_y = t2;
+    const sr_real w_x_a_y = (RP_02*t1) - (RP_00*w_y_x);
+    const sr_real tau_P_y = ((j_P*alpha_P_y) - (k_9*((RP_00*gamma_x) - (RP_02*t7)))) - (w_x_a_y*t4);
+    const sr_real t30 = (u_P - (w_P*k_P)) - tau_P_y;
     const sr_real tau_Y_y = j_yy*(t2 - (w_y_x*t1));
-    const sr_real tau_Y_z = -((t0*(k_21*w_y_x)) + (k_8*t3));
+    const sr_real tau_Y_z = -((t0*(k_19*w_y_x)) + (k_8*t3));
     const sr_real w_x_a_z = -(RP_02*w_p_y);
     const sr_real tau_P_z = (j_P*(alpha_P_z - (RP_00*a_alpha))) - ((RP_02*t6) + (w_x_a_z*t4));
     const sr_real b_x = ((RP_00*alpha_P_y) + (w_p_y*w_x_a_z)) - (t1*w_x_a_y);
@@ -485,27 +476,27 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     const sr_real b_z = ((w_y_x*w_x_a_y) - (RP_02*alpha_P_y)) - (w_p_y*w_x_a_x);
     const sr_real T_y = tau_Y_y + tau_P_y;
     const sr_real T_z = tau_Y_z + tau_P_z;
-    const sr_real S_0_0 = (((k_2 + t18) - (t10*t19)) - (t9 + t21)) - ((t16*t16)*t14);
-    const sr_real S_0_1 = (t5*((RP_02*k_3) - t22)) - (t24*t23);
-    const sr_real S_0_2 = (((t7*((RP_02*k_3) - t22)) - t26) - (t25*t19)) - (t27*t28);
-    const sr_real S_1_1 = -(t30 + (t23*(k_20*t23)));
-    const sr_real S_1_2 = (t5*((RP_00*k_3) - (k_0*t7))) - (t31*t23);
-    const sr_real S_2_2 = (((k_7 - t29) - t32) - ((RP_00*RP_00)*t19)) - ((t27*t27)*t14);
-    const sr_real g_0 = (((k_3*((t5*b_z) - (t7*b_y))) - ((w_Sx*k_S) + (t24*t33))) - T_x) - (t28*t34);
-    const sr_real g_1 = (k_3*((t7*b_x) - (gamma_x*b_z))) - ((t35*t33) + ((k_S*t0) + T_y));
-    const sr_real g_2 = (((k_3*((gamma_x*b_y) - (t5*b_x))) - ((k_S*t1) + (t31*t33))) - T_z) - (t36*t34);
-    const sr_real beta_0_3 = t28;
-    const sr_real beta_0_4 = t24;
-    const sr_real beta_1_4 = t35;
-    const sr_real beta_2_3 = t36;
-    const sr_real beta_2_4 = t31;
-    const sr_real fD_3 = t14*t34;
-    const sr_real fD_4 = k_20*t33;
-    const sr_real M_3_3 = t13;
+    const sr_real beta_0_3 = t14*t11;
+    const sr_real beta_0_4 = RP_02*t15;
+    const sr_real beta_1_4 = k_18*t17;
+    const sr_real beta_2_3 = t19*t11;
+    const sr_real beta_2_4 = RP_00*t15;
+    const sr_real S_0_0 = (((k_2 + t21) - ((t16*t5)*beta_0_4)) - (t20 + t23)) - (t14*beta_0_3);
+    const sr_real S_0_1 = (t5*((RP_02*k_3) - t24)) - (beta_0_4*t17);
+    const sr_real S_0_2 = (((t7*((RP_02*k_3) - t24)) - t18) - (t25*beta_0_4)) - (t19*beta_0_3);
+    const sr_real S_1_1 = -(t27 + (t17*beta_1_4));
+    const sr_real S_1_2 = (t5*((RP_00*k_3) - (k_0*t7))) - (t25*beta_1_4);
+    const sr_real S_2_2 = (((k_7 - t26) - t28) - (t25*beta_2_4)) - (t19*beta_2_3);
+    const sr_real g_0 = (((k_3*((t5*b_z) - (t7*b_y))) - ((w_Sx*k_S) + (beta_0_4*t30))) - T_x) - (beta_0_3*t29);
+    const sr_real g_1 = (k_3*((t7*b_x) - (gamma_x*b_z))) - ((beta_1_4*t30) + ((k_S*t0) + T_y));
+    const sr_real g_2 = (((k_3*((gamma_x*b_y) - (t5*b_x))) - ((k_S*t1) + (beta_2_4*t30))) - T_z) - (beta_2_3*t29);
+    const sr_real fD_3 = t11*t29;
+    const sr_real fD_4 = k_18*t30;
+    const sr_real M_3_3 = t10;
     const sr_real M_4_4 = j_P;
-    const sr_real M_0_0 = (k_2 + t18) + (t32 - t9);
-    const sr_real M_1_1 = -t30;
-    const sr_real M_2_2 = (k_7 - t29) + t21;
+    const sr_real M_0_0 = (k_2 + t21) + (t28 - t20);
+    const sr_real M_1_1 = -t27;
+    const sr_real M_2_2 = (k_7 - t26) + t23;
     /* M positive definite: the joint block, then the leading minors of S; C = adj S (symmetric). */
     if (!(M_3_3 > 0 && M_4_4 > 0)) return SR_GEN_SINGULAR;
     const sr_real C_0_0 = (S_1_1*S_2_2) - (S_1_2*S_1_2);

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources a07af9a72a44d236], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 0c19854e5b5e3289], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -23,19 +23,19 @@ typedef double sr_real;
 #define SR_GEN_NONFINITE 2
 #define SR_GEN_SINGULAR 4
 #define SR_GEN_NPARAM 12
-#define SR_GEN_NCONST 34
+#define SR_GEN_NCONST 33
 #define SR_GEN_NCONST_NAMED 12
 #define SR_GEN_NX 35
 #define SR_GEN_NU 2
 #define SR_GEN_NV 5
 
 /* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
-#define SR_GEN_CONSTANTS_FLOPS 59
+#define SR_GEN_CONSTANTS_FLOPS 57
 #define SR_GEN_INERTIA_FLOPS 107
 #define SR_GEN_RHS_FLOPS 168
 #define SR_GEN_ENERGY_FLOPS 136
 #define SR_GEN_EQUILIBRIUM_RESIDUAL_FLOPS 23
-#define SR_GEN_ACCEL_FLOPS 265
+#define SR_GEN_ACCEL_FLOPS 261
 
 /* The float build's symbols carry _f, so a float/double mismatch fails at link time. */
 #ifdef SR_USE_FLOAT
@@ -66,10 +66,9 @@ typedef double sr_real;
  *   c[27] k_15 = g*m_P
  *   c[28] k_16 = j_P/2 - j_xx/2
  *   c[29] k_17 = m_R*r**2/2
- *   c[30] k_18 = l**2*m_P**2*r**2/(4*j_P)
- *   c[31] k_19 = l*m_P*r/(2*j_P)
- *   c[32] k_20 = 1/j_P
- *   c[33] k_21 = j_xx - j_yy */
+ *   c[30] k_18 = 1/j_P
+ *   c[31] k_19 = j_xx - j_yy
+ *   c[32] k_20 = l*m_P*r/(2*j_P) */
 int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[SR_GEN_NCONST]);
 /* Generalized inertia M(γ, R_Y, R_P), row-major 5x5, kinetic energy ½νᵀMν. */
 int sr_gen_inertia(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr_real M[25]);
