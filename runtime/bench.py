@@ -237,6 +237,11 @@ def python_timings(model, X, U, batch_size, progress, with_kane=True, loop_steps
         for x, u in calls[:5]:
             check_close("KanesMethod model, no cse", plain.accel(x, u), model.accel(x, u), 1e-8)
         out["kane_lambdified_default_accel_ns"] = per_call_ns(plain.accel, calls[:5], min_seconds=0.5)
+        progress("KanesMethod model lambdified for Python floats (math module), hand-tuned")
+        tuned = KaneModel(model.params.as_dict(), module="math")
+        for x, u in calls[:20]:
+            check_close("KanesMethod model, math module", tuned.accel(x, u), model.accel(x, u), 1e-8)
+        out["kane_lambdified_math_accel_ns"] = per_call_ns(tuned.accel, calls[:20], min_seconds=0.5)
 
     progress(f"batch accel over {batch_size:.0e} states")
     reps = int(np.ceil(batch_size / len(X)))
@@ -318,6 +323,9 @@ def format_report(res):
         row("sympy.physics.mechanics KanesMethod, lambdify(cse=True), per call", py["kane_lambdified_accel_ns"])
         row("sympy.physics.mechanics KanesMethod, lambdify defaults, per call",
             py["kane_lambdified_default_accel_ns"])
+    if "kane_lambdified_math_accel_ns" in py:
+        row("KanesMethod, lambdify(cse=True) with the math module (hand-tuned), per call",
+            py["kane_lambdified_math_accel_ns"])
     for key, value in py.items():
         if key.startswith("t_shape_"):
             rows.append((f"t-shape 10,000 steps, {key[8:-3]}, end to end", f"{value:.2f} ms", ""))

@@ -98,3 +98,17 @@ def test_accel_batch_names_a_wrong_shape(models):
         km.accel_batch(np.zeros((3, 34)), np.zeros((3, 2)))
     with pytest.raises(ValueError, match="inputs must have shape"):
         km.accel_batch(np.zeros((3, 35)), np.zeros((2, 2)))
+
+
+def test_math_module_variant_agrees_with_the_numpy_one(models, rng):
+    km, _ = models
+    fast = KaneModel(Params.paper_simulation(), module="math")
+    p = Params.paper_simulation()
+    for _ in range(10):
+        x, u = random_state(rng, p), rng.uniform(-1.0, 1.0, size=2)
+        assert _rel(fast.accel(x, u), km.accel(x, u)) < 1e-13
+
+
+def test_module_is_checked():
+    with pytest.raises(ValueError, match="module"):
+        KaneModel(Params.paper_simulation(), module="fortran")

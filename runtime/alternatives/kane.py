@@ -4,7 +4,11 @@ A baseline for the benchmark (issue 7, alternative (c)).  Nothing here is
 shared with ``derive/``, ``generated/``, ``c/`` or ``runtime/reference.py``:
 the model is rebuilt from the bodies of Section 2.3 with
 ``sympy.physics.mechanics.KanesMethod`` and turned into NumPy code with
-``sympy.lambdify`` (``cse=True``).
+``sympy.lambdify`` (``cse=True``, NumPy functions: what PyDy's
+``generate_ode_function`` does).  ``KaneModel(..., module="math")`` is a
+hand-tuned variant for single states (Python's math functions on Python
+floats, about twice as fast per call), so that the benchmark also shows how
+far a careful user of these tools can get.
 
 Model
 -----
@@ -78,12 +82,12 @@ import numpy as np
 PARAM_NAMES = ("r", "m_S", "k_S", "b", "h", "m_b", "m_h", "k_Y", "l", "m_P", "k_P", "g")
 STATE_DIM = 35
 
-_LOCK = threading.Lock()
-_DERIVED = {}  # cse flag -> derived functions, filled once per process by _derivation()
+_LOCK = threading.RLock()  # _lambdified holds it while _lambdify asks _derivation
+_DERIVED = {}  # "symbolic" and (cse, module) -> derived functions, filled once per process
 
 
-def _derive(cse=True):
-    """Symbolic derivation with sympy.physics.mechanics and lambdify; returns a dict."""
+def _derive():
+    """Symbolic derivation with sympy.physics.mechanics; returns a dict of the expressions to lambdify."""
     import sympy as sm
     import sympy.physics.mechanics as me
 
@@ -174,16 +178,32 @@ def _derive(cse=True):
     M_s, F_s = M.xreplace(sub), F.xreplace(sub)
     udep_s = udep_expr.xreplace(sub)
     args = (qs, us, (u_Y, u_P), par)
-    f_MF = sm.lambdify(args, (M_s, F_s), modules="numpy", cse=cse)
-    f_udep = sm.lambdify((qs, us[:5], par), udep_s, modules="numpy", cse=cse)
-    seconds = time.perf_counter() - t0
-    # The same expressions lambdified for arrays of states (accel_batch): entries that do
-    # not depend on the state (the zeros of M and F) are broadcast to the batch.
-    batch = [{"array": _broadcast_array}, "numpy"]
-    f_MF_batch = sm.lambdify(args, (M_s, F_s), modules=batch, cse=cse)
-    f_udep_batch = sm.lambdify((qs, us[:5], par), udep_s, modules=batch, cse=cse)
-    return {"f_MF": f_MF, "f_udep": f_udep, "f_MF_batch": f_MF_batch, "f_udep_batch": f_udep_batch,
-            "seconds": seconds, "kane_seconds": t_kane, "n_ops": int(sm.count_ops(M_s) + sm.count_ops(F_s))}
+    return {"MF": (args, (M_s, F_s)), "udep": ((qs, us[:5], par), udep_s),
+            "seconds": time.perf_counter() - t0, "kane_seconds": t_kane,
+            "n_ops": int(sm.count_ops(M_s) + sm.count_ops(F_s))}
+
+
+#: lambdify's modules for each `module` of KaneModel: PyDy's choice (NumPy, with the
+#: matrices as arrays), or Python's math module for scalars (with the matrices as arrays).
+MODULES = {"numpy": "numpy",
+           "math": [{"ImmutableDenseMatrix": np.array, "MutableDenseMatrix": np.array}, "math"]}
+
+
+def _lambdify(cse, module):
+    """The lambdified M, F and dependent speeds, and (NumPy only) their batch forms; a dict."""
+    import sympy as sm
+    d = _derivation()
+    t0 = time.perf_counter()
+    out = {"f_MF": sm.lambdify(*d["MF"], modules=MODULES[module], cse=cse),
+           "f_udep": sm.lambdify(*d["udep"], modules=MODULES[module], cse=cse)}
+    if module == "numpy":
+        # The same expressions for arrays of states (accel_batch): entries that do not
+        # depend on the state (the zeros of M and F) are broadcast to the batch.
+        batch = [{"array": _broadcast_array}, "numpy"]
+        out["f_MF_batch"] = sm.lambdify(*d["MF"], modules=batch, cse=cse)
+        out["f_udep_batch"] = sm.lambdify(*d["udep"], modules=batch, cse=cse)
+    out["seconds"] = time.perf_counter() - t0
+    return out
 
 
 def _broadcast_array(rows):
@@ -193,11 +213,21 @@ def _broadcast_array(rows):
     return np.array([[np.broadcast_to(e, shape) for e in row] for row in rows])
 
 
-def _derivation(cse=True):
+def _derivation():
+    """The symbolic derivation, once per process."""
     with _LOCK:
-        if cse not in _DERIVED:
-            _DERIVED[cse] = _derive(cse)
-        return _DERIVED[cse]
+        if "symbolic" not in _DERIVED:
+            _DERIVED["symbolic"] = _derive()
+        return _DERIVED["symbolic"]
+
+
+def _lambdified(cse, module):
+    """The lambdified functions for (cse, module), once per process."""
+    _derivation()
+    with _LOCK:
+        if (cse, module) not in _DERIVED:
+            _DERIVED[(cse, module)] = _lambdify(cse, module)
+        return _DERIVED[(cse, module)]
 
 
 def euler_zyx(R_S):
@@ -218,10 +248,17 @@ class KaneModel:
     derivation and lambdify run once per process, on the first construction;
     ``derivation_seconds`` reports how long they took.  ``cse=False`` lambdifies
     with sympy's default options (no common-subexpression elimination).
+    ``module="numpy"`` is what PyDy's ``generate_ode_function`` does (NumPy
+    functions, ``cse=True``); ``module="math"`` is a hand-tuned variant for
+    single states: Python's math functions on Python floats, about twice as
+    fast per call.
     """
 
-    def __init__(self, params, cse=True):
+    def __init__(self, params, cse=True, module="numpy"):
         self.cse = bool(cse)
+        if module not in MODULES:
+            raise ValueError(f"module: expected one of {sorted(MODULES)}, got {module!r}")
+        self.module = module
         if not isinstance(params, dict):
             params = {k: getattr(params, k) for k in PARAM_NAMES}
         missing = [k for k in PARAM_NAMES if k not in params]
@@ -230,13 +267,13 @@ class KaneModel:
             raise ValueError(f"bad parameter set: missing={missing}, unknown={extra}")
         self.params = {k: float(params[k]) for k in PARAM_NAMES}
         self._p = tuple(self.params[k] for k in PARAM_NAMES)
-        d = _derivation(self.cse)
+        d = _lambdified(self.cse, self.module)
         self._f_MF, self._f_udep = d["f_MF"], d["f_udep"]
 
     @property
     def derivation_seconds(self) -> float:
         """Wall time of the symbolic derivation (KanesMethod) plus lambdify, once per process."""
-        return _derivation(self.cse)["seconds"]
+        return _derivation()["seconds"] + _lambdified(self.cse, self.module)["seconds"]
 
     @staticmethod
     def coordinates(x):
@@ -247,14 +284,14 @@ class KaneModel:
         psi, theta, phi = euler_zyx(x[0:9])
         th_Y = math.atan2(x[9 + 7], x[9 + 4])       # R_Y[2,1], R_Y[1,1]
         th_P = math.atan2(x[18 + 2], x[18 + 0])     # R_P[0,2], R_P[0,0]
-        return (psi, theta, phi, th_Y, th_P, x[27], x[28]), tuple(x[30:35])
+        return (psi, theta, phi, th_Y, th_P, float(x[27]), float(x[28])), tuple(x[30:35].tolist())
 
     def mass_matrix_forcing(self, x, u):
         """kane.mass_matrix (7x7) and kane.forcing (7) at our state x and input u."""
         qv, w = self.coordinates(x)
         udep = np.asarray(self._f_udep(qv, w, self._p), dtype=float).reshape(-1)
         uu = np.asarray(u, dtype=float).reshape(2)
-        M, F = self._f_MF(qv, w + tuple(udep), tuple(uu), self._p)
+        M, F = self._f_MF(qv, w + tuple(udep.tolist()), tuple(uu.tolist()), self._p)
         return np.asarray(M, dtype=float), np.asarray(F, dtype=float).reshape(-1)
 
     def accel(self, x, u) -> np.ndarray:
@@ -280,7 +317,9 @@ class KaneModel:
     def accel_batch(self, X, U) -> np.ndarray:
         """`accel` for states and inputs in rows, shape (n, 5): the lambdified code on arrays
         (what a NumPy user would do with a batch) and one batched solve."""
-        d = _derivation(self.cse)
+        if self.module != "numpy":
+            raise ValueError(f"accel_batch: needs module='numpy', this model has module={self.module!r}")
+        d = _lambdified(self.cse, self.module)
         qv, w = self.coordinates_batch(X)
         U = np.asarray(U, dtype=float)
         if U.shape != (len(qv[0]), 2):
