@@ -102,8 +102,8 @@ def test_accel_batch_names_a_wrong_shape(models):
 
 def test_math_module_variant_agrees_with_the_numpy_one(models, rng):
     km, _ = models
-    fast = KaneModel(Params.paper_simulation(), module="math")
     p = Params.paper_simulation()
+    fast = KaneModel(p, module="math")
     for _ in range(10):
         x, u = random_state(rng, p), rng.uniform(-1.0, 1.0, size=2)
         assert _rel(fast.accel(x, u), km.accel(x, u)) < 1e-13
@@ -112,3 +112,9 @@ def test_math_module_variant_agrees_with_the_numpy_one(models, rng):
 def test_module_is_checked():
     with pytest.raises(ValueError, match="module"):
         KaneModel(Params.paper_simulation(), module="fortran")
+
+
+def test_accel_batch_refuses_the_math_module_variant():
+    fast = KaneModel(Params.paper_simulation(), module="math")
+    with pytest.raises(ValueError, match="module='numpy'"):
+        fast.accel_batch(np.zeros((3, 35)), np.zeros((3, 2)))

@@ -82,7 +82,7 @@ import numpy as np
 PARAM_NAMES = ("r", "m_S", "k_S", "b", "h", "m_b", "m_h", "k_Y", "l", "m_P", "k_P", "g")
 STATE_DIM = 35
 
-_LOCK = threading.RLock()  # _lambdified holds it while _lambdify asks _derivation
+_LOCK = threading.Lock()
 _DERIVED = {}  # "symbolic" and (cse, module) -> derived functions, filled once per process
 
 
@@ -189,10 +189,10 @@ MODULES = {"numpy": "numpy",
            "math": [{"ImmutableDenseMatrix": np.array, "MutableDenseMatrix": np.array}, "math"]}
 
 
-def _lambdify(cse, module):
-    """The lambdified M, F and dependent speeds, and (NumPy only) their batch forms; a dict."""
+def _lambdify(d, cse, module):
+    """The expressions of `_derive` (d) lambdified: M, F and the dependent speeds, and (NumPy
+    only) their batch forms; a dict."""
     import sympy as sm
-    d = _derivation()
     t0 = time.perf_counter()
     out = {"f_MF": sm.lambdify(*d["MF"], modules=MODULES[module], cse=cse),
            "f_udep": sm.lambdify(*d["udep"], modules=MODULES[module], cse=cse)}
@@ -223,10 +223,10 @@ def _derivation():
 
 def _lambdified(cse, module):
     """The lambdified functions for (cse, module), once per process."""
-    _derivation()
+    d = _derivation()
     with _LOCK:
         if (cse, module) not in _DERIVED:
-            _DERIVED[(cse, module)] = _lambdify(cse, module)
+            _DERIVED[(cse, module)] = _lambdify(d, cse, module)
         return _DERIVED[(cse, module)]
 
 
