@@ -38,20 +38,19 @@
 /* Offsets of the blocks of the state x (see spherical_robot.h). */
 enum { RS = 0, RY = 9, RP = 18, Q = 27, W = 30 };
 
-/* Sum in four lanes (a short chain of additions, which compilers vectorize).  A NaN or an
- * infinity anywhere makes the sum non-finite; so can finite entries that overflow. */
+/* Sum in four lanes (a short chain of additions per lane).  A NaN or an infinity anywhere makes
+ * the sum non-finite; so can finite entries that overflow.  The lanes are an array indexed in an
+ * inner loop, the form compilers turn into plain vertical vector additions: with four named
+ * accumulators, GCC 12 -O2 -march=native on an AVX-512 machine fully unrolled the loop into
+ * 512-bit loads and shuffles around scalar additions, and sr_accel took 71 ns instead of 44. */
 static inline sr_real lane_sum(const sr_real *v, int n)
 {
-    sr_real s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-    int i;
-    for (i = 0; i + 4 <= n; i += 4) {
-        s0 += v[i];
-        s1 += v[i + 1];
-        s2 += v[i + 2];
-        s3 += v[i + 3];
-    }
-    for (; i < n; ++i) s0 += v[i];
-    return (s0 + s1) + (s2 + s3);
+    sr_real s[4] = {0, 0, 0, 0};
+    int i, k;
+    for (i = 0; i + 4 <= n; i += 4)
+        for (k = 0; k < 4; ++k) s[k] += v[i + k];
+    for (; i < n; ++i) s[0] += v[i];
+    return (s[0] + s[1]) + (s[2] + s[3]);
 }
 
 /* One test of the sum clears the common case; otherwise entry by entry. */
