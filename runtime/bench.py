@@ -71,11 +71,22 @@ def cpu_name():
     return platform.processor() or platform.machine()
 
 
+def best_seconds(fn, rounds):
+    """The shortest of `rounds` wall times of fn() [s]."""
+    best = np.inf
+    for _ in range(rounds):
+        start = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
 def per_call_ns(fn, calls, min_seconds=0.1, rounds=7):
     """Best of `rounds` timings of a Python loop over `calls` (list of argument tuples), each
-    lasting at least `min_seconds`.  Many short rounds, like the C loop's 11: a busy host slows
-    some rounds, and the best round is then still a quiet one (three 0.5 s rounds let one
-    noisy run of 2026-11-23 report the Kane call 40 % slow, flattering our ratios)."""
+    lasting at least `min_seconds`.  Many short rounds, like the C loop's 11, so that a host
+    busy for a moment slows some rounds and not the best one; a host busy for seconds still
+    shows (2026-11-23: the Kane call read 66 us with three 0.5 s rounds, 71 us with seven
+    0.2 s rounds, against 47-49 us when quiet), which flatters our ratios, never theirs."""
     best = np.inf
     for _ in range(rounds):
         n, start = 0, time.perf_counter()
@@ -255,12 +266,7 @@ def python_timings(model, X, U, batch_size, progress, with_kane=True, loop_steps
     start = time.perf_counter()
     AB = model.accel(XB, UB)
     out["python_batch_accel_first_call_ns_per_state"] = (time.perf_counter() - start) / batch_size * 1e9
-    best = float("inf")
-    for _ in range(3):
-        start = time.perf_counter()
-        model.accel(XB, UB)
-        best = min(best, time.perf_counter() - start)
-    out["python_batch_accel_ns_per_state"] = best / batch_size * 1e9
+    out["python_batch_accel_ns_per_state"] = best_seconds(lambda: model.accel(XB, UB), 3) / batch_size * 1e9
     out["batch_size"] = batch_size
     check_close("batch accel", AB[:len(X)], np.array([model.accel(x, u) for x, u in zip(X, U)]), 0)
 
@@ -268,12 +274,8 @@ def python_timings(model, X, U, batch_size, progress, with_kane=True, loop_steps
     x0 = initial_state()
     for method in METHODS:
         progress(f"t-shape, 10,000 steps, {method}")
-        best = np.inf
-        for _ in range(5):
-            start = time.perf_counter()
-            model.simulate(x0, 0.01, 10_000, u_prog, method=method)
-            best = min(best, time.perf_counter() - start)
-        out[f"t_shape_{method}_ms"] = best * 1e3
+        out[f"t_shape_{method}_ms"] = best_seconds(
+            lambda: model.simulate(x0, 0.01, 10_000, u_prog, method=method), 5) * 1e3
 
     batches = [("CasADi reference, Function.map", ref.accel_batch, 2_000)]
     if with_kane:
@@ -283,13 +285,10 @@ def python_timings(model, X, U, batch_size, progress, with_kane=True, loop_steps
         progress(f"batch accel, {name}, {n:,} states")
         n = min(n, batch_size)
         check_close(f"batch accel, {name}", accel_batch(XB[:len(X)], UB[:len(X)]), AB[:len(X)], 1e-8)
-        chunk, best = 10_000, np.inf
-        for _ in range(3):      # best of three, as for our batch
-            start = time.perf_counter()
+        def run(accel_batch=accel_batch, n=n, chunk=10_000):
             for i in range(0, n, chunk):
                 accel_batch(XB[i:min(i + chunk, n)], UB[i:min(i + chunk, n)])
-            best = min(best, time.perf_counter() - start)
-        out["alternative_batch_ns_per_state"][name] = best / n * 1e9
+        out["alternative_batch_ns_per_state"][name] = best_seconds(run, 3) / n * 1e9   # as for our batch
 
     alternatives = [("ours: Model.accel", model.accel), ("NumPy paper formulas", paper.accel),
                     ("CasADi reference from Python", ref.accel)]
