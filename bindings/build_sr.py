@@ -74,8 +74,12 @@ int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[], 
 # runs only if it is built with the same flag).
 NATIVE = ["-march=native"] if os.environ.get("SR_NATIVE") == "1" else []
 
+# The layout macros (SR_X_*, SR_U_*, SR_P_*) as the generator wrote them.
+LAYOUT = "\n".join(line for line in (ROOT / "generated" / "sr_generated.h").read_text().splitlines()
+                   if line.startswith(("#define SR_X_", "#define SR_U_", "#define SR_P_")))
+
 ffibuilder = cffi.FFI()
-ffibuilder.cdef(CDEF)
+ffibuilder.cdef(CDEF + LAYOUT)
 ffibuilder.set_source(
     "bindings._sr",
     '#include "spherical_robot.h"',

@@ -533,6 +533,18 @@ def banner():
             f"[sha256 of its sources {provenance()}], SymPy {sp.__version__}. */\n")
 
 
+def layout_macros():
+    """Index macros of the state blocks, the inputs and the parameters: each layout written once, here."""
+    assert sum(n for _, _, n in S.STATE_BLOCKS) == S.NX
+    lines = ["/* Layout of x[SR_GEN_NX]: offset of each block (matrices row-major; nu = (w_S, w_Y, w_P) starts at SR_X_w_S). */"]
+    lines += [f"#define SR_X_{name} {offset}" for name, offset, _ in S.STATE_BLOCKS]
+    lines += ["/* Layout of u[SR_GEN_NU]. */"]
+    lines += [f"#define SR_U_{name} {index}" for name, index in S.INPUT_NAMES]
+    lines += ["/* Layout of p[SR_GEN_NPARAM], the parameters of derive/parameters.py (SI). */"]
+    lines += [f"#define SR_P_{s.name} {i}" for i, s in enumerate(P.PARAMETERS)]
+    return "\n".join(lines)
+
+
 def header_text(ks, flops, n_constants):
     guard = "SR_GENERATED_H"
     protos = "\n".join(f"/* {k.doc} */\n{signature(k)};" for k in ks)
@@ -567,6 +579,8 @@ typedef double sr_real;
 #define SR_GEN_NX {S.NX}
 #define SR_GEN_NU {S.NU}
 #define SR_GEN_NV {S.NV}
+
+{layout_macros()}
 
 /* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
 {flop_macros}

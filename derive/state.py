@@ -17,6 +17,16 @@ import sympy as sp
 NX, NU, NV = 35, 2, 5
 OFFSET_RS, OFFSET_RY, OFFSET_RP, OFFSET_Q, OFFSET_W = 0, 9, 18, 27, 30
 
+#: The blocks of x: (name, offset, length).  The one source of the state layout: the generator
+#: emits it as the SR_X_<name> offsets of generated/sr_generated.h, which the hand-written C
+#: uses and the Python runtime reads from the compiled module.
+STATE_BLOCKS = (
+    ("R_S", OFFSET_RS, 9), ("R_Y", OFFSET_RY, 9), ("R_P", OFFSET_RP, 9), ("q", OFFSET_Q, 3),
+    ("w_S", OFFSET_W, 3), ("w_Y", OFFSET_W + 3, 1), ("w_P", OFFSET_W + 4, 1),
+)
+#: The entries of u: (name, index), emitted as SR_U_<name>.
+INPUT_NAMES = (("u_Y", 0), ("u_P", 1))
+
 
 def hat(w):
     """⟦w⟧ of eq. (2): the skew-symmetric matrix with ⟦w⟧ z = w × z."""

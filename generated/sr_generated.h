@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 0c19854e5b5e3289], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 3e7f9b377d69a03c], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -28,6 +28,31 @@ typedef double sr_real;
 #define SR_GEN_NX 35
 #define SR_GEN_NU 2
 #define SR_GEN_NV 5
+
+/* Layout of x[SR_GEN_NX]: offset of each block (matrices row-major; nu = (w_S, w_Y, w_P) starts at SR_X_w_S). */
+#define SR_X_R_S 0
+#define SR_X_R_Y 9
+#define SR_X_R_P 18
+#define SR_X_q 27
+#define SR_X_w_S 30
+#define SR_X_w_Y 33
+#define SR_X_w_P 34
+/* Layout of u[SR_GEN_NU]. */
+#define SR_U_u_Y 0
+#define SR_U_u_P 1
+/* Layout of p[SR_GEN_NPARAM], the parameters of derive/parameters.py (SI). */
+#define SR_P_r 0
+#define SR_P_m_S 1
+#define SR_P_k_S 2
+#define SR_P_b 3
+#define SR_P_h 4
+#define SR_P_m_b 5
+#define SR_P_m_h 6
+#define SR_P_k_Y 7
+#define SR_P_l 8
+#define SR_P_m_P 9
+#define SR_P_k_P 10
+#define SR_P_g 11
 
 /* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
 #define SR_GEN_CONSTANTS_FLOPS 57
