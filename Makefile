@@ -33,7 +33,7 @@ bench: $(STAMP)
 	$(PY) -m runtime bench --native
 
 figures: $(STAMP)
-	$(PY) -m runtime.figures
+	$(PY) -m runtime figures
 
 soak: $(STAMP)
 	$(PY) -m runtime soak

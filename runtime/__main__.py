@@ -3,12 +3,12 @@ import importlib
 import sys
 
 COMMANDS = {
-    "run": ("runtime.scenario_cli", "run a shipped scenario, a scenario file, or `all`"),
-    "verify": ("runtime.verify", "cross-check the kernels against the reference and the invariants"),
-    "convergence": ("runtime.convergence", "convergence and energy study of the integrators"),
-    "bench": ("runtime.bench", "benchmarks against the alternatives"),
-    "figures": ("runtime.figures", "regenerate the committed figures under docs/figures/"),
-    "soak": ("runtime.soak", "10^7 steps from random states: constraint and energy drift (not a unit test)"),
+    "run": ("runtime.scenarios.cli", "run a shipped scenario, a scenario file, or `all`"),
+    "verify": ("runtime.verification.verify", "cross-check the kernels against the reference and the invariants"),
+    "convergence": ("runtime.verification.convergence", "convergence and energy study of the integrators"),
+    "bench": ("runtime.bench.cli", "benchmarks against the alternatives"),
+    "figures": ("runtime.scenarios.figures", "regenerate the committed figures under docs/figures/"),
+    "soak": ("runtime.verification.soak", "10^7 steps from random states: constraint and energy drift (not a unit test)"),
 }
 
 

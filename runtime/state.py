@@ -1,27 +1,45 @@
-"""State layout (35 float64) and constructors; see README, "State, input and parameters"."""
+"""State layout and constructors; see README, "State, input and parameters".
+
+The layout is not written here: it is read from the compiled module, whose
+SR_X_* offsets the generator emitted from derive/state.py (the one place that
+decides it).  Every other runtime module indexes states through the names
+below, never through raw numbers.
+"""
 import numpy as np
 
-NX, NU, NV = 35, 2, 5
-#: Index ranges of the blocks of x.
-IDX_RS, IDX_RY, IDX_RP = slice(0, 9), slice(9, 18), slice(18, 27)
-IDX_Q, IDX_WS, IDX_WY, IDX_WP, IDX_NU = slice(27, 30), slice(30, 33), 33, 34, slice(30, 35)
+from bindings._sr import lib
+
+from .so3 import rot_x, rot_y, rot_z  # noqa: F401  (re-exported: the constructors' rotation forms)
+
+NX, NU, NV = lib.SR_NX, lib.SR_NU, lib.SR_NV
+
+#: Index ranges of the blocks of x (matrices row-major).  IDX_WY and IDX_WP are single entries.
+IDX_RS = slice(lib.SR_X_R_S, lib.SR_X_R_S + 9)
+IDX_RY = slice(lib.SR_X_R_Y, lib.SR_X_R_Y + 9)
+IDX_RP = slice(lib.SR_X_R_P, lib.SR_X_R_P + 9)
+IDX_Q = slice(lib.SR_X_q, lib.SR_X_q + 3)
+IDX_WS = slice(lib.SR_X_w_S, lib.SR_X_w_S + 3)
+IDX_WY, IDX_WP = lib.SR_X_w_Y, lib.SR_X_w_P
+#: ν = (ω_S, ω_Y, ω_P), contiguous from ω_S (the generated header promises it).
+IDX_NU = slice(lib.SR_X_w_S, lib.SR_X_w_S + NV)
+#: q_z (= r on every valid state).
+IDX_QZ = lib.SR_X_q + 2
+
+#: The rotation blocks by name, in state order.
+ROTATION_BLOCKS = {"R_S": IDX_RS, "R_Y": IDX_RY, "R_P": IDX_RP}
+#: Indices of the inputs u = (u_Y, u_P).
+IDX_UY, IDX_UP = lib.SR_U_u_Y, lib.SR_U_u_P
 
 
-def rot_x(theta):
-    """Rotation about x by theta: the form of R_Y (Section 2.4, Observation)."""
-    c, s = np.cos(theta), np.sin(theta)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+def rotations(x):
+    """(R_S, R_Y, R_P) of a state (35,) or of states (..., 35): arrays (..., 3, 3), views where possible."""
+    x = np.asarray(x)
+    return tuple(x[..., idx].reshape(x.shape[:-1] + (3, 3)) for idx in (IDX_RS, IDX_RY, IDX_RP))
 
 
-def rot_y(theta):
-    """Rotation about y by theta: the form of R_P, Exp(theta Σ_P)."""
-    c, s = np.cos(theta), np.sin(theta)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def rot_z(theta):
-    c, s = np.cos(theta), np.sin(theta)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+def gamma(x):
+    """γ = R_Sᵀ e_z, the vertical in the shell frame: the third row of R_S (..., 3)."""
+    return rotations(x)[0][..., 2, :]
 
 
 def initial_state(theta_Y=0.0, theta_P=0.0, R_S=None, q=None, w_S=(0.0, 0.0, 0.0), w_Y=0.0, w_P=0.0, *, r=0.3):
@@ -38,11 +56,28 @@ def initial_state(theta_Y=0.0, theta_P=0.0, R_S=None, q=None, w_S=(0.0, 0.0, 0.0
 
 def yoke_angle(x):
     """θ_Y read back from R_Y (for plots and summaries; the model never uses angles)."""
-    x = np.asarray(x)
-    return np.arctan2(x[..., 16], x[..., 13])
+    R_Y = rotations(x)[1]
+    return np.arctan2(R_Y[..., 2, 1], R_Y[..., 1, 1])
 
 
 def pendulum_angle(x):
     """θ_P read back from R_P."""
-    x = np.asarray(x)
-    return np.arctan2(x[..., 20], x[..., 18])
+    R_P = rotations(x)[2]
+    return np.arctan2(R_P[..., 0, 2], R_P[..., 0, 0])
+
+
+def _angle_to_vertical(axis):
+    """Angle [rad] between unit vectors `axis` (..., 3) and e_z, accurate near 0 and π."""
+    return np.arctan2(np.hypot(axis[..., 0], axis[..., 1]), axis[..., 2])
+
+
+def absolute_inclinations(x):
+    """(yoke, pendulum) [rad] against the vertical, as in Fig. 5, of a state or states (..., 35).
+
+    Yoke: the angle between the normal of the yoke plane, R_S R_Y e_z, and e_z.
+    Pendulum: the angle between the shaft, R_S R_Y R_P (−e_z), and −e_z.
+    Both are unsigned, in [0, π].
+    """
+    R_S, R_Y, R_P = rotations(x)
+    yoke = R_S @ R_Y
+    return _angle_to_vertical(yoke[..., :, 2]), _angle_to_vertical((yoke @ R_P)[..., :, 2])

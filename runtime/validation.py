@@ -29,7 +29,9 @@ import numpy as np
 
 from bindings._sr import ffi, lib
 
-from .state import NX, rot_x, rot_y
+from .errors import KernelError
+from .so3 import nearest_rotation, orthonormality, rot_x, rot_y
+from .state import IDX_Q, IDX_QZ, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NX, ROTATION_BLOCKS
 
 #: Tolerance of the state checks, exported from C (SR_ROTATION_TOL): entries of RᵀR − I,
 #: det R − 1, and |q_z − r| / r.
@@ -42,16 +44,22 @@ _KIND_NAMES = {"b": "bool", "c": "complex", "O": "object", "U": "string", "S": "
 
 
 def _entry_names():
-    names = []
-    for block in ("R_S", "R_Y", "R_P"):
-        names += [f"{block}[{i},{j}]" for i in range(3) for j in range(3)]
-    names += ["q_x", "q_y", "q_z", "w_S[0]", "w_S[1]", "w_S[2]", "w_Y", "w_P"]
+    names = [""] * NX
+    for block, idx in ROTATION_BLOCKS.items():
+        for k, (i, j) in enumerate((i, j) for i in range(3) for j in range(3)):
+            names[idx.start + k] = f"{block}[{i},{j}]"
+    for k, axis in enumerate("xyz"):
+        names[IDX_Q.start + k] = f"q_{axis}"
+        names[IDX_WS.start + k] = f"w_S[{k}]"
+    names[IDX_WY], names[IDX_WP] = "w_Y", "w_P"
+    assert all(names), "the state layout has an entry without a name"
     return tuple(names)
 
 
 #: Name of every entry of the state: STATE_ENTRY_NAMES[12] == "R_Y[1,0]".
 STATE_ENTRY_NAMES = _entry_names()
-_BLOCKS = (("R_S", 0), ("R_Y", 9), ("R_P", 18))
+#: The rotation about a fixed axis of each joint block (row and column `axis` equal e_axis).
+_JOINT_AXIS = {"R_Y": 0, "R_P": 1}
 
 
 # -- arrays ------------------------------------------------------------------------------------
@@ -94,14 +102,6 @@ def check_finite(arr, name, entry_names=None):
 
 
 # -- the state rules ----------------------------------------------------------------------------
-def _orthonormality(R):
-    """Largest |(RᵀR − I)_ij| and det R, as sr_check_state computes them."""
-    gram = R.T @ R - np.eye(3)
-    det = (R[0, 0] * (R[1, 1] * R[2, 2] - R[1, 2] * R[2, 1]) - R[0, 1] * (R[1, 0] * R[2, 2] - R[1, 2] * R[2, 0])
-           + R[0, 2] * (R[1, 0] * R[2, 1] - R[1, 1] * R[2, 0]))
-    return float(np.abs(gram).max()), float(det)
-
-
 def describe_state(x, r, name="x"):
     """Why the single state `x` (35,) breaks the rules of `sr_check_state`, or None if it does not.
 
@@ -114,10 +114,10 @@ def describe_state(x, r, name="x"):
         i = int(bad[0])
         return f"{name}: {name}[{i}] ({STATE_ENTRY_NAMES[i]}) is {float(x[i])!r}, expected a finite number"
     hint = "; Model.project(x) or runtime.project_state(x, r) re-projects a nearly valid state"
-    for block, start in _BLOCKS:
-        R = x[start:start + 9].reshape(3, 3)
-        where = f"{name}: {block} ({name}[{start}:{start + 9}])"
-        axis = {"R_Y": 0, "R_P": 1}.get(block)
+    for block, idx in ROTATION_BLOCKS.items():
+        R = x[idx].reshape(3, 3)
+        where = f"{name}: {block} ({name}[{idx.start}:{idx.stop}])"
+        axis = _JOINT_AXIS.get(block)
         if axis is not None:
             for i in range(3):
                 for entry, (a, b) in ((R[axis, i], (axis, i)), (R[i, axis], (i, axis))):
@@ -126,7 +126,7 @@ def describe_state(x, r, name="x"):
                         about = "xy"[axis]
                         return (f"{where} must be a rotation about {about}: {block}[{a},{b}] = {float(entry)!r} "
                                 f"must be exactly {want:g} (row and column {axis} equal e_{about}){hint}")
-        defect, det = _orthonormality(R)
+        defect, det = orthonormality(R)
         if det < 0:
             return f"{where} is not a rotation: det = {det:.6g}, a reflection (needs det = +1){hint}"
         if defect > ROTATION_TOL:
@@ -134,9 +134,9 @@ def describe_state(x, r, name="x"):
                     f"{ROTATION_TOL:g}{hint}")
         if abs(det - 1) > ROTATION_TOL:
             return f"{where} is not a rotation: |det R − 1| = {abs(det - 1):.3g} exceeds {ROTATION_TOL:g}{hint}"
-    dz = x[29] - r
+    dz = x[IDX_QZ] - r
     if abs(dz) > ROTATION_TOL * r:
-        return (f"{name}: {name}[29] (q_z) = {float(x[29])!r} must equal r = {r:g} (the shell rests on the plane): "
+        return (f"{name}: {name}[{IDX_QZ}] (q_z) = {float(x[IDX_QZ])!r} must equal r = {r:g} (the shell rests on the plane): "
                 f"off by {dz:.3g}, tolerance {ROTATION_TOL * r:.3g} = {ROTATION_TOL:g}·r{hint}")
     return None
 
@@ -155,19 +155,11 @@ def check_states(model_ptr, x, r, name="x"):
         state = x[row] if row >= 0 else None
     if status == lib.SR_OK:
         return
-    from .model import KernelError            # model imports this module
     message = describe_state(state, r, row_name) if state is not None else None
     raise KernelError(row_name, status, message=message)
 
 
 # -- re-projection ------------------------------------------------------------------------------
-def _nearest_rotation(R):
-    """The rotation nearest to R in the Frobenius norm (polar factor, det +1)."""
-    U, _, Vt = np.linalg.svd(R)
-    D = np.diag([1.0, 1.0, np.sign(np.linalg.det(U @ Vt)) or 1.0])
-    return U @ D @ Vt
-
-
 def project_state(x, r):
     """The nearest valid state: R_S by its polar factor, R_Y (R_P) by the nearest rotation about x (y),
     q_z = r.  x (35,) or (B, 35); returns a new array.  Speeds and q_x, q_y are kept.
@@ -182,11 +174,11 @@ def project_state(x, r):
         raise ValueError(f"r: expected a positive finite radius, got {r!r}")
     out = x.copy()
     for row in out.reshape(-1, NX):
-        row[0:9] = _nearest_rotation(row[0:9].reshape(3, 3)).ravel()
-        RY, RP = row[9:18].reshape(3, 3), row[18:27].reshape(3, 3)
+        row[IDX_RS] = nearest_rotation(row[IDX_RS].reshape(3, 3)).ravel()
+        RY, RP = row[IDX_RY].reshape(3, 3), row[IDX_RP].reshape(3, 3)
         ty = np.arctan2(RY[2, 1] - RY[1, 2], RY[1, 1] + RY[2, 2])
         tp = np.arctan2(RP[0, 2] - RP[2, 0], RP[0, 0] + RP[2, 2])
-        row[9:18] = rot_x(ty).ravel()
-        row[18:27] = rot_y(tp).ravel()
-        row[29] = r
+        row[IDX_RY] = rot_x(ty).ravel()
+        row[IDX_RP] = rot_y(tp).ravel()
+        row[IDX_QZ] = r
     return out

@@ -1,0 +1,137 @@
+"""Python-side timings: our `Model` from Python against the alternatives (the NumPy transcription of the
+paper's formulas, the CasADi reference, the sympy.physics.mechanics model), per call, in batches and in the
+t-shape run, each alternative's numbers checked against ours first."""
+import time
+
+import numpy as np
+
+from ..model import METHODS
+from ..so3 import exp, rot_x, rot_y
+from ..state import IDX_NU, IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, initial_state, rotations
+from .checks import check_close
+from .timing import best_seconds, per_call_ns
+
+
+def t_shape_program(steps=10_000):
+    u = np.zeros((steps, 2))
+    for first, last, column, value in [(1, 800, 0, 0.1), (1600, 1900, 1, -0.1), (2500, 3000, 0, -0.1),
+                                       (3400, 4500, 1, 0.1)]:
+        u[first - 1:last, column] = value
+    return u
+
+
+def lie_euler_loop(accel, x0, dt, u_prog, r):
+    """The t-shape run of an alternative: the paper's Lie–Euler method (Section 5) in a Python loop.
+
+    What a user of that alternative would write around its `accel(x, u)`:
+    x <- x . exp(dt f(x)) with R_S <- R_S Exp(dt [[w_S]]), R_Y <- R_Y Exp(dt w_Y [[e_x]]),
+    R_P <- R_P Exp(dt w_P [[e_y]]), q <- q + dt r R_S (w_S x gamma), nu <- nu + dt accel(x, u).
+    Returns the final state (compared with our C Lie–Euler run before its time counts).
+    """
+    x = np.array(x0, dtype=float)
+    for u in u_prog:
+        R_S, R_Y, R_P = rotations(x)
+        w_S = x[IDX_WS]
+        wx, wy, wz = w_S
+        gx, gy, gz = R_S[2]                     # γ, the vertical in the shell frame
+        v = R_S @ np.array([wy * gz - wz * gy, wz * gx - wx * gz, wx * gy - wy * gx])
+        nu_dot = accel(x, u)
+        new = np.empty_like(x)
+        new[IDX_RS] = (R_S @ exp(dt * w_S)).ravel()
+        new[IDX_RY] = (R_Y @ rot_x(dt * x[IDX_WY])).ravel()
+        new[IDX_RP] = (R_P @ rot_y(dt * x[IDX_WP])).ravel()
+        q = x[IDX_Q].copy()                     # q_z = r stays exact
+        q[0] += dt * r * v[0]
+        q[1] += dt * r * v[1]
+        new[IDX_Q] = q
+        new[IDX_NU] = x[IDX_NU] + dt * nu_dot
+        x = new
+    return x
+
+
+# -- Python-side timings -------------------------------------------------------------------------
+def python_timings(model, X, U, batch_size, progress, with_kane=True, loop_steps=10_000):
+    from ..verification.paper_formulas import PaperModel
+    from ..verification.reference import ReferenceModel
+    out = {}
+    calls = list(zip(X[:200], U[:200]))
+    progress("Model.accel per call from Python")
+    out["python_model_accel_ns"] = per_call_ns(model.accel, calls)
+
+    paper = PaperModel(model.params)
+    for x, u in calls[:20]:
+        check_close("NumPy paper formulas", paper.accel(x, u), model.accel(x, u), 1e-10)
+    progress("NumPy transcription of the paper's formulas")
+    out["numpy_paper_accel_ns"] = per_call_ns(paper.accel, calls[:50])
+
+    ref = ReferenceModel(model.params.as_dict())
+    progress("CasADi reference from Python")
+    out["casadi_python_accel_ns"] = per_call_ns(ref.accel, calls[:50])
+
+    if with_kane:
+        from ..verification.alternatives.kane import KaneModel
+        progress("sympy.physics.mechanics (KanesMethod) model: deriving and lambdifying")
+        kane = KaneModel(model.params.as_dict())
+        out["kane_derivation_s"] = float(kane.derivation_seconds)
+        for x, u in calls[:20]:
+            check_close("KanesMethod model", kane.accel(x, u), model.accel(x, u), 1e-8)
+        progress("KanesMethod model per call")
+        out["kane_lambdified_accel_ns"] = per_call_ns(kane.accel, calls[:20], min_seconds=0.2)
+        progress("KanesMethod model lambdified with sympy's defaults (no cse)")
+        plain = KaneModel(model.params.as_dict(), cse=False)
+        for x, u in calls[:5]:
+            check_close("KanesMethod model, no cse", plain.accel(x, u), model.accel(x, u), 1e-8)
+        out["kane_lambdified_default_accel_ns"] = per_call_ns(plain.accel, calls[:5], min_seconds=0.2)
+        progress("KanesMethod model lambdified for Python floats (math module), hand-tuned")
+        tuned = KaneModel(model.params.as_dict(), module="math")
+        for x, u in calls[:20]:
+            check_close("KanesMethod model, math module", tuned.accel(x, u), model.accel(x, u), 1e-8)
+        out["kane_lambdified_math_accel_ns"] = per_call_ns(tuned.accel, calls[:20], min_seconds=0.2)
+
+    progress(f"batch accel over {batch_size:.0e} states")
+    reps = int(np.ceil(batch_size / len(X)))
+    XB, UB = np.tile(X, (reps, 1))[:batch_size], np.tile(U, (reps, 1))[:batch_size]
+    # The first call on a fresh 10⁶-state batch pays for the output's first touch (page faults;
+    # 2x the steady-state time on a VM): it is recorded, and the steady state (best of three
+    # further calls) is what the table reports, as for the C loops.
+    start = time.perf_counter()
+    AB = model.accel(XB, UB)
+    out["python_batch_accel_first_call_ns_per_state"] = (time.perf_counter() - start) / batch_size * 1e9
+    out["python_batch_accel_ns_per_state"] = best_seconds(lambda: model.accel(XB, UB), 3) / batch_size * 1e9
+    out["batch_size"] = batch_size
+    check_close("batch accel", AB[:len(X)], np.array([model.accel(x, u) for x, u in zip(X, U)]), 0)
+
+    u_prog = t_shape_program()
+    x0 = initial_state()
+    for method in METHODS:
+        progress(f"t-shape, 10,000 steps, {method}")
+        out[f"t_shape_{method}_ms"] = best_seconds(
+            lambda: model.simulate(x0, 0.01, 10_000, u_prog, method=method), 5) * 1e3
+
+    batches = [("CasADi reference, Function.map", ref.accel_batch, 2_000)]
+    if with_kane:
+        batches.append(("KanesMethod lambdify(cse=True) on arrays", kane.accel_batch, 100_000))
+    out["alternative_batch_ns_per_state"] = {}
+    for name, accel_batch, n in batches:
+        progress(f"batch accel, {name}, {n:,} states")
+        n = min(n, batch_size)
+        check_close(f"batch accel, {name}", accel_batch(XB[:len(X)], UB[:len(X)]), AB[:len(X)], 1e-8)
+        def run(accel_batch=accel_batch, n=n, chunk=10_000):
+            for i in range(0, n, chunk):
+                accel_batch(XB[i:min(i + chunk, n)], UB[i:min(i + chunk, n)])
+        out["alternative_batch_ns_per_state"][name] = best_seconds(run, 3) / n * 1e9   # as for our batch
+
+    alternatives = [("ours: Model.accel", model.accel), ("NumPy paper formulas", paper.accel),
+                    ("CasADi reference from Python", ref.accel)]
+    if with_kane:
+        alternatives.append(("KanesMethod lambdify(cse=True)", kane.accel))
+    expected = model.simulate(x0, 0.01, loop_steps, u_prog[:loop_steps], method="lie-euler")[-1]
+    out["lie_euler_loop_steps"] = loop_steps
+    out["lie_euler_loop_ms"] = {}
+    for name, accel in alternatives:
+        progress(f"t-shape, {loop_steps:,} Lie-Euler steps in a Python loop around {name}")
+        start = time.perf_counter()
+        final = lie_euler_loop(accel, x0, 0.01, u_prog[:loop_steps], model.params.r)
+        out["lie_euler_loop_ms"][name] = (time.perf_counter() - start) * 1e3
+        check_close(f"t-shape in a Python loop around {name}", final, expected, 1e-8)
+    return out

@@ -1,0 +1,81 @@
+"""`python -m runtime bench` (`make bench`): see runtime/bench/__init__.py for what is measured."""
+import argparse
+import datetime
+import os
+import pathlib
+import sys
+import tempfile
+
+import numpy as np
+
+from ..model import Model
+from ..params import Params
+from ..verification.sampling import random_inputs, random_states
+from .baselines import python_timings
+from .checks import WrongNumbers
+from .harness import ROOT, build_harness, casadi_reference_c, check_harness, run_harness
+from .report import format_report, write_results
+from .timing import cpu_name, pin_to_one_core
+
+RESULTS = ROOT / "bench" / "results"
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m runtime bench", description="Benchmarks against the alternatives.")
+    parser.add_argument("--states", type=int, default=1024, help="states in the C loop (<= 4096)")
+    parser.add_argument("--repeats", type=int, default=200, help="sweeps over the states per timing")
+    parser.add_argument("--batch", type=int, default=1_000_000, help="states in the Python batch accel")
+    parser.add_argument("--native", action="store_true", help="also build the C loop with -march=native")
+    parser.add_argument("--no-kane", action="store_true", help="skip the sympy.physics.mechanics baseline")
+    parser.add_argument("--loop-steps", type=int, default=10_000,
+                        help="steps of the alternatives' t-shape run in a Python Lie-Euler loop (<= 10,000)")
+    parser.add_argument("--out", type=pathlib.Path, default=RESULTS)
+    args = parser.parse_args(argv)
+    if not 1 <= args.states <= 4096:
+        parser.error("--states: must be between 1 and 4096")
+    if not 1 <= args.loop_steps <= 10_000:
+        parser.error("--loop-steps: must be between 1 and 10,000")
+
+    def progress(msg):
+        print(f"bench: {msg}", file=sys.stderr, flush=True)
+
+    try:
+        original_affinity = os.sched_getaffinity(0)
+    except (AttributeError, OSError):
+        original_affinity = None
+    core = pin_to_one_core()
+    try:
+        return run(args, core, progress)
+    finally:
+        if original_affinity:
+            os.sched_setaffinity(0, original_affinity)
+
+
+def run(args, core, progress):
+    rng = np.random.default_rng(0)
+    params = Params.paper_simulation()
+    model = Model(params)
+    X, U = random_states(rng, args.states, params), random_inputs(rng, args.states)
+    result = {"date": datetime.datetime.now().isoformat(timespec="seconds"), "cpu": cpu_name(),
+              "pinned_core": core, "states": args.states, "params": "Params.paper_simulation()"}
+    try:
+        with tempfile.TemporaryDirectory() as tmp:
+            build = pathlib.Path(tmp)
+            progress("generating the CasADi reference C and building the C loop")
+            casadi_reference_c(params, build)
+            exe = build_harness(build, native=False, with_casadi=True)
+            result["c_loop"] = run_harness(exe, params, X, U, args.repeats)
+            check_harness(result["c_loop"], model, X, U)
+            if args.native:
+                exe = build_harness(build, native=True, with_casadi=False)
+                result["c_loop_native"] = run_harness(exe, params, X, U, args.repeats)
+                check_harness(result["c_loop_native"], model, X, U)
+        result["python"] = python_timings(model, X, U, args.batch, progress, with_kane=not args.no_kane,
+                                          loop_steps=args.loop_steps)
+    except WrongNumbers as exc:
+        print(f"bench: WRONG NUMBERS: {exc}", file=sys.stderr)
+        return 1
+    print(format_report(result))
+    written = write_results(result, args.out)
+    print(f"\nwritten: {', '.join(map(str, written))}")
+    return 0

@@ -1,0 +1,77 @@
+"""The C loop (bench/bench_kernels.c): build it with our kernels and the CasADi-generated reference, run it
+over random states, and check its outputs before any of its times is believed."""
+import json
+import os
+import pathlib
+import shutil
+import struct
+import subprocess
+
+import numpy as np
+
+from ..verification.reference import ReferenceModel
+from .checks import check_close
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def casadi_reference_c(params, build):
+    """The independent reference's accel as one CasADi Function, through CasADi's code generator."""
+    import casadi as ca
+
+    ref = ReferenceModel(params.as_dict())
+    x, u = ca.MX.sym("x", 35), ca.MX.sym("u", 2)
+    kkt, rhs = ref._f_kkt(x, u)
+    sol = ca.solve(kkt, rhs, "qr")
+    J, b = ref._f_conv(x)
+    accel = ca.vertcat(ca.mtimes(J, sol[0:7]) + b, sol[3:5])
+    fn = ca.Function("ref_accel", [x, u], [accel])
+    cwd = os.getcwd()
+    try:
+        os.chdir(build)
+        fn.generate("ref_accel.c", {"with_header": True, "casadi_real": "double"})
+    finally:
+        os.chdir(cwd)
+    return build / "ref_accel.c"
+
+
+def build_harness(build, native, with_casadi):
+    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+    sources = [str(p) for d in ("generated", "c") for p in sorted((ROOT / d).glob("*.c"))]
+    flags = ["-std=c99", "-O2", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c'}", f"-I{build}"]
+    if native:
+        flags.append("-march=native")
+    if with_casadi:
+        flags.append("-DWITH_CASADI")
+        sources.append(str(build / "ref_accel.c"))
+    exe = build / ("bench_native" if native else "bench")
+    subprocess.run([cc, *flags, str(ROOT / "bench" / "bench_kernels.c"), *sources, "-lm", "-o", str(exe)],
+                   check=True)
+    return exe
+
+
+def run_harness(exe, params, X, U, repeats):
+    data = build_dir_input = exe.parent / "input.bin"
+    with open(build_dir_input, "wb") as f:
+        f.write(struct.pack("i", len(X)))
+        f.write(np.ascontiguousarray(params.as_array()).tobytes())
+        f.write(np.ascontiguousarray(X).tobytes())
+        f.write(np.ascontiguousarray(U).tobytes())
+    out = subprocess.run([str(exe), str(data), str(repeats)], check=True, capture_output=True, text=True)
+    return json.loads(out.stdout)
+
+
+def check_harness(result, model, X, U):
+    """The C loop's outputs against the Python-visible kernels and the reference, before any time is believed."""
+    ref = ReferenceModel(model.params.as_dict())
+    n = len(result["accel"]["check"])
+    for i in range(n):
+        check_close("C accel vs reference", result["accel"]["check"][i], ref.accel(X[i], U[i]), 1e-10)
+        check_close("C raw accel", result["accel_unchecked"]["check"][i], model.accel(X[i], U[i]), 1e-12)
+        check_close("C inertia", np.reshape(result["inertia"]["check"][i], (5, 5)), model.inertia(X[i]), 1e-13)
+        for key, method in [("step_lie_euler", "lie-euler"), ("step_rkmk4", "rkmk4"), ("step_cf4", "cf4")]:
+            if key in result:
+                check_close(f"C {key}", result[key]["check"][i], model.step(X[i], U[i], 0.01, method), 1e-12)
+        if "casadi_generated_reference_accel" in result:
+            check_close("CasADi-generated reference", result["casadi_generated_reference_accel"]["check"][i],
+                        ref.accel(X[i], U[i]), 1e-10)

@@ -1,0 +1,56 @@
+"""How a time is taken: one pinned core, best of several rounds; and the CPU the times belong to."""
+import os
+import pathlib
+import platform
+import time
+
+import numpy as np
+
+
+def pin_to_one_core():
+    try:
+        cpus = sorted(os.sched_getaffinity(0))
+        os.sched_setaffinity(0, {cpus[-1]})
+        return cpus[-1]
+    except (AttributeError, OSError):
+        return None
+
+
+def cpu_name():
+    try:
+        for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def best_seconds(fn, rounds):
+    """The shortest of `rounds` wall times of fn() [s]."""
+    best = np.inf
+    for _ in range(rounds):
+        start = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def per_call_ns(fn, calls, min_seconds=0.1, rounds=7):
+    """Best of `rounds` timings of a Python loop over `calls` (list of argument tuples), each
+    lasting at least `min_seconds`.  Many short rounds, like the C loop's 11, so that a host
+    busy for a moment slows some rounds and not the best one; a host busy for seconds still
+    shows (2026-11-23: the Kane call read 66 us with three 0.5 s rounds, 71 us with seven
+    0.2 s rounds, against 47-49 us when quiet), which flatters our ratios, never theirs."""
+    best = np.inf
+    for _ in range(rounds):
+        n, start = 0, time.perf_counter()
+        while True:
+            for args in calls:
+                fn(*args)
+            n += len(calls)
+            elapsed = time.perf_counter() - start
+            if elapsed > min_seconds:
+                break
+        best = min(best, elapsed / n * 1e9)
+    return best

@@ -1,0 +1,36 @@
+"""`python -m runtime figures [--out DIR]`: regenerate the committed figures under docs/figures/.
+
+One trajectory figure per paper scenario (the paper's Figs. 2, 4, 6) and the
+relative inclinations of the t-shape run (Fig. 7), at 100 dpi so the PNGs
+stay small.  The numbers quoted in docs/scenarios.md come from the same runs
+(see each run's summary.json, `python -m runtime run all`).
+"""
+import argparse
+import pathlib
+import sys
+
+from . import plots
+from .scenario import PAPER_SCENARIOS, load_scenario, run_scenario
+
+DEFAULT_OUT = pathlib.Path(__file__).resolve().parents[2] / "docs" / "figures"
+
+#: (scenario, figure function, file name suffix) of every committed figure.
+COMMITTED = [(name, plots.trajectory_figure, "trajectory") for name in PAPER_SCENARIOS]
+COMMITTED.append(("t-shape", plots.inclinations_figure, "inclinations"))
+
+
+def main(argv):
+    parser = argparse.ArgumentParser(prog="python -m runtime figures", description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=pathlib.Path, default=DEFAULT_OUT, help=f"folder (default: {DEFAULT_OUT})")
+    args = parser.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    results = {name: run_scenario(load_scenario(name)) for name in PAPER_SCENARIOS}
+    for name, draw, suffix in COMMITTED:
+        target = args.out / f"{name}-{suffix}.png"
+        plots.save_figure(draw(results[name]), target, dpi=plots.FIGURE_DPI)
+        print(target)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

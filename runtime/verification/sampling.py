@@ -1,0 +1,35 @@
+"""Random states, inputs and parameter sets for the cross-checks (tests and `python -m runtime verify`)."""
+import numpy as np
+
+from ..params import Params
+from ..so3 import random_rotation
+from ..state import NU, initial_state
+
+
+def random_state(rng, params=None, max_speed=10.0):
+    """Random R_S, θ_Y, θ_P, position on the plane and speeds with |ω| components up to max_speed rad/s."""
+    r = (params or Params()).r
+    w = rng.uniform(-max_speed, max_speed, size=5)
+    q = (rng.uniform(-1, 1), rng.uniform(-1, 1), r)
+    return initial_state(theta_Y=rng.uniform(-np.pi, np.pi), theta_P=rng.uniform(-np.pi, np.pi),
+                         R_S=random_rotation(rng), q=q, w_S=w[:3], w_Y=w[3], w_P=w[4], r=r)
+
+
+def random_states(rng, n, params=None, max_speed=10.0):
+    return np.array([random_state(rng, params, max_speed) for _ in range(n)])
+
+
+def random_inputs(rng, n, max_torque=1.0):
+    return rng.uniform(-max_torque, max_torque, size=(n, NU))
+
+
+def random_params(rng):
+    """A parameter set that respects the geometry (yoke and pendulum inside the shell)."""
+    r = rng.uniform(0.1, 0.6)
+    half_diag = rng.uniform(0.3, 0.95) * r
+    angle = rng.uniform(0.15, np.pi / 2 - 0.15)
+    return Params(r=r, m_S=rng.uniform(0.5, 5), k_S=rng.uniform(0, 0.3),
+                  b=2 * half_diag * np.sin(angle), h=2 * half_diag * np.cos(angle),
+                  m_b=rng.uniform(0.2, 5), m_h=rng.uniform(0.2, 5), k_Y=rng.uniform(0, 0.1),
+                  l=rng.uniform(0.2, 1.0) * r, m_P=rng.uniform(0.2, 5), k_P=rng.uniform(0, 0.1),
+                  g=rng.uniform(1.0, 10.0))

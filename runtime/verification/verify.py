@@ -1,0 +1,290 @@
+"""Verification of the generated kernels: an independent model, and the physics itself.
+
+`python -m runtime verify [--states N] [--seed S]` runs every check below,
+prints a table (check, worst absolute and relative error, tolerance, pass or
+fail) and exits non-zero on any failure.  The tests in tests/runtime/verification/test_verify.py
+call the same functions.
+
+Checks
+  cross-check   accel, inertia and energy against `runtime.verification.reference` (CasADi AD,
+                Lagrange–d'Alembert in coordinates) at random states and parameters
+  energy        conservation without friction and torques over 20 s (solve_ivp, rtol 1e-12)
+  power         dE/dt = u·(ω_Y, ω_P) − k_S|ω_S|² − k_Y ω_Y² − k_P ω_P² at random states
+  rolling       the contact point of the simulated motion does not slip
+  equilibria    accel = 0 at eq. (108); linearization stable below, unstable above
+  symmetry      planar motions stay planar
+"""
+import argparse
+import dataclasses
+import sys
+import time
+
+import numpy as np
+
+from ..model import Model
+from ..params import Params
+from ..so3 import exp, hat, rot_x, rot_y, rot_z, vee
+from ..state import IDX_NU, IDX_Q, IDX_QZ, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NX, initial_state, rotations
+from ..validation import project_state
+from .sampling import random_inputs, random_params, random_state
+
+
+@dataclasses.dataclass
+class CheckResult:
+    name: str
+    abs_error: float
+    rel_error: float
+    tolerance: float
+    detail: str = ""
+    at_least: bool = False      # a lower bound on abs_error instead of an upper bound on rel_error
+
+    @property
+    def passed(self):
+        if self.at_least:
+            return bool(self.abs_error >= self.tolerance)
+        return bool(self.rel_error <= self.tolerance)
+
+
+def state_derivative(model, x, u=None):
+    """ẋ for the whole 35-vector: Ṙ_S = R_S⟦ω_S⟧, Ṙ_Y = R_Y ω_Y Σ_Y, Ṙ_P = R_P ω_P Σ_P, q̇ = r R_S(ω_S × γ), ν̇.
+
+    The dynamics live on SO(3)³; a Runge–Kutta integrator in ℝ³⁵ evaluates stages slightly
+    off it, so the vector field is extended by projection (`project_state`).
+    """
+    xp = project_state(x, model.params.r)
+    R_S, R_Y, R_P = rotations(xp)
+    w = xp[IDX_WS]
+    d = np.empty(NX)
+    d[IDX_RS] = (R_S @ hat(w)).ravel()
+    d[IDX_RY] = (R_Y @ hat([xp[IDX_WY], 0, 0])).ravel()
+    d[IDX_RP] = (R_P @ hat([0, xp[IDX_WP], 0])).ravel()
+    d[IDX_Q] = model.params.r * R_S @ np.cross(w, R_S[2])
+    d[IDX_NU] = model.accel(xp, u)
+    return d
+
+
+def integrate(model, x0, t_end, u=None, rtol=1e-12, atol=1e-12, dense=False):
+    """solve_ivp (DOP853) on the 35 entries with `state_derivative`: the independent tight-tolerance solution."""
+    from scipy.integrate import solve_ivp
+    return solve_ivp(lambda t, x: state_derivative(model, x, u), (0.0, t_end), x0, method="DOP853",
+                     rtol=rtol, atol=atol, first_step=1e-4, dense_output=dense)
+
+
+# -- cross-check against the independent reference --------------------------------------
+def parameter_sets(rng, n_random=5):
+    return [Params.paper_simulation()] + [random_params(rng) for _ in range(n_random)]
+
+
+def cross_check(n_states=1000, seed=0, n_param_sets=6):
+    """Kernel vs reference; n_states per parameter set."""
+    from .reference import ReferenceModel
+    rng = np.random.default_rng(seed)
+    worst = {k: [0.0, 0.0, ""] for k in ("accel", "inertia", "energy")}
+    for params in parameter_sets(rng, n_param_sets - 1):
+        model, ref = Model(params), ReferenceModel(params.as_dict())
+        constant_potential = (params.m_S + 2 * (params.m_b + params.m_h)) * params.g
+        for _ in range(n_states):
+            x, u = random_state(rng, params), random_inputs(rng, 1)[0]
+            pairs = {
+                "accel": (model.accel(x, u), ref.accel(x, u)),
+                "inertia": (model.inertia(x), ref.inertia(x)),
+                # The reference counts the shell's and yoke's constant potential (m_S + m_Y) g q_z.
+                "energy": (model.energy(x), ref.energy(x) - constant_potential * x[IDX_QZ]),
+            }
+            for key, (ours, theirs) in pairs.items():
+                err = float(np.abs(np.asarray(ours) - theirs).max())
+                rel = err / max(float(np.abs(theirs).max()), 1e-300)
+                if rel > worst[key][1]:
+                    worst[key] = [err, rel, f"worst at a state with |ν| = {np.linalg.norm(x[IDX_NU]):.3g}"]
+    total = n_states * n_param_sets
+    return [CheckResult(f"cross-check {k} ({total} states, {n_param_sets} param sets)", *v[:2], 1e-10, v[2])
+            for k, v in worst.items()]
+
+
+# -- physics invariants ------------------------------------------------------------------
+def energy_conservation(n_runs=3, seed=1, t_end=20.0):
+    rng = np.random.default_rng(seed)
+    model = Model(Params(k_S=0.0, k_Y=0.0, k_P=0.0))
+    worst = (0.0, 0.0)
+    for _ in range(n_runs):
+        x0 = random_state(rng, model.params, max_speed=3.0)
+        sol = integrate(model, x0, t_end)
+        E0 = model.energy(x0)
+        drift = max(abs(model.energy(project_state(x, model.params.r)) - E0) for x in sol.y.T)
+        if drift / abs(E0) > worst[1]:
+            worst = (drift, drift / abs(E0))
+    return CheckResult(f"energy conserved without friction ({n_runs} runs, {t_end:g} s)", *worst, 1e-9)
+
+
+def configuration_flow(x, t):
+    """The state moved for time t along the exact kinematics with the speeds frozen."""
+    y = x.copy()
+    R_S, R_Y, R_P = rotations(x)
+    y[IDX_RS] = (R_S @ exp(t * x[IDX_WS])).ravel()
+    y[IDX_RY] = (R_Y @ rot_x(t * x[IDX_WY])).ravel()
+    y[IDX_RP] = (R_P @ rot_y(t * x[IDX_WP])).ravel()
+    return y
+
+
+def energy_rate(model, x, u):
+    """dE/dt = νᵀ M ν̇ (kernel inertia and accel) + ∂E/∂(configuration)·(kinematics).
+
+    The configuration part is an 8th-order central difference of E along the
+    exact configuration flow (q does not enter E except through q_z, which is
+    constant), accurate to rounding.
+    """
+    nu = x[IDX_NU]
+    kinetic_part = nu @ model.inertia(x) @ model.accel(x, u)
+    h = 1e-3
+    weights = {1: 4 / 5, 2: -1 / 5, 3: 4 / 105, 4: -1 / 280}
+    config_part = sum(w * (model.energy(configuration_flow(x, k * h)) - model.energy(configuration_flow(x, -k * h)))
+                      for k, w in weights.items()) / h
+    return kinetic_part + config_part
+
+
+def power_balance(n_states=200, seed=2):
+    rng = np.random.default_rng(seed)
+    worst = (0.0, 0.0)
+    for params in parameter_sets(rng, 2):
+        model = Model(params)
+        for _ in range(n_states):
+            x, u = random_state(rng, params), random_inputs(rng, 1)[0]
+            w_S, w_Y, w_P, w = x[IDX_WS], x[IDX_WY], x[IDX_WP], x[IDX_NU]
+            supplied = u @ (w_Y, w_P)
+            dissipated = params.k_S * w_S @ w_S + params.k_Y * w_Y ** 2 + params.k_P * w_P ** 2
+            err = abs(energy_rate(model, x, u) - (supplied - dissipated))
+            scale = abs(supplied) + dissipated + abs(w @ model.inertia(x) @ model.accel(x, u))
+            if err / scale > worst[1]:
+                worst = (err, err / scale)
+    return CheckResult(f"power balance dE/dt = u·ω − Σ k ω² ({3 * n_states} states)", *worst, 1e-9,
+                       "relative to |u·ω| + Σ k ω² + |νᵀMν̇|")
+
+
+def rolling_constraint(seed=3, t_end=2.0):
+    """Differentiate the simulated q(t) and R_S(t) and check the contact point's velocity is zero."""
+    from .reference import ReferenceModel
+    rng = np.random.default_rng(seed)
+    params = Params.paper_simulation()
+    model, ref = Model(params), ReferenceModel(params.as_dict())
+    x0 = random_state(rng, params, max_speed=3.0)
+    sol = integrate(model, x0, t_end, u=np.array([0.2, -0.1]), dense=True)
+    worst = (0.0, 0.0)
+    h = 1e-4
+    for t in np.linspace(0.1, t_end - 0.1, 40):
+        x = project_state(sol.sol(t), params.r)
+        q_dot = (sol.sol(t + h)[IDX_Q] - sol.sol(t - h)[IDX_Q]) / (2 * h)
+        R_dot = (sol.sol(t + h)[IDX_RS] - sol.sol(t - h)[IDX_RS]).reshape(3, 3) / (2 * h)
+        R_S = rotations(x)[0]
+        w_inertial = R_dot @ R_S.T                      # ⟦R_S ω_S⟧ from the motion itself
+        omega = vee(w_inertial)
+        v_contact = q_dot + np.cross(omega, -params.r * np.array([0, 0, 1.0]))
+        v_ref = ref.contact_point_velocity(x, qdot=q_dot)
+        err = max(np.abs(v_contact).max(), np.abs(v_ref).max())
+        scale = np.linalg.norm(q_dot) + 1e-12
+        if err / scale > worst[1]:
+            worst = (err, err / scale)
+    return CheckResult("rolling: contact point velocity of the simulated motion", *worst, 1e-6,
+                       "central differences of the dense solution, h = 1e-4 s")
+
+
+def equilibrium_state(theta_Y, theta_P, up, alpha=0.0):
+    R_YP = rot_x(theta_Y) @ rot_y(theta_P)
+    flip = rot_x(np.pi) if up else np.eye(3)
+    return initial_state(theta_Y, theta_P, R_S=rot_z(alpha) @ flip @ R_YP.T)
+
+
+def linearization(model, x):
+    """Jacobian of (configuration, ν) ↦ (ν, ν̇) at x; configuration = (φ on R_S, θ_Y, θ_P)."""
+    def field(z):
+        y = x.copy()
+        R_S, R_Y, R_P = rotations(x)
+        y[IDX_RS] = (R_S @ exp(z[0:3])).ravel()
+        y[IDX_RY] = (R_Y @ rot_x(z[3])).ravel()
+        y[IDX_RP] = (R_P @ rot_y(z[4])).ravel()
+        y[IDX_NU] = z[5:10]
+        # d/dt of the chart coordinates equals ν to first order at z = 0.
+        return np.concatenate([z[5:10], model.accel(y)])
+    h = 1e-6
+    return np.column_stack([(field(h * e) - field(-h * e)) / (2 * h) for e in np.eye(10)])
+
+
+def equilibria(seed=4):
+    rng = np.random.default_rng(seed)
+    model = Model(Params.paper_simulation())
+    worst_accel = 0.0
+    down_max, up_max = -np.inf, np.inf
+    for _ in range(10):
+        theta_Y, theta_P, alpha = rng.uniform(-np.pi, np.pi, size=3)
+        for up in (False, True):
+            x = equilibrium_state(theta_Y, theta_P, up, alpha)
+            worst_accel = max(worst_accel, float(np.abs(model.accel(x)).max()))
+            growth = np.linalg.eigvals(linearization(model, x)).real.max()
+            if up:
+                up_max = min(up_max, growth)
+            else:
+                down_max = max(down_max, growth)
+    return [
+        CheckResult("equilibria of eq. (108): accel = 0", worst_accel, worst_accel, 1e-12),
+        CheckResult("pendulum down: max Re(eigenvalue) <= 1e-6", max(down_max, 0.0), max(down_max, 0.0), 1e-6),
+        CheckResult("pendulum up: max Re(eigenvalue) >= 0.1 1/s", up_max, float("nan"), 0.1,
+                    "smallest growth rate over the cases", at_least=True),
+    ]
+
+
+def planar_symmetry(steps=2000):
+    """R_Y = I, yoke at rest: motion in the x–z plane; R_P = I, pendulum at rest: the y–z plane."""
+    model = Model(Params.paper_simulation())
+    a = model.simulate(initial_state(theta_P=0.7), 0.01, steps, u=np.tile([0.0, 0.05], (steps, 1)))
+    b = model.simulate(initial_state(theta_Y=0.7), 0.01, steps, u=np.tile([0.05, 0.0], (steps, 1)))
+    q_x, q_y = IDX_Q.start, IDX_Q.start + 1
+    w_Sx, w_Sy, w_Sz = range(IDX_WS.start, IDX_WS.stop)
+    off_a = np.abs(a[:, [q_y, w_Sx, w_Sz, IDX_WY]]).max()
+    off_b = np.abs(b[:, [q_x, w_Sy, w_Sz, IDX_WP]]).max()
+    scale_a, scale_b = np.abs(a[:, q_x]).max(), np.abs(b[:, q_y]).max()
+    return [CheckResult("symmetry: R_Y = I, yoke at rest -> x-z plane", off_a, off_a / scale_a, 1e-12,
+                        "q_y, ω_Sx, ω_Sz, ω_Y"),
+            CheckResult("symmetry: R_P = I, pendulum at rest -> y-z plane", off_b, off_b / scale_b, 1e-12,
+                        "q_x, ω_Sy, ω_Sz, ω_P")]
+
+
+def run_all(n_states=1000, seed=0, progress=None):
+    steps = [
+        ("cross-check", lambda: cross_check(n_states, seed)),
+        ("energy", lambda: [energy_conservation(seed=seed + 1)]),
+        ("power", lambda: [power_balance(max(n_states // 5, 20), seed=seed + 2)]),
+        ("rolling", lambda: [rolling_constraint(seed=seed + 3)]),
+        ("equilibria", lambda: equilibria(seed=seed + 4)),
+        ("symmetry", planar_symmetry),
+    ]
+    results = []
+    for i, (name, fn) in enumerate(steps):
+        if progress:
+            progress(f"[{i + 1}/{len(steps)}] {name} ...")
+        results.extend(fn())
+    return results
+
+
+def format_table(results):
+    rows = [("check", "worst abs", "worst rel", "tolerance", "result")]
+    rows += [(r.name, f"{r.abs_error:.2e}", "-" if np.isnan(r.rel_error) else f"{r.rel_error:.2e}",
+              (">= " if r.at_least else "") + f"{r.tolerance:.0e}",
+              "pass" if r.passed else "FAIL") for r in results]
+    widths = [max(len(row[i]) for row in rows) for i in range(5)]
+    lines = ["  ".join(cell.ljust(w) for cell, w in zip(row, widths)) for row in rows]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m runtime verify", description="Verify the generated kernels.")
+    parser.add_argument("--states", type=int, default=1000, help="random states per parameter set (default 1000)")
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args(argv)
+    if args.states < 1:
+        parser.error("--states: must be at least 1")
+    start = time.perf_counter()
+    results = run_all(args.states, args.seed, progress=lambda m: print(m, file=sys.stderr, flush=True))
+    print(format_table(results))
+    failed = [r for r in results if not r.passed]
+    print(f"\n{len(results) - len(failed)} passed, {len(failed)} failed ({time.perf_counter() - start:.1f} s)")
+    return 1 if failed else 0
