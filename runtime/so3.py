@@ -48,8 +48,9 @@ def log(R):
         return skew * (1.0 + theta * theta / 6)     # θ/sin θ to second order
     if math.pi - theta > 1e-6:
         return skew * (theta / sin_theta)
-    # Near π, sin θ carries no accuracy: the axis from the symmetric part, R + I = 2 n nᵀ + O(π − θ).
-    S = 0.5 * (R + np.eye(3))
+    # Near π, sin θ carries no accuracy: the axis from the symmetric part,
+    # (R + Rᵀ)/2 + I = (1 + cos θ) I + (1 − cos θ) n nᵀ = 2 n nᵀ + O((π − θ)²).
+    S = 0.25 * (R + R.T) + 0.5 * np.eye(3)
     column = int(np.argmax(np.diag(S)))
     n = S[:, column] / math.sqrt(S[column, column])
     if n @ skew < 0:

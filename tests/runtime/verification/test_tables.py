@@ -1,0 +1,75 @@
+"""The independent models keep their own parameter order and state layout on purpose; these must equal the
+generated ones (SR_P_* and SR_X_* of generated/sr_generated.h, read from the compiled module)."""
+import numpy as np
+
+from bindings._sr import lib
+from runtime.so3 import random_rotation
+from runtime.state import initial_state
+from runtime.verification import reference
+from runtime.verification.alternatives import kane
+
+
+def generated_parameter_order():
+    indices = {name[len("SR_P_"):]: getattr(lib, name) for name in dir(lib) if name.startswith("SR_P_")}
+    return tuple(sorted(indices, key=indices.get))
+
+
+def generated_state_offsets():
+    return {name[len("SR_X_"):]: getattr(lib, name) for name in dir(lib) if name.startswith("SR_X_")}
+
+
+def layout_mismatches(param_names, state_dim, offsets):
+    """What differs between a model's own tables and the generated ones (empty when they agree)."""
+    problems = []
+    if tuple(param_names) != generated_parameter_order():
+        problems.append(f"parameter order {tuple(param_names)} != {generated_parameter_order()}")
+    if state_dim != lib.SR_NX:
+        problems.append(f"state dimension {state_dim} != {lib.SR_NX}")
+    generated = generated_state_offsets()
+    if set(offsets) != set(generated):
+        problems.append(f"blocks {sorted(offsets)} != {sorted(generated)}")
+    problems += [f"{block} at {offset} != {generated[block]}" for block, offset in offsets.items()
+                 if block in generated and offset != generated[block]]
+    return problems
+
+
+def test_the_generated_tables_are_complete():
+    assert len(generated_parameter_order()) == lib.SR_NPARAM
+    assert set(generated_state_offsets()) == {"R_S", "R_Y", "R_P", "q", "w_S", "w_Y", "w_P"}
+
+
+def test_the_reference_tables_follow_the_generated_order():
+    offsets = {"R_S": reference._RS.start, "R_Y": reference._RY.start, "R_P": reference._RP.start,
+               "q": reference._Q.start, "w_S": reference._WS.start, "w_Y": reference._WY, "w_P": reference._WP}
+    assert layout_mismatches(reference.PARAM_NAMES, reference.STATE_DIM, offsets) == []
+    assert reference._NU.start == lib.SR_X_w_S
+
+
+def test_the_kane_tables_follow_the_generated_order():
+    offsets = {"R_S": kane.X_R_S, "R_Y": kane.X_R_Y, "R_P": kane.X_R_P, "q": kane.X_Q,
+               "w_S": kane.X_NU, "w_Y": kane.X_NU + 3, "w_P": kane.X_NU + 4}
+    assert layout_mismatches(kane.PARAM_NAMES, kane.STATE_DIM, offsets) == []
+
+
+def test_a_swapped_table_is_reported():
+    names = list(reference.PARAM_NAMES)
+    names[0], names[1] = names[1], names[0]
+    offsets = dict(generated_state_offsets(), w_Y=lib.SR_X_w_P, w_P=lib.SR_X_w_Y)
+    problems = layout_mismatches(names, lib.SR_NX, offsets)
+    assert len(problems) == 3 and "parameter order" in problems[0]
+    assert layout_mismatches(reference.PARAM_NAMES, lib.SR_NX + 1, generated_state_offsets()) != []
+
+
+def test_the_reference_builds_the_same_state_as_the_runtime(rng):
+    R_S = random_rotation(rng)
+    ours = initial_state(0.3, -1.1, R_S=R_S, q=(0.5, -0.25, 0.4), w_S=(1.0, 2.0, 3.0), w_Y=4.0, w_P=5.0)
+    theirs = reference.make_state(R_S=R_S, theta_Y=0.3, theta_P=-1.1, q_xy=(0.5, -0.25), omega_S=(1.0, 2.0, 3.0),
+                                  omega_Y=4.0, omega_P=5.0, r=0.4)
+    assert np.array_equal(ours, theirs)
+
+
+def test_the_kane_model_reads_the_runtime_state_by_its_blocks():
+    x = initial_state(0.3, -1.1, q=(0.5, -0.25, 0.3), w_S=(1.0, 2.0, 3.0), w_Y=4.0, w_P=5.0)
+    coordinates, speeds = kane.KaneModel.coordinates(x)
+    assert np.allclose(coordinates, (0.0, 0.0, 0.0, 0.3, -1.1, 0.5, -0.25), atol=1e-15)
+    assert speeds == (1.0, 2.0, 3.0, 4.0, 5.0)
