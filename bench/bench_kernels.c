@@ -5,7 +5,7 @@
  * Prints one JSON object: ns per call of each kernel (best of 11 rounds, each kernel timed
  * once per round over REPEATS sweeps of the n states, after a 0.3 s warm-up) and the outputs for the first 8 states, which the
  * Python driver checks against the reference before reporting any time.
- * Built by runtime/bench.py; with -DWITH_CASADI the CasADi-generated reference
+ * Built by runtime/bench/harness.py; with -DWITH_CASADI the CasADi-generated reference
  * (ref_accel.c, written by the driver) is timed too.
  */
 #define _POSIX_C_SOURCE 199309L
