@@ -1,21 +1,17 @@
-"""Scenario files, the `run` command and its outputs, and the paper's Section 5.3 statements on our data.
+"""Scenario files (runtime/scenarios/scenario.py) and the paper's Section 5.3 statements on our data.
 
-The physics checks read the raw trajectory and compute what they need from
+The `results` fixture (the three shipped runs) is in conftest.py next to this file.  The physics checks read the raw trajectory and compute what they need from
 the rotation matrices themselves (inclinations, rolling angle), so they do not
 lean on runtime/scenarios/report.py.  The t-shape torque program is rebuilt here from
 the windows of Section 5.3.3 and compared with what the file produces.
 """
-import json
 import math
-import pathlib
 
 import numpy as np
 import pytest
 
 from conftest import ROOT
 from runtime import Model, Params, initial_state
-from runtime.scenarios import animation, report
-from runtime.scenarios import cli as scenario_cli
 from runtime.scenarios.scenario import load_scenario, parse_scenario, run_scenario, shipped_scenarios
 
 R = 0.3   # shell radius of the paper (Section 5.2)
@@ -49,11 +45,6 @@ def paper_t_shape_torques(steps, per_step=1):
     u[2499:3000, 0] = -0.1
     u[3399:4500, 1] = 0.1
     return np.repeat(u, per_step, axis=0)[:steps]
-
-
-@pytest.fixture(scope="module")
-def results():
-    return {name: run_scenario(load_scenario(name)) for name in ("tilted-pendulum", "tilted-yoke", "t-shape")}
 
 
 # -- the shipped files -------------------------------------------------------------------------
@@ -289,108 +280,6 @@ def test_parse_scenario_accepts_full_matrices():
     x0 = parse_scenario(data, "inline").x0
     np.testing.assert_allclose(x0, initial_state(theta_Y=0.3, R_S=[[c, -s, 0], [s, c, 0], [0, 0, 1]], w_Y=0.5),
                                atol=1e-15)
-
-
-# -- the command line and its files ------------------------------------------------------------------------
-def read_csv(path):
-    lines = path.read_text().splitlines()
-    header = lines[0].split(",")
-    rows = np.array([[float(v) for v in line.split(",")] for line in lines[1:]])
-    return header, rows
-
-
-def test_cli_writes_csv_figures_and_summary(tmp_path):
-    assert scenario_cli.main(["t-shape", "--out", str(tmp_path), "--steps", "300", "--no-gif", "--quiet"]) == 0
-    folder = tmp_path / "t-shape"
-    names = sorted(p.name for p in folder.iterdir())
-    assert names == sorted(["trajectory.csv", "summary.json", "trajectory.png", "inclinations.png",
-                            "absolute_inclinations.png", "energy.png"])
-    for png in folder.glob("*.png"):
-        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-
-    header, rows = read_csv(folder / "trajectory.csv")
-    columns = 1 + 3 + 3 * 9 + 5 + 2 + 1                         # t, q, R_S R_Y R_P, speeds, torques, E
-    assert len(header) == rows.shape[1] == columns and len(set(header)) == columns
-    assert rows.shape[0] == 301
-    col = {name: i for i, name in enumerate(header)}
-    model = Model(Params.paper_simulation())
-    direct = model.simulate(initial_state(), 0.01, 300, paper_t_shape_torques(300))
-    np.testing.assert_allclose(rows[:, col["t"]], 0.01 * np.arange(301), rtol=0, atol=1e-12)
-    # Shortest repr round-trips: the file holds the simulated doubles exactly.
-    np.testing.assert_array_equal(rows[:, [col["q_x"], col["q_y"], col["q_z"]]], direct[:, 27:30])
-    np.testing.assert_array_equal(rows[:, col["R_S_13"]], direct[:, 2])
-    np.testing.assert_array_equal(rows[:, col["R_Y_32"]], direct[:, 9 + 7])
-    np.testing.assert_array_equal(rows[:, col["R_P_31"]], direct[:, 18 + 6])
-    np.testing.assert_array_equal(rows[:, [col["w_S_x"], col["w_S_y"], col["w_S_z"], col["w_Y"], col["w_P"]]],
-                                  direct[:, 30:35])
-    assert np.all(rows[:, col["u_Y"]] == 0.1) and np.all(rows[:, col["u_P"]] == 0.0)
-    assert rows[-1, col["E"]] == model.energy(direct[-1])
-
-    summary = json.loads((folder / "summary.json").read_text())
-    assert summary["final_position_m"] == direct[-1, 27:29].tolist()
-    distances = np.hypot(direct[:, 27], direct[:, 28])
-    assert summary["largest_excursion_m"] == pytest.approx(distances.max(), rel=1e-12)
-    assert summary["steps"] == 300 and summary["method"] == "lie-euler"
-    assert set(summary["final_inclinations_rad"]) == {"yoke_relative_to_shell", "pendulum_relative_to_yoke",
-                                                      "yoke_normal_to_vertical", "pendulum_shaft_to_vertical"}
-    assert summary["wall_time_s"]["simulation"] > 0
-
-
-def test_cli_reports_a_bad_scenario_and_exits_2(tmp_path, capsys):
-    assert scenario_cli.main(["no-such-scenario", "--out", str(tmp_path)]) == 2
-    assert "no-such-scenario: no such scenario file" in capsys.readouterr().err
-    assert scenario_cli.main(["t-shape", "--out", str(tmp_path), "--method", "rk99", "--no-gif"]) == 2
-    assert "method: unknown integrator" in capsys.readouterr().err
-
-
-def test_summary_energy_balance_for_the_tilted_pendulum(results):
-    """Motors off: the energy lost is m_P g (l/2)(1 − cos π/4) (pendulum from π/4 to hanging).
-
-    The summary's damping integral exceeds it at dt = 0.01 (measured by 10%):
-    explicit Lie-Euler feeds energy into the oscillation and the dampers take
-    it out again.  The balance residual (initial − dissipated − final) must
-    therefore vanish at first order: halve with dt (measured ratios 2.12, 2.06).
-    """
-    p = Params.paper_simulation()
-    expected = p.m_P * p.g * (p.l / 2) * (1 - math.cos(math.pi / 4))
-    energy = report.summary(results["tilted-pendulum"])["energy_J"]
-    assert energy["initial"] - energy["final"] == pytest.approx(expected, rel=1e-9)
-    assert energy["motor_work"] == 0.0
-    assert expected < energy["dissipated"] < 1.15 * expected
-    base = load_scenario("tilted-pendulum")
-    residuals = [report.summary(run_scenario(base.with_overrides(dt=base.dt / k)))["energy_J"]["balance_residual"]
-                 for k in (1, 2, 4)]
-    assert residuals[0] == energy["balance_residual"]
-    assert 1.7 < residuals[0] / residuals[1] < 2.4 and 1.7 < residuals[1] / residuals[2] < 2.4
-
-
-# -- atomic writing and the animation ------------------------------------------------------------------------
-def test_rendering_failure_leaves_no_partial_file(tmp_path, monkeypatch, results):
-    folder = tmp_path / "run"
-    folder.mkdir()
-    (folder / "trajectory.png").write_bytes(b"old figure")
-
-    def failing_savefig(self, fname, *args, **kwargs):
-        pathlib.Path(fname).write_bytes(b"\x89PNG half a file")
-        raise RuntimeError("renderer crashed")
-
-    monkeypatch.setattr("matplotlib.figure.Figure.savefig", failing_savefig)
-    with pytest.raises(RuntimeError, match="renderer crashed"):
-        report.write_outputs(results["tilted-yoke"], folder, gif=False)
-    assert (folder / "trajectory.png").read_bytes() == b"old figure"    # untouched
-    assert sorted(p.name for p in folder.iterdir()) == ["trajectory.csv", "trajectory.png"]  # no temporaries
-
-
-def test_gif_is_an_animation_with_the_requested_frames(tmp_path, results):
-    from PIL import Image
-
-    target = tmp_path / "robot.gif"
-    seen = []
-    animation.write_gif(results["tilted-yoke"], target, frames=4, progress=lambda done, total: seen.append(total))
-    with Image.open(target) as gif:
-        assert gif.format == "GIF" and gif.n_frames == 4
-    assert seen and set(seen) == {4}
-    assert [p.name for p in tmp_path.iterdir()] == ["robot.gif"]
 
 
 def test_a_file_that_is_not_utf8_is_named(tmp_path):
