@@ -27,7 +27,8 @@ from ..errors import SimulationStopped
 from ..model import Model
 from ..params import NAMES as PARAM_NAMES
 from ..params import Params
-from ..state import IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NU, NX, rot_x, rot_y
+from ..so3 import rot_x, rot_y
+from ..state import IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NU, NX
 from ..validation import ROTATION_TOL, describe_state
 
 #: The paper's simulations in the order of Section 5.3 (`run all` runs them in this order).
