@@ -67,6 +67,15 @@ typedef struct sr_adaptive_stats {
 int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[], sr_real dt_out,
                          long n_out, const sr_real *u, sr_real rtol, sr_real atol, sr_real h_init,
                          long max_steps, sr_real *traj, sr_adaptive_stats *stats);
+#define SR_BATCH_NMETRICS 4
+#define SR_BATCH_PATH_LENGTH 0
+#define SR_BATCH_MAX_DISTANCE 1
+#define SR_BATCH_MAX_SHELL_RATE 2
+#define SR_BATCH_FINAL_ENERGY 3
+int sr_simulate_batch(int method, long n, const sr_real *params, long params_stride, const sr_real *x0,
+                      long x0_stride, sr_real dt, long steps, const sr_real *u, long u_stride,
+                      sr_real energy_tol, long chunk_steps, sr_real *work, sr_real *traj,
+                      sr_real *x_final, sr_real *metrics, int *status, long *steps_done);
 """
 
 # Portable -O2 by default; SR_NATIVE=1 at install time (`SR_NATIVE=1 pip install -e .`) adds

@@ -248,6 +248,47 @@ int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[SR_
                          long n_out, const sr_real *u, sr_real rtol, sr_real atol, sr_real h_init,
                          long max_steps, sr_real *traj, sr_adaptive_stats *stats);
 
+/* ---- Many robots in one call (c/sr_batch.c) ---------------------------------------------- */
+#ifdef SR_USE_FLOAT
+#define sr_simulate_batch sr_simulate_batch_f
+#endif
+
+/* Summary metrics of one simulated sample, SR_BATCH_NMETRICS numbers in this order. */
+#define SR_BATCH_NMETRICS 4
+#define SR_BATCH_PATH_LENGTH 0    /* length of the path of the shell centre q, sum of |q_k+1 - q_k| [m] */
+#define SR_BATCH_MAX_DISTANCE 1   /* largest distance |q_k - q_0| from the start [m] */
+#define SR_BATCH_MAX_SHELL_RATE 2 /* largest shell angular speed |w_S| over the rows [rad/s] */
+#define SR_BATCH_FINAL_ENERGY 3   /* total energy of the final state (sr_energy) [J] */
+
+/* n independent runs of sr_simulate_guarded, one per sample i, each with its own parameters,
+ * initial state and torque program:
+ *   params + i*params_stride  [SR_NPARAM]       (stride 0: every sample has the same parameters)
+ *   x0 + i*x0_stride          [SR_NX]           (stride 0: the same initial state)
+ *   u + i*u_stride            [steps x SR_NU]   (stride 0: the same program; u NULL: zero torque)
+ * with the same method, dt, steps and energy guard tolerance energy_tol (< 0: no energy guard;
+ * see sr_energy_guard).  Sample i is exactly the run "sr_model_init, then sr_simulate_guarded in
+ * consecutive calls of chunk_steps steps (the last one shorter), one sr_energy_guard carried
+ * across them": the same bits as a caller making those calls (the Kahan compensation of the
+ * fourth-order methods restarts with every call, so chunk_steps is part of the result).
+ * Outputs (any of traj, x_final, metrics may be NULL; traj and work not both):
+ *   traj     n x (steps+1) x SR_NX: every sample's trajectory, x0 included (rows past a
+ *            failure as in sr_simulate); when NULL, work holds one chunk instead:
+ *   work     (chunk_steps+1) x SR_NX scratch rows, reused by every sample (unused with traj)
+ *   x_final  n x SR_NX: the state after the last step
+ *   metrics  n x SR_BATCH_NMETRICS: the summary metrics above, over rows 0..steps
+ *   status   n: the status of each sample: SR_OK, or the error of sr_model_init (its
+ *            parameters), sr_check_state (its x0) or sr_simulate_guarded (its run)
+ *   steps_done n: the steps completed before the sample stopped (steps on SR_OK)
+ * One failing sample never touches another's outputs; its own x_final and metrics rows are
+ * left untouched.  status[i] and steps_done[i] are written when sample i is finished, in
+ * order of i.  Returns SR_ERR_NULL or SR_ERR_ARG (n, steps or a stride < 0, chunk_steps < 1,
+ * dt not positive and finite, an unknown method, energy_tol infinite) before running any
+ * sample, else SR_OK: the outcome of each sample is in status. */
+int sr_simulate_batch(int method, long n, const sr_real *params, long params_stride, const sr_real *x0,
+                      long x0_stride, sr_real dt, long steps, const sr_real *u, long u_stride,
+                      sr_real energy_tol, long chunk_steps, sr_real *work, sr_real *traj,
+                      sr_real *x_final, sr_real *metrics, int *status, long *steps_done);
+
 #ifdef __cplusplus
 }
 #endif

@@ -26,10 +26,12 @@ _API = {
     "Params": "params",
     "initial_state": "state",
     "ROTATION_TOL": "validation", "project_state": "validation",
+    "simulate_many": "batch", "BatchResult": "batch",
 }
 
 __all__ = ["Model", "Params", "initial_state", "METHODS", "KernelError", "SimulationStopped",
-           "ROTATION_TOL", "ENERGY_TOL", "project_state"]
+           "ROTATION_TOL", "ENERGY_TOL", "project_state",
+           "simulate_many", "BatchResult"]
 
 
 def __getattr__(name):

@@ -44,6 +44,7 @@ int main(void)
     suite_buffers();
     suite_precision();
     suite_guards();
+    suite_batch();
     return sr_test_summary();
 }
 

@@ -66,6 +66,7 @@ void suite_numerics(void);
 void suite_buffers(void);
 void suite_precision(void);
 void suite_guards(void);
+void suite_batch(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 
