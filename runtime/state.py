@@ -34,7 +34,10 @@ IDX_UY, IDX_UP = lib.SR_U_u_Y, lib.SR_U_u_P
 def rotations(x):
     """(R_S, R_Y, R_P) of a state (35,) or of states (..., 35): arrays (..., 3, 3), views where possible."""
     x = np.asarray(x)
-    return tuple(x[..., idx].reshape(x.shape[:-1] + (3, 3)) for idx in (IDX_RS, IDX_RY, IDX_RP))
+    if x.ndim == 1:                     # the common case, kept cheap for per-step Python loops
+        return x[IDX_RS].reshape(3, 3), x[IDX_RY].reshape(3, 3), x[IDX_RP].reshape(3, 3)
+    shape = x.shape[:-1] + (3, 3)
+    return x[..., IDX_RS].reshape(shape), x[..., IDX_RY].reshape(shape), x[..., IDX_RP].reshape(shape)
 
 
 def gamma(x):
