@@ -8,6 +8,7 @@ COMMANDS = {
     "convergence": ("runtime.verification.convergence", "convergence and energy study of the integrators"),
     "bench": ("runtime.bench.cli", "benchmarks against the alternatives"),
     "figures": ("runtime.scenarios.figures", "regenerate the committed figures under docs/figures/"),
+    "sweep": ("runtime.sweep.cli", "many runs of a scenario with varied inputs, on Dask (results in Parquet)"),
     "soak": ("runtime.verification.soak", "10^7 steps from random states: constraint and energy drift (not a unit test)"),
 }
 

@@ -1,0 +1,75 @@
+"""Run a sweep: its tasks on Dask distributed (an embedded LocalCluster, or any scheduler), or
+serially in this process; each finished task's rows go to disk at once (see store.py).
+
+The client process submits every missing task, writes the rows of each as it completes, and
+shows a progress bar; the workers only compute (they need this package installed, not the
+output folder).
+"""
+import contextlib
+import logging
+import os
+import time
+
+from tqdm.auto import tqdm
+
+from .store import SweepStore
+from .task import run_chunk
+
+#: Default wall time of one task: long against Dask's per-task cost (about a millisecond, see
+#: docs/sweeps.md), short enough that a lost worker or an interrupt costs little.
+TASK_SECONDS = 2.0
+#: `scheduler` value that runs the tasks in this process, without Dask.
+SERIAL = "serial"
+
+
+def measure_samples_per_task(spec, seconds=TASK_SECONDS):
+    """Samples per task so that one task takes about `seconds` here: times the first few samples."""
+    probe = min(spec.samples, 8)
+    started = time.perf_counter()
+    run_chunk(spec, 0, probe)
+    per_sample = max((time.perf_counter() - started) / probe, 1e-6)
+    return max(1, min(spec.samples, round(seconds / per_sample)))
+
+
+@contextlib.contextmanager
+def dask_client(scheduler=None, workers=None):
+    """A distributed.Client: on `scheduler` (an address), or on a new LocalCluster of `workers`
+    single-threaded worker processes (default: one per core)."""
+    from distributed import Client, LocalCluster
+    if scheduler is not None:
+        with Client(scheduler) as client:
+            yield client
+        return
+    n = workers or os.cpu_count() or 1
+    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                      silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+        yield client
+
+
+def run_sweep(spec, out, scheduler=None, workers=None, samples_per_task=None, progress=True):
+    """Run `spec` into the folder `out` (resuming what is there); returns the results table.
+
+    scheduler: None (an embedded LocalCluster of `workers` processes), SERIAL (this process,
+    no Dask), or the address of a running Dask scheduler ("tcp://host:8786").
+    samples_per_task: None for the sweep file's, else measured for TASK_SECONDS.
+    """
+    per_task = samples_per_task or spec.samples_per_task
+    store = SweepStore.open(out, spec, lambda: per_task or measure_samples_per_task(spec))
+    todo = store.missing()
+    done = spec.samples - sum(b - a for a, b in todo)
+    with tqdm(total=spec.samples, initial=done, unit="sample", desc=spec.name, disable=not progress or None,
+              smoothing=0.1) as bar:
+        if todo and scheduler == SERIAL:
+            for a, b in todo:
+                store.write_chunk(a, b, run_chunk(spec, a, b))
+                bar.update(b - a)
+        elif todo:
+            from distributed import as_completed
+            with dask_client(scheduler, workers) as client:
+                futures = {client.submit(run_chunk, spec, a, b, pure=False): (a, b) for a, b in todo}
+                for future in as_completed(futures):
+                    a, b = futures.pop(future)
+                    store.write_chunk(a, b, future.result())
+                    future.release()
+                    bar.update(b - a)
+    return store.combine()
