@@ -49,7 +49,9 @@ static inline sr_real lane_sum(const sr_real *v, int n)
     int i, k;
     for (i = 0; i + 4 <= n; i += 4)
         for (k = 0; k < 4; ++k) s[k] += v[i + k];
-    for (; i < n; ++i) s[0] += v[i];
+    /* The tail counted from 0: written as `for (; i < n; ++i)`, GCC 12 for 32-bit Arm at -O2
+     * reports a false "iteration 1073741823 invokes undefined behavior" (-Werror). */
+    for (k = 0; k < n - i; ++k) s[0] += v[i + k];
     return (s[0] + s[1]) + (s[2] + s[3]);
 }
 

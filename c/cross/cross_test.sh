@@ -1,0 +1,182 @@
+#!/bin/sh
+# cross_test.sh [OUT] -- the library on emulated Cortex-M parts (`make cross-test` in c/, which
+# passes CROSS_PREFIX, QEMU, MAKE, M4_CPU_FLAGS and M7_CPU_FLAGS; run from c/).
+#
+#  1. the tools: arm-none-eabi-gcc + newlib, qemu-system-arm, cmake; installed with apt-get when
+#     missing and we are root (as .ci/run does for clang), otherwise a clear failure;
+#  2. host builds (this Makefile, host CC) of the firmware example and the C tests, double and float;
+#  3. with the same Makefile and only its variables (CC, AR, CFLAGS, LDFLAGS, BUILD): the float
+#     library, tests and example for the Cortex-M4F, the double ones for the Cortex-M7;
+#  4. the float library for the M4 once more under -Wdouble-promotion -Wfloat-conversion -Werror,
+#     and its objects checked for software double routines (__aeabi_d*);
+#  5. the C tests under QEMU (mps2-an386, mps2-an500): the same "N passed, 0 failed" as the host;
+#  6. the firmware example under QEMU against the host build of the same precision
+#     (compare_runs.py: double identical; float within 1e-4 m at 10 s); the double build again
+#     with -ffp-contract=fast must be caught, and its difference is printed (also the float one);
+#  7. the CMake toolchain file (c/cmake/arm-none-eabi.cmake): both libraries configured and built
+#     for the two CPUs, and checked like the Makefile's;
+#  8. the M4 sizes and stacks (m4_report.py): a Lie-Euler-only firmware linked and run under QEMU,
+#     checked for __aeabi_d*.
+# Every step runs even if an earlier one failed; the exit status is 1 if any failed.
+set -u
+OUT=${1:-build/cross}
+CROSS_PREFIX=${CROSS_PREFIX:-arm-none-eabi-}
+QEMU=${QEMU:-qemu-system-arm}
+MAKE=${MAKE:-make}
+M4_CPU_FLAGS=${M4_CPU_FLAGS:--mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard}
+M7_CPU_FLAGS=${M7_CPU_FLAGS:--mcpu=cortex-m7 -mthumb -mfpu=fpv5-d16 -mfloat-abi=hard}
+CC_CROSS=${CROSS_PREFIX}gcc
+QEMU_TIMEOUT=${QEMU_TIMEOUT:-900}   # seconds per emulated program; the slowest takes ~1 min
+
+failures=0
+step() { printf '\n== %s\n' "$*"; }
+fail() { echo "cross-test: FAIL: $*"; failures=$((failures + 1)); }
+
+# ---- 1. tools ---------------------------------------------------------------------------------
+missing=""
+command -v "$CC_CROSS" >/dev/null 2>&1 || missing="$missing gcc-arm-none-eabi libnewlib-arm-none-eabi"
+command -v "$QEMU" >/dev/null 2>&1 || missing="$missing qemu-system-arm"
+command -v cmake >/dev/null 2>&1 || missing="$missing cmake"
+if [ -n "$missing" ]; then
+    step "installing$missing"
+    if command -v apt-get >/dev/null 2>&1 && [ "$(id -u)" = 0 ]; then
+        started=$(date +%s)
+        apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+            --no-install-recommends $missing >/dev/null ||
+            { echo "cross-test: apt-get could not install$missing"; exit 1; }
+        echo "cross-test: installed in $(( $(date +%s) - started )) s"
+    else
+        echo "cross-test: missing$missing; install them (Debian: apt-get install$missing) or run as root"
+        exit 1
+    fi
+fi
+echo "$("$CC_CROSS" --version | head -n 1); $("$QEMU" --version | head -n 1)"
+
+# The two targets: name, CPU flags, QEMU machine, linker script, library scalar.
+M4_DIR=$OUT/m4 M7_DIR=$OUT/m7 HOST_DIR=$OUT/host
+
+# cross_make DIR CPU_FLAGS LINKER_SCRIPT TARGET...: c/Makefile for a Cortex-M, through its variables.
+cross_make() {
+    dir=$1 cpu=$2 script=$3
+    shift 3
+    mkdir -p "$dir" &&
+        "$CC_CROSS" $cpu -O2 -std=c99 -Wall -Wextra -Wpedantic -Werror -c cross/startup.c -o "$dir/startup.o" &&
+        $MAKE --no-print-directory CC="$CC_CROSS" AR="${CROSS_PREFIX}ar" CFLAGS="$cpu -O2" \
+            LDFLAGS="-Lcross -T cross/$script --specs=rdimon.specs -nostartfiles $dir/startup.o" \
+            BUILD="$dir" "$@"
+}
+
+# soft_double_symbols FILE...: the software double-precision routines the files use or define.
+soft_double_symbols() {
+    "${CROSS_PREFIX}nm" "$@" 2>/dev/null | awk '$NF ~ /^__aeabi_(d|[fil]2d|ui2d|ul2d)/ { print $NF }' | sort -u
+}
+
+# ---- 2.-3. builds -------------------------------------------------------------------------------
+step "host builds (double and float)"
+$MAKE --no-print-directory BUILD="$HOST_DIR" "$HOST_DIR/firmware_tshape" "$HOST_DIR/firmware_tshape_f" \
+    "$HOST_DIR/sr_tests" "$HOST_DIR/sr_tests_f" || fail "host build"
+step "Cortex-M4F build (float): $M4_CPU_FLAGS -O2"
+cross_make "$M4_DIR" "$M4_CPU_FLAGS" mps2-an386.ld "$M4_DIR/firmware_tshape_f" "$M4_DIR/sr_tests_f" ||
+    fail "Cortex-M4F build"
+step "Cortex-M7 build (double): $M7_CPU_FLAGS -O2"
+cross_make "$M7_DIR" "$M7_CPU_FLAGS" mps2-an500.ld "$M7_DIR/firmware_tshape" "$M7_DIR/sr_tests" ||
+    fail "Cortex-M7 build"
+
+# ---- 4. no double arithmetic in the float build ---------------------------------------------------
+step "float library for the M4 under -Wdouble-promotion -Wfloat-conversion -Werror; no __aeabi_d*"
+if $MAKE --no-print-directory CC="$CC_CROSS" AR="${CROSS_PREFIX}ar" BUILD="$OUT/m4-strict" \
+        CFLAGS="$M4_CPU_FLAGS -O2 -Wdouble-promotion -Wfloat-conversion" "$OUT/m4-strict/libsphericalrobot_f.a"; then
+    found=$(soft_double_symbols "$OUT/m4-strict/libsphericalrobot_f.a")
+    [ -z "$found" ] && echo "  no software double routine referenced" || fail "float library uses$found"
+else
+    fail "float library does not build under -Wdouble-promotion -Wfloat-conversion -Werror"
+fi
+# The check itself must be able to fail: one float expression with a double constant.
+printf 'float scaled(float x);\nfloat scaled(float x) { return x * 0.1; }\n' >"$OUT/double_slip.c"
+"$CC_CROSS" $M4_CPU_FLAGS -O2 -c "$OUT/double_slip.c" -o "$OUT/double_slip.o" &&
+    found=$(soft_double_symbols "$OUT/double_slip.o") && [ -n "$found" ] &&
+    echo "  self-check: 'x * 0.1' on a float is caught ($(echo $found))" ||
+    fail "the __aeabi_d* check does not see a double slipped into float code"
+
+# ---- 5.-6. under QEMU ----------------------------------------------------------------------------
+# run_qemu MACHINE ELF OUTPUT: the program's semihosting output into OUTPUT; its exit status.
+run_qemu() {
+    timeout "$QEMU_TIMEOUT" "$QEMU" -M "$1" -nographic -monitor none -serial none \
+        -semihosting-config enable=on,target=native -kernel "$2" >"$3"
+}
+
+# c_tests LABEL MACHINE TARGET_ELF HOST_PROGRAM
+c_tests() {
+    step "C tests, $1 ($2 under QEMU) against the host"
+    "$4" >"$OUT/$(basename "$4").host.txt" 2>&1
+    want=$(tail -n 1 "$OUT/$(basename "$4").host.txt")
+    started=$(date +%s)
+    run_qemu "$2" "$3" "$OUT/$(basename "$3").$2.txt"
+    rc=$?
+    got=$(tail -n 1 "$OUT/$(basename "$3").$2.txt")
+    echo "  host: $want; target: $got (exit $rc, $(( $(date +%s) - started )) s)"
+    case $got in *" passed, 0 failed") ;; *) fail "$1 C tests: $got" ;; esac
+    [ "$rc" = 0 ] || fail "$1 C tests exited with $rc"
+    [ "$got" = "$want" ] || fail "$1 C tests ran a different number of tests than the host"
+}
+c_tests "Cortex-M4F float" mps2-an386 "$M4_DIR/sr_tests_f" "$HOST_DIR/sr_tests_f"
+c_tests "Cortex-M7 double" mps2-an500 "$M7_DIR/sr_tests" "$HOST_DIR/sr_tests"
+
+step "firmware example (t-shape, 10,000 Lie-Euler steps) under QEMU against the host"
+"$HOST_DIR/firmware_tshape" >"$OUT/tshape.host.csv" || fail "host double example"
+"$HOST_DIR/firmware_tshape_f" >"$OUT/tshape_f.host.csv" || fail "host float example"
+run_qemu mps2-an500 "$M7_DIR/firmware_tshape" "$OUT/tshape.m7.csv" || fail "Cortex-M7 example exited with $?"
+run_qemu mps2-an386 "$M4_DIR/firmware_tshape_f" "$OUT/tshape_f.m4.csv" || fail "Cortex-M4F example exited with $?"
+python3 cross/compare_runs.py double "$OUT/tshape.host.csv" "$OUT/tshape.m7.csv" || fail "Cortex-M7 example"
+python3 cross/compare_runs.py float "$OUT/tshape_f.host.csv" "$OUT/tshape_f.m4.csv" "$OUT/tshape.host.csv" ||
+    fail "Cortex-M4F example"
+
+# A slightly different kernel must be caught: the same double build with fused multiply-adds
+# (-ffp-contract=fast; the M7's FPU has VFMA).  Its distance from the host is what contraction
+# costs; the float build's is printed for information.
+step "the Cortex-M7 double build with -ffp-contract=fast must differ from the host"
+cross_make "$OUT/m7-contract" "$M7_CPU_FLAGS -ffp-contract=fast" mps2-an500.ld "$OUT/m7-contract/firmware_tshape" &&
+    run_qemu mps2-an500 "$OUT/m7-contract/firmware_tshape" "$OUT/tshape.m7-contract.csv" ||
+    fail "Cortex-M7 build or run with -ffp-contract=fast"
+if python3 cross/compare_runs.py double "$OUT/tshape.host.csv" "$OUT/tshape.m7-contract.csv"; then
+    fail "the double comparison did not see fused multiply-adds"
+fi
+step "for information: the Cortex-M4F float build with -ffp-contract=fast"
+cross_make "$OUT/m4-contract" "$M4_CPU_FLAGS -ffp-contract=fast" mps2-an386.ld "$OUT/m4-contract/firmware_tshape_f" &&
+    run_qemu mps2-an386 "$OUT/m4-contract/firmware_tshape_f" "$OUT/tshape_f.m4-contract.csv" &&
+    python3 cross/compare_runs.py float "$OUT/tshape_f.host.csv" "$OUT/tshape_f.m4-contract.csv" "$OUT/tshape.host.csv" ||
+    echo "  (not a failure: contraction is off in the builds above)"
+
+# ---- 7. CMake -------------------------------------------------------------------------------------
+# cmake_build CPU FLOAT(ON/OFF)
+cmake_build() {
+    dir=$OUT/cmake-$1-$2
+    step "CMake, toolchain file cmake/arm-none-eabi.cmake, SR_CPU=$1, SR_USE_FLOAT=$2"
+    if cmake -S . -B "$dir" -DCMAKE_TOOLCHAIN_FILE=cmake/arm-none-eabi.cmake -DSR_CPU="$1" \
+            -DSR_USE_FLOAT="$2" -DSR_BUILD_TESTS=OFF >"$dir.log" 2>&1 && cmake --build "$dir" -j 2 >>"$dir.log" 2>&1; then
+        lib=$(ls "$dir"/libsphericalrobot*.a)
+        attrs=$("${CROSS_PREFIX}readelf" -A "$lib" | sort -u | grep -E 'Tag_CPU_name|Tag_FP_arch|Tag_ABI_VFP_args' | tr -s ' \n' ' ')
+        echo "  $lib:$attrs"
+        if [ "$2" = ON ]; then
+            found=$(soft_double_symbols "$lib")
+            [ -z "$found" ] || fail "CMake float library uses$found"
+        fi
+    else
+        cat "$dir.log"
+        fail "CMake build for $1"
+    fi
+}
+cmake_build cortex-m4 ON
+cmake_build cortex-m7 OFF
+
+# ---- 8. sizes and stacks ---------------------------------------------------------------------------
+step "Cortex-M4F sizes and stacks (m4_report.py)"
+python3 cross/m4_report.py --build "$OUT/report" --cross-prefix "$CROSS_PREFIX" --qemu "$QEMU" ||
+    fail "m4_report"
+
+echo
+if [ "$failures" -ne 0 ]; then
+    echo "cross-test: $failures FAILED"
+    exit 1
+fi
+echo "cross-test: all passed"
