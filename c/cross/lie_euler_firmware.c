@@ -85,10 +85,9 @@ int main(void)
     const uintptr_t top = stack_pointer();
     int status, n, i;
 
-    x[0] = x[4] = x[8] = 1;    /* R_S = I */
-    x[9] = x[13] = x[17] = 1;  /* R_Y = I */
-    x[18] = x[22] = x[26] = 1; /* R_P = I */
-    x[29] = PARAMS[0];         /* q = (0, 0, r) */
+    for (i = 0; i < 3; ++i) /* R_S = R_Y = R_P = I (row-major 3x3 blocks) */
+        x[SR_X_R_S + 4 * i] = x[SR_X_R_Y + 4 * i] = x[SR_X_R_P + 4 * i] = 1;
+    x[SR_X_q + 2] = PARAMS[SR_P_r]; /* q = (0, 0, r) */
 
     paint_stack(top);
     status = sr_model_init(&model, PARAMS);
@@ -121,9 +120,9 @@ int main(void)
     put("ticks ");
     put_long(n);
     put(" q_um");
-    for (i = 27; i < 30; ++i) {
+    for (i = 0; i < 3; ++i) {
         put(" ");
-        put_long((long)(x[i] * SR_C(1e6)));
+        put_long((long)(x[SR_X_q + i] * SR_C(1e6)));
     }
     put("\n");
     return 0;
