@@ -10,13 +10,14 @@ def main(argv):
     if os.environ.get("PYTHONHASHSEED") != "0":
         os.environ["PYTHONHASHSEED"] = "0"
         os.execv(sys.executable, [sys.executable, "-m", "derive", *argv])
-    from . import codegen, dynamics
+    from . import dynamics
+    from .codegen import emit
     start = time.perf_counter()
-    out_dir = argv[0] if argv else codegen.ROOT / "generated"
+    out_dir = argv[0] if argv else emit.ROOT / "generated"
     failed = [e for e in dynamics.check_equilibrium_set() if e != 0]
     if failed:
         sys.exit(f"derive: the equilibrium set of eq. (108) did not check out: {failed}")
-    for path in codegen.write(out_dir):
+    for path in emit.write(out_dir):
         print(f"derive: wrote {path}")
     print(f"derive: generation took {time.perf_counter() - start:.1f} s")
 

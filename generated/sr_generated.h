@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 3e7f9b377d69a03c], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 1567ac1f2e5ad3c6], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -9,19 +9,9 @@
 #ifndef SR_GENERATED_H
 #define SR_GENERATED_H
 
-#ifdef SR_USE_FLOAT
-typedef float sr_real;
-#define SR_C(v) ((sr_real)(v##f))
-#define SR_GEN_PIVOT_TOL SR_C(1e-6)
-#else
-typedef double sr_real;
-#define SR_C(v) ((sr_real)(v))
-#define SR_GEN_PIVOT_TOL SR_C(1e-13)
-#endif
+/* sr_real, SR_C, SR_GEN_PIVOT_TOL and the SR_GEN_ status codes: hand-written, in c/. */
+#include "sr_real.h"
 
-#define SR_GEN_OK 0
-#define SR_GEN_NONFINITE 2
-#define SR_GEN_SINGULAR 4
 #define SR_GEN_NPARAM 12
 #define SR_GEN_NCONST 33
 #define SR_GEN_NCONST_NAMED 12

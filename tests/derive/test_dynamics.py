@@ -1,11 +1,9 @@
-"""The symbolic derivation: structure of M and f, and the equilibrium set of eq. (108)."""
+"""dynamics: structure of M and f, and the equilibrium set of eq. (108)."""
 import sympy as sp
 
 from derive import dynamics as D
 from derive import lagrangian as L
-from derive import newton_euler as NE
 from derive import state as S
-from derive import yoke_frame as YF
 
 
 def test_inertia_is_symmetric():
@@ -50,28 +48,6 @@ def test_equilibrium_check_can_fail():
     a = D.pendulum_axis()
     wrong = sp.expand(res[0] - 2 * D.cross(a, S.gamma)[0])
     assert wrong != 0
-
-
-def test_body_by_body_rhs_equals_the_euler_poincare_rhs():
-    assert NE.check_equal_to_rhs() == [0] * 5
-
-
-def test_body_by_body_check_can_fail():
-    """Dropping one intermediate (the yoke's bias torque) leaves a residual that does not reduce to zero."""
-    p, f = NE.program()
-    p.definitions = [(s, 0 if s.name.startswith("tau_Y") else value) for s, value in p.definitions]
-    wrong = p.inline(f)
-    assert D.on_manifold(sp.expand(wrong[0] - D.rhs()[0])) != 0
-
-
-def test_program_inlines_to_one_expression_in_the_state_symbols():
-    p, f = NE.program()
-    defined = {s for s, _ in p.definitions}
-    assert defined and not (p.inline(f).free_symbols & defined)
-
-
-def test_yoke_frame_forms_equal_the_shell_frame_forms():
-    assert YF.check_equivalence() == [0] * 30
 
 
 def test_yoke_and_pendulum_rates_do_not_couple():

@@ -1,0 +1,42 @@
+/*
+ * sr_real.h -- the hand-written part of the generated kernels' interface.
+ *
+ * generated/sr_generated.h includes this header and adds only what derive/
+ * derives (sizes, layout macros, flop counts, prototypes).  What is chosen
+ * rather than derived lives here, in C, not in the generator's strings:
+ *
+ *   sr_real           the scalar type: double, or float with -DSR_USE_FLOAT.
+ *   SR_C(v)           a numeric literal in sr_real (1.5 -> 1.5f in the float
+ *                     build), so that both builds are clean under
+ *                     -Wall -Wextra -Wpedantic -Werror (no double promotion).
+ *   SR_GEN_PIVOT_TOL  relative pivot tolerance of the joint-first solve in
+ *                     sr_gen_accel: each pivot of M (M_33, M_44, the leading
+ *                     minors of the Schur complement) must exceed it times
+ *                     M's diagonal entry, as in an LDL^T, or the kernel
+ *                     returns SR_GEN_SINGULAR (1e-13 for double, 1e-6 for
+ *                     float).
+ *   SR_GEN_OK, SR_GEN_NONFINITE, SR_GEN_SINGULAR
+ *                     the kernels' status codes; c/sr_internal.h asserts
+ *                     that they equal SR_OK, SR_ERR_NONFINITE and
+ *                     SR_ERR_SINGULAR of the public API.
+ *
+ * Internal to the library: use the checked API of c/spherical_robot.h.
+ */
+#ifndef SR_REAL_H
+#define SR_REAL_H
+
+#ifdef SR_USE_FLOAT
+typedef float sr_real;
+#define SR_C(v) ((sr_real)(v##f))
+#define SR_GEN_PIVOT_TOL SR_C(1e-6)
+#else
+typedef double sr_real;
+#define SR_C(v) ((sr_real)(v))
+#define SR_GEN_PIVOT_TOL SR_C(1e-13)
+#endif
+
+#define SR_GEN_OK 0
+#define SR_GEN_NONFINITE 2
+#define SR_GEN_SINGULAR 4
+
+#endif /* SR_REAL_H */

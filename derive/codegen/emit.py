@@ -1,0 +1,189 @@
+"""Emission: each kernel as C text, the header and source texts, and `write`, the one place that writes files.
+
+The generated header includes the hand-written c/sr_real.h (the scalar type
+`sr_real`, SR_C, SR_GEN_PIVOT_TOL and the SR_GEN_ status codes) and adds only
+what is derived: sizes, layout macros, flop counts and prototypes.
+"""
+import hashlib
+import pathlib
+
+import sympy as sp
+
+from .. import parameters as P
+from .. import state as S
+from .c_printer import Printer, Scheduler, count_flops, dependency_order
+from .constant_pool import pool_constants
+from .joint_first import emit_shell_solve
+from .kernels import INPUT_DOCS, array_layouts, input_symbols, kernels
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+HEADER_NAME = "sr_generated.h"
+SOURCE_NAME = "sr_generated.c"
+HAND_WRITTEN_HEADER = "sr_real.h"   # in c/: what is chosen, not derived
+PREFIX = "sr_gen_"
+
+
+def emit_assignments(scheduler, assignments, declare):
+    lines = []
+    for name, expr in assignments:
+        prefix = "const sr_real " if declare else ""
+        lines.append(f"    {prefix}{name} = {scheduler.assign(name, expr)};")
+    return lines
+
+
+def emit_inputs(kernel, used, layouts):
+    table = input_symbols(kernel.inputs, layouts)
+    missing = [s for s in used if s not in table]
+    if missing:
+        raise ValueError(f"kernel {kernel.name} uses symbols outside its inputs: {missing}")
+    lines = []
+    for sym in sorted(used, key=lambda s: (kernel.inputs.index(table[s][0]), table[s][1])):
+        array, index = table[sym]
+        lines.append(f"    const sr_real {sym.name} = {array}[{index}];")
+    return lines
+
+
+def emit_results(scheduler, results, finite_or_untouched):
+    """Assign the outputs; with `finite_or_untouched`, only after checking that all are finite.
+
+    One test of their sum clears the common case (a NaN or an infinity makes
+    it non-finite); a sum that is not finite is decided value by value, so
+    finite values whose sum overflows still pass.  The caller's arrays are
+    written last, so they may alias the inputs.
+    """
+    if not finite_or_untouched:
+        return [f"    {target} = {scheduler.assign(target, value)};" for target, value in results]
+    names = [f"out_{i}" for i in range(len(results))]
+    lines = [f"    const sr_real {n} = {scheduler.assign(n, value)};" for n, (_, value) in zip(names, results)]
+    each = " && ".join(f"isfinite({n})" for n in names)
+    if len(names) == 1:
+        lines.append(f"    if (!{each}) return SR_GEN_NONFINITE;")
+    else:
+        lines.append(f"    const sr_real out_sum = {scheduler.assign('out_sum', sp.Add(*sp.symbols(names, real=True)))};")
+        lines.append(f"    if (!isfinite(out_sum) && !({each})) return SR_GEN_NONFINITE;")
+    lines += [f"    {target} = {n};" for n, (target, _) in zip(names, results)]
+    return lines
+
+
+def signature(kernel):
+    args = [INPUT_DOCS[a][0] for a in kernel.inputs]
+    if kernel.solve:
+        args.append("sr_real a[SR_GEN_NV]")
+    else:
+        args += [f"sr_real {o.name}[{'SR_GEN_NCONST' if o.name == 'c' else len(o.exprs)}]" for o in kernel.outputs]
+    return f"int {PREFIX}{kernel.name}({', '.join(args)})"
+
+
+def emit_kernel(kernel, layouts):
+    """C text of one kernel and its flop count."""
+    scheduler = Scheduler(Printer())
+    defined = [symbol for symbol, _ in kernel.definitions]
+    exprs = [value for _, value in kernel.definitions] + [e for o in kernel.outputs for e in o.exprs]
+    temporaries, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"), order="canonical")
+    definitions, reduced = list(zip(defined, reduced[:len(defined)])), reduced[len(defined):]
+    used = set().union(*(e.free_symbols for e in exprs)) - set(defined) if exprs else set()
+    body = emit_inputs(kernel, used, layouts)
+    nodes = temporaries + definitions
+    body += emit_assignments(scheduler, dependency_order(nodes, [s for s, _ in nodes] + reduced), declare=True)
+    k, results = 0, []
+    for out in kernel.outputs:
+        values = reduced[k:k + len(out.exprs)]
+        k += len(out.exprs)
+        if out.local_names:
+            body += emit_assignments(scheduler, list(zip(out.local_names, values)), declare=True)
+        else:
+            results += [(f"{out.name}[{i}]", v) for i, v in enumerate(values)]
+    if kernel.solve:
+        lines, results = emit_shell_solve(scheduler, "a", S.R_Y, {s.name for s in defined})
+        body += lines
+    body += emit_results(scheduler, results, kernel.finite_or_untouched)
+    body.append("    return SR_GEN_OK;")
+    doc = f"/* {kernel.doc} */"
+    return "\n".join([doc, signature(kernel), "{", *body, "}", ""]), count_flops(body)
+
+
+def provenance():
+    """Digest of the derivation sources (every derive/**/*.py, by path), so a generated file names exactly what it came from."""
+    package = ROOT / "derive"
+    digest = hashlib.sha256()
+    for path in sorted(package.rglob("*.py"), key=lambda p: p.relative_to(package).as_posix()):
+        digest.update(path.relative_to(package).as_posix().encode() + b"\0" + path.read_bytes())
+    return digest.hexdigest()[:16]
+
+
+def banner():
+    return (f"/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package "
+            f"[sha256 of its sources {provenance()}], SymPy {sp.__version__}. */\n")
+
+
+def layout_macros():
+    """Index macros of the state blocks, the inputs and the parameters: each layout written once, here."""
+    assert sum(n for _, _, n in S.STATE_BLOCKS) == S.NX
+    lines = ["/* Layout of x[SR_GEN_NX]: offset of each block (matrices row-major; nu = (w_S, w_Y, w_P) starts at SR_X_w_S). */"]
+    lines += [f"#define SR_X_{name} {offset}" for name, offset, _ in S.STATE_BLOCKS]
+    lines += ["/* Layout of u[SR_GEN_NU]. */"]
+    lines += [f"#define SR_U_{name} {index}" for name, index in S.INPUT_NAMES]
+    lines += ["/* Layout of p[SR_GEN_NPARAM], the parameters of derive/parameters.py (SI). */"]
+    lines += [f"#define SR_P_{s.name} {i}" for i, s in enumerate(P.PARAMETERS)]
+    return "\n".join(lines)
+
+
+def header_text(ks, flops, n_constants):
+    guard = "SR_GENERATED_H"
+    protos = "\n".join(f"/* {k.doc} */\n{signature(k)};" for k in ks)
+    flop_macros = "\n".join(f"#define SR_GEN_{k.name.upper()}_FLOPS {flops[k.name]}" for k in ks)
+    float_names = "\n".join(f"#define {PREFIX}{k.name} {PREFIX}{k.name}_f" for k in ks)
+    return f"""{banner()}/*
+ * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
+ * Internal to the library: use the checked API of c/spherical_robot.h.
+ * Every function returns SR_GEN_OK, SR_GEN_NONFINITE (a result is not finite) or, for accel,
+ * SR_GEN_SINGULAR; outputs are caller-provided and written only on SR_GEN_OK (sr_gen_constants:
+ * always, the caller checks them).
+ */
+#ifndef {guard}
+#define {guard}
+
+/* sr_real, SR_C, SR_GEN_PIVOT_TOL and the SR_GEN_ status codes: hand-written, in c/. */
+#include "{HAND_WRITTEN_HEADER}"
+
+#define SR_GEN_NPARAM {len(P.PARAMETERS)}
+#define SR_GEN_NCONST {n_constants}
+#define SR_GEN_NCONST_NAMED {len(P.CONSTANTS)}
+#define SR_GEN_NX {S.NX}
+#define SR_GEN_NU {S.NU}
+#define SR_GEN_NV {S.NV}
+
+{layout_macros()}
+
+/* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
+{flop_macros}
+
+/* The float build's symbols carry _f, so a float/double mismatch fails at link time. */
+#ifdef SR_USE_FLOAT
+{float_names}
+#endif
+
+{protos}
+
+#endif /* {guard} */
+"""
+
+
+def source_text(emitted):
+    return banner() + f'#include "{HEADER_NAME}"\n\n#include <math.h>\n\n' + "\n".join(text for text, _ in emitted)
+
+
+def write(out_dir):
+    """The one place that writes files: generated/sr_generated.{{h,c}}."""
+    out_dir = pathlib.Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    ks, constants = pool_constants(kernels())
+    layouts = array_layouts(constants)
+    emitted = [emit_kernel(k, layouts) for k in ks]
+    flops = {k.name: n for k, (_, n) in zip(ks, emitted)}
+    files = {HEADER_NAME: header_text(ks, flops, len(constants)), SOURCE_NAME: source_text(emitted)}
+    for name, text in files.items():
+        tmp = out_dir / (name + ".tmp")
+        tmp.write_text(text)
+        tmp.replace(out_dir / name)
+    return [out_dir / n for n in files]

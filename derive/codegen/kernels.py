@@ -1,0 +1,91 @@
+"""WHAT is emitted: the declarative list of kernels.
+
+Each kernel is (name, inputs, outputs): inputs are the arrays it reads
+(`p` parameters, `c` constants, `x` state, `u` input), outputs are named
+arrays of SymPy expressions.  All kernels of a file share nothing at run
+time; within a kernel common subexpressions are eliminated by SymPy's CSE.
+`rhs` and `accel` evaluate f in the body-by-body form of
+`derive.newton_euler`, after proving it equal to `dynamics.rhs`; `accel`
+additionally solves M ν̇ = f, joint accelerations first (see
+`joint_first.emit_shell_solve`: M is symmetric positive definite, so no
+pivoting is needed and no square root is taken).
+"""
+from .. import dynamics as D
+from .. import newton_euler as NE
+from .. import parameters as P
+from .. import state as S
+from .. import yoke_frame as YF
+from .joint_first import joint_first_system
+from .spec import Kernel, Output
+
+
+INPUT_DOCS = {
+    "p": ("const sr_real p[SR_GEN_NPARAM]", "parameters (r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g), SI"),
+    "c": ("const sr_real c[SR_GEN_NCONST]", "constants from sr_gen_constants"),
+    "x": ("const sr_real x[SR_GEN_NX]", "state [R_S | R_Y | R_P | q | w_S | w_Y | w_P]"),
+    "u": ("const sr_real u[SR_GEN_NU]", "motor torques (yoke, pendulum) [N m]"),
+}
+
+
+def array_layouts(constants):
+    """Symbol -> index for each input array; `constants` is the full constants array (named, then pooled)."""
+    return {
+        "p": {s: i for i, s in enumerate(P.PARAMETERS)},
+        "c": {s: i for i, s in enumerate(constants)},
+        "x": S.STATE_LAYOUT,
+        "u": S.INPUT_LAYOUT,
+    }
+
+
+def input_symbols(arrays, layouts):
+    """Symbol -> (array, index) for the arrays a kernel reads."""
+    return {s: (a, i) for a in arrays for s, i in layouts[a].items()}
+
+
+def proven(name, residuals):
+    if any(r != 0 for r in residuals):
+        raise ValueError(f"{name}: the evaluated form differs from the derivation: {residuals}")
+
+
+def rhs_program():
+    """f body by body in the shell frame: (definitions, f), after the proof of `newton_euler`."""
+    proven("newton_euler", NE.check_equal_to_rhs())
+    p, f = NE.program()
+    return tuple(p.definitions), f
+
+
+def accel_program():
+    """(definitions, outputs of joint_first_system) in the yoke frame, at the shell-frame state.
+
+    After the proofs of `newton_euler` and `yoke_frame`.
+    """
+    proven("newton_euler", NE.check_equal_to_rhs())
+    proven("yoke_frame", YF.check_equivalence())
+    sub = YF.from_shell_frame()
+    p, f = YF.program()
+    definitions = tuple((symbol, value.xreplace(sub)) for symbol, value in p.definitions)
+    solve_definitions, outputs = joint_first_system(YF.inertia().xreplace(sub), f.xreplace(sub))
+    return definitions + solve_definitions, outputs
+
+
+def kernels():
+    """The functions to emit."""
+    M = D.inertia()
+    rhs_definitions, f = rhs_program()
+    accel_definitions, accel_outputs = accel_program()
+    return (
+        Kernel("constants", "Derived constants of Section 2.3 from the twelve parameters, c[0..11] ="
+               " (r, l, g, m_P, m_R, j_S, j_xx, j_yy, j_P, k_S, k_Y, k_P), then the parameter-only"
+               " subexpressions of the kernels, computed once per model:",
+               ("p",), (Output("c", tuple(P.constant_expressions()), "constants (r, l, g, m_P, m_R, j_S, j_xx, j_yy, j_P, k_S, k_Y, k_P)"),), finite_or_untouched=False),
+        Kernel("inertia", "Generalized inertia M(γ, R_Y, R_P), row-major 5x5, kinetic energy ½νᵀMν.",
+               ("c", "x"), (Output("M", tuple(M), "M, row-major 5x5"),)),
+        Kernel("rhs", "Right-hand side f of M ν̇ = f: gyroscopic, non-holonomic, gravity, motor and friction terms.",
+               ("c", "x", "u"), (Output("f", tuple(f), "f"),), definitions=rhs_definitions),
+        Kernel("energy", "Total energy: ½νᵀMν + m_P g e_zᵀ(q + R_S R_Y R_P c̄_P) [J].",
+               ("c", "x"), (Output("E", (D.energy(),), "energy"),)),
+        Kernel("equilibrium_residual", "f at ν = 0, u = 0 (eq. 106); zero iff R_S R_Y R_P e_z = ±e_z (eq. 108).",
+               ("c", "x"), (Output("res", tuple(D.equilibrium_residual()), "residual"),)),
+        Kernel("accel", "ν̇ = (ω̇_S, ω̇_Y, ω̇_P) solving M ν̇ = f, joints first; SR_GEN_SINGULAR if M is not positive definite.",
+               ("c", "x", "u"), accel_outputs, solve=True, definitions=accel_definitions),
+    )

@@ -1,0 +1,107 @@
+"""emit: generated/ is reproducible, up to date, clean C99, names its sources and carries the one layout."""
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from conftest import ROOT
+from derive import parameters as P
+from derive import state as S
+from derive.codegen import emit
+
+GENERATED = ["sr_generated.c", "sr_generated.h"]
+WARNINGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror"]
+
+
+def generate(out_dir):
+    env = dict(os.environ)
+    env.pop("PYTHONHASHSEED", None)
+    subprocess.run([sys.executable, "-m", "derive", str(out_dir)], cwd=ROOT, env=env, check=True,
+                   capture_output=True)
+    return {name: (out_dir / name).read_bytes() for name in GENERATED}
+
+
+@pytest.fixture(scope="module")
+def fresh(tmp_path_factory):
+    return generate(tmp_path_factory.mktemp("gen1"))
+
+
+def test_generation_is_deterministic(fresh, tmp_path):
+    assert generate(tmp_path) == fresh
+
+
+def test_committed_generated_files_are_up_to_date(fresh):
+    for name in GENERATED:
+        assert (ROOT / "generated" / name).read_bytes() == fresh[name], (
+            f"generated/{name} differs from a fresh `make generate`")
+
+
+def test_generated_files_say_they_are_generated():
+    for name in GENERATED:
+        first = (ROOT / "generated" / name).read_text().splitlines()[0]
+        assert "GENERATED FILE, DO NOT EDIT" in first and "derive" in first
+
+
+@pytest.mark.parametrize("scalar", ["double", "float"])
+@pytest.mark.parametrize("source", ["generated/sr_generated.c", "c/sr_runtime.c"])
+def test_c_compiles_cleanly_as_c99(scalar, source, tmp_path):
+    cc = shutil.which("cc") or shutil.which("gcc")
+    flags = WARNINGS + ["-O2", "-Igenerated", "-Ic"] + (["-DSR_USE_FLOAT"] if scalar == "float" else [])
+    subprocess.run([cc, *flags, "-c", source, "-o", str(tmp_path / "out.o")], cwd=ROOT, check=True)
+
+
+def test_generated_header_takes_the_hand_written_types_from_c():
+    header = (ROOT / "generated" / "sr_generated.h").read_text()
+    hand_written = (ROOT / "c" / emit.HAND_WRITTEN_HEADER).read_text()
+    assert f'#include "{emit.HAND_WRITTEN_HEADER}"' in header
+    for chosen in ("typedef", "#define SR_C(", "#define SR_GEN_PIVOT_TOL", "#define SR_GEN_OK", "#define SR_GEN_SINGULAR"):
+        assert chosen not in header and chosen in hand_written
+
+
+def macros(header, prefix):
+    """{name: value} of the `#define <prefix><name> <integer>` lines of a header."""
+    return {name: int(value) for name, value in re.findall(rf"^#define {prefix}(\w+) (\d+)$", header, re.M)}
+
+
+def layout_mismatches(header):
+    """Where the header's SR_P_/SR_X_/SR_U_ macros and sizes differ from derive/parameters.py and derive/state.py."""
+    expected = {
+        "SR_P_": {s.name: i for i, s in enumerate(P.PARAMETERS)},
+        "SR_X_": {name: offset for name, offset, _ in S.STATE_BLOCKS},
+        "SR_U_": dict(S.INPUT_NAMES),
+        "SR_GEN_N": {"PARAM": len(P.PARAMETERS), "X": S.NX, "U": S.NU, "V": S.NV},
+    }
+    found = {prefix: macros(header, prefix) for prefix in expected}
+    found["SR_GEN_N"] = {k: v for k, v in found["SR_GEN_N"].items() if k in expected["SR_GEN_N"]}
+    return {prefix: (found[prefix], want) for prefix, want in expected.items() if found[prefix] != want}
+
+
+def test_header_layout_macros_equal_the_derive_sources():
+    assert layout_mismatches((ROOT / "generated" / "sr_generated.h").read_text()) == {}
+
+
+@pytest.mark.parametrize("perturb", [
+    lambda h: h.replace("#define SR_P_m_P 9", "#define SR_P_m_P 10"),
+    lambda h: h.replace("#define SR_X_w_Y 33\n", ""),
+    lambda h: h.replace("#define SR_U_u_P 1", "#define SR_U_u_P 0"),
+    lambda h: h.replace("#define SR_GEN_NX 35", "#define SR_GEN_NX 36"),
+], ids=["parameter index", "missing state block", "input index", "state size"])
+def test_header_layout_check_fails_for_a_perturbed_header(perturb):
+    header = (ROOT / "generated" / "sr_generated.h").read_text()
+    perturbed = perturb(header)
+    assert perturbed != header
+    assert layout_mismatches(perturbed) != {}
+
+
+def test_provenance_covers_every_file_of_the_package(tmp_path, monkeypatch):
+    """The banner's digest changes when any derive/**/*.py changes, a nested one included."""
+    shutil.copytree(ROOT / "derive", tmp_path / "derive", ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(emit, "ROOT", tmp_path)
+    before = emit.provenance()
+    assert before == emit.provenance()
+    nested = tmp_path / "derive" / "codegen" / "c_printer.py"
+    nested.write_text(nested.read_text() + "# changed\n")
+    assert emit.provenance() != before
