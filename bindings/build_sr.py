@@ -78,6 +78,30 @@ int sr_simulate_batch(int method, long n, const sr_real *params, long params_str
                       sr_real *x_final, sr_real *metrics, int *status, long *steps_done);
 """
 
+# The single-state entry points of the Python API (runtime/model.py, `Model.accel` and `Model.step`
+# on one state): the full state check and the kernel in one C call, so that a call from Python
+# crosses the cffi boundary once.  The buffers are `void *`, so that the `char[]` of
+# ffi.from_buffer passes without an ffi.cast (each costs about as much as the kernel itself).
+# Binding glue only: firmware calls sr_check_state and the kernel itself.
+PY_ENTRIES_CDEF = """
+int sr_py_accel(const sr_model *model, const void *x, const void *u, void *a);
+int sr_py_step(const sr_model *model, int method, const void *x, const void *u, double dt, void *x_next);
+"""
+PY_ENTRIES_SOURCE = """
+static int sr_py_accel(const sr_model *model, const void *x, const void *u, void *a)
+{
+    int status = sr_check_state(model, (const sr_real *)x);
+    return status != SR_OK ? status : sr_accel(model, (const sr_real *)x, (const sr_real *)u, (sr_real *)a);
+}
+
+static int sr_py_step(const sr_model *model, int method, const void *x, const void *u, double dt, void *x_next)
+{
+    int status = sr_check_state(model, (const sr_real *)x);
+    return status != SR_OK ? status
+                           : sr_step(model, method, (const sr_real *)x, (const sr_real *)u, dt, (sr_real *)x_next);
+}
+"""
+
 # Portable -O2 by default; SR_NATIVE=1 at install time (`SR_NATIVE=1 pip install -e .`) adds
 # -march=native for this machine's vector units (the firmware example then matches the Python
 # runs only if it is built with the same flag).
@@ -88,10 +112,10 @@ LAYOUT = "\n".join(line for line in (ROOT / "generated" / "sr_generated.h").read
                    if line.startswith(("#define SR_X_", "#define SR_U_", "#define SR_P_")))
 
 ffibuilder = cffi.FFI()
-ffibuilder.cdef(CDEF + LAYOUT)
+ffibuilder.cdef(CDEF + LAYOUT + PY_ENTRIES_CDEF)
 ffibuilder.set_source(
     "bindings._sr",
-    '#include "spherical_robot.h"',
+    '#include "spherical_robot.h"\n' + PY_ENTRIES_SOURCE,
     sources=SOURCES,
     include_dirs=INCLUDE_DIRS,
     # No FMA contraction: the firmware example (c/examples) must reproduce the Python runs bit for bit.

@@ -1,6 +1,7 @@
 """`Model`: the compiled kernels behind a NumPy interface (shapes and checks here, loops in C)."""
 import numpy as np
 
+from bindings._fastcall import Kernels
 from bindings._sr import ffi, lib
 
 from .errors import KernelError, SimulationStopped
@@ -29,6 +30,12 @@ ENERGY_TOL = 0.5
 
 #: Steps per C call of `Model.simulate` (between calls the progress callback runs).
 CHUNK_STEPS = 2000
+
+
+def _address(cdata):
+    """The address of a cffi pointer as an int (handed to bindings._fastcall)."""
+    return int(ffi.cast("uintptr_t", cdata))
+
 
 def _double_array(value, field, shape_tail):
     """`value` as a C-contiguous float64 array whose trailing shape is `shape_tail` (see validation.real_array)."""
@@ -71,6 +78,9 @@ class Model:
         status = lib.sr_model_init(self._model, _ptr(self._p))
         if status != lib.SR_OK:
             raise KernelError("params", status, message=_PARAM_MESSAGES.get(status))
+        # The one-state fast path of accel and step (bindings/fastcall.c); it keeps self._model alive.
+        self._fast = Kernels(_address(self._model), _address(ffi.addressof(lib, "sr_py_accel")),
+                             _address(ffi.addressof(lib, "sr_py_step")), self._model)
 
     def project(self, x):
         """The nearest valid state to x (35,) or (B, 35): see `runtime.validation.project_state`."""
@@ -97,6 +107,16 @@ class Model:
 
     def accel(self, x, u=None):
         """ν̇ = (ω̇_S, ω̇_Y, ω̇_P): shape (5,) for x (35,), or (B, 5) for x (B, 35); u (2,) / (B, 2) or None."""
+        # The fast path (one float64 state): C checks everything in one call (sr_check_state and
+        # the kernel's own checks; bindings/fastcall.c); None when it does not apply or C refuses,
+        # and then the full path checks again in Python's terms to raise the precise message.
+        out = self._fast.accel(x, u)
+        if out is not None:
+            return out
+        return self._accel(x, u)
+
+    def _accel(self, x, u):
+        """`accel` for every input: converted and checked in Python's terms, then C."""
         x, u = self._state_and_input(x, u)
         if x.ndim == 1:
             out = np.empty(NV)
@@ -136,6 +156,15 @@ class Model:
     # -- time stepping ----------------------------------------------------------
     def step(self, x, u=None, dt=0.01, method="lie-euler"):
         """One step of `method` with torques u held constant; returns the new state (35,)."""
+        code = METHODS.get(method) if method.__class__ is str else None
+        if code is not None:               # the fast path, as in `accel` (C also checks dt and the method)
+            out = self._fast.step(x, u, dt, code)
+            if out is not None:
+                return out
+        return self._step(x, u, dt, method)
+
+    def _step(self, x, u, dt, method):
+        """`step` for every input: converted and checked in Python's terms, then C."""
         x, u = self._state_and_input(x, u, batch=False)
         dt = self._dt(dt)
         out = np.empty(NX)

@@ -8,8 +8,8 @@ import numpy as np
 from ..model import METHODS
 from ..so3 import exp, rot_x, rot_y
 from ..state import IDX_NU, IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, initial_state, rotations
-from .checks import check_close
-from .timing import best_seconds, per_call_ns
+from .checks import WrongNumbers, check_close
+from .timing import best_seconds, per_call_ns, per_call_ns_interleaved
 
 
 def t_shape_program(steps=10_000):
@@ -50,13 +50,46 @@ def lie_euler_loop(accel, x0, dt, u_prog, r):
 
 
 # -- Python-side timings -------------------------------------------------------------------------
+def call_overhead_timings(model, calls, min_seconds=0.05, rounds=11):
+    """One call from Python (issue 17, item 8): Model.accel and Model.step against the raw cffi call of
+    the checked C function (sr_accel, sr_step) on buffers prepared beforehand, over the same states,
+    their rounds interleaved (per_call_ns_interleaved), in ns.  The raw calls' outputs are checked first."""
+    from bindings._sr import ffi, lib
+
+    def checked(name, status, raw, ours):
+        if status != lib.SR_OK:
+            raise WrongNumbers(f"{name}: status {status}")
+        check_close(name, raw, ours, 0)
+
+    keep = []                                           # the arrays behind the prepared pointers
+
+    def pointer(arr):
+        keep.append(arr)
+        return ffi.cast("double *", ffi.from_buffer(arr))
+
+    m = model._model
+    raw_accel = [(m, pointer(x), pointer(u), pointer(np.empty(5))) for x, u in calls]
+    raw_step = {method: [(m, METHODS[method], args[1], args[2], 0.01, pointer(np.empty(len(x))))
+                         for args, (x, _) in zip(raw_accel, calls)] for method in ("lie-euler", "rkmk4")}
+    for (x, u), args in zip(calls[:20], raw_accel):
+        checked("raw cffi sr_accel", lib.sr_accel(*args), ffi.unpack(args[3], 5), model.accel(x, u))
+    cases = {"python_model_accel_ns": (model.accel, calls), "raw_cffi_accel_ns": (lib.sr_accel, raw_accel)}
+    for method, raw in raw_step.items():
+        for (x, u), args in zip(calls[:20], raw):
+            checked(f"raw cffi sr_step {method}", lib.sr_step(*args), ffi.unpack(args[5], len(x)),
+                    model.step(x, u, 0.01, method))
+        cases[f"python_model_step_{method}_ns"] = (model.step, [(x, u, 0.01, method) for x, u in calls])
+        cases[f"raw_cffi_step_{method}_ns"] = (lib.sr_step, raw)
+    return per_call_ns_interleaved(cases, min_seconds, rounds)
+
+
 def python_timings(model, X, U, batch_size, progress, with_kane=True, loop_steps=10_000):
     from ..verification.paper_formulas import PaperModel
     from ..verification.reference import ReferenceModel
     out = {}
     calls = list(zip(X[:200], U[:200]))
-    progress("Model.accel per call from Python")
-    out["python_model_accel_ns"] = per_call_ns(model.accel, calls)
+    progress("Model.accel and Model.step per call from Python, and the raw cffi calls they wrap")
+    out.update(call_overhead_timings(model, calls))
 
     paper = PaperModel(model.params)
     for x, u in calls[:20]:

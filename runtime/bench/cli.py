@@ -77,5 +77,5 @@ def run(args, core, progress):
         return 1
     print(format_report(result))
     written = write_results(result, args.out)
-    print(f"\nwritten: {', '.join(map(str, written))}")
+    print(f"\nwritten: {written}")
     return 0

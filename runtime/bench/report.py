@@ -1,5 +1,6 @@
 """The benchmark's report: the table on stdout (with the targets of issue 7) and the result files."""
 import json
+import os
 import pathlib
 
 
@@ -22,6 +23,14 @@ def format_report(res):
     if res.get("c_loop_native"):
         row("accel, checked API, -march=native (C loop)", res["c_loop_native"]["accel"]["ns"])
     row("Model.accel, one call from Python", py["python_model_accel_ns"])
+    if "raw_cffi_accel_ns" in py:
+        raw = py["raw_cffi_accel_ns"]
+        rows.append(("  raw cffi call of sr_accel, buffers prepared (same run)", f"{raw:,.1f} ns",
+                     f"Model.accel {py['python_model_accel_ns'] / raw:.2f}x it"))
+        for method in ("lie-euler", "rkmk4"):
+            step, raw = py[f"python_model_step_{method}_ns"], py[f"raw_cffi_step_{method}_ns"]
+            rows.append((f"Model.step {method}, one call from Python / raw cffi sr_step",
+                         f"{step:,.1f} / {raw:,.1f} ns", f"{step / raw:.2f}x"))
     row(f"Model.accel batch of {py['batch_size']:,}, per state", py["python_batch_accel_ns_per_state"])
     if "python_batch_accel_first_call_ns_per_state" in py:
         row("  the same, first call (output memory touched for the first time)",
@@ -61,6 +70,10 @@ def format_report(res):
                         py["kane_lambdified_default_accel_ns"] >= 1000 * ours))
         targets.append(("1000x faster per call than Kane lambdified with cse=True",
                         py["kane_lambdified_accel_ns"] >= 1000 * ours))
+    if "raw_cffi_accel_ns" in py:
+        targets.append(("Model.accel <= 2x the raw cffi call", py["python_model_accel_ns"] <= 2 * py["raw_cffi_accel_ns"]))
+        targets.append(("Model.step <= 2x the raw cffi call", all(
+            py[f"python_model_step_{m}_ns"] <= 2 * py[f"raw_cffi_step_{m}_ns"] for m in ("lie-euler", "rkmk4"))))
     for method in ("rkmk4", "cf4"):
         if f"t_shape_{method}_ms" in py:
             targets.append((f"t-shape with {method} <= 10 ms", py[f"t_shape_{method}_ms"] <= 10))
@@ -68,15 +81,29 @@ def format_report(res):
     return "\n".join(lines)
 
 
+def result_file_name(date):
+    """`<date and time>.json` of a run (ISO time with ':' -> '-', which every file system takes)."""
+    return f"{date.replace(':', '-')}.json"
+
+
 def write_results(result, folder):
-    """The run as JSON: `<date and time>.json` (each run its own file) and `latest.json`; written atomically.
-    Returns the paths written."""
+    """The run as JSON in its own file, `<date and time>.json` (issue 17, item 7: every run is kept,
+    so every figure the README quotes is in a stored file).  Never overwrites: a second run within
+    the same second gets `-2`, `-3`, ...  Written to a temporary file first, then linked under its
+    name (os.link fails rather than replace an existing file).  Returns the path written."""
     folder = pathlib.Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    written = []
-    for name in (f"{result['date'].replace(':', '-')}.json", "latest.json"):
-        tmp = folder / (name + ".tmp")
-        tmp.write_text(json.dumps(result, indent=1) + "\n")
-        tmp.replace(folder / name)
-        written.append(folder / name)
-    return written
+    stem = result_file_name(result["date"])[:-len(".json")]
+    tmp = folder / f".{stem}.json.tmp"
+    tmp.write_text(json.dumps(result, indent=1) + "\n")
+    try:
+        for n in range(1, 1000):
+            path = folder / (f"{stem}.json" if n == 1 else f"{stem}-{n}.json")
+            try:
+                os.link(tmp, path)
+                return path
+            except FileExistsError:
+                continue
+        raise FileExistsError(f"{folder}: 999 result files for {stem}")
+    finally:
+        tmp.unlink()

@@ -36,21 +36,32 @@ def best_seconds(fn, rounds):
     return best
 
 
+def _round_ns(fn, calls, min_seconds):
+    """One round: a Python loop over `calls` (argument tuples) lasting at least `min_seconds`; ns per call."""
+    n, start = 0, time.perf_counter()
+    while True:
+        for args in calls:
+            fn(*args)
+        n += len(calls)
+        elapsed = time.perf_counter() - start
+        if elapsed > min_seconds:
+            return elapsed / n * 1e9
+
+
 def per_call_ns(fn, calls, min_seconds=0.1, rounds=7):
     """Best of `rounds` timings of a Python loop over `calls` (list of argument tuples), each
     lasting at least `min_seconds`.  Many short rounds, like the C loop's 11, so that a host
     busy for a moment slows some rounds and not the best one; a host busy for seconds still
     shows (2026-11-23: the Kane call read 66 us with three 0.5 s rounds, 71 us with seven
     0.2 s rounds, against 47-49 us when quiet), which flatters our ratios, never theirs."""
-    best = np.inf
+    return min(_round_ns(fn, calls, min_seconds) for _ in range(rounds))
+
+
+def per_call_ns_interleaved(cases, min_seconds=0.05, rounds=11):
+    """`per_call_ns` for several {name: (fn, calls)} whose ratios are reported: their rounds
+    alternate, round robin, so that a busy spell of the host slows all of them alike."""
+    best = {name: np.inf for name in cases}
     for _ in range(rounds):
-        n, start = 0, time.perf_counter()
-        while True:
-            for args in calls:
-                fn(*args)
-            n += len(calls)
-            elapsed = time.perf_counter() - start
-            if elapsed > min_seconds:
-                break
-        best = min(best, elapsed / n * 1e9)
+        for name, (fn, calls) in cases.items():
+            best[name] = min(best[name], _round_ns(fn, calls, min_seconds))
     return best

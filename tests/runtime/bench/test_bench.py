@@ -3,16 +3,19 @@ import json
 
 import numpy as np
 
-from runtime.bench import baselines, checks, cli
+from runtime.bench import baselines, checks, cli, report
 from runtime.model import Model
 from runtime.params import Params
 from runtime.state import initial_state
+from runtime.verification.sampling import random_inputs, random_states
 
 
 def test_bench_runs_and_checks_numbers_on_a_tiny_problem(tmp_path):
     args = ["--states", "16", "--repeats", "1", "--batch", "2000", "--no-kane", "--loop-steps", "20"]
     assert cli.main([*args, "--out", str(tmp_path)]) == 0
-    result = json.loads((tmp_path / "latest.json").read_text())
+    [written] = tmp_path.glob("*.json")
+    result = json.loads(written.read_text())
+    assert written.name == report.result_file_name(result["date"])
     assert result["c_loop"]["accel_flops"] > 0
     assert "casadi_generated_reference_accel" in result["c_loop"]
     assert set(result["python"]["lie_euler_loop_ms"]) == {
@@ -34,3 +37,22 @@ def test_check_close_rejects_wrong_numbers():
     except checks.WrongNumbers:
         return
     raise AssertionError("a relative difference of 5e-7 passed a 1e-10 check")
+
+
+def test_every_run_is_kept_in_its_own_file_and_none_is_overwritten(tmp_path):
+    run = {"date": "2026-11-23T22:10:05", "cpu": "test"}
+    first = report.write_results(run, tmp_path)
+    second = report.write_results({**run, "cpu": "other"}, tmp_path)
+    assert first.name == "2026-11-23T22-10-05.json" and second.name == "2026-11-23T22-10-05-2.json"
+    assert json.loads(first.read_text())["cpu"] == "test"
+    assert {p.name for p in tmp_path.iterdir()} == {first.name, second.name}   # no temporary left
+
+
+def test_call_overhead_timings_check_the_raw_calls_and_time_both_sides():
+    model = Model(Params.paper_simulation())
+    rng = np.random.default_rng(3)
+    X, U = random_states(rng, 4, model.params), random_inputs(rng, 4)
+    out = baselines.call_overhead_timings(model, list(zip(X, U)), min_seconds=1e-4, rounds=1)
+    assert set(out) == {"python_model_accel_ns", "raw_cffi_accel_ns", "python_model_step_lie-euler_ns",
+                        "raw_cffi_step_lie-euler_ns", "python_model_step_rkmk4_ns", "raw_cffi_step_rkmk4_ns"}
+    assert all(v > 0 for v in out.values())
