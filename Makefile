@@ -8,7 +8,7 @@ C_SOURCES := $(wildcard generated/*.c generated/*.h c/*.c c/*.h)
 
 .PHONY: install test run generate verify bench figures soak fuzz c-lib c-test clean
 
-$(STAMP): pyproject.toml setup.py bindings/build_sr.py $(C_SOURCES)
+$(STAMP): pyproject.toml setup.py bindings/build_sr.py bindings/fastcall.c $(C_SOURCES)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[dev]'
@@ -50,4 +50,4 @@ c-test:
 
 clean:
 	$(MAKE) -C c clean
-	rm -rf $(VENV) build out *.egg-info bindings/_sr*.so bindings/_sr.c
+	rm -rf $(VENV) build out *.egg-info bindings/_sr*.so bindings/_sr.c bindings/_fastcall*.so
