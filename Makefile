@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 C_SOURCES := $(wildcard generated/*.c generated/*.h c/*.c c/*.h)
 
-.PHONY: install test run generate verify bench figures soak fuzz c-lib c-test clean
+.PHONY: install test run generate verify bench sweep-bench figures soak fuzz c-lib c-test clean
 
 $(STAMP): pyproject.toml setup.py bindings/build_sr.py bindings/fastcall.c $(C_SOURCES)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -31,6 +31,12 @@ verify: $(STAMP)
 
 bench: $(STAMP)
 	$(PY) -m runtime bench --native
+	$(MAKE) sweep-bench
+
+# Sweep throughput on Dask (1 and 2 workers), overhead against the C batch, per-task cost, bytes
+# per result: bench/results/sweep/<date>.json (docs/sweeps.md).
+sweep-bench: $(STAMP)
+	$(PY) -m runtime.sweep.bench
 
 figures: $(STAMP)
 	$(PY) -m runtime figures

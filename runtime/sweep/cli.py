@@ -13,7 +13,10 @@ status); 2 on a bad argument, sweep file or output folder.
 import argparse
 import sys
 
+from ..errors import SimulationStopped
+from ..model import Model
 from ..scenarios.atomic import write_text
+from ..state import IDX_Q
 from .runner import SERIAL, run_sweep
 from .spec import load_sweep, shipped_sweeps
 from .summary import percentile_table, write_summary_figure
@@ -31,6 +34,16 @@ def build_parser():
     return p
 
 
+def nominal_end_point(spec):
+    """Where the base scenario, unvaried, ends (x, y) [m]; None if its run stops at a guard."""
+    s = spec.scenario
+    try:
+        traj = Model(s.params).simulate(s.x0, s.dt, s.steps, s.torque_at_step_starts(), method=s.method)
+    except SimulationStopped:
+        return None
+    return tuple(traj[-1, IDX_Q][:2])
+
+
 def main(argv):
     args = build_parser().parse_args(argv)
     try:
@@ -46,8 +59,10 @@ def main(argv):
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    colour = next((q.name for q in spec.quantities), None)
-    write_summary_figure(table, f"{args.out}/summary.png", spec.name, colour_by=colour)
+    first = spec.quantities[0] if spec.quantities else None
+    write_summary_figure(table, f"{args.out}/summary.png", spec.name, colour_by=first and first.name,
+                         colour_label=first and (f"{first.name} (factor)" if first.relative else first.name),
+                         nominal=nominal_end_point(spec))
     summary = percentile_table(table)
     write_text(f"{args.out}/percentiles.md", summary + "\n")
     print(summary)

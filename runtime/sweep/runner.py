@@ -41,17 +41,19 @@ def dask_client(scheduler=None, workers=None):
             yield client
         return
     n = workers or os.cpu_count() or 1
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+    logging.getLogger("distributed").setLevel(logging.WARNING)   # no INFO lines when the cluster closes
+    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",  # any free port: no clash
                       silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
         yield client
 
 
-def run_sweep(spec, out, scheduler=None, workers=None, samples_per_task=None, progress=True):
+def run_sweep(spec, out, scheduler=None, workers=None, samples_per_task=None, progress=True, client=None):
     """Run `spec` into the folder `out` (resuming what is there); returns the results table.
 
     scheduler: None (an embedded LocalCluster of `workers` processes), SERIAL (this process,
     no Dask), or the address of a running Dask scheduler ("tcp://host:8786").
     samples_per_task: None for the sweep file's, else measured for TASK_SECONDS.
+    client: a distributed.Client to use instead (the benchmark reuses one cluster).
     """
     per_task = samples_per_task or spec.samples_per_task
     store = SweepStore.open(out, spec, lambda: per_task or measure_samples_per_task(spec))
@@ -65,7 +67,8 @@ def run_sweep(spec, out, scheduler=None, workers=None, samples_per_task=None, pr
                 bar.update(b - a)
         elif todo:
             from distributed import as_completed
-            with dask_client(scheduler, workers) as client:
+            with (contextlib.nullcontext(client) if client is not None
+                  else dask_client(scheduler, workers)) as client:
                 futures = {client.submit(run_chunk, spec, a, b, pure=False): (a, b) for a, b in todo}
                 for future in as_completed(futures):
                     a, b = futures.pop(future)

@@ -19,14 +19,18 @@ def _ok_columns(table):
     return {k: np.asarray(v, dtype=float)[ok] if k != "status" else np.asarray(v) for k, v in cols.items()}, ok
 
 
-def summary_figure(table, title, colour_by=None, size=(9.5, 4.2)):
-    """End points of the shell centre (coloured by `colour_by`, a column) and the path lengths."""
+def summary_figure(table, title, colour_by=None, colour_label=None, nominal=None, size=(9.5, 4.2)):
+    """End points of the shell centre (coloured by the column `colour_by`, its colour bar labelled
+    `colour_label`), the nominal end point `nominal` (x, y) if given, and the path lengths."""
     cols, ok = _ok_columns(table)
     fig, (ax, hist) = plt.subplots(1, 2, figsize=size, layout="constrained", width_ratios=(1.3, 1))
     colour = cols[colour_by] if colour_by else None
     dots = ax.scatter(cols["end_x"], cols["end_y"], c=colour, s=4, cmap="viridis", alpha=0.7, linewidths=0)
     if colour_by:
-        fig.colorbar(dots, ax=ax, label=colour_by)
+        fig.colorbar(dots, ax=ax, label=colour_label or colour_by)
+    if nominal is not None:
+        ax.plot(*nominal, "r*", ms=12, mec="k", label="nominal parameters")
+        ax.legend(loc="best", fontsize=8)
     ax.set_xlabel("end point x [m]")
     ax.set_ylabel("end point y [m]")
     ax.set_aspect("equal", adjustable="datalim")
@@ -38,8 +42,8 @@ def summary_figure(table, title, colour_by=None, size=(9.5, 4.2)):
     return fig
 
 
-def write_summary_figure(table, target, title, colour_by=None):
-    save_figure(summary_figure(table, title, colour_by), target)
+def write_summary_figure(table, target, title, colour_by=None, colour_label=None, nominal=None):
+    save_figure(summary_figure(table, title, colour_by, colour_label, nominal), target)
 
 
 def percentile_table(table):

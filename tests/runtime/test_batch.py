@@ -10,7 +10,8 @@ from bindings._sr import lib
 from runtime import Model, Params, initial_state, simulate_many
 from runtime.batch import METRIC_NAMES
 from runtime.model import CHUNK_STEPS
-from runtime.state import IDX_Q, IDX_WS, NX
+from runtime.params import NAMES as PARAM_NAMES
+from runtime.state import IDX_Q, IDX_QZ, IDX_WS, NX
 
 STEPS = CHUNK_STEPS + 300     # crosses a chunk boundary: the energy guard and Kahan sums restart there
 
@@ -76,9 +77,9 @@ def test_shared_arguments_equal_the_same_values_repeated(rng):
 def test_a_bad_sample_fails_alone_with_its_status(rng):
     params, x0, u = samples(5, rng, steps=300)
     p = np.stack([q.as_array() for q in params])
-    p[1, 9] = -1.0                                  # m_P < 0
+    p[1, PARAM_NAMES.index("m_P")] = -1.0          # m_P < 0
     x0[2, 0] = np.nan                               # non-finite initial state
-    x0[3, 27 + 2] *= 1.01                           # q_z != r
+    x0[3, IDX_QZ] *= 1.01                           # q_z != r
     u[4, 99, 0] = np.inf                            # a bad torque at step 100
     result = simulate_many(p, x0, 0.01, 300, u, trajectories=True)
     assert result.status.tolist() == [lib.SR_OK, lib.SR_ERR_PARAM, lib.SR_ERR_NONFINITE,
