@@ -14,7 +14,7 @@ On the first N samples of the shipped sweep (t-shape, +-10 % in every mass and d
 From these, a scaling model (docs/sweeps.md): wall time of n samples on W workers in tasks of
 k samples ~ n c / W + (n / k) o / W, with c the cost of one sample and o the per-task cost; the
 scheduler hands out at most about 1 / o_s tasks per second.  Every run is written to its own
-file under bench/results/sweep/ (and latest.json), with the CPU it ran on.
+file under bench/results/sweep/ (never overwritten), with the CPU it ran on.
 """
 import argparse
 import datetime
@@ -196,8 +196,7 @@ def main(argv=None):
               "load_average_at_end": os.getloadavg(), "measured": measured,
               "derived": derive(measured)}
     print(format_report(result))
-    written = write_results(result, args.out)
-    print(f"\nwritten: {', '.join(map(str, written))}")
+    print(f"\nwritten: {write_results(result, args.out)}")
     return 0
 
 
