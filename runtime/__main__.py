@@ -4,6 +4,7 @@ import sys
 
 COMMANDS = {
     "run": ("runtime.scenarios.cli", "run a shipped scenario, a scenario file, or `all`"),
+    "view": ("runtime.scenarios.view", "open the interactive replay of a run (e.g. out/t-shape) in the browser"),
     "verify": ("runtime.verification.verify", "cross-check the kernels against the reference and the invariants"),
     "convergence": ("runtime.verification.convergence", "convergence and energy study of the integrators"),
     "bench": ("runtime.bench.cli", "benchmarks against the alternatives"),

@@ -1,8 +1,11 @@
-"""`python -m runtime run SCENARIO [--out DIR] [--method M] [--dt DT] [--steps N] [--no-gif] [--force]`.
+"""`python -m runtime run SCENARIO [--out DIR] [--method M] [--dt DT] [--steps N] [--no-gif] [--no-replay] [--force]`.
 
 SCENARIO is a shipped name (see `--help`), a path to a TOML scenario file
 (format: docs/scenarios.md), or `all` for the paper's three simulations.
 Each scenario writes into OUT/<name>/ (see runtime/scenarios/report.py for the files).
+The simulations run one after the other; then the files of all runs are
+written in parallel processes (runtime/scenarios/parallel.py), with one
+progress bar per run on a terminal.
 
 A folder that already holds outputs of a run (any of report.OUTPUT_FILES) is
 not overwritten unless --force is given; with --force, the output files of
@@ -20,58 +23,21 @@ by a guard (partial outputs written).
 import argparse
 import pathlib
 import sys
-import time
+
+from tqdm import tqdm
 
 from . import report
 from ..errors import KernelError, SimulationStopped
+from .parallel import write_runs
 from .scenario import PAPER_SCENARIOS, load_scenario, run_scenario, scenario_path, shipped_scenarios
-
-
-class Progress:
-    """A one-line progress indicator on stderr, shown only once a task has taken more than `delay` s.
-
-    On a terminal the line is redrawn in place; otherwise a line is printed at
-    every quarter, so logs stay readable.
-    """
-
-    def __init__(self, label, stream=None, delay=1.0):
-        self.label = label
-        self.stream = stream if stream is not None else sys.stderr
-        self.delay = delay
-        self.started = time.perf_counter()
-        self.shown = False
-        self.last_quarter = -1
-        self.interactive = hasattr(self.stream, "isatty") and self.stream.isatty()
-
-    def __call__(self, what, done, total):
-        elapsed = time.perf_counter() - self.started
-        if elapsed < self.delay and not self.shown:
-            return
-        fraction = done / total if total else 1.0
-        if self.interactive:
-            bar = "#" * int(30 * fraction)
-            self.stream.write(f"\r{self.label}: {what:<9} [{bar:<30}] {100 * fraction:5.1f}%  {elapsed:5.1f} s")
-            if done >= total:
-                self.stream.write("\n")
-        else:
-            quarter = int(4 * fraction)
-            if quarter == self.last_quarter:
-                return
-            self.last_quarter = quarter
-            self.stream.write(f"{self.label}: {what} {100 * fraction:.0f}% ({elapsed:.1f} s)\n")
-        self.stream.flush()
-        self.shown = True
-
-    def restart(self):
-        self.started, self.shown, self.last_quarter = time.perf_counter(), False, -1
 
 
 def build_parser():
     shipped = ", ".join(shipped_scenarios())
     parser = argparse.ArgumentParser(
         prog="python -m runtime run",
-        description="Simulate a scenario and write trajectory.csv, figures, robot.gif and summary.json "
-                    "into OUT/<name>/.")
+        description="Simulate a scenario and write trajectory.csv, figures, robot.gif, replay.html and "
+                    "summary.json into OUT/<name>/.")
     parser.add_argument("scenario", metavar="SCENARIO",
                         help=f"a shipped scenario ({shipped}), a path to a .toml file, or 'all' (the three of the paper)")
     parser.add_argument("--out", default="out", type=pathlib.Path, help="output folder (default: out)")
@@ -79,8 +45,10 @@ def build_parser():
     parser.add_argument("--dt", type=float, help="time step [s], overriding the file's; the duration is kept "
                                                  "unless --steps is given")
     parser.add_argument("--steps", type=int, help="number of steps, overriding the file's")
-    parser.add_argument("--no-gif", dest="gif", action="store_false", help="skip the animation (the slow part)")
-    parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    parser.add_argument("--no-gif", dest="gif", action="store_false", help="skip the animation (robot.gif)")
+    parser.add_argument("--no-replay", dest="replay", action="store_false",
+                        help="skip the interactive replay (replay.html)")
+    parser.add_argument("--quiet", action="store_true", help="print nothing but errors (no progress bars)")
     parser.add_argument("--force", "--overwrite", dest="force", action="store_true",
                         help="overwrite an output folder that already holds the outputs of a run")
     return parser
@@ -90,31 +58,52 @@ class Stopped(Exception):
     """A run stopped by a simulation guard; the partial outputs are written (exit status 3)."""
 
 
-def run_one(name_or_path, args):
-    """Load, override, simulate and write one scenario; returns its summary dict."""
-    scenario = load_scenario(name_or_path).with_overrides(dt=args.dt, steps=args.steps, method=args.method)
+def simulate(scenario, args):
+    """Simulate one loaded scenario (a passing progress bar for long runs); a guard's stop writes the
+    partial outputs and raises Stopped, a kernel error raises ValueError naming the scenario."""
     folder = args.out / scenario.name
-    check_output_folder(folder, args.force)
-    progress = Progress(scenario.name, delay=float("inf") if args.quiet else 1.0)
-    try:
-        result = run_scenario(scenario, progress=lambda done, total: progress("simulate", done, total))
-    except SimulationStopped as exc:  # a guard fired: keep what was computed, clearly marked
-        written = report.write_partial_outputs(exc.result, folder, exc)
-        report.remove_stale(folder, written)
-        raise Stopped(f"{scenario.source}: {exc}; wrote the {len(exc.trajectory)} valid rows to "
-                      f"{written[0]} and {written[1].name}") from None
-    except KernelError as exc:        # the state left the model's domain: say which scenario
-        raise ValueError(f"{scenario.source}: simulation failed: {exc}") from None
-    progress.restart()
-    written = report.write_outputs(result, folder, gif=args.gif, progress=progress)
-    report.remove_stale(folder, written)
-    summary = report.summary(result)
-    if not args.quiet:
-        x, y = summary["final_position_m"]
-        print(f"{scenario.name}: {scenario.steps} steps of {scenario.dt:g} s ({scenario.method}) in "
-              f"{result.wall_time_s:.3f} s; final position ({x:+.4f}, {y:+.4f}) m, largest excursion "
-              f"{summary['largest_excursion_m']:.4f} m; wrote {len(written)} files to {folder}/")
-    return summary
+    with tqdm(total=scenario.steps, desc=f"{scenario.name} (simulating)", unit="step", leave=False,
+              disable=True if args.quiet else None, delay=1.0) as bar:
+        try:
+            return run_scenario(scenario, progress=lambda done, total: bar.update(done - bar.n))
+        except SimulationStopped as exc:  # a guard fired: keep what was computed, clearly marked
+            written = report.write_partial_outputs(exc.result, folder, exc)
+            report.remove_stale(folder, written)
+            raise Stopped(f"{scenario.source}: {exc}; wrote the {len(exc.trajectory)} valid rows to "
+                          f"{written[0]} and {written[1].name}") from None
+        except KernelError as exc:        # the state left the model's domain: say which scenario
+            raise ValueError(f"{scenario.source}: simulation failed: {exc}") from None
+
+
+def run_many(names, args):
+    """Simulate the scenarios in turn, then write the files of every run that finished (in parallel);
+    returns their summaries.  If a run fails, the runs before it are still written, then the error
+    is raised (the runs after it are not simulated)."""
+    scenarios = [load_scenario(name).with_overrides(dt=args.dt, steps=args.steps, method=args.method)
+                 for name in names]
+    results, failure = [], None
+    for scenario in scenarios:
+        check_output_folder(args.out / scenario.name, args.force)
+        try:
+            results.append(simulate(scenario, args))
+        except (Stopped, ValueError) as exc:
+            failure = exc
+            break
+    written = write_runs([(result, args.out / result.scenario.name) for result in results],
+                         gif=args.gif, replay=args.replay, quiet=args.quiet)
+    summaries = []
+    for result, files in zip(results, written):
+        summary = report.summary(result)
+        summaries.append(summary)
+        if not args.quiet:
+            scenario = result.scenario
+            x, y = summary["final_position_m"]
+            print(f"{scenario.name}: {scenario.steps} steps of {scenario.dt:g} s ({scenario.method}) in "
+                  f"{result.wall_time_s:.3f} s; final position ({x:+.4f}, {y:+.4f}) m, largest excursion "
+                  f"{summary['largest_excursion_m']:.4f} m; wrote {len(files)} files to {files[0].parent}/")
+    if failure is not None:
+        raise failure
+    return summaries
 
 
 def check_output_folder(folder, force):
@@ -132,8 +121,7 @@ def main(argv):
         # Every folder is checked before the first run, so `all` does not stop half-way.
         for name in names:
             check_output_folder(args.out / scenario_path(name).stem, args.force)
-        for name in names:
-            run_one(name, args)
+        run_many(names, args)
     except Stopped as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 3

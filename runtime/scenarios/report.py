@@ -5,7 +5,8 @@ Every file is written atomically (runtime/scenarios/atomic.py).
     files = write_outputs(result, pathlib.Path("out/t-shape"), gif=True)
 
 writes the CSV, the figures (runtime/scenarios/plots.py), the animation
-(runtime/scenarios/animation.py) and the summary.  Nothing here simulates:
+(runtime/scenarios/animation.py), the interactive replay (runtime/scenarios/replay.py)
+and the summary.  Nothing here simulates:
 see runtime/scenarios/scenario.py.
 """
 import contextlib
@@ -17,9 +18,10 @@ import numpy as np
 
 from ..state import (IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, absolute_inclinations,
                      pendulum_angle, yoke_angle)
-from .animation import write_gif
+from .animation import frame_samples, write_gif
 from .atomic import write_text
 from .plots import FIGURES, save_figure
+from .replay import write_replay
 
 #: Columns of trajectory.csv, in order (matrices row-major: R_S_12 is row 1, column 2).
 CSV_COLUMNS = (["t", "q_x", "q_y", "q_z"]
@@ -112,8 +114,63 @@ def write_summary(summary_dict, target):
 #: Files a stopped run writes instead of the outputs (marked by name: never mistaken for a full run).
 PARTIAL_FILES = ("trajectory.partial.csv", "summary.partial.json")
 
+
+def _write_figure(draw):
+    return lambda result, target, progress=None: save_figure(draw(result), target)
+
+
+#: How each output file of a complete run is written: writer(result, target, progress=None), where
+#: `progress(done, total)` may be called as the work goes (the GIF's frames).  summary.json is not
+#: here: it is written last, from the others' timings.
+WRITERS = {
+    "trajectory.csv": lambda result, target, progress=None: write_csv(result, target),
+    **{name: _write_figure(draw) for name, draw in FIGURES.items()},
+    "robot.gif": write_gif,
+    "replay.html": write_replay,
+}
+
 #: Every file name a run may write into its folder: a folder holding any of them "holds outputs".
-OUTPUT_FILES = ("trajectory.csv", *FIGURES, "robot.gif", "summary.json", *PARTIAL_FILES)
+OUTPUT_FILES = (*WRITERS, "summary.json", *PARTIAL_FILES)
+
+#: Which wall-time entry of summary.json each file's writing time is added to.
+TIMING_KEYS = {"robot.gif": "gif", "replay.html": "replay"}
+
+
+def planned_files(gif=True, replay=True):
+    """The names of the files a complete run writes before summary.json, in writing order."""
+    return [name for name in WRITERS
+            if (gif or name != "robot.gif") and (replay or name != "replay.html")]
+
+
+def progress_units(result, name):
+    """How many progress units writing `name` counts for: its frames for the GIF, 1 for any other file."""
+    return len(frame_samples(len(result.trajectory))) if name == "robot.gif" else 1
+
+
+def write_file(result, folder, name, progress=None):
+    """Write the output file `name` (one of WRITERS) of `result` into `folder`; returns its wall time [s]."""
+    started = time.perf_counter()
+    WRITERS[name](result, pathlib.Path(folder) / name, progress=progress)
+    return time.perf_counter() - started
+
+
+def timings_by_key(seconds_by_file):
+    """The "wall_time_s" entries of summary.json from each file's writing time."""
+    out = {}
+    for name, seconds in seconds_by_file.items():
+        key = TIMING_KEYS.get(name, "csv_and_figures")
+        out[key] = out.get(key, 0.0) + seconds
+    return out
+
+
+def finish_run(result, folder, seconds_by_file):
+    """Write summary.json (last, so a folder with a summary is complete) and delete the stale outputs
+    of an earlier run; returns the paths the run wrote."""
+    folder = pathlib.Path(folder)
+    written = [folder / name for name in seconds_by_file] + [folder / "summary.json"]
+    write_summary(summary(result, timings_by_key(seconds_by_file)), written[-1])
+    remove_stale(folder, written)
+    return written
 
 
 def existing_outputs(folder):
@@ -132,29 +189,23 @@ def remove_stale(folder, keep):
                 (pathlib.Path(folder) / name).unlink()
 
 
-def write_outputs(result, folder, gif=True, progress=None):
-    """Write trajectory.csv, the FIGURES, robot.gif (if `gif`) and summary.json (last) into `folder`.
+def write_outputs(result, folder, gif=True, replay=True, progress=None):
+    """Write the files of a complete run into `folder` in this process, one after the other:
+    trajectory.csv, the FIGURES, robot.gif (if `gif`), replay.html (if `replay`), summary.json (last).
 
-    `progress(what, done, total)` reports the GIF's frames.  Returns the paths written.
+    `progress(what, done, total)` reports each file's work.  Returns the paths written.  Output files
+    of an earlier run that this one does not write are not deleted here (see `finish_run`).
     Whether an existing folder may be overwritten is the caller's decision (the CLI's --force).
+    runtime/scenarios/parallel.py writes the same files of several runs in parallel processes.
     """
-    started = time.perf_counter()
     folder = pathlib.Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    written = [folder / "trajectory.csv"]
-    write_csv(result, written[-1])
-    for filename, draw in FIGURES.items():
-        written.append(folder / filename)
-        save_figure(draw(result), written[-1])
-    timings = {"csv_and_figures": time.perf_counter() - started}
-    if gif:
-        gif_started = time.perf_counter()
-        written.append(folder / "robot.gif")
-        write_gif(result, written[-1],
-                  progress=None if progress is None else (lambda done, total: progress("gif", done, total)))
-        timings["gif"] = time.perf_counter() - gif_started
-    written.append(folder / "summary.json")
-    write_summary(summary(result, timings), written[-1])
+    seconds = {}
+    for name in planned_files(gif, replay):
+        report = None if progress is None else (lambda done, total, name=name: progress(name, done, total))
+        seconds[name] = write_file(result, folder, name, report)
+    written = [folder / name for name in seconds] + [folder / "summary.json"]
+    write_summary(summary(result, timings_by_key(seconds)), written[-1])
     return written
 
 

@@ -20,7 +20,7 @@ def test_cli_writes_csv_figures_and_summary(tmp_path):
     folder = tmp_path / "t-shape"
     names = sorted(p.name for p in folder.iterdir())
     assert names == sorted(["trajectory.csv", "summary.json", "trajectory.png", "inclinations.png",
-                            "absolute_inclinations.png", "energy.png"])
+                            "absolute_inclinations.png", "energy.png", "replay.html"])
     for png in folder.glob("*.png"):
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 

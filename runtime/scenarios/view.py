@@ -1,0 +1,45 @@
+"""`python -m runtime view FOLDER`: open the replay page of a run (FOLDER/replay.html) in the browser.
+
+FOLDER is a run's output folder (`out/t-shape`) or the page itself.  The page
+is a local file and needs no network (runtime/scenarios/replay.py).  Exit
+status 0 when a browser was asked to open it, 2 when there is no such page or
+no browser could be started (the page's path is printed either way, so it
+can be opened by hand).
+"""
+import argparse
+import pathlib
+import sys
+import webbrowser
+
+
+def replay_page(path):
+    """The replay.html of a run folder (or the page itself); ValueError naming what is missing."""
+    path = pathlib.Path(path)
+    page = path / "replay.html" if path.is_dir() else path
+    if not page.is_file():
+        hint = "run `python -m runtime run` first (without --no-replay)"
+        if not path.exists():
+            raise ValueError(f"{path}: no such folder; {hint}")
+        raise ValueError(f"{page}: no replay page here; {hint}")
+    return page.resolve()
+
+
+def main(argv):
+    parser = argparse.ArgumentParser(prog="python -m runtime view",
+                                     description="Open the interactive replay of a run in the browser.")
+    parser.add_argument("folder", metavar="FOLDER", help="a run's output folder (e.g. out/t-shape) or its replay.html")
+    args = parser.parse_args(argv)
+    try:
+        page = replay_page(args.folder)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print(f"opening {page.as_uri()}")
+    if not webbrowser.open(page.as_uri()):
+        print("error: no browser could be started; open the page above by hand", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
