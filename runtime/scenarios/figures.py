@@ -2,14 +2,17 @@
 
 One trajectory figure per paper scenario (the paper's Figs. 2, 4, 6) and the
 relative inclinations of the t-shape run (Fig. 7), at 100 dpi so the PNGs
-stay small.  The numbers quoted in docs/scenarios.md come from the same runs
+stay small; and a screenshot of the t-shape run's replay page in headless
+chromium (runtime/scenarios/browser.py), when chromium is installed.  The numbers quoted in docs/scenarios.md come from the same runs
 (see each run's summary.json, `python -m runtime run all`).
 """
 import argparse
 import pathlib
 import sys
+import tempfile
 
-from . import plots
+from . import browser, plots
+from .replay import write_replay
 from .scenario import PAPER_SCENARIOS, load_scenario, run_scenario
 
 DEFAULT_OUT = pathlib.Path(__file__).resolve().parents[2] / "docs" / "figures"
@@ -29,6 +32,16 @@ def main(argv):
         target = args.out / f"{name}-{suffix}.png"
         plots.save_figure(draw(results[name]), target, dpi=plots.FIGURE_DPI)
         print(target)
+    target = args.out / "replay-t-shape.png"
+    why_not = browser.missing()
+    if why_not:
+        print(f"{target}: not redrawn: {why_not}", file=sys.stderr)
+        return 0
+    with tempfile.TemporaryDirectory() as folder:
+        page = pathlib.Path(folder) / "replay.html"
+        write_replay(results["t-shape"], page)
+        browser.screenshot(page, target)
+    print(target)
     return 0
 
 
