@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 C_SOURCES := $(wildcard generated/*.c generated/*.h c/*.c c/*.h)
 
-.PHONY: install test run generate verify bench sweep-bench figures soak fuzz c-lib c-test clean
+.PHONY: install test run generate verify bench sweep-bench figures soak fuzz c-lib c-test clean control envelope
 
 $(STAMP): pyproject.toml setup.py bindings/build_sr.py bindings/fastcall.c $(C_SOURCES)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -40,6 +40,14 @@ sweep-bench: $(STAMP)
 
 figures: $(STAMP)
 	$(PY) -m runtime figures
+
+# Every controller on every benchmark task: out/control/table.md, table.csv, a folder per run (docs/control.md).
+control: $(STAMP)
+	$(PY) -m runtime.control.benchmark --out out/control
+
+# The envelope of docs/control.md (prints its numbers, rewrites docs/figures/control-envelope.png).
+envelope: $(STAMP)
+	$(PY) -m runtime.control.envelope
 
 soak: $(STAMP)
 	$(PY) -m runtime soak

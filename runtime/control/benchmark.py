@@ -1,0 +1,79 @@
+"""`make control`: every available controller on every shipped task; one table (Markdown and CSV),
+a folder per run with summary.json (metrics under `tracking`) and figures.
+
+    python -m runtime.control.benchmark [--out out/control] [--tasks circle,line]
+"""
+import argparse
+import csv
+import json
+import platform
+import subprocess
+import sys
+import pathlib
+
+from tqdm.auto import tqdm
+
+from ..scenarios.atomic import atomic_path, write_text
+from .closed_loop import simulate_closed_loop
+from .metrics import tracking_metrics
+from .plots import plot_run
+from .task import load_task, shipped_tasks
+
+COLUMNS = ("cross_track_rms_m", "cross_track_max_m", "heading_settle_s", "speed_settle_s", "overshoot",
+           "motor_energy_j", "saturated_fraction", "solve_ms_p50", "solve_ms_p99")
+
+
+def cpu_name():
+    try:
+        out = subprocess.run(["lscpu"], capture_output=True, text=True, check=True).stdout
+        return next(line.split(":", 1)[1].strip() for line in out.splitlines() if line.startswith("Model name"))
+    except (OSError, subprocess.CalledProcessError, StopIteration):
+        return platform.processor() or "unknown CPU"
+
+
+def run_task(task, progress=False):
+    """(ClosedLoopResult, reference, tracking metrics) of one task."""
+    reference = task.reference()
+    result = simulate_closed_loop(task.plant_params, task.controller(), reference, task.scenario.x0,
+                                  task.duration, task.scenario.dt, task.scenario.method, task.noise, progress)
+    every = max(1, round(1 / (task.rate * task.scenario.dt)))
+    return result, reference, tracking_metrics(result, reference, task.reference_spec["kind"],
+                                               task.plant_params.r, sample_every=every)
+
+
+def _fmt(value):
+    return "—" if value is None else f"{value:.4g}"
+
+
+def main(argv=()):
+    parser = argparse.ArgumentParser(prog="python -m runtime.control.benchmark")
+    parser.add_argument("--out", default="out/control")
+    parser.add_argument("--tasks", default=",".join(shipped_tasks()))
+    args = parser.parse_args(list(argv))
+    out = pathlib.Path(args.out)
+    rows = []
+    for name in tqdm(args.tasks.split(","), unit="task"):
+        task = load_task(name)
+        result, reference, metrics = run_task(task)
+        folder = out / f"{name}-{task.controller_kind}"
+        folder.mkdir(parents=True, exist_ok=True)
+        summary = {"task": name, "controller": task.controller_kind, "rate_hz": task.rate, "u_max": task.u_max,
+                   "duration_s": task.duration, "cpu": cpu_name(), "tracking": metrics}
+        write_text(folder / "summary.json", json.dumps(summary, indent=2) + "\n")
+        plot_run(result, reference, task, folder / "tracking.png")
+        rows.append({"task": name, "controller": task.controller_kind, **metrics})
+    header = ["task", "controller", *COLUMNS]
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join([r["task"], r["controller"]] + [_fmt(r[c]) for c in COLUMNS]) + " |" for r in rows]
+    table = "\n".join(lines) + f"\n\nCPU: {cpu_name()}\n"
+    write_text(out / "table.md", table)
+    with atomic_path(out / "table.csv") as tmp, open(tmp, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=header)
+        writer.writeheader()
+        writer.writerows(rows)
+    print(table)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,92 @@
+"""Closed-loop simulation: the plant on the C steppers, the controller sampled with a zero-order hold.
+
+Every controller period the controller reads the measured state (the plant's state, plus sensor
+noise if asked), its torques are held constant, and the plant advances by `Model.simulate` (the
+guarded C loop) for the period's steps.  The plant may have other parameters than the
+controller's model (`[plant]` in a task file).
+"""
+import dataclasses
+import time
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from ..model import Model
+from ..state import IDX_Q, NU
+from ..validation import project_state
+from .geometry import heading
+
+
+@dataclasses.dataclass(frozen=True)
+class Noise:
+    """Sensor noise (standard deviations, Gaussian, independent per sample; seeded)."""
+    position_m: float = 0.0      # on q_x, q_y
+    attitude_rad: float = 0.0    # a small random rotation of R_S (re-projected onto SO(3))
+    rate_rad_s: float = 0.0      # on ω_S, ω_Y, ω_P
+    seed: int = 0
+
+    @property
+    def active(self):
+        return self.position_m > 0 or self.attitude_rad > 0 or self.rate_rad_s > 0
+
+
+@dataclasses.dataclass(frozen=True)
+class ClosedLoopResult:
+    """Row n of `trajectory` belongs to `time[n]`; `torques[n]` acts from time[n] to time[n+1]."""
+    time: np.ndarray            # (n+1,) [s]
+    trajectory: np.ndarray      # (n+1, 35), the plant's true states
+    torques: np.ndarray         # (n+1, 2) [N m]; the last row repeats the one before
+    control_time: np.ndarray    # (k,) [s] the controller's sample times
+    saturated_fraction: float
+    solve_s: np.ndarray         # (k,) [s] the controller's computation time per sample
+    wall_time_s: float
+
+
+def _measure(x, r, noise, rng):
+    if not noise.active:
+        return x
+    from ..so3 import exp
+    from ..state import IDX_NU, IDX_RS
+    y = x.copy()
+    y[IDX_Q.start:IDX_Q.start + 2] += rng.normal(0.0, noise.position_m, 2) if noise.position_m > 0 else 0.0
+    if noise.attitude_rad > 0:
+        y[IDX_RS] = (x[IDX_RS].reshape(3, 3) @ exp(rng.normal(0.0, noise.attitude_rad, 3))).ravel()
+    if noise.rate_rad_s > 0:
+        y[IDX_NU] += rng.normal(0.0, noise.rate_rad_s, IDX_NU.stop - IDX_NU.start)
+    return project_state(y, r)
+
+
+def simulate_closed_loop(plant_params, controller, reference, x0, duration, dt, method="rkmk4",
+                         noise=Noise(), progress=False):
+    """Run `controller` on `reference` from x0 for `duration` s; the plant steps by `dt`.
+
+    The controller period must be a whole number of plant steps.
+    """
+    per = round(controller.period / dt)
+    if per < 1 or abs(per * dt - controller.period) > 1e-9 * controller.period:
+        raise ValueError(f"controller.rate: the period 1/{controller.rate:g} s is not a whole number of "
+                         f"plant steps dt = {dt:g} s")
+    samples = round(duration / controller.period)
+    if samples < 1:
+        raise ValueError(f"duration: {duration:g} s is shorter than one controller period")
+    plant = Model(plant_params)
+    rng = np.random.default_rng(noise.seed)
+    traj = np.empty((samples * per + 1, x0.size))
+    torques = np.empty((samples * per + 1, NU))
+    traj[0] = x0
+    controller.reset(_measure(x0, plant_params.r, noise, rng))
+    if hasattr(reference, "reset"):
+        reference.reset()
+    started = time.perf_counter()
+    for k in tqdm(range(samples), disable=not progress or None, unit="sample", leave=False):
+        x = traj[k * per]
+        y = _measure(x, plant_params.r, noise, rng)
+        target = reference.target(k * controller.period, y[IDX_Q], float(heading(y)))
+        u = controller.update(k * controller.period, y, target)
+        torques[k * per:(k + 1) * per] = u
+        traj[k * per:(k + 1) * per + 1] = plant.simulate(x, dt, per, np.tile(u, (per, 1)), method=method)
+    torques[-1] = torques[-2]
+    return ClosedLoopResult(time=np.arange(len(traj)) * dt, trajectory=traj, torques=torques,
+                            control_time=np.arange(samples) * controller.period,
+                            saturated_fraction=controller.saturated_fraction,
+                            solve_s=np.asarray(controller.solve_s), wall_time_s=time.perf_counter() - started)

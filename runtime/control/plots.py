@@ -1,0 +1,36 @@
+"""Figure of one closed-loop run: path against reference, errors, torques."""
+import numpy as np
+
+from ..state import IDX_Q
+from .geometry import forward_speed, heading, wrap_angle
+
+
+def plot_run(result, reference, task, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    x = result.trajectory
+    fig, (a, b, c) = plt.subplots(1, 3, figsize=(15, 4.5))
+    q = x[:, IDX_Q]
+    if reference.is_path:
+        end = np.searchsorted(reference.s, reference.s[reference.nearest(q[-1, :2], None)[0]] + 0.5)
+        a.plot(reference.points[:end, 0], reference.points[:end, 1], "k--", lw=1, label="reference")
+    a.plot(q[:, 0], q[:, 1], label="robot")
+    a.plot(q[0, 0], q[0, 1], "go")
+    a.set_aspect("equal"), a.set_xlabel("x [m]"), a.set_ylabel("y [m]"), a.legend(), a.set_title(task.name)
+    every = max(1, len(x) // 2000)
+    t, xs = result.time[::every], x[::every]
+    if reference.is_path:
+        b.plot(t, reference.cross_track(xs[:, IDX_Q][:, :2]), label="cross-track [m]")
+    else:
+        b.plot(t, np.degrees(wrap_angle(reference.heading - heading(xs))), label="heading error [deg]")
+    b.plot(t, forward_speed(xs, task.plant_params.r) - reference.speed, label="speed error [m/s]")
+    b.axhline(0, color="k", lw=0.5), b.set_xlabel("t [s]"), b.legend(), b.set_title("errors")
+    c.plot(result.time, result.torques[:, 0], label="u_Y")
+    c.plot(result.time, result.torques[:, 1], label="u_P")
+    for s in (-1, 1):
+        c.axhline(s * task.u_max, color="r", lw=0.5, ls=":")
+    c.set_xlabel("t [s]"), c.set_ylabel("torque [N m]"), c.legend(), c.set_title(f"torques ({task.controller_kind})")
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)

@@ -1,0 +1,209 @@
+"""Benchmark task files: a scenario (params, initial state, dt, duration, method) plus
+`[reference]`, `[controller]` and `[plant]` (docs/control.md, "Task files").
+
+    task = load_task("circle")            # a shipped name (runtime/control/tasks/), or a path
+    controller, reference = task.controller(), task.reference()
+
+The scenario part is validated by runtime/scenarios/scenario.py (`parse_scenario`); every bad
+value here raises ValueError("<file>: <section>.<key>: <what is wrong>").
+"""
+import dataclasses
+import importlib.resources
+import math
+import pathlib
+import tomllib
+
+import numpy as np
+
+from ..params import NAMES as PARAM_NAMES
+from ..scenarios.scenario import parse_scenario
+from .closed_loop import Noise
+from .controller import DEFAULT_U_MAX
+from .geometry import heading
+from .pid import GAIN_NAMES, Pid, PidGains
+from .reference import KINDS, SpeedHeading, circle_path, figure8_path, line_path, waypoints_path
+from ..state import IDX_Q
+
+#: Controller kinds of issue #20; only these are built so far (NMPC and LQR wait for #19).
+CONTROLLER_KINDS = ("pid", "nmpc", "lqr")
+AVAILABLE_CONTROLLERS = {"pid": (Pid, PidGains, GAIN_NAMES)}
+_SCENARIO_KEYS = {"description", "dt", "duration", "steps", "method", "params", "initial"}
+_REFERENCE_KEYS = {"kind", "speed", "heading", "offset", "radius", "size", "points"}
+_NEEDS = {"speed": ("speed",), "heading": ("speed", "heading"), "line": ("speed", "offset"),
+          "circle": ("speed", "radius"), "figure8": ("speed", "size"), "waypoints": ("speed", "points")}
+_NOISE_KEYS = {"noise_position_m": "position_m", "noise_attitude_rad": "attitude_rad",
+               "noise_rate_rad_s": "rate_rad_s", "noise_seed": "seed"}
+
+
+@dataclasses.dataclass(frozen=True)
+class Task:
+    name: str
+    source: str
+    scenario: object            # runtime.scenarios.scenario.Scenario: the controller's model and x0
+    reference_spec: dict
+    controller_kind: str
+    rate: float
+    u_max: float
+    gains: object
+    plant_params: object        # runtime.Params of the simulated robot
+    noise: Noise
+
+    @property
+    def duration(self):
+        return self.scenario.duration
+
+    def controller(self):
+        cls = AVAILABLE_CONTROLLERS[self.controller_kind][0]
+        return cls(self.scenario.params, rate=self.rate, u_max=self.u_max, gains=self.gains)
+
+    def reference(self):
+        """The reference, built from the start pose (paths start at the robot, tangent to its heading)."""
+        spec, x0 = self.reference_spec, self.scenario.x0
+        start, psi0 = x0[IDX_Q][:2], float(heading(x0))
+        speed = spec["speed"]
+        length = abs(speed) * self.duration + 2.0
+        kind = spec["kind"]
+        if kind == "speed":
+            return SpeedHeading(speed, spec.get("heading", psi0))
+        if kind == "heading":
+            return SpeedHeading(speed, spec["heading"])
+        if kind == "line":
+            return line_path(start, spec.get("heading", psi0), spec["offset"], length, speed)
+        if kind == "circle":
+            return circle_path(start, psi0, spec["radius"], length, speed)
+        if kind == "figure8":
+            return figure8_path(start, psi0, spec["size"], length, speed)
+        return waypoints_path(start, spec["points"], speed)
+
+
+def task_dir():
+    return importlib.resources.files("runtime") / "control" / "tasks"
+
+
+def shipped_tasks():
+    return sorted(p.name[:-5] for p in task_dir().iterdir() if p.name.endswith(".toml"))
+
+
+def load_task(name_or_path):
+    candidate = task_dir() / f"{name_or_path}.toml"
+    path = pathlib.Path(str(candidate)) if "/" not in str(name_or_path) and candidate.is_file() \
+        else pathlib.Path(name_or_path)
+    if not path.is_file():
+        raise ValueError(f"{path}: no such task file (shipped tasks: {', '.join(shipped_tasks())})")
+    try:
+        with open(path, "rb") as f:
+            data = tomllib.load(f)
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path}: not valid TOML ({exc})") from None
+    return parse_task(data, source=str(path), name=path.stem)
+
+
+def parse_task(data, source="<task>", name="task"):
+    if not isinstance(data, dict):
+        raise ValueError(f"{source}: expected a table")
+    unknown = sorted(set(data) - _SCENARIO_KEYS - {"reference", "controller", "plant"})
+    if unknown:
+        raise ValueError(f"{source}: unknown key(s) {', '.join(map(repr, unknown))}; allowed: "
+                         f"{', '.join(sorted(_SCENARIO_KEYS | {'reference', 'controller', 'plant'}))}")
+    scenario = parse_scenario({k: v for k, v in data.items() if k in _SCENARIO_KEYS}, source, name)
+    reference = _parse_reference(data.get("reference"), source)
+    kind, rate, u_max, gains = _parse_controller(data.get("controller"), source)
+    per = rate * scenario.dt
+    if abs(1 / per - round(1 / per)) > 1e-9 * (1 / per):
+        raise ValueError(f"{source}: controller.rate: the period 1/{rate:g} s is not a whole number of "
+                         f"steps dt = {scenario.dt:g} s")
+    plant, noise = _parse_plant(data.get("plant", {}), scenario.params, source)
+    return Task(name=name, source=source, scenario=scenario, reference_spec=reference, controller_kind=kind,
+                rate=rate, u_max=u_max, gains=gains, plant_params=plant, noise=noise)
+
+
+def _table(value, where, allowed):
+    if not isinstance(value, dict):
+        raise ValueError(f"{where}: expected a table, got {type(value).__name__} {value!r}")
+    unknown = sorted(set(value) - set(allowed))
+    if unknown:
+        raise ValueError(f"{where}: unknown key(s) {', '.join(map(repr, unknown))}; allowed: "
+                         f"{', '.join(sorted(allowed))}")
+    return value
+
+
+def _real(value, where, positive=False, nonnegative=False):
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"{where}: expected a number, got {type(value).__name__} {value!r}")
+    if not math.isfinite(value):
+        raise ValueError(f"{where}: must be finite, got {value!r}")
+    if positive and not value > 0:
+        raise ValueError(f"{where}: must be > 0, got {value!r}")
+    if nonnegative and not value >= 0:
+        raise ValueError(f"{where}: must be >= 0, got {value!r}")
+    return float(value)
+
+
+def _parse_reference(table, source):
+    where = f"{source}: reference"
+    if table is None:
+        raise ValueError(f"{where}: missing (required): give kind = one of {', '.join(KINDS)}")
+    _table(table, where, _REFERENCE_KEYS)
+    kind = table.get("kind")
+    if kind not in KINDS:
+        raise ValueError(f"{where}.kind: expected one of {', '.join(KINDS)}, got {kind!r}")
+    for key in _NEEDS[kind]:
+        if key not in table:
+            raise ValueError(f"{where}.{key}: missing (required for kind = {kind!r})")
+    spec = {"kind": kind}
+    for key in ("speed", "heading", "offset"):
+        if key in table:
+            spec[key] = _real(table[key], f"{where}.{key}")
+    for key in ("radius", "size"):
+        if key in table:
+            spec[key] = _real(table[key], f"{where}.{key}", positive=True)
+    if "points" in table:
+        pts = table["points"]
+        if not (isinstance(pts, list) and pts and all(isinstance(p, list) and len(p) == 2 for p in pts)):
+            raise ValueError(f"{where}.points: expected a non-empty list of [x, y] pairs in m, got {pts!r}")
+        spec["points"] = np.array([[_real(v, f"{where}.points[{i}][{j}]") for j, v in enumerate(p)]
+                                   for i, p in enumerate(pts)])
+        if np.any(np.hypot(*np.diff(spec["points"], axis=0).T) == 0):
+            raise ValueError(f"{where}.points: two consecutive points are equal")
+    return spec
+
+
+def _parse_controller(table, source):
+    where = f"{source}: controller"
+    if table is None:
+        raise ValueError(f"{where}: missing (required): give kind = \"pid\"")
+    if not isinstance(table, dict):
+        raise ValueError(f"{where}: expected a table, got {type(table).__name__} {table!r}")
+    kind = table.get("kind")
+    if kind not in CONTROLLER_KINDS:
+        raise ValueError(f"{where}.kind: expected one of {', '.join(CONTROLLER_KINDS)}, got {kind!r}")
+    if kind not in AVAILABLE_CONTROLLERS:
+        raise ValueError(f"{where}.kind: {kind!r} is not yet available (it waits for the Jacobians and the "
+                         f"CasADi model of issue #19); available: {', '.join(AVAILABLE_CONTROLLERS)}")
+    _, gains_cls, gain_names = AVAILABLE_CONTROLLERS[kind]
+    _table(table, where, {"kind", "rate", "u_max", *gain_names})
+    rate = _real(table.get("rate", 50.0), f"{where}.rate", positive=True)
+    u_max = _real(table.get("u_max", DEFAULT_U_MAX), f"{where}.u_max", positive=True)
+    gains = gains_cls(**{k: _real(v, f"{where}.{k}", nonnegative=True)
+                         for k, v in table.items() if k in gain_names})
+    return kind, rate, u_max, gains
+
+
+def _parse_plant(table, params, source):
+    where = f"{source}: plant"
+    _table(table, where, set(PARAM_NAMES) | set(_NOISE_KEYS))
+    overrides = {k: _real(v, f"{where}.{k}") for k, v in table.items() if k in PARAM_NAMES}
+    try:
+        plant = dataclasses.replace(params, **overrides)
+    except ValueError as exc:
+        raise ValueError(f"{where}: {exc}") from None
+    noise = {}
+    for key, field in _NOISE_KEYS.items():
+        if key in table:
+            if key == "noise_seed":
+                if isinstance(table[key], bool) or not isinstance(table[key], int) or table[key] < 0:
+                    raise ValueError(f"{where}.{key}: expected a non-negative whole number, got {table[key]!r}")
+                noise[field] = table[key]
+            else:
+                noise[field] = _real(table[key], f"{where}.{key}", nonnegative=True)
+    return plant, Noise(**noise)

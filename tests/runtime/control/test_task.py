@@ -1,0 +1,55 @@
+"""Task files: the shipped ones load; every bad value is named."""
+import pytest
+
+from runtime.control.task import load_task, parse_task, shipped_tasks
+
+BASE = {"dt": 0.005, "duration": 1.0, "params": {"preset": "paper_simulation"},
+        "reference": {"kind": "speed", "speed": 0.3}, "controller": {"kind": "pid", "rate": 50.0}}
+
+
+def with_(section, **values):
+    data = {k: (dict(v) if isinstance(v, dict) else v) for k, v in BASE.items()}
+    data.setdefault(section, {}).update(values)
+    return data
+
+
+def test_the_six_tasks_of_issue_20_ship():
+    assert set(shipped_tasks()) >= {"speed-step", "heading-step", "line", "circle", "figure8", "square"}
+    for name in shipped_tasks():
+        assert load_task(name).controller_kind == "pid"
+
+
+@pytest.mark.parametrize("section, values, named", [
+    ("reference", {"kind": "spiral"}, "reference.kind"),
+    ("reference", {"kind": "circle"}, "reference.radius"),
+    ("reference", {"kind": "circle", "radius": -2.0}, "reference.radius"),
+    ("reference", {"speed": "fast"}, "reference.speed"),
+    ("reference", {"kind": "waypoints", "points": [[1.0]]}, "reference.points"),
+    ("reference", {"colour": 1}, "reference: unknown key"),
+    ("controller", {"kind": "nmpc"}, "controller.kind: 'nmpc' is not yet available"),
+    ("controller", {"kind": "lqr"}, "controller.kind: 'lqr' is not yet available"),
+    ("controller", {"rate": -5.0}, "controller.rate"),
+    ("controller", {"rate": 30.0}, "controller.rate"),
+    ("controller", {"u_max": 0.0}, "controller.u_max"),
+    ("controller", {"k_v": -1.0}, "controller.k_v"),
+    ("controller", {"gain": 1.0}, "controller: unknown key"),
+    ("plant", {"m_P": -1.0}, "plant"),
+    ("plant", {"noise_position_m": -0.1}, "plant.noise_position_m"),
+    ("plant", {"wheels": 4}, "plant: unknown key"),
+])
+def test_bad_values_are_named(section, values, named):
+    with pytest.raises(ValueError, match=named.replace(".", r"\.").replace("(", r"\(")):
+        parse_task(with_(section, **values), source="t.toml")
+
+
+def test_missing_reference_is_named():
+    data = dict(BASE)
+    del data["reference"]
+    with pytest.raises(ValueError, match="reference: missing"):
+        parse_task(data)
+
+
+def test_plant_overrides_change_only_the_plant():
+    task = parse_task(with_("plant", m_P=1.1, k_S=0.2))
+    assert task.plant_params.m_P == 1.1 and task.scenario.params.m_P == 1.0
+    assert task.plant_params.k_S == 0.2
