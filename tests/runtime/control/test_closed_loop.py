@@ -66,3 +66,30 @@ def test_mismatched_noisy_plant_still_tracks_the_speed():
     result, _, _ = run_task(task)
     v = forward_speed(result.trajectory[-200:], plant.r)
     assert abs(v.mean() - 0.3) < 0.03
+
+
+def test_the_shrinking_error_check_fails_for_a_controller_steering_the_wrong_way():
+    from runtime.control.pid import Pid
+
+    class WrongWay(Pid):
+        def compute(self, t, x, target):
+            u_Y, u_P = super().compute(t, x, target)
+            return u_Y, -u_P
+
+    task = short("heading-step", 8.0)
+    reference = task.reference()
+    from runtime.control.closed_loop import simulate_closed_loop
+    controller = WrongWay(task.scenario.params, rate=task.rate, u_max=task.u_max, gains=task.gains)
+    result = simulate_closed_loop(task.plant_params, controller, reference, task.scenario.x0, task.duration,
+                                  task.scenario.dt, task.scenario.method)
+    e = np.abs(wrap_angle(reference.heading - heading(result.trajectory)))
+    assert not e[-1] < 0.5 * e[0]
+
+
+def test_the_speed_check_fails_for_a_controller_without_its_speed_loop():
+    from runtime.control.pid import PidGains
+    task = short("speed-step", 6.0, gains=PidGains(k_v=0.0, k_vi=0.0))
+    result, _, metrics = run_task(task)
+    v = forward_speed(result.trajectory, 0.3)
+    assert metrics["speed_settle_s"] is None or metrics["speed_settle_s"] >= 5.0
+    assert not abs(v[-1] - 0.3) < 0.1 * abs(v[0] - 0.3)
