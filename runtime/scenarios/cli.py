@@ -24,11 +24,9 @@ import argparse
 import pathlib
 import sys
 
-from tqdm import tqdm
-
 from . import report
 from ..errors import KernelError, SimulationStopped
-from .parallel import write_runs
+from .parallel import RunBar, write_runs
 from .scenario import PAPER_SCENARIOS, load_scenario, run_scenario, scenario_path, shipped_scenarios
 
 
@@ -62,7 +60,7 @@ def simulate(scenario, args):
     """Simulate one loaded scenario (a passing progress bar for long runs); a guard's stop writes the
     partial outputs and raises Stopped, a kernel error raises ValueError naming the scenario."""
     folder = args.out / scenario.name
-    with tqdm(total=scenario.steps, desc=f"{scenario.name} (simulating)", unit="step", leave=False,
+    with RunBar(total=scenario.steps, desc=f"{scenario.name} (simulating)", unit="step", leave=False,
               disable=True if args.quiet else None, delay=1.0) as bar:
         try:
             return run_scenario(scenario, progress=lambda done, total: bar.update(done - bar.n))

@@ -22,6 +22,12 @@ from . import report
 _progress_queue = None     # set in each worker by _start_worker
 
 
+class RunBar(tqdm):
+    """tqdm without its monitor thread: the pool forks its workers, and a fork should copy no thread
+    that may hold a lock (tqdm's monitor only retunes the refresh rate of stalled bars)."""
+    monitor_interval = 0
+
+
 def _start_worker(progress_queue):
     global _progress_queue
     _progress_queue = progress_queue
@@ -67,7 +73,7 @@ def write_runs(runs, gif=True, replay=True, quiet=False, workers=None):
     # Longest first: the GIFs, then the replay pages, then the rest.
     order = {"robot.gif": 0, "replay.html": 1}
     tasks.sort(key=lambda task: order.get(task[1], 2))
-    bars = [tqdm(total=sum(report.progress_units(result, name) for name in names), desc=result.scenario.name,
+    bars = [RunBar(total=sum(report.progress_units(result, name) for name in names), desc=result.scenario.name,
                  position=run, leave=True, disable=True if quiet else None, unit="part", dynamic_ncols=True)
             for run, (result, _) in enumerate(runs)]
     seconds = [{} for _ in runs]

@@ -63,3 +63,28 @@ def test_progress_counts_every_frame_and_file(short_runs):
 def test_worker_count_is_at_least_one_and_at_most_one_per_task():
     assert parallel.worker_count(1) == 1
     assert 1 <= parallel.worker_count(100) <= 100
+
+
+def _threads_started_by(bar_class):
+    import os
+    import threading
+
+    before = {thread.ident for thread in threading.enumerate()}
+    with open(os.devnull, "w") as sink, bar_class(total=3, disable=False, file=sink) as bar:
+        bar.update(1)
+        return [thread for thread in threading.enumerate() if thread.ident not in before]
+
+
+def test_progress_bars_start_no_thread_that_the_pool_would_fork():
+    from tqdm import tqdm
+
+    assert _threads_started_by(parallel.RunBar) == []
+
+    class Monitored(tqdm):                 # plain tqdm, with a monitor slot of its own: it starts one
+        monitor = None
+
+    started = _threads_started_by(Monitored)
+    try:
+        assert len(started) == 1
+    finally:
+        Monitored.monitor.exit()
