@@ -132,19 +132,22 @@ def test_play_advances_and_pause_stops(page):
     from selenium.webdriver.common.by import By
     from selenium.webdriver.support.ui import Select
 
+    # The slowest speed, and checks that do not depend on how fast frames come: in software WebGL on a
+    # busy host a frame can take seconds, and the clock follows the wall, so at 5x a run played out
+    # between two of our checks.  At 0.25x even 60 s of delays move it by 15 s of the 90 s left.
     move_slider_to(page, 10.0)
-    Select(page.find_element(By.ID, "speed")).select_by_value("5")
+    Select(page.find_element(By.ID, "speed")).select_by_value("0.25")
     button = page.find_element(By.ID, "play")
     button.click()
-    assert wait_for(page, "return window.replay.playing && window.replay.time > 12")   # it plays ...
-    # Pause by a click from the page's own script: WebGL in software (SwiftShader) keeps a playing page so
-    # busy that a synthetic mouse click can arrive only after the run has played to its end.
+    assert wait_for(page, "return window.replay.playing && window.replay.time > 10")   # it plays ...
+    # Pause by a click from the page's own script: a playing page in software WebGL is so busy that a
+    # synthetic mouse click can arrive long after it was sent.
     page.execute_script("document.getElementById('play').click()")
     assert wait_for(page, "return !window.replay.playing")                            # ... and pauses
     paused_at = page.execute_script("return window.replay.time")
     time.sleep(0.5)
     assert page.execute_script("return window.replay.time") == paused_at
-    assert 12 < paused_at < 100
+    assert 10 < paused_at < 100
     assert browser.console_errors(page) == []
 
 
