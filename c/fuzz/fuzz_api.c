@@ -171,11 +171,11 @@ static void read_state(reader *r, sr_real radius, sr_real x[SR_NX])
     int i;
     for (i = 0; i < 3; ++i) w[i] = (sr_real)(3.2 * unit(r));
     if (sr_so3_exp(w, x) != SR_OK) abort();
-    rot_axis(0, 3.2 * unit(r), x + 9);
-    rot_axis(1, 3.2 * unit(r), x + 18);
-    x[27] = (sr_real)unit(r);
-    x[28] = (sr_real)unit(r);
-    x[29] = isfinite(radius) ? radius : SR_C(0.3);
+    rot_axis(0, 3.2 * unit(r), x + SR_X_R_Y);
+    rot_axis(1, 3.2 * unit(r), x + SR_X_R_P);
+    x[SR_X_q] = (sr_real)unit(r);
+    x[SR_X_q + 1] = (sr_real)unit(r);
+    x[SR_X_q + 2] = isfinite(radius) ? radius : SR_C(0.3);
     for (i = 30; i < SR_NX; ++i) x[i] = (sr_real)(speed * unit(r));
     for (i = 0; i < SR_NX; ++i) x[i] = pick(r, (double)x[i]);
 }
@@ -210,7 +210,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (!isfinite(model.c[i])) fail("sr_model_init", status, "non-finite constant with SR_OK");
     }
 
-    read_state(&rd, model.p[0], x);
+    read_state(&rd, model.p[SR_P_r], x);
     for (i = 0; i < MAX_STEPS * SR_NU; ++i) u[i] = pick(&rd, 0.3 * unit(&rd));
     u_or_null = read_u8(&rd) % 4 == 3 ? NULL : u;
     dt = pick(&rd, 0.002 + 0.05 * fabs(unit(&rd)));
@@ -241,7 +241,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     status = sr_equilibrium_residual(&model, x, arm(&g, SR_NV));
     EXPECT_STATUS("sr_equilibrium_residual", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION);
     expect("sr_equilibrium_residual", status, &g, status == SR_OK ? SR_NV : 0, 1);
-    status = sr_so3_exp(x + 30, arm(&g, 9));
+    status = sr_so3_exp(x + SR_X_w_S, arm(&g, 9));
     EXPECT_STATUS("sr_so3_exp", status, SR_OK, SR_ERR_NONFINITE);
     expect("sr_so3_exp", status, &g, status == SR_OK ? 9 : 0, 1);
 
