@@ -187,7 +187,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     reader rd = {data, size};
     sr_model model, fallback;
-    sr_real p[SR_NPARAM], x[SR_NX], x2[2 * SR_NX], u[MAX_STEPS * SR_NU], dt;
+    sr_real p[SR_NPARAM], raw_p[SR_NPARAM], x[SR_NX], x2[2 * SR_NX], u[MAX_STEPS * SR_NU], dt;
     const sr_real *u_or_null;
     static guarded g; /* static: too large for some stacks, and the harness is single-threaded */
     long done, row;
@@ -195,6 +195,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     /* sr_model_init: untouched on error */
     read_params(&rd, p);
+    memcpy(raw_p, p, sizeof p); /* the batch below gets them even when they are invalid */
     memset(&model, CANARY, sizeof model);
     status = sr_model_init(&model, p);
     EXPECT_STATUS("sr_model_init", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_PARAM, SR_ERR_SINGULAR);
@@ -330,6 +331,47 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (st.rows_done < 0 || st.rows_done > n_out + 1) fail("sr_simulate_adaptive", status, "rows_done out of range");
         if (status == SR_OK && st.rows_done != n_out + 1) fail("sr_simulate_adaptive", status, "rows_done short on success");
         expect("sr_simulate_adaptive", status, &g, (int)st.rows_done * SR_NX, 1);
+    }
+
+    /* sr_simulate_batch: sample 0 the model's parameters and x, sample 1 the raw fuzzed parameters
+     * and the perturbed second row of x2; every sample gets its own status, a failed sample's
+     * final row stays untouched, arguments are refused before any sample runs */
+    {
+        sr_real bp[2 * SR_NPARAM], work[5 * SR_NX], metrics[2 * SR_BATCH_NMETRICS];
+        int bstatus[2] = {-7, -7}, s;
+        long bdone[2] = {-7, -7};
+        const long chunk = (long)(read_u8(&rd) % 4) + 1; /* 1..4 steps per sr_simulate_guarded call */
+        const sr_real tol = pick(&rd, 0.5);
+        memcpy(bp, model.p, sizeof model.p);
+        memcpy(bp + SR_NPARAM, raw_p, sizeof raw_p);
+        status = sr_simulate_batch(method, 2, bp, SR_NPARAM, x2, SR_NX, dt, steps, u_or_null, 0, tol, chunk, work,
+                                   NULL, arm(&g, 2 * SR_NX), metrics, bstatus, bdone);
+        EXPECT_STATUS("sr_simulate_batch", status, SR_OK, SR_ERR_ARG);
+        for (i = 0; i < GUARD; ++i)
+            if (!is_canary(g.buf + i) || !is_canary(g.buf + GUARD + g.n + i))
+                fail("sr_simulate_batch", status, "wrote outside its buffer");
+        for (s = 0; s < 2; ++s) {
+            const sr_real *row_out = g.buf + GUARD + s * SR_NX;
+            if (status != SR_OK) {
+                if (bstatus[s] != -7 || !is_canary(row_out)) fail("sr_simulate_batch", status, "ran a sample after refusing");
+                continue;
+            }
+            EXPECT_STATUS("sr_simulate_batch sample", bstatus[s], SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                          SR_ERR_SINGULAR, SR_ERR_CONSTRAINT, SR_ERR_ENERGY, SR_ERR_PARAM);
+            if (bstatus[s] == SR_OK) {
+                if (bdone[s] != steps) fail("sr_simulate_batch", bstatus[s], "steps_done != steps on success");
+                for (i = 0; i < SR_NX; ++i)
+                    if (is_canary(row_out + i) || !isfinite(row_out[i])) fail("sr_simulate_batch", bstatus[s], "final row unwritten or not finite");
+                for (i = 0; i < SR_BATCH_NMETRICS; ++i)
+                    if (!isfinite(metrics[s * SR_BATCH_NMETRICS + i])) fail("sr_simulate_batch", bstatus[s], "non-finite metric");
+            } else {
+                /* steps_done = steps only when every step ran and the final energy overflowed */
+                const long most = bstatus[s] == SR_ERR_NONFINITE ? steps : (steps > 0 ? steps - 1 : 0);
+                if (bdone[s] < 0 || bdone[s] > most) fail("sr_simulate_batch", bstatus[s], "steps_done out of range");
+                for (i = 0; i < SR_NX; ++i)
+                    if (!is_canary(row_out + i)) fail("sr_simulate_batch", bstatus[s], "wrote a failed sample's final row");
+            }
+        }
     }
 
     /* NULL pointers */
