@@ -13,6 +13,7 @@ from ..params import Params
 from ..verification.sampling import random_inputs, random_states
 from .baselines import python_timings
 from .checks import WrongNumbers
+from .kane_compiled import kane_inputs as kane_coordinates, write_kane_c
 from .harness import ROOT, build_harness, casadi_reference_c, check_harness, run_harness
 from .report import format_report, write_results
 from .timing import cpu_name, pin_to_one_core
@@ -63,8 +64,12 @@ def run(args, core, progress):
             build = pathlib.Path(tmp)
             progress("generating the CasADi reference C and building the C loop")
             casadi_reference_c(params, build)
-            exe = build_harness(build, native=False, with_casadi=True)
-            result["c_loop"] = run_harness(exe, params, X, U, args.repeats)
+            kane, kane_inputs = None, None
+            if not args.no_kane:
+                progress("the Kane model as C: CasADi (ca.solve), SymPy's C printer and PyDy's C (generic LU)")
+                kane, kane_inputs = write_kane_c(build), kane_coordinates(X)
+            exe = build_harness(build, native=False, with_casadi=True, kane=kane)
+            result["c_loop"] = run_harness(exe, params, X, U, args.repeats, kane_inputs)
             check_harness(result["c_loop"], model, X, U)
             if args.native:
                 exe = build_harness(build, native=True, with_casadi=False)
