@@ -50,7 +50,7 @@ def lie_euler_loop(accel, x0, dt, u_prog, r):
 
 
 # -- Python-side timings -------------------------------------------------------------------------
-def call_overhead_timings(model, calls, min_seconds=0.05, rounds=11):
+def call_overhead_timings(model, calls, min_seconds=0.02, rounds=25):
     """One call from Python (issue 17, item 8): Model.accel and Model.step against the raw cffi call of
     the checked C function (sr_accel, sr_step) on buffers prepared beforehand, over the same states,
     their rounds interleaved (per_call_ns_interleaved), in ns.  The raw calls' outputs are checked first."""
