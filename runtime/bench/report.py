@@ -49,10 +49,12 @@ def targets(res):
     return out
 
 
-def format_report(res):
+def sections(res):
+    """The report's families as [(title, rows)], rows[0] the header: rendered as text (format_report)
+    and as the README's Markdown tables (format_markdown)."""
     c, py = res["c_loop"], res["python"]
     ours = c["accel"]["ns"]
-    lines = [f"CPU: {res.get('cpu', '?')}", "", "C against C (the C loop, no Python in the timed region)"]
+    out = []
     rows = [("quantity", "time", "vs our checked accel")]
     rows.append(("our accel, checked API", f"{ours:,.1f} ns", "1"))
     rows.append(("our accel, raw generated kernel", f"{c['accel_unchecked']['ns']:,.1f} ns", ""))
@@ -65,9 +67,8 @@ def format_report(res):
     for key, label in C_BASELINES:
         if key in c:
             rows.append((label, f"{c[key]['ns']:,.1f} ns", f"{c[key]['ns'] / ours:,.1f}x slower"))
-    lines += _table(rows)
+    out.append(("C against C (the C loop, no Python in the timed region)", rows))
 
-    lines += ["", "Python call against Python call (one call from Python, best of several rounds)"]
     mine = py["python_model_accel_ns"]
     rows = [("quantity", "time", "vs Model.accel"), ("Model.accel", f"{mine:,.0f} ns", "1")]
     if "raw_cffi_accel_ns" in py:
@@ -81,9 +82,8 @@ def format_report(res):
     for key, label in PYTHON_BASELINES:
         if key in py:
             rows.append((label, f"{py[key]:,.0f} ns", f"{py[key] / mine:,.1f}x slower"))
-    lines += _table(rows)
+    out.append(("Python call against Python call (one call from Python, best of several rounds)", rows))
 
-    lines += ["", "Batches (per state) and the t-shape run (10,000 steps, end to end from Python)"]
     batch = py["python_batch_accel_ns_per_state"]
     rows = [("quantity", "time", "ratio"), (f"Model.accel batch of {py['batch_size']:,}", f"{batch:,.1f} ns", "1")]
     if "python_batch_accel_first_call_ns_per_state" in py:
@@ -99,9 +99,28 @@ def format_report(res):
         for name, ms in py["lie_euler_loop_ms"].items():
             rows.append((f"t-shape {py['lie_euler_loop_steps']:,} steps, Lie-Euler in a Python loop, {name}",
                          f"{ms:,.1f} ms", f"{ms / ours_le:,.0f}x our C lie-euler"))
-    lines += _table(rows)
+    out.append(("Batches (per state) and the t-shape run (10,000 steps, end to end from Python)", rows))
+    return out
+
+
+def format_report(res):
+    c = res["c_loop"]
+    lines = [f"CPU: {res.get('cpu', '?')}"]
+    for title, rows in sections(res):
+        lines += ["", title, *_table(rows)]
     flops = c["accel_flops"]
     lines.append(f"\naccel: {flops} flops after CSE -> {flops / c['accel_unchecked']['ns']:.2f} GFLOP/s (raw kernel)")
+    lines.append("targets: " + "; ".join(f"{name}: {'met' if ok else 'MISSED'}" for name, ok in targets(res)))
+    return "\n".join(lines)
+
+
+def format_markdown(res):
+    """The families as Markdown tables, for the README (which quotes stored runs)."""
+    lines = []
+    for title, rows in sections(res):
+        lines += [f"**{title}**", "", "| " + " | ".join(rows[0]) + " |", "|---|---:|---:|"]
+        lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |" for row in rows[1:]]
+        lines.append("")
     lines.append("targets: " + "; ".join(f"{name}: {'met' if ok else 'MISSED'}" for name, ok in targets(res)))
     return "\n".join(lines)
 
