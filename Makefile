@@ -43,7 +43,7 @@ figures: $(STAMP)
 
 # Every controller on every benchmark task: out/control/table.md, table.csv, a folder per run (docs/control.md).
 control: $(STAMP)
-	$(PY) -m runtime.control.benchmark --out out/control
+	$(PY) -m runtime control --out out/control
 
 # The envelope of docs/control.md (prints its numbers, rewrites docs/figures/control-envelope.png).
 envelope: $(STAMP)

@@ -10,6 +10,7 @@ COMMANDS = {
     "bench": ("runtime.bench.cli", "benchmarks against the alternatives"),
     "figures": ("runtime.scenarios.figures", "regenerate the committed figures under docs/figures/"),
     "sweep": ("runtime.sweep.cli", "many runs of a scenario with varied inputs, on Dask (results in Parquet)"),
+    "control": ("runtime.control.benchmark", "closed-loop benchmark: every controller on every task (make control)"),
     "soak": ("runtime.verification.soak", "10^7 steps from random states: constraint and energy drift (not a unit test)"),
 }
 

@@ -1,10 +1,13 @@
 """`make control`: every available controller on every shipped task; one table (Markdown and CSV),
 a folder per run with summary.json (metrics under `tracking`) and figures.
 
-    python -m runtime.control.benchmark [--out out/control] [--tasks circle,line]
+    python -m runtime control [--out out/control] [--tasks circle,line] [--duration S]
+
+`--duration` cuts every task short (a smoke run; the table then says so).
 """
 import argparse
 import csv
+import dataclasses
 import json
 import platform
 import subprocess
@@ -49,11 +52,17 @@ def main(argv=()):
     parser = argparse.ArgumentParser(prog="python -m runtime.control.benchmark")
     parser.add_argument("--out", default="out/control")
     parser.add_argument("--tasks", default=",".join(shipped_tasks()))
+    parser.add_argument("--duration", type=float, default=None, help="cut every task to this many seconds")
     args = parser.parse_args(list(argv))
+    if args.duration is not None and not args.duration > 0:
+        parser.error(f"--duration: must be > 0 s, got {args.duration:g}")
     out = pathlib.Path(args.out)
     rows = []
     for name in tqdm(args.tasks.split(","), unit="task"):
         task = load_task(name)
+        if args.duration is not None:
+            steps = max(1, round(min(args.duration, task.duration) / task.scenario.dt))
+            task = dataclasses.replace(task, scenario=dataclasses.replace(task.scenario, steps=steps))
         result, reference, metrics = run_task(task)
         folder = out / f"{name}-{task.controller_kind}"
         folder.mkdir(parents=True, exist_ok=True)
@@ -65,7 +74,8 @@ def main(argv=()):
     header = ["task", "controller", *COLUMNS]
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join([r["task"], r["controller"]] + [_fmt(r[c]) for c in COLUMNS]) + " |" for r in rows]
-    table = "\n".join(lines) + f"\n\nCPU: {cpu_name()}\n"
+    cut = "" if args.duration is None else f" Every task cut to at most {args.duration:g} s (smoke run)."
+    table = "\n".join(lines) + f"\n\nCPU: {cpu_name()}.{cut}\n"
     write_text(out / "table.md", table)
     with atomic_path(out / "table.csv") as tmp, open(tmp, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=header)
