@@ -1,12 +1,15 @@
 /* bench_kernels.c -- times the kernels in a C loop (no Python in the timed region).
  *
  * usage: bench_kernels INPUT.bin REPEATS
- * INPUT.bin: int32 n, then params[12], states[n][35], inputs[n][2] (float64).
+ * INPUT.bin: int32 n, then params[12], states[n][35], inputs[n][2] (float64); with -DWITH_KANE
+ * also kane[n][12], each state in the Kane model's coordinates (runtime/bench/kane_compiled.py).
  * Prints one JSON object: ns per call of each kernel (best of 11 rounds, each kernel timed
  * once per round over REPEATS sweeps of the n states, after a 0.3 s warm-up) and the outputs for the first 8 states, which the
  * Python driver checks against the reference before reporting any time.
  * Built by runtime/bench/harness.py; with -DWITH_CASADI the CasADi-generated reference
- * (ref_accel.c, written by the driver) is timed too.
+ * (ref_accel.c, written by the driver) is timed too; with -DWITH_KANE the Kane model compiled
+ * three ways (kane_baselines.h: CasADi's C with ca.solve, SymPy's C printer and PyDy's C, both
+ * with a generic LU).
  */
 #define _POSIX_C_SOURCE 199309L
 #include "spherical_robot.h"
@@ -17,6 +20,9 @@
 
 #ifdef WITH_CASADI
 #include "ref_accel.h"
+#endif
+#ifdef WITH_KANE
+#include "kane_baselines.h"
 #endif
 
 #define NMAX 4096
@@ -39,6 +45,13 @@ static int k_accel(const sr_model *m, int i, int arg) { (void)arg; return sr_acc
 static int k_gen_accel(const sr_model *m, int i, int arg) { (void)arg; return sr_gen_accel(m->c, X[i], U[i], OUT[i]); }
 static int k_inertia(const sr_model *m, int i, int arg) { (void)arg; return sr_inertia(m, X[i], OUT[i]); }
 static int k_step(const sr_model *m, int i, int method) { return sr_step(m, method, X[i], U[i], 0.01, OUT[i]); }
+
+#ifdef WITH_KANE
+static double KANE[NMAX][12], KANE_P[SR_NPARAM];
+static int k_kane_casadi(const sr_model *m, int i, int arg) { (void)m; (void)arg; return kane_casadi_c(KANE[i], U[i], KANE_P, OUT[i]); }
+static int k_kane_sympy(const sr_model *m, int i, int arg) { (void)m; (void)arg; return kane_sympy_c(KANE[i], U[i], KANE_P, OUT[i]); }
+static int k_kane_pydy(const sr_model *m, int i, int arg) { (void)m; (void)arg; return kane_pydy_c(KANE[i], U[i], KANE_P, OUT[i]); }
+#endif
 
 #ifdef WITH_CASADI
 static casadi_int iw[4096];
@@ -108,12 +121,19 @@ int main(int argc, char **argv)
     FILE *f;
     int n, repeats;
     sr_real p[SR_NPARAM];
+#ifdef WITH_KANE
+    int n_p;
+#endif
     if (argc != 3) { fprintf(stderr, "usage: %s INPUT.bin REPEATS\n", argv[0]); return 2; }
     f = fopen(argv[1], "rb");
     if (!f || fread(&n, sizeof n, 1, f) != 1 || n < 1 || n > NMAX) { fprintf(stderr, "bad input\n"); return 2; }
     if (fread(p, sizeof(sr_real), SR_NPARAM, f) != SR_NPARAM
         || fread(X, sizeof(sr_real) * SR_NX, (size_t)n, f) != (size_t)n
         || fread(U, sizeof(sr_real) * SR_NU, (size_t)n, f) != (size_t)n) { fprintf(stderr, "short input\n"); return 2; }
+#ifdef WITH_KANE
+    if (fread(KANE, sizeof(double) * 12, (size_t)n, f) != (size_t)n) { fprintf(stderr, "short input\n"); return 2; }
+    for (n_p = 0; n_p < SR_NPARAM; ++n_p) KANE_P[n_p] = (double)p[n_p];
+#endif
     fclose(f);
     repeats = atoi(argv[2]);
     if (sr_model_init(&model, p) != SR_OK) { fprintf(stderr, "bad params\n"); return 2; }
@@ -135,6 +155,11 @@ int main(int argc, char **argv)
             {k_step, SR_CF4, SR_NX, 1, "step_cf4", 0},
 #ifdef WITH_CASADI
             {k_casadi, 0, SR_NV, 10, "casadi_generated_reference_accel", 0},
+#endif
+#ifdef WITH_KANE
+            {k_kane_casadi, 0, SR_NV, 4, "kane_casadi_c_accel", 0},
+            {k_kane_sympy, 0, SR_NV, 4, "kane_sympy_c_accel", 0},
+            {k_kane_pydy, 0, SR_NV, 4, "kane_pydy_c_accel", 0},
 #endif
         };
         const int ncases = (int)(sizeof cases / sizeof cases[0]);

@@ -1,6 +1,10 @@
 """cffi builder for `bindings._sr`: compiles generated/ and c/ into one extension module."""
 import os
 import pathlib
+import re
+import shlex
+import subprocess
+import sysconfig
 
 import cffi
 
@@ -9,74 +13,72 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 SOURCES = sorted(str(p.relative_to(ROOT)) for d in ("generated", "c") for p in (ROOT / d).glob("*.c"))
 INCLUDE_DIRS = ["generated", "c"]
 
-# The double build of c/spherical_robot.h, as cffi's parser needs it (no preprocessor).
-CDEF = """
-#define SR_NPARAM 12
-#define SR_NX 35
-#define SR_NU 2
-#define SR_NV 5
-#define SR_OK 0
-#define SR_ERR_NULL 1
-#define SR_ERR_NONFINITE 2
-#define SR_ERR_NOT_ROTATION 3
-#define SR_ERR_SINGULAR 4
-#define SR_ERR_PARAM 5
-#define SR_ERR_ARG 6
-#define SR_ERR_CONSTRAINT 7
-#define SR_ERR_STEP_SIZE 8
-#define SR_ERR_MAX_STEPS 9
-#define SR_ERR_ENERGY 10
-#define SR_GUARD_INTERVAL 16
-#define SR_LIE_EULER 0
-#define SR_RKMK4 1
-#define SR_CF4 2
-#define SR_PROJECT 16
-typedef double sr_real;
-static const double SR_ROTATION_TOL;
-typedef struct sr_model { ...; } sr_model;
-const char *sr_status_string(int status);
-int sr_model_init(sr_model *model, const sr_real params[]);
-int sr_check_state(const sr_model *model, const sr_real x[]);
-int sr_check_state_batch(const sr_model *model, long n, const sr_real *x, long *failed_row);
-int sr_accel(const sr_model *model, const sr_real x[], const sr_real u[], sr_real a[]);
-int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real *a, long *failed_row);
-int sr_inertia(const sr_model *model, const sr_real x[], sr_real M[]);
-int sr_rhs(const sr_model *model, const sr_real x[], const sr_real u[], sr_real f[]);
-int sr_energy(const sr_model *model, const sr_real x[], sr_real *energy);
-int sr_equilibrium_residual(const sr_model *model, const sr_real x[], sr_real res[]);
-int sr_so3_exp(const sr_real w[], sr_real R[]);
-int sr_step(const sr_model *model, int method, const sr_real x[], const sr_real u[], sr_real dt, sr_real x_next[]);
-int sr_simulate(const sr_model *model, int method, const sr_real x0[], sr_real dt, long steps,
-                const sr_real *u, sr_real *traj, long *steps_done);
-typedef struct sr_energy_guard {
-    sr_real tol;
-    int in_stretch;
-    sr_real e_start;
-    sr_real scale;
-    sr_real energy;
-} sr_energy_guard;
-int sr_simulate_guarded(const sr_model *model, int method, const sr_real x0[], sr_real dt, long steps,
-                        const sr_real *u, sr_energy_guard *guard, sr_real *traj, long *steps_done);
-typedef struct sr_adaptive_stats {
-    long accepted;
-    long rejected;
-    long evaluations;
-    long rows_done;
-    sr_real h_next;
-} sr_adaptive_stats;
-int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[], sr_real dt_out,
-                         long n_out, const sr_real *u, sr_real rtol, sr_real atol, sr_real h_init,
-                         long max_steps, sr_real *traj, sr_adaptive_stats *stats);
-#define SR_BATCH_NMETRICS 4
-#define SR_BATCH_PATH_LENGTH 0
-#define SR_BATCH_MAX_DISTANCE 1
-#define SR_BATCH_MAX_SHELL_RATE 2
-#define SR_BATCH_FINAL_ENERGY 3
-int sr_simulate_batch(int method, long n, const sr_real *params, long params_stride, const sr_real *x0,
-                      long x0_stride, sr_real dt, long steps, const sr_real *u, long u_stride,
-                      sr_real energy_tol, long chunk_steps, sr_real *work, sr_real *traj,
-                      sr_real *x_final, sr_real *metrics, int *status, long *steps_done);
-"""
+HEADER = ROOT / "c" / "spherical_robot.h"
+
+
+def compiler():
+    """The C compiler that setuptools will use for the extension (CC, else Python's own)."""
+    return shlex.split(os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc")
+
+
+def preprocessed_header():
+    """(file, line) pairs of the double build of c/spherical_robot.h after the C preprocessor,
+    the #define lines kept in place (-dD); file is the header each line comes from."""
+    out = subprocess.run([*compiler(), "-E", "-dD", "-std=c99", f"-I{ROOT / 'c'}", f"-I{ROOT / 'generated'}",
+                          "-x", "c", str(HEADER)], check=True, capture_output=True, text=True).stdout
+    current, lines = None, []
+    for line in out.splitlines():
+        marker = re.match(r'# \d+ "([^"]+)"', line)
+        if marker:
+            current = marker.group(1)
+        elif line.strip():
+            lines.append((current, line))
+    return lines
+
+
+_INT = re.compile(r"^\(?\s*([-+]?(?:0[xX][0-9a-fA-F]+|\d+))[uUlL]*\s*\)?$")
+_FLOAT = re.compile(r"^\(?\s*(?:SR_C\()?\s*[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?[fFlL]?\s*\)?\s*\)?$")
+
+
+def header_cdef():
+    """The cdef cffi needs, read from the checked-in headers (no hand copy): the declarations
+    of c/ and generated/ as the preprocessor leaves them, every object-like SR_* macro whose
+    value is an integer (directly or through other macros: SR_NX -> SR_GEN_NX -> 35) as a
+    #define, and every one whose value is a floating literal (SR_ROTATION_TOL) as a
+    `static const double` that cffi reads from the compiled module."""
+    ours = {str(d) for d in (ROOT / "c", ROOT / "generated")}
+    macros, declarations = {}, []
+    for path, line in preprocessed_header():
+        if not path or not any(os.path.abspath(path).startswith(d) for d in ours):
+            continue
+        define = re.match(r"#define (SR_\w+)(\(?)\s*(.*)$", line)
+        if define:
+            name, function_like, body = define.groups()
+            if not function_like:
+                macros[name] = body.strip()
+        elif not line.startswith("#"):
+            declarations.append(line)
+
+    def integer(name, seen=()):
+        body = macros.get(name)
+        if body is None or name in seen:
+            return None
+        literal = _INT.match(body)
+        if literal:
+            return int(literal.group(1), 0)
+        return integer(body, seen + (name,)) if re.fullmatch(r"SR_\w+", body) else None
+
+    defines, constants = [], []
+    for name, body in macros.items():
+        value = integer(name)
+        if value is not None:
+            defines.append(f"#define {name} {value}")
+        elif _FLOAT.match(body):
+            constants.append(f"static const double {name};")
+    return "\n".join(defines + constants + declarations) + "\n"
+
+
+CDEF = header_cdef()
 
 # The single-state entry points of the Python API (runtime/model.py, `Model.accel` and `Model.step`
 # on one state): the full state check and the kernel in one C call, so that a call from Python
@@ -107,12 +109,8 @@ static int sr_py_step(const sr_model *model, int method, const void *x, const vo
 # runs only if it is built with the same flag).
 NATIVE = ["-march=native"] if os.environ.get("SR_NATIVE") == "1" else []
 
-# The layout macros (SR_X_*, SR_U_*, SR_P_*) as the generator wrote them.
-LAYOUT = "\n".join(line for line in (ROOT / "generated" / "sr_generated.h").read_text().splitlines()
-                   if line.startswith(("#define SR_X_", "#define SR_U_", "#define SR_P_")))
-
 ffibuilder = cffi.FFI()
-ffibuilder.cdef(CDEF + LAYOUT + PY_ENTRIES_CDEF)
+ffibuilder.cdef(CDEF + PY_ENTRIES_CDEF)
 ffibuilder.set_source(
     "bindings._sr",
     '#include "spherical_robot.h"\n' + PY_ENTRIES_SOURCE,

@@ -4,8 +4,10 @@
  * Model: S. Fiori (2024), "Lie-group modeling and simulation of a spherical
  * robot, actuated by a yoke-pendulum system, rolling over a flat surface
  * without slipping".  The equations are derived symbolically in derive/ and
- * emitted to generated/sr_generated.c; this header and c/sr_runtime.c add
- * input checks, the SO(3) exponential and the time steppers.
+ * emitted to generated/sr_generated.c; this header and the hand-written c/sr_*.c add
+ * input checks, the SO(3) exponential and the time steppers (c/sr_model.c: status strings,
+ * parameter rules, model; c/sr_checks.c: state checks; c/sr_kernels.c: the checked kernels;
+ * c/sr_steppers.c: every stepper; c/sr_drivers.c: the simulation loops).
  *
  * Self-contained C99: no dynamic allocation, no mutable globals, every
  * function is re-entrant, every buffer is provided by the caller, every
@@ -15,11 +17,13 @@
  *
  * Units and frames (SI throughout):
  *   params  [SR_NPARAM] = (r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g)
+ *           (index of each: SR_P_r ... SR_P_g in sr_generated.h)
  *           r shell radius [m], m_S shell mass [kg], b, h yoke sides [m]
  *           (b-rods along y, h-rods along x), m_b, m_h rod masses [kg],
  *           l pendulum length [m], m_P pendulum mass [kg], g gravity [m/s^2],
  *           k_S, k_Y, k_P physical damping [N m s/rad]: torque -k*omega.
- *   x       [SR_NX] = 35 state entries:
+ *   x       [SR_NX] = 35 state entries (offset of each block: SR_X_R_S ... SR_X_w_P in
+ *           sr_generated.h):
  *           x[0..8]   R_S row-major, shell frame -> inertial frame
  *           x[9..17]  R_Y row-major, yoke relative to shell, rotation about x
  *           x[18..26] R_P row-major, pendulum relative to yoke, rotation about y
@@ -45,6 +49,8 @@ extern "C" {
  * buffer, and one program can link both builds. */
 #ifdef SR_USE_FLOAT
 #define sr_status_string sr_status_string_f
+#define sr_param_rule_string sr_param_rule_string_f
+#define sr_check_params sr_check_params_f
 #define sr_model_init sr_model_init_f
 #define sr_check_state sr_check_state_f
 #define sr_check_state_batch sr_check_state_batch_f
@@ -56,6 +62,9 @@ extern "C" {
 #define sr_equilibrium_residual sr_equilibrium_residual_f
 #define sr_so3_exp sr_so3_exp_f
 #define sr_step sr_step_f
+#define sr_step_lie_euler sr_step_lie_euler_f
+#define sr_step_rkmk4 sr_step_rkmk4_f
+#define sr_step_cf4 sr_step_cf4_f
 #define sr_simulate sr_simulate_f
 #define sr_simulate_guarded sr_simulate_guarded_f
 #define sr_simulate_adaptive sr_simulate_adaptive_f
@@ -94,7 +103,7 @@ extern "C" {
 
 /* Time-stepping methods. */
 #define SR_LIE_EULER 0         /* the paper's eq. (111), first order */
-/* Fourth-order Lie-group methods (c/sr_lie_integrators.c).  Both advance the state on
+/* Fourth-order Lie-group methods (c/sr_steppers.c).  Both advance the state on
  * SO(3) x SO(2)_x x SO(2)_y x R^3 x R^5: R_S by right multiplication with Exp of an so(3)
  * element, R_Y and R_P by exact rotations about x and y, q and nu additively.  The torque u
  * is held constant over the step; q is a stage variable like every other (order 4 overall).
@@ -121,8 +130,27 @@ typedef struct sr_model {
 /* Human-readable name of a status code (static string, never NULL). */
 const char *sr_status_string(int status);
 
-/* Validate params (all finite; r, m_S, b, h, m_b, m_h, l, m_P > 0; k_S, k_Y, k_P, g >= 0;
- * yoke half-diagonal sqrt(b^2+h^2)/2 <= r and l <= r) and fill *model.  The derived
+/* The rules a parameter vector must obey, in the order sr_check_params tests them. */
+#define SR_PARAM_RULE_NONE 0         /* no rule broken */
+#define SR_PARAM_RULE_FINITE 1       /* every parameter finite */
+#define SR_PARAM_RULE_POSITIVE 2     /* r, m_S, b, h, m_b, m_h, l, m_P > 0 */
+#define SR_PARAM_RULE_NONNEGATIVE 3  /* k_S, k_Y, k_P, g >= 0 */
+#define SR_PARAM_RULE_YOKE_FITS 4    /* yoke half-diagonal sqrt(b^2 + h^2)/2 <= r */
+#define SR_PARAM_RULE_PENDULUM_FITS 5 /* l <= r */
+
+/* The one place that decides whether params are in their physical range (sr_model_init and
+ * the Python runtime's Params call it).  Tests the rules above in order and, for the first
+ * one broken, writes its SR_PARAM_RULE_* code to *rule and the index (SR_P_*) of the first
+ * parameter that breaks it to *bad_index (for the yoke rule SR_P_b, for the pendulum rule
+ * SR_P_l); with every rule kept, SR_PARAM_RULE_NONE and -1.  bad_index and rule may be NULL.
+ * Returns SR_OK, SR_ERR_NULL (params), SR_ERR_NONFINITE (rule FINITE) or SR_ERR_PARAM. */
+int sr_check_params(const sr_real params[SR_NPARAM], int *bad_index, int *rule);
+
+/* The text of a rule of sr_check_params ("must be > 0", ...; static string, never NULL). */
+const char *sr_param_rule_string(int rule);
+
+/* Validate params (sr_check_params: all finite; r, m_S, b, h, m_b, m_h, l, m_P > 0; k_S, k_Y,
+ * k_P, g >= 0; yoke half-diagonal sqrt(b^2+h^2)/2 <= r and l <= r) and fill *model.  The derived
  * constants, M and the energy at the reference state (R_S = R_Y = R_P = I, q = (0, 0, r), at
  * rest) must be finite (else SR_ERR_PARAM: a value so large that it overflows), and M there
  * positive definite (else SR_ERR_SINGULAR: values so small that the inertias underflow).
@@ -175,6 +203,18 @@ int sr_so3_exp(const sr_real w[3], sr_real R[9]);
  * on SR_OK (a non-finite new state gives SR_ERR_NONFINITE). */
 int sr_step(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
             sr_real dt, sr_real x_next[SR_NX]);
+
+/* sr_step with the method fixed (no projection): the same bits and status codes as
+ * sr_step(model, SR_LIE_EULER / SR_RKMK4 / SR_CF4, ...), to which sr_step dispatches.  Each one
+ * reaches only its own method's code: a firmware that calls sr_step_lie_euler alone (and
+ * neither sr_step nor the drivers), compiled with -ffunction-sections and linked with
+ * --gc-sections, links no fourth-order code (docs/embedding.md). */
+int sr_step_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+                      sr_real x_next[SR_NX]);
+int sr_step_rkmk4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+                  sr_real x_next[SR_NX]);
+int sr_step_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+                sr_real x_next[SR_NX]);
 
 /* steps steps of size dt from x0: traj[(steps+1) x SR_NX] receives x0 and every state after;
  * u is steps x SR_NU (torque held over each step) or NULL.  x0 gets the full check
@@ -277,7 +317,9 @@ int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[SR_
  *   x_final  n x SR_NX: the state after the last step
  *   metrics  n x SR_BATCH_NMETRICS: the summary metrics above, over rows 0..steps
  *   status   n: the status of each sample: SR_OK, or the error of sr_model_init (its
- *            parameters), sr_check_state (its x0) or sr_simulate_guarded (its run)
+ *            parameters), sr_check_state (its x0), sr_simulate_guarded (its run) or
+ *            sr_energy (SR_ERR_NONFINITE with steps_done = steps: every step ran, but the final
+ *            energy overflowed, so the sample has no finite metrics)
  *   steps_done n: the steps completed before the sample stopped (steps on SR_OK)
  * One failing sample never touches another's outputs; its own x_final and metrics rows are
  * left untouched.  status[i] and steps_done[i] are written when sample i is finished, in

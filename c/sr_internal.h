@@ -1,10 +1,17 @@
 /*
- * sr_internal.h -- helpers shared by the hand-written C files (sr_runtime.c,
- * sr_lie_integrators.c).  Internal to the library: not part of the public API
- * of spherical_robot.h, and not seen by the cffi bindings.
+ * sr_internal.h -- helpers shared by the hand-written C files.  Internal to the library: not
+ * part of the public API of spherical_robot.h, and not seen by the cffi bindings.
  *
- * Everything here is static inline (no code unless used) or a declaration of
- * an internal stepper; no globals.
+ * The files and who calls whom (no file calls a file above it, so there is no call cycle):
+ *     sr_drivers.c   sr_simulate, sr_simulate_guarded, sr_simulate_adaptive
+ *       -> sr_steppers.c  every stepper (Lie-Euler, RKMK4, CF4) on one vector field, projection
+ *       -> sr_checks.c    sr_check_state (full state check)
+ *     sr_kernels.c   the checked wrappers of the generated kernels, sr_so3_exp
+ *     sr_model.c     sr_status_string, sr_check_params, sr_model_init
+ * and all of them -> generated/sr_generated.c and the inline helpers below.
+ *
+ * Everything here is static inline (no code unless used) or a declaration of an internal
+ * function of sr_steppers.c; no globals.
  */
 #ifndef SR_INTERNAL_H
 #define SR_INTERNAL_H
@@ -35,9 +42,6 @@
 #error "generated status codes differ from spherical_robot.h"
 #endif
 
-/* Offsets of the blocks of the state x (see spherical_robot.h). */
-enum { RS = 0, RY = 9, RP = 18, Q = 27, W = 30 };
-
 /* Sum in four lanes (a short chain of additions per lane).  A NaN or an infinity anywhere makes
  * the sum non-finite; so can finite entries that overflow.  The lanes are an array indexed in an
  * inner loop, the form compilers turn into plain vertical vector additions: with four named
@@ -67,27 +71,30 @@ static inline int all_finite(const sr_real *v, int n)
 
 static inline int near(sr_real a, sr_real b) { return SR_FABS(a - b) <= SR_ROTATION_TOL; }
 
+/* Zero torque, for the callers that pass u = NULL. */
+static const sr_real sr_zero_u[SR_NU] = {0, 0};
+
 /* Checks before every kernel call: all of x (and u, if given) finite; gamma = third row of
  * R_S of unit length; the cos/sin entries of R_Y and R_P of unit length.  The full structure
  * check is sr_check_state. */
 static inline int checks(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU])
 {
-    const sr_real *gam = x + RS + 6;
+    const sr_real *gam = x + SR_X_R_S + 6;
     sr_real sum, worst, defect;
     if (!model || !x) return SR_ERR_NULL;
     /* Fast path, one branch: the sum of all entries finite and the largest unit-length defect
      * within tolerance (a NaN fails both tests).  Anything else is sorted out below, in order. */
     sum = lane_sum(x, SR_NX) + (u ? u[0] + u[1] : 0);
     worst = SR_FABS(gam[0] * gam[0] + gam[1] * gam[1] + gam[2] * gam[2] - 1);
-    defect = SR_FABS(x[RY + 4] * x[RY + 4] + x[RY + 7] * x[RY + 7] - 1);
+    defect = SR_FABS(x[SR_X_R_Y + 4] * x[SR_X_R_Y + 4] + x[SR_X_R_Y + 7] * x[SR_X_R_Y + 7] - 1);
     worst = defect > worst ? defect : worst;
-    defect = SR_FABS(x[RP + 0] * x[RP + 0] + x[RP + 2] * x[RP + 2] - 1);
+    defect = SR_FABS(x[SR_X_R_P + 0] * x[SR_X_R_P + 0] + x[SR_X_R_P + 2] * x[SR_X_R_P + 2] - 1);
     worst = defect > worst ? defect : worst;
     if (isfinite(sum) && worst <= SR_ROTATION_TOL) return SR_OK;
     if (!all_finite(x, SR_NX) || (u && !all_finite(u, SR_NU))) return SR_ERR_NONFINITE;
     if (!near(gam[0] * gam[0] + gam[1] * gam[1] + gam[2] * gam[2], 1)) return SR_ERR_NOT_ROTATION;
-    if (!near(x[RY + 4] * x[RY + 4] + x[RY + 7] * x[RY + 7], 1)) return SR_ERR_NOT_ROTATION;
-    if (!near(x[RP + 0] * x[RP + 0] + x[RP + 2] * x[RP + 2], 1)) return SR_ERR_NOT_ROTATION;
+    if (!near(x[SR_X_R_Y + 4] * x[SR_X_R_Y + 4] + x[SR_X_R_Y + 7] * x[SR_X_R_Y + 7], 1)) return SR_ERR_NOT_ROTATION;
+    if (!near(x[SR_X_R_P + 0] * x[SR_X_R_P + 0] + x[SR_X_R_P + 2] * x[SR_X_R_P + 2], 1)) return SR_ERR_NOT_ROTATION;
     return SR_OK;
 }
 
@@ -151,24 +158,59 @@ static inline void rotate_about_axis(const sr_real *R, int k, sr_real angle, sr_
     matmul3(R, E, out);
 }
 
+/* Copy n results from tmp to out when the computation succeeded and they are all finite:
+ * outputs are either fully written and finite or untouched.  (The generated kernels do the
+ * same themselves: they write only on SR_GEN_OK, and return SR_GEN_NONFINITE, equal to
+ * SR_ERR_NONFINITE, when a result is not finite.) */
+static inline int deliver(int status, const sr_real *tmp, int n, sr_real *out)
+{
+    int i;
+    if (status != SR_OK) return status;
+    if (!all_finite(tmp, n)) return SR_ERR_NONFINITE;
+    for (i = 0; i < n; ++i) out[i] = tmp[i];
+    return SR_OK;
+}
+
+/* ---- sr_steppers.c, for the drivers of sr_drivers.c ---------------------------------------- */
 #ifdef SR_USE_FLOAT /* float symbols carry _f, as in spherical_robot.h */
-#define sr_internal_rkmk4_step sr_internal_rkmk4_step_f
-#define sr_internal_cf4_step sr_internal_cf4_step_f
+#define sr_internal_valid_method sr_internal_valid_method_f
+#define sr_internal_advance sr_internal_advance_f
+#define sr_internal_vector_field sr_internal_vector_field_f
+#define sr_internal_rkmk4_core sr_internal_rkmk4_core_f
+#define sr_internal_dexpinv sr_internal_dexpinv_f
 #define sr_internal_project sr_internal_project_f
 #endif
 
-/* One step of the Lie-group methods of sr_lie_integrators.c, without argument checks
- * (sr_step/sr_simulate check first).  u must not be NULL; out may alias x.  comp: NULL for a
- * single step, or the running Kahan compensation of a simulation (SR_NX entries, zero at its
- * start), updated only when the step succeeds. */
-int sr_internal_rkmk4_step(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                           sr_real dt, sr_real *comp, sr_real out[SR_NX]);
-int sr_internal_cf4_step(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                         sr_real dt, sr_real *comp, sr_real out[SR_NX]);
+/* A Lie-algebra element ("tangent coordinates") of the state's group, 13 numbers:
+ * [th_S (3) | th_Y | th_P | th_q (3) | th_nu (5)] (see the top of sr_steppers.c). */
+enum { SR_T_S = 0, SR_T_Y = 3, SR_T_P = 4, SR_T_Q = 5, SR_T_V = 8, SR_NT = 13 };
 
-/* The optional correction of SR_PROJECT (sr_lie_integrators.c): one Newton-Schulz step
- * R <- R (3I - R^T R)/2 towards the nearest rotation for R_S, the same on the (cos, sin) pair
- * of R_Y and R_P. */
+/* Nonzero if method is SR_LIE_EULER, SR_RKMK4 or SR_CF4, optionally | SR_PROJECT. */
+int sr_internal_valid_method(int method);
+
+/* One step of any valid method without argument checks (sr_step/sr_simulate check first);
+ * u must not be NULL; out may alias x.  comp: NULL for a single step, or the running Kahan
+ * compensation of a simulation (SR_NX entries, zero at its start) for the fourth-order
+ * methods, updated only when the step succeeds (Lie-Euler stays the paper's plain eq. (111)). */
+int sr_internal_advance(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                        sr_real dt, sr_real *comp, sr_real out[SR_NX]);
+
+/* f = the velocity of the state in the Lie algebra (SR_NT entries); counts the acceleration
+ * evaluations in *evaluations (if not NULL). */
+int sr_internal_vector_field(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                             sr_real f[SR_NT], long *evaluations);
+
+/* The stages of RKMK4 from K[0] = f(x) (filled by the caller): K[1..3] and the final Theta;
+ * out = x . exp(Theta) (out must not alias x). */
+int sr_internal_rkmk4_core(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
+                           sr_real K[4][SR_NT], sr_real theta[SR_NT], sr_real *comp, sr_real out[SR_NX],
+                           long *evaluations);
+
+/* k = dexp^{-1}_{-th}(f) (k may alias f). */
+void sr_internal_dexpinv(const sr_real th[SR_NT], const sr_real f[SR_NT], sr_real k[SR_NT]);
+
+/* The optional correction of SR_PROJECT: one Newton-Schulz step R <- R (3I - R^T R)/2 towards
+ * the nearest rotation for R_S, the same on the (cos, sin) pair of R_Y and R_P. */
 void sr_internal_project(sr_real x[SR_NX]);
 
 #endif /* SR_INTERNAL_H */

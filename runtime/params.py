@@ -1,13 +1,27 @@
-"""Robot parameters by the paper's names (Section 5.2), physical SI units."""
+"""Robot parameters by the paper's names (Section 5.2), physical SI units.
+
+The C library decides which values are valid (sr_check_params, the same function
+sr_model_init calls): Params asks it, and words its answer.  The order of the
+parameters is read from the compiled module (SR_P_<name>), never assumed.
+"""
 import dataclasses
 import math
 
 import numpy as np
 
-#: Parameter order of the C API (c/spherical_robot.h).
-NAMES = ("r", "m_S", "k_S", "b", "h", "m_b", "m_h", "k_Y", "l", "m_P", "k_P", "g")
-_POSITIVE = ("r", "m_S", "b", "h", "m_b", "m_h", "l", "m_P")
-_NONNEGATIVE = ("k_S", "k_Y", "k_P", "g")
+from bindings._sr import ffi, lib
+
+def parameter_order(names, module=lib):
+    """names sorted by their index SR_P_<name> in module; ValueError unless they are exactly
+    the indices 0 .. SR_NPARAM-1 of module, one each (no parameter missing on either side)."""
+    indices = {name: getattr(module, f"SR_P_{name}", None) for name in names}
+    missing = sorted(name for name, index in indices.items() if index is None)
+    if missing:
+        raise ValueError(f"Params: no SR_P_ index in the C library for {', '.join(missing)}")
+    if sorted(indices.values()) != list(range(module.SR_NPARAM)):
+        raise ValueError(f"Params: the fields {sorted(names)} do not match the C library's parameter "
+                         f"indices {indices} (SR_NPARAM = {module.SR_NPARAM})")
+    return tuple(sorted(names, key=indices.get))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -37,21 +51,20 @@ class Params:
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
                 raise ValueError(f"Params.{name}: expected a real number, got {value!r}")
-            if not math.isfinite(value):
-                raise ValueError(f"Params.{name}: must be finite, got {value!r}")
             object.__setattr__(self, name, float(value))
-        for name in _POSITIVE:
-            if not getattr(self, name) > 0:
-                raise ValueError(f"Params.{name}: must be > 0, got {getattr(self, name)!r}")
-        for name in _NONNEGATIVE:
-            if not getattr(self, name) >= 0:
-                raise ValueError(f"Params.{name}: must be >= 0, got {getattr(self, name)!r}")
-        half_diagonal = 0.5 * math.hypot(self.b, self.h)
-        if half_diagonal > self.r:
-            raise ValueError(f"Params.b, Params.h: the yoke (half-diagonal {half_diagonal:g} m) "
-                             f"does not fit inside the shell (r = {self.r:g} m)")
-        if self.l > self.r:
-            raise ValueError(f"Params.l: the pendulum (l = {self.l:g} m) does not fit inside the shell (r = {self.r:g} m)")
+        bad_index, rule = ffi.new("int *"), ffi.new("int *")
+        if lib.sr_check_params(ffi.new("double[]", list(self.as_array())), bad_index, rule) != lib.SR_OK:
+            raise ValueError(self._rule_broken(NAMES[bad_index[0]], rule[0]))
+
+    def _rule_broken(self, name, rule):
+        """The message for C's verdict: the parameters involved, the rule (C's text), the values."""
+        text = ffi.string(lib.sr_param_rule_string(rule)).decode()
+        if rule == lib.SR_PARAM_RULE_YOKE_FITS:
+            return (f"Params.b, Params.h: {text}: half-diagonal {0.5 * math.hypot(self.b, self.h):g} m, "
+                    f"r = {self.r:g} m")
+        if rule == lib.SR_PARAM_RULE_PENDULUM_FITS:
+            return f"Params.l: {text}: l = {self.l:g} m, r = {self.r:g} m"
+        return f"Params.{name}: {text}, got {getattr(self, name)!r}"
 
     @classmethod
     def paper(cls, **overrides):
@@ -73,7 +86,12 @@ class Params:
         return cls(**values)
 
     def as_array(self):
+        """The values in the C library's order (index SR_P_<name>)."""
         return np.array([getattr(self, n) for n in NAMES], dtype=np.float64)
 
     def as_dict(self):
         return {n: getattr(self, n) for n in NAMES}
+
+
+#: Parameter order of the C API: every field at its index SR_P_<name> (checked at import).
+NAMES = parameter_order(tuple(field.name for field in dataclasses.fields(Params)))

@@ -139,7 +139,7 @@ def test_every_public_function_returns_a_status_code():
     prototypes = re.findall(r"^([A-Za-z_][\w \t\*]*?)\b(sr_\w+)\s*\(", text, flags=re.M)
     assert len(prototypes) >= 12
     for ret, name in prototypes:
-        expected = "const char *" if name == "sr_status_string" else "int"
+        expected = "const char *" if name.endswith("_string") else "int"
         assert ret.strip() == expected.strip(), f"{name} returns {ret.strip()!r}"
 
 
@@ -242,6 +242,35 @@ def test_cmake_standalone_build_runs_the_c_tests(tmp_path):
     run(["cmake", "--build", str(tmp_path), "-j2"])
     assert (tmp_path / "libsphericalrobot.a").exists()
     run(["ctest", "--test-dir", str(tmp_path), "--output-on-failure"])
+
+
+# ---- what a Lie-Euler-only firmware links ------------------------------------------------------
+
+#: Functions that exist only for the fourth-order methods, the dispatcher and the drivers.
+NOT_LIE_EULER = {"sr_step", "sr_step_rkmk4", "sr_step_cf4", "sr_internal_advance", "sr_internal_rkmk4_core",
+                 "sr_internal_dexpinv", "sr_internal_project", "sr_simulate", "sr_simulate_guarded",
+                 "sr_simulate_adaptive"}
+
+
+def defined_functions(program):
+    return {name for kind, name in nm_symbols(program) if kind in "tT"}
+
+
+def test_the_lie_euler_example_links_no_fourth_order_code(build):
+    functions = defined_functions(build / "firmware_tshape")
+    assert "sr_step_lie_euler" in functions
+    assert not functions & NOT_LIE_EULER, sorted(functions & NOT_LIE_EULER)
+
+
+def test_a_program_calling_a_fourth_order_step_links_it(build, tmp_path):
+    """The control of the test above: linked the same way, a call of sr_step_rkmk4 shows up."""
+    probe = tmp_path / "probe.c"
+    probe.write_text('#include "spherical_robot.h"\n'
+                     "int main(void) { sr_model m; sr_real x[SR_NX] = {0};\n"
+                     "    return sr_step_rkmk4(&m, x, 0, SR_C(0.01), x) == SR_OK; }\n")
+    run([CC, "-std=c99", "-O2", f"-I{C_DIR}", f"-I{ROOT / 'generated'}", str(probe), str(build / "libsphericalrobot.a"),
+         "-lm", "-Wl,--gc-sections", "-o", str(tmp_path / "probe")])
+    assert "sr_step_rkmk4" in defined_functions(tmp_path / "probe")
 
 
 # ---- documentation tools ------------------------------------------------------------------------

@@ -22,10 +22,11 @@
 #define PAINT_BYTES 8192u       /* painted below main's frame: far more than any entry point uses */
 #define PAINT_WORD 0xA5C3E10Fu
 
-/* runtime.Params.paper_simulation(): r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g (SI). */
+/* runtime.Params.paper_simulation() (SI), each value at its index SR_P_<name>. */
 static const sr_real PARAMS[SR_NPARAM] = {
-    SR_C(0.3), SR_C(2.0), SR_C(0.16), SR_C(0.2), SR_C(0.5), SR_C(2.0),
-    SR_C(5.0), SR_C(0.04), SR_C(0.2), SR_C(1.0), SR_C(0.10), SR_C(9.81),
+    [SR_P_r] = SR_C(0.3),   [SR_P_m_S] = SR_C(2.0), [SR_P_k_S] = SR_C(0.16), [SR_P_b] = SR_C(0.2),
+    [SR_P_h] = SR_C(0.5),   [SR_P_m_b] = SR_C(2.0), [SR_P_m_h] = SR_C(5.0),  [SR_P_k_Y] = SR_C(0.04),
+    [SR_P_l] = SR_C(0.2),   [SR_P_m_P] = SR_C(1.0), [SR_P_k_P] = SR_C(0.10), [SR_P_g] = SR_C(9.81),
 };
 
 static uintptr_t stack_pointer(void)
@@ -102,13 +103,13 @@ int main(void)
     report("sr_accel", stack_used(top));
 
     paint_stack(top);
-    if (status == SR_OK) status = sr_step(&model, SR_LIE_EULER, x, u, SR_C(0.01), x);
-    report("sr_step(SR_LIE_EULER)", stack_used(top));
+    if (status == SR_OK) status = sr_step_lie_euler(&model, x, u, SR_C(0.01), x);
+    report("sr_step_lie_euler", stack_used(top));
 
     /* The control loop proper: one second at 100 Hz. */
     for (n = 1; n < 100 && status == SR_OK; ++n) {
         status = sr_accel(&model, x, u, a);
-        if (status == SR_OK) status = sr_step(&model, SR_LIE_EULER, x, u, SR_C(0.01), x);
+        if (status == SR_OK) status = sr_step_lie_euler(&model, x, u, SR_C(0.01), x);
     }
     if (status != SR_OK) {
         put("lie_euler_firmware: ");

@@ -13,7 +13,8 @@
  *     steps 3400 - 4500   pendulum  +0.1 N m
  *
  * 10,000 steps (100 s) from rest with R_S = R_Y = R_P = I and q = (0, 0, r),
- * parameters runtime.Params.paper_simulation(), Lie-Euler (SR_LIE_EULER).
+ * parameters runtime.Params.paper_simulation(), Lie-Euler (sr_step_lie_euler: linked with
+ * --gc-sections, as `make example` does, the program contains no fourth-order stepper).
  *
  * Output (stdout): CSV, a header line then one row per sample (t = 0 and after
  * every step): t and the 35 state entries in the order of spherical_robot.h,
@@ -31,7 +32,7 @@
 #define DT_SECONDS 0.01    /* the same period as a double, for the time column */
 #define N_STEPS 10000L     /* 100 s */
 
-enum { JOINT_YOKE = 0, JOINT_PENDULUM = 1 }; /* index into u[SR_NU] */
+enum { JOINT_YOKE = SR_U_u_Y, JOINT_PENDULUM = SR_U_u_P }; /* index into u[SR_NU] */
 
 /* One window of the torque program: `torque` on `joint` during steps first..last (inclusive). */
 typedef struct torque_window {
@@ -48,10 +49,11 @@ static const torque_window TSHAPE_PROGRAM[] = {
 };
 #define N_WINDOWS (sizeof TSHAPE_PROGRAM / sizeof TSHAPE_PROGRAM[0])
 
-/* runtime.Params.paper_simulation(): r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g (SI). */
+/* runtime.Params.paper_simulation() (SI), each value at its index SR_P_<name>. */
 static const sr_real PARAMS[SR_NPARAM] = {
-    SR_C(0.3), SR_C(2.0), SR_C(0.16), SR_C(0.2), SR_C(0.5), SR_C(2.0),
-    SR_C(5.0), SR_C(0.04), SR_C(0.2), SR_C(1.0), SR_C(0.10), SR_C(9.81),
+    [SR_P_r] = SR_C(0.3),   [SR_P_m_S] = SR_C(2.0), [SR_P_k_S] = SR_C(0.16), [SR_P_b] = SR_C(0.2),
+    [SR_P_h] = SR_C(0.5),   [SR_P_m_b] = SR_C(2.0), [SR_P_m_h] = SR_C(5.0),  [SR_P_k_Y] = SR_C(0.04),
+    [SR_P_l] = SR_C(0.2),   [SR_P_m_P] = SR_C(1.0), [SR_P_k_P] = SR_C(0.10), [SR_P_g] = SR_C(9.81),
 };
 
 /* The motor torques held during step n (1-based). */
@@ -95,10 +97,8 @@ int main(void)
     int status;
 
     /* Initial state: at rest, all rotations identity, centre at q = (0, 0, r). */
-    x[0] = x[4] = x[8] = 1;    /* R_S */
-    x[9] = x[13] = x[17] = 1;  /* R_Y */
-    x[18] = x[22] = x[26] = 1; /* R_P */
-    x[29] = PARAMS[0];         /* q_z = r */
+    for (n = 0; n < 3; ++n) x[SR_X_R_S + 4 * n] = x[SR_X_R_Y + 4 * n] = x[SR_X_R_P + 4 * n] = 1;
+    x[SR_X_q + 2] = PARAMS[SR_P_r];
 
     status = sr_model_init(&model, PARAMS);
     if (status == SR_OK) status = sr_check_state(&model, x);
@@ -112,7 +112,7 @@ int main(void)
     for (n = 1; n <= N_STEPS; ++n) {
         wait_for_tick();
         torque_program(n, u);
-        status = sr_step(&model, SR_LIE_EULER, x, u, DT, x); /* in place: x_next may alias x */
+        status = sr_step_lie_euler(&model, x, u, DT, x); /* in place: x_next may alias x */
         if (status != SR_OK) {
             fprintf(stderr, "firmware_tshape: step %ld failed: %s\n", n, sr_status_string(status));
             return 1;

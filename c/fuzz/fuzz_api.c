@@ -171,11 +171,11 @@ static void read_state(reader *r, sr_real radius, sr_real x[SR_NX])
     int i;
     for (i = 0; i < 3; ++i) w[i] = (sr_real)(3.2 * unit(r));
     if (sr_so3_exp(w, x) != SR_OK) abort();
-    rot_axis(0, 3.2 * unit(r), x + 9);
-    rot_axis(1, 3.2 * unit(r), x + 18);
-    x[27] = (sr_real)unit(r);
-    x[28] = (sr_real)unit(r);
-    x[29] = isfinite(radius) ? radius : SR_C(0.3);
+    rot_axis(0, 3.2 * unit(r), x + SR_X_R_Y);
+    rot_axis(1, 3.2 * unit(r), x + SR_X_R_P);
+    x[SR_X_q] = (sr_real)unit(r);
+    x[SR_X_q + 1] = (sr_real)unit(r);
+    x[SR_X_q + 2] = isfinite(radius) ? radius : SR_C(0.3);
     for (i = 30; i < SR_NX; ++i) x[i] = (sr_real)(speed * unit(r));
     for (i = 0; i < SR_NX; ++i) x[i] = pick(r, (double)x[i]);
 }
@@ -187,7 +187,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     reader rd = {data, size};
     sr_model model, fallback;
-    sr_real p[SR_NPARAM], x[SR_NX], x2[2 * SR_NX], u[MAX_STEPS * SR_NU], dt;
+    sr_real p[SR_NPARAM], raw_p[SR_NPARAM], x[SR_NX], x2[2 * SR_NX], u[MAX_STEPS * SR_NU], dt;
     const sr_real *u_or_null;
     static guarded g; /* static: too large for some stacks, and the harness is single-threaded */
     long done, row;
@@ -195,14 +195,26 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     /* sr_model_init: untouched on error */
     read_params(&rd, p);
+    memcpy(raw_p, p, sizeof p); /* the batch below gets them even when they are invalid */
     memset(&model, CANARY, sizeof model);
     status = sr_model_init(&model, p);
     EXPECT_STATUS("sr_model_init", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_PARAM, SR_ERR_SINGULAR);
+    { /* sr_check_params is sr_model_init's range verdict */
+        int bad = -7, rule = -7;
+        const int verdict = sr_check_params(p, &bad, &rule);
+        if (verdict != SR_OK ? verdict != status : status == SR_ERR_NONFINITE)
+            fail("sr_check_params", verdict, "disagrees with sr_model_init");
+        if ((verdict == SR_OK) != (bad == -1 && rule == SR_PARAM_RULE_NONE) || bad < -1 || bad >= SR_NPARAM)
+            fail("sr_check_params", verdict, "bad index or rule");
+    }
     if (status != SR_OK) {
         const unsigned char *b = (const unsigned char *)&model;
         for (i = 0; i < (int)sizeof model; ++i)
             if (b[i] != CANARY) fail("sr_model_init", status, "wrote the model on error");
-        for (i = 0; i < SR_NPARAM; ++i) p[i] = (sr_real)((const double[]){0.3, 2, 0.16, 0.2, 0.5, 2, 5, 0.04, 0.2, 1, 0.1, 9.81})[i];
+        static const double paper[SR_NPARAM] = {[SR_P_r] = 0.3, [SR_P_m_S] = 2, [SR_P_k_S] = 0.16, [SR_P_b] = 0.2,
+                                                [SR_P_h] = 0.5, [SR_P_m_b] = 2, [SR_P_m_h] = 5, [SR_P_k_Y] = 0.04,
+                                                [SR_P_l] = 0.2, [SR_P_m_P] = 1, [SR_P_k_P] = 0.1, [SR_P_g] = 9.81};
+        for (i = 0; i < SR_NPARAM; ++i) p[i] = (sr_real)paper[i];
         if (sr_model_init(&fallback, p) != SR_OK) abort();
         model = fallback; /* keep fuzzing the state paths */
     } else {
@@ -210,7 +222,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (!isfinite(model.c[i])) fail("sr_model_init", status, "non-finite constant with SR_OK");
     }
 
-    read_state(&rd, model.p[0], x);
+    read_state(&rd, model.p[SR_P_r], x);
     for (i = 0; i < MAX_STEPS * SR_NU; ++i) u[i] = pick(&rd, 0.3 * unit(&rd));
     u_or_null = read_u8(&rd) % 4 == 3 ? NULL : u;
     dt = pick(&rd, 0.002 + 0.05 * fabs(unit(&rd)));
@@ -241,7 +253,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     status = sr_equilibrium_residual(&model, x, arm(&g, SR_NV));
     EXPECT_STATUS("sr_equilibrium_residual", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION);
     expect("sr_equilibrium_residual", status, &g, status == SR_OK ? SR_NV : 0, 1);
-    status = sr_so3_exp(x + 30, arm(&g, 9));
+    status = sr_so3_exp(x + SR_X_w_S, arm(&g, 9));
     EXPECT_STATUS("sr_so3_exp", status, SR_OK, SR_ERR_NONFINITE);
     expect("sr_so3_exp", status, &g, status == SR_OK ? 9 : 0, 1);
 
@@ -262,6 +274,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     status = sr_step(&model, method, x, u_or_null, dt, arm(&g, SR_NX));
     EXPECT_STATUS("sr_step", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_SINGULAR, SR_ERR_ARG);
     expect("sr_step", status, &g, status == SR_OK ? SR_NX : 0, 1);
+    if (method == SR_LIE_EULER || method == SR_RKMK4 || method == SR_CF4) { /* = the per-method entry */
+        sr_real via_step[SR_NX], fixed[SR_NX];
+        const int want = sr_step(&model, method, x, u_or_null, dt, via_step);
+        const int got = method == SR_LIE_EULER ? sr_step_lie_euler(&model, x, u_or_null, dt, fixed)
+                      : method == SR_RKMK4     ? sr_step_rkmk4(&model, x, u_or_null, dt, fixed)
+                                               : sr_step_cf4(&model, x, u_or_null, dt, fixed);
+        if (got != want || (got == SR_OK && memcmp(via_step, fixed, sizeof fixed) != 0))
+            fail("sr_step_<method>", got, "differs from sr_step");
+    }
 
     /* simulations: rows 0..steps_done valid; nothing past row steps_done + 1 */
     {
@@ -310,6 +331,47 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (st.rows_done < 0 || st.rows_done > n_out + 1) fail("sr_simulate_adaptive", status, "rows_done out of range");
         if (status == SR_OK && st.rows_done != n_out + 1) fail("sr_simulate_adaptive", status, "rows_done short on success");
         expect("sr_simulate_adaptive", status, &g, (int)st.rows_done * SR_NX, 1);
+    }
+
+    /* sr_simulate_batch: sample 0 the model's parameters and x, sample 1 the raw fuzzed parameters
+     * and the perturbed second row of x2; every sample gets its own status, a failed sample's
+     * final row stays untouched, arguments are refused before any sample runs */
+    {
+        sr_real bp[2 * SR_NPARAM], work[5 * SR_NX], metrics[2 * SR_BATCH_NMETRICS];
+        int bstatus[2] = {-7, -7}, s;
+        long bdone[2] = {-7, -7};
+        const long chunk = (long)(read_u8(&rd) % 4) + 1; /* 1..4 steps per sr_simulate_guarded call */
+        const sr_real tol = pick(&rd, 0.5);
+        memcpy(bp, model.p, sizeof model.p);
+        memcpy(bp + SR_NPARAM, raw_p, sizeof raw_p);
+        status = sr_simulate_batch(method, 2, bp, SR_NPARAM, x2, SR_NX, dt, steps, u_or_null, 0, tol, chunk, work,
+                                   NULL, arm(&g, 2 * SR_NX), metrics, bstatus, bdone);
+        EXPECT_STATUS("sr_simulate_batch", status, SR_OK, SR_ERR_ARG);
+        for (i = 0; i < GUARD; ++i)
+            if (!is_canary(g.buf + i) || !is_canary(g.buf + GUARD + g.n + i))
+                fail("sr_simulate_batch", status, "wrote outside its buffer");
+        for (s = 0; s < 2; ++s) {
+            const sr_real *row_out = g.buf + GUARD + s * SR_NX;
+            if (status != SR_OK) {
+                if (bstatus[s] != -7 || !is_canary(row_out)) fail("sr_simulate_batch", status, "ran a sample after refusing");
+                continue;
+            }
+            EXPECT_STATUS("sr_simulate_batch sample", bstatus[s], SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                          SR_ERR_SINGULAR, SR_ERR_CONSTRAINT, SR_ERR_ENERGY, SR_ERR_PARAM);
+            if (bstatus[s] == SR_OK) {
+                if (bdone[s] != steps) fail("sr_simulate_batch", bstatus[s], "steps_done != steps on success");
+                for (i = 0; i < SR_NX; ++i)
+                    if (is_canary(row_out + i) || !isfinite(row_out[i])) fail("sr_simulate_batch", bstatus[s], "final row unwritten or not finite");
+                for (i = 0; i < SR_BATCH_NMETRICS; ++i)
+                    if (!isfinite(metrics[s * SR_BATCH_NMETRICS + i])) fail("sr_simulate_batch", bstatus[s], "non-finite metric");
+            } else {
+                /* steps_done = steps only when every step ran and the final energy overflowed */
+                const long most = bstatus[s] == SR_ERR_NONFINITE ? steps : (steps > 0 ? steps - 1 : 0);
+                if (bdone[s] < 0 || bdone[s] > most) fail("sr_simulate_batch", bstatus[s], "steps_done out of range");
+                for (i = 0; i < SR_NX; ++i)
+                    if (!is_canary(row_out + i)) fail("sr_simulate_batch", bstatus[s], "wrote a failed sample's final row");
+            }
+        }
     }
 
     /* NULL pointers */

@@ -61,10 +61,10 @@ double rng_uniform(test_rng *rng, double lo, double hi)
 
 void paper_simulation_params(sr_real p[SR_NPARAM])
 {
-    /* r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g */
-    const sr_real values[SR_NPARAM] = {SR_C(0.3),  SR_C(2.0), SR_C(0.16), SR_C(0.2),
-                                       SR_C(0.5),  SR_C(2.0), SR_C(5.0),  SR_C(0.04),
-                                       SR_C(0.2),  SR_C(1.0), SR_C(0.10), SR_C(9.81)};
+    const sr_real values[SR_NPARAM] = {
+        [SR_P_r] = SR_C(0.3),  [SR_P_m_S] = SR_C(2.0), [SR_P_k_S] = SR_C(0.16), [SR_P_b] = SR_C(0.2),
+        [SR_P_h] = SR_C(0.5),  [SR_P_m_b] = SR_C(2.0), [SR_P_m_h] = SR_C(5.0),  [SR_P_k_Y] = SR_C(0.04),
+        [SR_P_l] = SR_C(0.2),  [SR_P_m_P] = SR_C(1.0), [SR_P_k_P] = SR_C(0.10), [SR_P_g] = SR_C(9.81)};
     int i;
     for (i = 0; i < SR_NPARAM; ++i) p[i] = values[i];
 }
@@ -92,10 +92,10 @@ void make_state(sr_real x[SR_NX], double theta_Y, double theta_P, double r)
 {
     int i;
     for (i = 0; i < SR_NX; ++i) x[i] = 0;
-    rot_z(0.0, x);
-    rot_x(theta_Y, x + 9);
-    rot_y(theta_P, x + 18);
-    x[29] = (sr_real)r;
+    rot_z(0.0, x + SR_X_R_S);
+    rot_x(theta_Y, x + SR_X_R_Y);
+    rot_y(theta_P, x + SR_X_R_P);
+    x[SR_X_q + 2] = (sr_real)r;
 }
 
 void random_state(test_rng *rng, double r, double max_speed, sr_real x[SR_NX])
@@ -105,9 +105,9 @@ void random_state(test_rng *rng, double r, double max_speed, sr_real x[SR_NX])
     make_state(x, rng_uniform(rng, -3.14159, 3.14159), rng_uniform(rng, -3.14159, 3.14159), r);
     for (i = 0; i < 3; ++i) w[i] = (sr_real)rng_uniform(rng, -1.8, 1.8); /* |w| up to ~pi */
     CHECK_STATUS(sr_so3_exp(w, x), SR_OK);
-    x[27] = (sr_real)rng_uniform(rng, -1, 1);
-    x[28] = (sr_real)rng_uniform(rng, -1, 1);
-    for (i = 30; i < 35; ++i) x[i] = (sr_real)rng_uniform(rng, -max_speed, max_speed);
+    x[SR_X_q] = (sr_real)rng_uniform(rng, -1, 1);
+    x[SR_X_q + 1] = (sr_real)rng_uniform(rng, -1, 1);
+    for (i = SR_X_w_S; i < SR_NX; ++i) x[i] = (sr_real)rng_uniform(rng, -max_speed, max_speed);
 }
 
 double orthonormality_error(const sr_real R[9])

@@ -52,9 +52,9 @@ static int guarded_ok(const guarded *g, int written)
 static void moving_state(sr_real x[SR_NX])
 {
     make_state(x, 0.4, -0.7, 0.3);
-    x[30] = SR_C(0.3);
-    x[32] = SR_C(-0.2);
-    x[34] = SR_C(1.0);
+    x[SR_X_w_S] = SR_C(0.3);
+    x[SR_X_w_S + 2] = SR_C(-0.2);
+    x[SR_X_w_P] = SR_C(1.0);
 }
 
 static void test_kernels_write_exactly_their_outputs(void)
@@ -76,7 +76,7 @@ static void test_kernels_write_exactly_their_outputs(void)
     CHECK(guarded_ok(&g, 1));
     CHECK_STATUS(sr_equilibrium_residual(&m, x, guarded_init(&g, SR_NV)), SR_OK);
     CHECK(guarded_ok(&g, SR_NV));
-    CHECK_STATUS(sr_so3_exp(x + 30, guarded_init(&g, 9)), SR_OK);
+    CHECK_STATUS(sr_so3_exp(x + SR_X_w_S, guarded_init(&g, 9)), SR_OK);
     CHECK(guarded_ok(&g, 9));
     CHECK_STATUS(sr_step(&m, SR_LIE_EULER, x, u, SR_C(0.01), guarded_init(&g, SR_NX)), SR_OK);
     CHECK(guarded_ok(&g, SR_NX));
@@ -89,7 +89,7 @@ static void test_kernels_leave_outputs_untouched_on_error(void)
     guarded g;
     paper_simulation_model(&m);
     moving_state(x);
-    x[31] = (sr_real)NAN;
+    x[SR_X_w_S + 1] = (sr_real)NAN;
 
     CHECK_STATUS(sr_accel(&m, x, NULL, guarded_init(&g, SR_NV)), SR_ERR_NONFINITE);
     CHECK(guarded_ok(&g, 0));
@@ -116,7 +116,7 @@ static void test_model_init_writes_only_the_model(void)
     int i;
     paper_simulation_params(p);
     memset(&s, CANARY_BYTE, sizeof s);
-    p[1] = -1; /* invalid: the model must stay untouched */
+    p[SR_P_m_S] = -1; /* invalid: the model must stay untouched */
     CHECK_STATUS(sr_model_init(&s.model, p), SR_ERR_PARAM);
     for (i = 0; i < SR_NPARAM; ++i) CHECK(is_canary(s.model.p + i));
     for (i = 0; i < SR_GEN_NCONST; ++i) CHECK(is_canary(s.model.c + i));

@@ -19,10 +19,10 @@
 
 static void scale_lengths(sr_real p[SR_NPARAM], sr_real s)
 {
-    p[0] *= s; /* r */
-    p[3] *= s; /* b */
-    p[4] *= s; /* h */
-    p[8] *= s; /* l */
+    p[SR_P_r] *= s; /* r */
+    p[SR_P_b] *= s; /* b */
+    p[SR_P_h] *= s; /* h */
+    p[SR_P_l] *= s; /* l */
 }
 
 static void test_model_init_rejects_lengths_whose_inertias_underflow(void)
@@ -52,9 +52,9 @@ static void test_kernel_results_that_overflow_are_reported_not_returned(void)
     int i;
     paper_simulation_model(&m);
     make_state(x, 0.3, 0.2, 0.3);
-    for (i = 30; i < 35; ++i) x[i] = (sr_real)(0.3 * FLT_MAX * (i % 2 ? 1 : -1)); /* finite speeds */
+    for (i = SR_X_w_S; i < SR_NX; ++i) x[i] = (sr_real)(0.3 * FLT_MAX * (i % 2 ? 1 : -1)); /* finite speeds */
 #ifndef SR_USE_FLOAT
-    for (i = 30; i < 35; ++i) x[i] = (sr_real)(1e200 * (i % 2 ? 1 : -1));
+    for (i = SR_X_w_S; i < SR_NX; ++i) x[i] = (sr_real)(1e200 * (i % 2 ? 1 : -1));
 #endif
     CHECK_STATUS(sr_accel(&m, x, NULL, a), SR_ERR_NONFINITE);
     CHECK(a[0] == 7 && a[4] == 7);
@@ -90,9 +90,9 @@ static void nearly_orthonormal_spinning_state(sr_real x[SR_NX], double d)
     make_state(x, 0.3, 0.2, 0.3);
     for (i = 0; i < 3; ++i)
         for (j = 0; j < 3; ++j) x[3 * i + j] = (sr_real)((i == j ? 1.0 : 0.5 * d));
-    x[30] = SR_C(3.0);
-    x[31] = SR_C(-2.0);
-    x[32] = SR_C(5.0);
+    x[SR_X_w_S] = SR_C(3.0);
+    x[SR_X_w_S + 1] = SR_C(-2.0);
+    x[SR_X_w_S + 2] = SR_C(5.0);
 }
 
 static void test_simulate_stops_when_a_rotation_drifts_out_of_tolerance(void)
@@ -128,7 +128,7 @@ static void frictionless_swing(sr_model *m, sr_real x[SR_NX])
 {
     sr_real p[SR_NPARAM];
     paper_simulation_params(p);
-    p[2] = p[7] = p[10] = 0; /* k_S, k_Y, k_P */
+    p[SR_P_k_S] = p[SR_P_k_Y] = p[SR_P_k_P] = 0; /* k_S, k_Y, k_P */
     CHECK_STATUS(sr_model_init(m, p), SR_OK);
     make_state(x, 0.0, 1.0, 0.3);
 }
@@ -182,7 +182,7 @@ static void test_energy_guard_passes_an_accurate_damped_run(void)
     long done = -1;
     paper_simulation_model(&m);
     make_state(x, 0.5, 0.8, 0.3);
-    x[30] = SR_C(1.0);
+    x[SR_X_w_S] = SR_C(1.0);
     memset(&guard, 0, sizeof guard);
     guard.tol = SR_C(1e-3);
     CHECK_STATUS(sr_simulate_guarded(&m, SR_RKMK4, x, SR_C(0.01), STEPS, NULL, &guard, traj, &done), SR_OK);

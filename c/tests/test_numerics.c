@@ -110,8 +110,8 @@ static void test_accel_at_identity_equilibrium_is_zero(void)
     }
     /* Any heading of the shell (R_S about the vertical) is the same equilibrium. */
     rot_z(1.234, x);
-    x[27] = SR_C(0.5);
-    x[28] = SR_C(-2.0);
+    x[SR_X_q] = SR_C(0.5);
+    x[SR_X_q + 1] = SR_C(-2.0);
     CHECK_STATUS(sr_accel(&m, x, NULL, a), SR_OK);
     for (i = 0; i < SR_NV; ++i) CHECK(a[i] == 0);
 }
@@ -130,7 +130,7 @@ static void test_tilted_equilibrium_has_zero_residual(void)
     CHECK_STATUS(sr_accel(&m, x, NULL, a), SR_OK);
     CHECK(max_abs(a, SR_NV) <= 256 * TEST_EPS);
     /* ... and not when the pendulum swings out of the vertical. */
-    rot_y(0.3, x + 18);
+    rot_y(0.3, x + SR_X_R_P);
     CHECK_STATUS(sr_equilibrium_residual(&m, x, res), SR_OK);
     CHECK(max_abs(res, SR_NV) > 0.1);
 }
@@ -195,7 +195,7 @@ static void test_kinetic_energy_is_half_nu_M_nu(void)
         for (i = 30; i < SR_NX; ++i) rest[i] = 0;
         CHECK_STATUS(sr_inertia(&m, x, M), SR_OK);
         for (i = 0; i < SR_NV; ++i)
-            for (j = 0; j < SR_NV; ++j) T += 0.5 * (double)x[30 + i] * (double)M[SR_NV * i + j] * (double)x[30 + j];
+            for (j = 0; j < SR_NV; ++j) T += 0.5 * (double)x[SR_X_w_S + i] * (double)M[SR_NV * i + j] * (double)x[SR_X_w_S + j];
         CHECK(T > 0);
         CHECK_NEAR(energy_of(&m, x) - energy_of(&m, rest), T, 64 * TEST_EPS * (T + 5));
     }
@@ -226,14 +226,14 @@ static double frictionless_drift(double dt, double *E0)
     const long steps = (long)(1.0 / dt + 0.5);
     long n;
     paper_simulation_params(p);
-    p[2] = p[7] = p[10] = 0; /* k_S = k_Y = k_P = 0 */
+    p[SR_P_k_S] = p[SR_P_k_Y] = p[SR_P_k_P] = 0; /* k_S = k_Y = k_P = 0 */
     CHECK_STATUS(sr_model_init(&m, p), SR_OK);
     make_state(x, 0.3, 0.5, 0.3);
-    x[30] = SR_C(0.4);
-    x[31] = SR_C(-0.3);
-    x[32] = SR_C(0.2);
-    x[33] = SR_C(0.8);
-    x[34] = SR_C(-0.5);
+    x[SR_X_w_S] = SR_C(0.4);
+    x[SR_X_w_S + 1] = SR_C(-0.3);
+    x[SR_X_w_S + 2] = SR_C(0.2);
+    x[SR_X_w_Y] = SR_C(0.8);
+    x[SR_X_w_P] = SR_C(-0.5);
     *E0 = (double)energy_of(&m, x);
     for (n = 0; n < steps; ++n) CHECK_STATUS(sr_step(&m, SR_LIE_EULER, x, NULL, (sr_real)dt, x), SR_OK);
     return (double)energy_of(&m, x) - *E0;
@@ -255,8 +255,8 @@ static void test_friction_dissipates_energy(void)
     int n;
     paper_simulation_model(&m);
     make_state(x, 0.0, 0.8, 0.3);
-    x[30] = SR_C(1.0);
-    x[33] = SR_C(2.0);
+    x[SR_X_w_S] = SR_C(1.0);
+    x[SR_X_w_Y] = SR_C(2.0);
     E0 = (double)energy_of(&m, x);
     for (n = 0; n < 500; ++n) CHECK_STATUS(sr_step(&m, SR_LIE_EULER, x, NULL, SR_C(0.01), x), SR_OK);
     CHECK((double)energy_of(&m, x) < E0 - 0.01);
@@ -271,10 +271,10 @@ static void test_rolling_keeps_the_centre_at_height_r_and_rotations_orthonormal(
     paper_simulation_model(&m);
     random_state(&rng, 0.3, 2.0, x);
     for (n = 0; n < 2000; ++n) CHECK_STATUS(sr_step(&m, SR_LIE_EULER, x, u, SR_C(0.01), x), SR_OK);
-    CHECK_NEAR(x[29], 0.3, 1e3 * TEST_EPS);
+    CHECK_NEAR(x[SR_X_q + 2], 0.3, 1e3 * TEST_EPS);
     CHECK(orthonormality_error(x) <= 1e3 * TEST_EPS);
-    CHECK(orthonormality_error(x + 9) <= 1e3 * TEST_EPS);
-    CHECK(orthonormality_error(x + 18) <= 1e3 * TEST_EPS);
+    CHECK(orthonormality_error(x + SR_X_R_Y) <= 1e3 * TEST_EPS);
+    CHECK(orthonormality_error(x + SR_X_R_P) <= 1e3 * TEST_EPS);
     CHECK_STATUS(sr_check_state(&m, x), SR_OK);
 }
 
@@ -288,6 +288,41 @@ static void test_step_in_place_equals_step_out_of_place(void)
     CHECK_STATUS(sr_step(&m, SR_LIE_EULER, x, u, SR_C(0.01), y), SR_OK);
     CHECK_STATUS(sr_step(&m, SR_LIE_EULER, x, u, SR_C(0.01), x), SR_OK);
     CHECK(memcmp(x, y, sizeof x) == 0);
+}
+
+typedef int (*fixed_method_step)(const sr_model *, const sr_real *, const sr_real *, sr_real, sr_real *);
+
+/* sr_step_lie_euler, sr_step_rkmk4 and sr_step_cf4 are sr_step with the method fixed: the same
+ * bits on valid input, the same status on invalid input; and the three methods differ. */
+static void test_per_method_steps_equal_sr_step(void)
+{
+    const int methods[3] = {SR_LIE_EULER, SR_RKMK4, SR_CF4};
+    const fixed_method_step steps[3] = {sr_step_lie_euler, sr_step_rkmk4, sr_step_cf4};
+    test_rng rng = {17ULL};
+    sr_model m;
+    sr_real x[SR_NX], bad[SR_NX], want[3][SR_NX], got[SR_NX], u[SR_NU] = {SR_C(0.1), SR_C(-0.05)};
+    int k;
+    paper_simulation_model(&m);
+    random_state(&rng, 0.3, 2.0, x);
+    for (k = 0; k < 3; ++k) {
+        CHECK_STATUS(sr_step(&m, methods[k], x, u, SR_C(0.01), want[k]), SR_OK);
+        CHECK_STATUS(steps[k](&m, x, u, SR_C(0.01), got), SR_OK);
+        CHECK(memcmp(got, want[k], sizeof got) == 0);
+        CHECK_STATUS(steps[k](&m, x, NULL, SR_C(0.01), got), SR_OK); /* NULL: zero torque */
+        CHECK_STATUS(sr_step(&m, methods[k], x, NULL, SR_C(0.01), want[k]), SR_OK);
+        CHECK(memcmp(got, want[k], sizeof got) == 0);
+        memcpy(got, x, sizeof got); /* in place */
+        CHECK_STATUS(steps[k](&m, got, NULL, SR_C(0.01), got), SR_OK);
+        CHECK(memcmp(got, want[k], sizeof got) == 0);
+        memcpy(bad, x, sizeof bad);
+        bad[SR_X_w_S] = (sr_real)NAN;
+        CHECK_STATUS(steps[k](&m, bad, u, SR_C(0.01), got), SR_ERR_NONFINITE);
+        CHECK_STATUS(steps[k](&m, x, u, SR_C(0.0), got), SR_ERR_ARG);
+        CHECK_STATUS(steps[k](&m, x, u, SR_C(0.01), NULL), SR_ERR_NULL);
+        CHECK_STATUS(steps[k](NULL, x, u, SR_C(0.01), got), SR_ERR_NULL);
+    }
+    CHECK(memcmp(want[0], want[1], sizeof want[0]) != 0);
+    CHECK(memcmp(want[1], want[2], sizeof want[1]) != 0);
 }
 
 static void test_simulate_equals_repeated_steps(void)
@@ -319,8 +354,8 @@ static void test_interleaved_models_do_not_interfere(void)
     int n;
     paper_simulation_model(&m1);
     paper_simulation_params(p);
-    p[9] = SR_C(3.0); /* a heavier pendulum */
-    p[2] = 0;
+    p[SR_P_m_P] = SR_C(3.0); /* a heavier pendulum */
+    p[SR_P_k_S] = 0;
     CHECK_STATUS(sr_model_init(&m2, p), SR_OK);
     make_state(x1, 0.1, 0.2, 0.3);
     memcpy(x2, x1, sizeof x1);
@@ -351,6 +386,7 @@ void suite_numerics(void)
     RUN_TEST(test_friction_dissipates_energy);
     RUN_TEST(test_rolling_keeps_the_centre_at_height_r_and_rotations_orthonormal);
     RUN_TEST(test_step_in_place_equals_step_out_of_place);
+    RUN_TEST(test_per_method_steps_equal_sr_step);
     RUN_TEST(test_simulate_equals_repeated_steps);
     RUN_TEST(test_interleaved_models_do_not_interfere);
 }

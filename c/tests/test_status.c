@@ -97,9 +97,9 @@ static void expect_all(const sr_model *m, const sr_real *x, const sr_real *u, in
 static void good_input(sr_real x[SR_NX], sr_real u[SR_NU])
 {
     make_state(x, 0.3, -0.4, 0.3);
-    x[30] = SR_C(0.2);
-    x[31] = SR_C(-0.1);
-    x[33] = SR_C(0.5);
+    x[SR_X_w_S] = SR_C(0.2);
+    x[SR_X_w_S + 1] = SR_C(-0.1);
+    x[SR_X_w_Y] = SR_C(0.5);
     u[0] = SR_C(0.1);
     u[1] = SR_C(-0.05);
 }
@@ -160,7 +160,7 @@ static void test_null_pointers(void)
     CHECK_STATUS(sr_model_init(NULL, p), SR_ERR_NULL);
     CHECK_STATUS(sr_model_init(&m, NULL), SR_ERR_NULL);
     CHECK_STATUS(sr_so3_exp(NULL, out), SR_ERR_NULL);
-    CHECK_STATUS(sr_so3_exp(x + 30, NULL), SR_ERR_NULL);
+    CHECK_STATUS(sr_so3_exp(x + SR_X_w_S, NULL), SR_ERR_NULL);
     CHECK_STATUS(sr_accel_batch(&m, 1, x, u, out, &row), SR_OK);
     CHECK(row == -1);
     /* The optional out-parameters may be NULL. */
@@ -215,15 +215,15 @@ static void test_bad_rotations_seen_by_every_function(void)
     expect_all(&m, x, u, SR_ERR_NOT_ROTATION, 0, "R_S = 1.01 I");
 
     good_input(x, u);
-    rot_z(0.3, x + 9); /* R_Y about z */
+    rot_z(0.3, x + SR_X_R_Y); /* R_Y about z */
     expect_all(&m, x, u, SR_ERR_NOT_ROTATION, 0, "R_Y about z");
 
     good_input(x, u);
-    rot_z(0.3, x + 18); /* R_P about z */
+    rot_z(0.3, x + SR_X_R_P); /* R_P about z */
     expect_all(&m, x, u, SR_ERR_NOT_ROTATION, 0, "R_P about z");
 
     good_input(x, u);
-    x[20] *= SR_C(1.5); /* R_P's first column no longer unit */
+    x[SR_X_R_P + 2] *= SR_C(1.5); /* R_P's first column no longer unit */
     expect_all(&m, x, u, SR_ERR_NOT_ROTATION, 0, "R_P stretched");
 }
 
@@ -248,20 +248,20 @@ static void test_check_state_rejects_every_non_rotation(void)
     CHECK_STATUS(sr_check_state(&m, x), SR_ERR_NOT_ROTATION);
 
     good_input(x, u); /* R_Y a rotation, but about y: not about x */
-    rot_y(0.3, x + 9);
+    rot_y(0.3, x + SR_X_R_Y);
     CHECK_STATUS(sr_check_state(&m, x), SR_ERR_NOT_ROTATION);
 
     good_input(x, u); /* R_Y = [[1,0,0],[0,c,s],[0,s,-c]]: orthonormal columns, det -1 */
-    x[14] = -x[14];
-    x[17] = -x[17];
+    x[SR_X_R_Y + 5] = -x[SR_X_R_Y + 5];
+    x[SR_X_R_Y + 8] = -x[SR_X_R_Y + 8];
     CHECK_STATUS(sr_check_state(&m, x), SR_ERR_NOT_ROTATION);
 
     good_input(x, u); /* R_P about x: not about y */
-    rot_x(0.3, x + 18);
+    rot_x(0.3, x + SR_X_R_P);
     CHECK_STATUS(sr_check_state(&m, x), SR_ERR_NOT_ROTATION);
 
     good_input(x, u); /* R_Y with a stray entry outside its plane */
-    x[10] = SR_C(1e-3);
+    x[SR_X_R_Y + 1] = SR_C(1e-3);
     CHECK_STATUS(sr_check_state(&m, x), SR_ERR_NOT_ROTATION);
 
     /* Within tolerance: accepted. */
@@ -276,17 +276,16 @@ static void test_rolling_constraint(void)
     sr_real x[SR_NX], u[SR_NU];
     paper_simulation_model(&m);
     good_input(x, u);
-    x[29] = SR_C(0.31); /* q_z != r */
+    x[SR_X_q + 2] = SR_C(0.31); /* q_z != r */
     CHECK_STATUS(sr_check_state(&m, x), SR_ERR_CONSTRAINT);
-    x[29] = SR_C(0.0);
+    x[SR_X_q + 2] = SR_C(0.0);
     CHECK_STATUS(sr_check_state(&m, x), SR_ERR_CONSTRAINT);
 }
 
 static void test_invalid_parameters(void)
 {
-    enum { r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g };
-    const int positive[] = {r, m_S, b, h, m_b, m_h, l, m_P};
-    const int nonnegative[] = {k_S, k_Y, k_P, g};
+    const int positive[] = {SR_P_r, SR_P_m_S, SR_P_b, SR_P_h, SR_P_m_b, SR_P_m_h, SR_P_l, SR_P_m_P};
+    const int nonnegative[] = {SR_P_k_S, SR_P_k_Y, SR_P_k_P, SR_P_g};
     sr_model m;
     sr_real p[SR_NPARAM];
     int i;
@@ -312,11 +311,70 @@ static void test_invalid_parameters(void)
         CHECK_STATUS(sr_model_init(&m, p), SR_OK);
     }
     paper_simulation_params(p); /* the yoke's corners stick out of the shell */
-    p[h] = SR_C(0.6);
+    p[SR_P_h] = SR_C(0.6);
     CHECK_STATUS(sr_model_init(&m, p), SR_ERR_PARAM);
     paper_simulation_params(p); /* the pendulum is longer than the radius */
-    p[l] = SR_C(0.31);
+    p[SR_P_l] = SR_C(0.31);
     CHECK_STATUS(sr_model_init(&m, p), SR_ERR_PARAM);
+}
+
+/* sr_check_params(p) must give (status, bad_index, rule); prints the case when it does not. */
+static void expect_param_verdict(const sr_real p[SR_NPARAM], int status, int bad_index, int rule, const char *what)
+{
+    int got_index = -7, got_rule = -7;
+    const int got = sr_check_params(p, &got_index, &got_rule);
+    if (got != status || got_index != bad_index || got_rule != rule)
+        sr_test_fail(__FILE__, __LINE__, "%s: got status %d, index %d, rule %d; want %d, %d, %d", what, got,
+                     got_index, got_rule, status, bad_index, rule);
+}
+
+/* sr_check_params names the first rule broken and the parameter that breaks it, in the order
+ * of spherical_robot.h, and keeps its outputs at "none" for valid parameters. */
+static void test_check_params_names_the_rule_and_the_parameter(void)
+{
+    const int positive[] = {SR_P_r, SR_P_m_S, SR_P_b, SR_P_h, SR_P_m_b, SR_P_m_h, SR_P_l, SR_P_m_P};
+    const int nonnegative[] = {SR_P_k_S, SR_P_k_Y, SR_P_k_P, SR_P_g};
+    sr_real p[SR_NPARAM];
+    int i, rule;
+    paper_simulation_params(p);
+    expect_param_verdict(p, SR_OK, -1, SR_PARAM_RULE_NONE, "valid");
+    CHECK_STATUS(sr_check_params(p, NULL, NULL), SR_OK);
+    CHECK_STATUS(sr_check_params(NULL, NULL, NULL), SR_ERR_NULL);
+    for (i = 0; i < SR_NPARAM; ++i) {
+        paper_simulation_params(p);
+        p[i] = (sr_real)NAN;
+        expect_param_verdict(p, SR_ERR_NONFINITE, i, SR_PARAM_RULE_FINITE, "NaN");
+        p[SR_P_m_S] = -1; /* a later rule broken too: the first one is reported */
+        if (i != SR_P_m_S) expect_param_verdict(p, SR_ERR_NONFINITE, i, SR_PARAM_RULE_FINITE, "NaN first");
+    }
+    for (i = 0; i < (int)(sizeof positive / sizeof positive[0]); ++i) {
+        paper_simulation_params(p);
+        p[positive[i]] = 0;
+        expect_param_verdict(p, SR_ERR_PARAM, positive[i], SR_PARAM_RULE_POSITIVE, "zero");
+    }
+    for (i = 0; i < (int)(sizeof nonnegative / sizeof nonnegative[0]); ++i) {
+        paper_simulation_params(p);
+        p[nonnegative[i]] = SR_C(-0.01);
+        expect_param_verdict(p, SR_ERR_PARAM, nonnegative[i], SR_PARAM_RULE_NONNEGATIVE, "negative");
+    }
+    paper_simulation_params(p);
+    p[SR_P_b] = SR_C(0.4); /* half-diagonal sqrt(0.16 + 0.25)/2 = 0.32 > r = 0.3 */
+    expect_param_verdict(p, SR_ERR_PARAM, SR_P_b, SR_PARAM_RULE_YOKE_FITS, "yoke");
+    p[SR_P_b] = SR_C(0.33); /* 0.2996 <= 0.3: fits */
+    expect_param_verdict(p, SR_OK, -1, SR_PARAM_RULE_NONE, "yoke just fits");
+    paper_simulation_params(p);
+    p[SR_P_l] = SR_C(0.31);
+    expect_param_verdict(p, SR_ERR_PARAM, SR_P_l, SR_PARAM_RULE_PENDULUM_FITS, "pendulum");
+    p[SR_P_l] = p[SR_P_r]; /* touching the shell: allowed */
+    expect_param_verdict(p, SR_OK, -1, SR_PARAM_RULE_NONE, "pendulum just fits");
+    /* Every rule has its own text. */
+    for (rule = SR_PARAM_RULE_NONE; rule <= SR_PARAM_RULE_PENDULUM_FITS; ++rule) {
+        int other;
+        CHECK(strcmp(sr_param_rule_string(rule), "unknown rule") != 0);
+        for (other = SR_PARAM_RULE_NONE; other < rule; ++other)
+            CHECK(strcmp(sr_param_rule_string(rule), sr_param_rule_string(other)) != 0);
+    }
+    CHECK(strcmp(sr_param_rule_string(SR_PARAM_RULE_PENDULUM_FITS + 1), "unknown rule") == 0);
 }
 
 /* Parameters that pass the range checks but make M singular: a shell so small that
@@ -332,7 +390,7 @@ static void test_singular_inertia(void)
     sr_model m;
     sr_real p[SR_NPARAM];
     paper_simulation_params(p);
-    p[0] = p[3] = p[4] = p[8] = tiny; /* r, b, h, l */
+    p[SR_P_r] = p[SR_P_b] = p[SR_P_h] = p[SR_P_l] = tiny; /* r, b, h, l */
     CHECK_STATUS(sr_model_init(&m, p), SR_ERR_SINGULAR);
 }
 
@@ -419,6 +477,7 @@ void suite_status(void)
     RUN_TEST(test_check_state_rejects_every_non_rotation);
     RUN_TEST(test_rolling_constraint);
     RUN_TEST(test_invalid_parameters);
+    RUN_TEST(test_check_params_names_the_rule_and_the_parameter);
     RUN_TEST(test_singular_inertia);
     RUN_TEST(test_bad_time_step);
     RUN_TEST(test_unknown_method);

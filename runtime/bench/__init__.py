@@ -1,23 +1,25 @@
-"""Benchmarks, `python -m runtime bench` (`make bench`): our kernels against the alternatives, side by side in one run.
+"""Benchmarks, `python -m runtime bench` (`make bench`): our kernels against the alternatives, like
+against like (issue 17, item 5), every alternative's numbers checked against ours before its time counts.
 
-Measured on one pinned core:
-  C loop (bench/bench_kernels.c, no Python in the timed region): ns per accel
-    (checked API and raw kernel), inertia, Lie–Euler step, fourth-order steps,
-    and the CasADi-generated C of the independent reference model;
-  from Python: ns per call of Model.accel, the NumPy transcription of the
-    paper's formulas, the CasADi reference, the sympy.physics.mechanics
-    (KanesMethod) model lambdified; batch accel over 10⁶ states, and for the
-    alternatives over their own batch paths (CasADi's Function.map, the
-    lambdified Kane model on arrays); the 10,000-step t-shape scenario end to
-    end for every method, and for every alternative as the paper's Lie–Euler
-    method in a Python loop around its accel.
-Every alternative's numbers are compared with ours before its time is
-reported; the bench exits non-zero only when a kernel gives wrong numbers.
-Results: a table on stdout and JSON under bench/results/.
+C against C (bench/bench_kernels.c, no Python in the timed region, one pinned core): our checked
+  accel, the raw generated kernel, inertia, one step of every integrator; the Kane model
+  (sympy.physics.mechanics) compiled the ways its users ship it: CasADi's C of M and F with
+  ca.solve, SymPy's C printer with a generic LU, PyDy's C with the same LU
+  (`kane_compiled`); and the CasADi C of our own 9x9 KKT reference, a verification model.
+Python call against Python call: Model.accel and Model.step against the raw cffi call of the
+  checked C function with prepared buffers (item 8), PyDy's Cython ODE function, the lambdified
+  Kane model (three ways), a CasADi Function call of the Kane model, the CasADi reference and the
+  NumPy transcription of the paper's formulas.
+Batches (Model.accel over 10⁶ states, CasADi's Function.map, the lambdified Kane model on
+  arrays) and the 10,000-step t-shape scenario end to end, for every method, and for every
+  alternative as the paper's Lie–Euler method in a Python loop around its accel.
+The bench exits non-zero only when a kernel or a baseline gives wrong numbers.  Results: a table
+on stdout, with the CPU, and one JSON per run under bench/results/ (`<date and time>.json`,
+never overwritten).
 
-Modules: `cli` (the command), `harness` (the C loop: build, run, check),
-`baselines` (the Python-side timings of ours and of the alternatives, and the
-Lie–Euler loop a user of an alternative would write), `timing` (how a time is
-taken), `checks` (numbers compared before a time counts), `report` (the table
-and the result files).
+Modules: `cli` (the command), `harness` (the C loop: build, run, check), `kane_compiled` (the
+Kane model as C and as compiled Python calls), `baselines` (the Python-side timings of ours and
+of the alternatives, and the Lie–Euler loop a user of an alternative would write), `timing` (how
+a time is taken), `checks` (numbers compared before a time counts), `report` (the table, the
+targets and the result file).
 """

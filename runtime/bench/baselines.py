@@ -50,7 +50,7 @@ def lie_euler_loop(accel, x0, dt, u_prog, r):
 
 
 # -- Python-side timings -------------------------------------------------------------------------
-def call_overhead_timings(model, calls, min_seconds=0.05, rounds=11):
+def call_overhead_timings(model, calls, min_seconds=0.02, rounds=25):
     """One call from Python (issue 17, item 8): Model.accel and Model.step against the raw cffi call of
     the checked C function (sr_accel, sr_step) on buffers prepared beforehand, over the same states,
     their rounds interleaved (per_call_ns_interleaved), in ns.  The raw calls' outputs are checked first."""
@@ -81,6 +81,32 @@ def call_overhead_timings(model, calls, min_seconds=0.05, rounds=11):
         cases[f"python_model_step_{method}_ns"] = (model.step, [(x, u, 0.01, method) for x, u in calls])
         cases[f"raw_cffi_step_{method}_ns"] = (lib.sr_step, raw)
     return per_call_ns_interleaved(cases, min_seconds, rounds)
+
+
+def compiled_kane_timings(model, calls, progress, min_seconds=0.2, rounds=7):
+    """The compiled Kane model called from Python (issue 17, item 5): PyDy's Cython ODE function and
+    the CasADi Function (ca.solve of M and F), each on its own coordinates prepared beforehand
+    (the conversion from our states is not timed), each checked against Model.accel first; ns."""
+    import tempfile
+
+    from .kane_compiled import casadi_kane_function, dependent_speeds, kane_inputs, pydy_cython_rhs
+    p = model.params.as_array()
+    qw = kane_inputs(np.array([x for x, _ in calls]))
+    ud = dependent_speeds(qw, p)
+    with tempfile.TemporaryDirectory() as tmp:
+        progress("PyDy: generate_ode_function(generator='cython'), compiling")
+        rhs = pydy_cython_rhs(tmp)
+        pydy_calls = [(np.concatenate([q, d]), 0.0, np.array(u), p) for q, d, (_, u) in zip(qw, ud, calls)]
+        for (x, u), args in zip(calls, pydy_calls):
+            check_close("PyDy Cython ODE function", rhs(*args)[7:12], model.accel(x, u), 1e-8)
+        out = {"pydy_cython_rhs_ns": per_call_ns(rhs, pydy_calls, min_seconds, rounds)}
+    progress("CasADi Function of the Kane model (ca.solve), called from Python")
+    fn = casadi_kane_function()
+    casadi_calls = [(q, np.array(u), p) for q, (_, u) in zip(qw, calls)]
+    for (x, u), args in zip(calls, casadi_calls):
+        check_close("CasADi Function of the Kane model", np.asarray(fn(*args)).ravel(), model.accel(x, u), 1e-8)
+    out["kane_casadi_function_ns"] = per_call_ns(fn, casadi_calls, min_seconds, rounds)
+    return out
 
 
 def python_timings(model, X, U, batch_size, progress, with_kane=True, loop_steps=10_000):
@@ -120,6 +146,7 @@ def python_timings(model, X, U, batch_size, progress, with_kane=True, loop_steps
         for x, u in calls[:20]:
             check_close("KanesMethod model, math module", tuned.accel(x, u), model.accel(x, u), 1e-8)
         out["kane_lambdified_math_accel_ns"] = per_call_ns(tuned.accel, calls[:20], min_seconds=0.2)
+        out.update(compiled_kane_timings(model, calls[:20], progress))
 
     progress(f"batch accel over {batch_size:.0e} states")
     reps = int(np.ceil(batch_size / len(X)))

@@ -1,5 +1,6 @@
 """`python -m runtime bench` (`make bench`): see runtime/bench/__init__.py for what is measured."""
 import argparse
+import json
 import datetime
 import os
 import pathlib
@@ -13,8 +14,9 @@ from ..params import Params
 from ..verification.sampling import random_inputs, random_states
 from .baselines import python_timings
 from .checks import WrongNumbers
+from .kane_compiled import kane_inputs as kane_coordinates, write_kane_c
 from .harness import ROOT, build_harness, casadi_reference_c, check_harness, run_harness
-from .report import format_report, write_results
+from .report import format_markdown, format_report, write_results
 from .timing import cpu_name, pin_to_one_core
 
 RESULTS = ROOT / "bench" / "results"
@@ -30,7 +32,12 @@ def main(argv=None):
     parser.add_argument("--loop-steps", type=int, default=10_000,
                         help="steps of the alternatives' t-shape run in a Python Lie-Euler loop (<= 10,000)")
     parser.add_argument("--out", type=pathlib.Path, default=RESULTS)
+    parser.add_argument("--markdown", type=pathlib.Path, metavar="RESULT.json",
+                        help="print a stored run's tables as Markdown (for the README) and exit")
     args = parser.parse_args(argv)
+    if args.markdown:
+        print(format_markdown(json.loads(args.markdown.read_text())))
+        return 0
     if not 1 <= args.states <= 4096:
         parser.error("--states: must be between 1 and 4096")
     if not 1 <= args.loop_steps <= 10_000:
@@ -63,8 +70,12 @@ def run(args, core, progress):
             build = pathlib.Path(tmp)
             progress("generating the CasADi reference C and building the C loop")
             casadi_reference_c(params, build)
-            exe = build_harness(build, native=False, with_casadi=True)
-            result["c_loop"] = run_harness(exe, params, X, U, args.repeats)
+            kane, kane_inputs = None, None
+            if not args.no_kane:
+                progress("the Kane model as C: CasADi (ca.solve), SymPy's C printer and PyDy's C (generic LU)")
+                kane, kane_inputs = write_kane_c(build), kane_coordinates(X)
+            exe = build_harness(build, native=False, with_casadi=True, kane=kane)
+            result["c_loop"] = run_harness(exe, params, X, U, args.repeats, kane_inputs)
             check_harness(result["c_loop"], model, X, U)
             if args.native:
                 exe = build_harness(build, native=True, with_casadi=False)

@@ -35,7 +35,8 @@ def casadi_reference_c(params, build):
     return build / "ref_accel.c"
 
 
-def build_harness(build, native, with_casadi):
+def build_harness(build, native, with_casadi, kane=None):
+    """The C loop's executable; `kane` = (sources, macros) of runtime/bench/kane_compiled.write_kane_c."""
     cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
     sources = [str(p) for d in ("generated", "c") for p in sorted((ROOT / d).glob("*.c"))]
     flags = ["-std=c99", "-O2", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c'}", f"-I{build}"]
@@ -44,19 +45,25 @@ def build_harness(build, native, with_casadi):
     if with_casadi:
         flags.append("-DWITH_CASADI")
         sources.append(str(build / "ref_accel.c"))
+    if kane is not None:
+        kane_sources, macros = kane
+        flags += ["-DWITH_KANE", *(f"-D{name}={value}" for name, value in macros.items())]
+        sources += map(str, kane_sources)
     exe = build / ("bench_native" if native else "bench")
     subprocess.run([cc, *flags, str(ROOT / "bench" / "bench_kernels.c"), *sources, "-lm", "-o", str(exe)],
                    check=True)
     return exe
 
 
-def run_harness(exe, params, X, U, repeats):
+def run_harness(exe, params, X, U, repeats, kane_inputs=None):
     data = build_dir_input = exe.parent / "input.bin"
     with open(build_dir_input, "wb") as f:
         f.write(struct.pack("i", len(X)))
         f.write(np.ascontiguousarray(params.as_array()).tobytes())
         f.write(np.ascontiguousarray(X).tobytes())
         f.write(np.ascontiguousarray(U).tobytes())
+        if kane_inputs is not None:
+            f.write(np.ascontiguousarray(kane_inputs, dtype=np.float64).tobytes())
     out = subprocess.run([str(exe), str(data), str(repeats)], check=True, capture_output=True, text=True)
     return json.loads(out.stdout)
 
@@ -72,6 +79,9 @@ def check_harness(result, model, X, U):
         for key, method in [("step_lie_euler", "lie-euler"), ("step_rkmk4", "rkmk4"), ("step_cf4", "cf4")]:
             if key in result:
                 check_close(f"C {key}", result[key]["check"][i], model.step(X[i], U[i], 0.01, method), 1e-12)
+        for key in ("kane_casadi_c_accel", "kane_sympy_c_accel", "kane_pydy_c_accel"):
+            if key in result:
+                check_close(f"C loop {key}", result[key]["check"][i], model.accel(X[i], U[i]), 1e-10)
         if "casadi_generated_reference_accel" in result:
             check_close("CasADi-generated reference", result["casadi_generated_reference_accel"]["check"][i],
                         ref.accel(X[i], U[i]), 1e-10)

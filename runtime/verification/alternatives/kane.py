@@ -183,7 +183,12 @@ def _derive():
     M_s, F_s = M.xreplace(sub), F.xreplace(sub)
     udep_s = udep_expr.xreplace(sub)
     args = (qs, us, (u_Y, u_P), par)
-    return {"MF": (args, (M_s, F_s)), "udep": ((qs, us[:5], par), udep_s),
+    # The kinematic differential equations q' = f(q, u) (with the 1/cos(theta) of the Euler
+    # angles): not used by `accel`, but part of the ODE function a PyDy user generates
+    # (runtime/bench/kane_compiled.py).
+    kdd = kane.kindiffdict()
+    qdot_s = sm.Matrix([kdd[qi.diff()] for qi in q]).xreplace(sub)
+    return {"MF": (args, (M_s, F_s)), "udep": ((qs, us[:5], par), udep_s), "qdot": ((qs, us, par), qdot_s),
             "seconds": time.perf_counter() - t0, "kane_seconds": t_kane,
             "n_ops": int(sm.count_ops(M_s) + sm.count_ops(F_s))}
 

@@ -56,3 +56,13 @@ def test_call_overhead_timings_check_the_raw_calls_and_time_both_sides():
     assert set(out) == {"python_model_accel_ns", "raw_cffi_accel_ns", "python_model_step_lie-euler_ns",
                         "raw_cffi_step_lie-euler_ns", "python_model_step_rkmk4_ns", "raw_cffi_step_rkmk4_ns"}
     assert all(v > 0 for v in out.values())
+
+
+def test_a_stored_run_renders_as_the_readmes_markdown_tables(capsys):
+    stored = sorted((cli.RESULTS).glob("2026-11-23T22-24-32.json"))[0]
+    assert cli.main(["--markdown", str(stored)]) == 0
+    text = capsys.readouterr().out
+    for title in ("**C against C", "**Python call against Python call", "**Batches"):
+        assert title in text
+    assert "| Kane model, CasADi C: M, F and ca.solve (what a CasADi user ships) |" in text
+    assert text.rstrip().splitlines()[-1].startswith("targets: accel <= 150 ns: met")
