@@ -25,7 +25,8 @@ cross-test:
 	$(CROSS_ENV) sh cross/cross_test.sh $(BUILD)/cross
 
 cross-report:
-	$(CROSS_ENV) python3 cross/m4_report.py --build $(BUILD)/cross/report --update ../docs/embedding.md
+	python3 cross/m4_report.py --build $(BUILD)/cross/report --cross-prefix '$(CROSS_PREFIX)' --qemu '$(QEMU)' \
+	    --update ../docs/embedding.md
 
 .PHONY: cross-clean
 clean: cross-clean
