@@ -15,6 +15,7 @@ CDEF = """
 #define SR_NX 35
 #define SR_NU 2
 #define SR_NV 5
+#define SR_NE 12
 #define SR_OK 0
 #define SR_ERR_NULL 1
 #define SR_ERR_NONFINITE 2
@@ -72,6 +73,10 @@ int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[], 
 #define SR_BATCH_MAX_DISTANCE 1
 #define SR_BATCH_MAX_SHELL_RATE 2
 #define SR_BATCH_FINAL_ENERGY 3
+int sr_retract(const sr_model *model, const sr_real x[], const sr_real d[], sr_real y[]);
+int sr_local(const sr_model *model, const sr_real x[], const sr_real y[], sr_real d[]);
+int sr_retract_batch(const sr_model *model, long n, const sr_real *x, const sr_real *d, sr_real *y, long *failed_row);
+int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_real *y, sr_real *d, long *failed_row);
 int sr_simulate_batch(int method, long n, const sr_real *params, long params_stride, const sr_real *x0,
                       long x0_stride, sr_real dt, long steps, const sr_real *u, long u_stride,
                       sr_real energy_tol, long chunk_steps, sr_real *work, sr_real *traj,
@@ -107,9 +112,10 @@ static int sr_py_step(const sr_model *model, int method, const void *x, const vo
 # runs only if it is built with the same flag).
 NATIVE = ["-march=native"] if os.environ.get("SR_NATIVE") == "1" else []
 
-# The layout macros (SR_X_*, SR_U_*, SR_P_*) as the generator wrote them.
+# The layout macros (SR_X_*, SR_U_*, SR_P_*, SR_E_* and the error-state size) as the generator wrote them.
 LAYOUT = "\n".join(line for line in (ROOT / "generated" / "sr_generated.h").read_text().splitlines()
-                   if line.startswith(("#define SR_X_", "#define SR_U_", "#define SR_P_")))
+                   if line.startswith(("#define SR_X_", "#define SR_U_", "#define SR_P_", "#define SR_E_",
+                                       "#define SR_GEN_NE ")))
 
 ffibuilder = cffi.FFI()
 ffibuilder.cdef(CDEF + LAYOUT + PY_ENTRIES_CDEF)

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 1567ac1f2e5ad3c6], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources dc8766f2f620a5be], SymPy 1.14.0. */
 #include "sr_generated.h"
 
 #include <math.h>

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 1567ac1f2e5ad3c6], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources dc8766f2f620a5be], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -18,6 +18,7 @@
 #define SR_GEN_NX 35
 #define SR_GEN_NU 2
 #define SR_GEN_NV 5
+#define SR_GEN_NE 12
 
 /* Layout of x[SR_GEN_NX]: offset of each block (matrices row-major; nu = (w_S, w_Y, w_P) starts at SR_X_w_S). */
 #define SR_X_R_S 0
@@ -30,6 +31,12 @@
 /* Layout of u[SR_GEN_NU]. */
 #define SR_U_u_Y 0
 #define SR_U_u_P 1
+/* Layout of the error state d[SR_GEN_NE] (tangent coordinates of x, right-trivialised: x (+) d). */
+#define SR_E_xi_S 0
+#define SR_E_th_Y 3
+#define SR_E_th_P 4
+#define SR_E_q 5
+#define SR_E_nu 7
 /* Layout of p[SR_GEN_NPARAM], the parameters of derive/parameters.py (SI). */
 #define SR_P_r 0
 #define SR_P_m_S 1

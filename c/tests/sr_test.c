@@ -45,6 +45,7 @@ int main(void)
     suite_precision();
     suite_guards();
     suite_batch();
+    suite_group();
     return sr_test_summary();
 }
 

@@ -67,6 +67,7 @@ void suite_buffers(void);
 void suite_precision(void);
 void suite_guards(void);
 void suite_batch(void);
+void suite_group(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 
