@@ -77,6 +77,9 @@ int sr_retract(const sr_model *model, const sr_real x[], const sr_real d[], sr_r
 int sr_local(const sr_model *model, const sr_real x[], const sr_real y[], sr_real d[]);
 int sr_retract_batch(const sr_model *model, long n, const sr_real *x, const sr_real *d, sr_real *y, long *failed_row);
 int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_real *y, sr_real *d, long *failed_row);
+int sr_accel_jacobian(const sr_model *model, const sr_real x[], const sr_real u[], sr_real Ja[], sr_real Jb[]);
+int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
+                            sr_real *Ja, sr_real *Jb, long *failed_row);
 int sr_simulate_batch(int method, long n, const sr_real *params, long params_stride, const sr_real *x0,
                       long x0_stride, sr_real dt, long steps, const sr_real *u, long u_stride,
                       sr_real energy_tol, long chunk_steps, sr_real *work, sr_real *traj,

@@ -323,6 +323,27 @@ int sr_retract_batch(const sr_model *model, long n, const sr_real *x, const sr_r
 int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_real *y, sr_real *d,
                    long *failed_row);
 
+/* ---- Derivatives of the dynamics (c/sr_jacobians.c) ------------------------------------------ */
+#ifdef SR_USE_FLOAT
+#define sr_accel_jacobian sr_accel_jacobian_f
+#define sr_accel_jacobian_batch sr_accel_jacobian_batch_f
+#endif
+
+/* Jacobians of the accelerations in the error coordinates:
+ *   nu'(x (+) d, u + w) = nu'(x, u) + Ja d + Jb w + O(|d|^2 + |w|^2),
+ * Ja row-major SR_NV x SR_NE, Jb row-major SR_NV x SR_NU.  Derived symbolically from the same
+ * derivation as sr_accel (derive/derivatives.py): d(nu') = M^-1 (df - (dM) nu'), one Cholesky
+ * factorisation of M for nu' and every column; cost SR_GEN_ACCEL_JACOBIAN_TERMS_FLOPS plus the
+ * solves.  Checks and status codes as sr_accel (u may be NULL: zero torque); the outputs are
+ * written only on SR_OK. */
+int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                      sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU]);
+
+/* The same over n rows (x n x SR_NX, u n x SR_NU or NULL, Ja n x SR_NV x SR_NE, Jb n x SR_NV x
+ * SR_NU); stops at the first failing row, its index in *failed_row (-1 when all succeed). */
+int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
+                            sr_real *Ja, sr_real *Jb, long *failed_row);
+
 #ifdef __cplusplus
 }
 #endif

@@ -46,6 +46,7 @@ int main(void)
     suite_guards();
     suite_batch();
     suite_group();
+    suite_jacobians();
     return sr_test_summary();
 }
 

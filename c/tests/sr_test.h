@@ -68,6 +68,7 @@ void suite_precision(void);
 void suite_guards(void);
 void suite_batch(void);
 void suite_group(void);
+void suite_jacobians(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 
