@@ -74,6 +74,7 @@ extern "C" {
 #define SR_NX SR_GEN_NX
 #define SR_NU SR_GEN_NU
 #define SR_NV SR_GEN_NV
+#define SR_NE SR_GEN_NE
 
 /* Status codes. */
 #define SR_OK 0
@@ -330,6 +331,60 @@ int sr_simulate_batch(int method, long n, const sr_real *params, long params_str
                       long x0_stride, sr_real dt, long steps, const sr_real *u, long u_stride,
                       sr_real energy_tol, long chunk_steps, sr_real *work, sr_real *traj,
                       sr_real *x_final, sr_real *metrics, int *status, long *steps_done);
+
+/* ---- The state on its group: error coordinates (c/sr_group.c) ------------------------------ */
+#ifdef SR_USE_FLOAT
+#define sr_retract sr_retract_f
+#define sr_local sr_local_f
+#define sr_retract_batch sr_retract_batch_f
+#define sr_local_batch sr_local_batch_f
+#endif
+
+/* The error state d[SR_NE] = 12 entries (issue 19; offsets SR_E_* of sr_generated.h), the
+ * right-trivialised tangent coordinates in which every Jacobian of this library is expressed:
+ *   d[SR_E_xi_S + 0..2]  shell rotation vector, R_S <- R_S Exp([[d]])          [rad]
+ *   d[SR_E_th_Y]         yoke angle, R_Y <- R_Y Exp(d Sigma_Y)                  [rad]
+ *   d[SR_E_th_P]         pendulum angle, R_P <- R_P Exp(d Sigma_P)              [rad]
+ *   d[SR_E_q + 0..1]     shell centre along the plane's x and y axes, q_z kept  [m]
+ *   d[SR_E_nu + 0..4]    nu <- nu + d (w_S, w_Y, w_P)                           [rad/s]
+ * sr_retract gives y = x (+) d for every finite d (the exponentials are exact for every angle).
+ * sr_local gives d = y (-) x, its inverse: Log(R_S^T R_S') with |xi| <= pi (accurate near pi,
+ * where the axis is taken from the symmetric part), the joint angle differences in (-pi, pi],
+ * the in-plane difference of q, the difference of nu.  So local(x, retract(x, d)) = d whenever
+ * |d_xi_S| < pi and |d_th_Y|, |d_th_P| < pi, and retract(x, local(x, y)) = y for all valid x, y.
+ * Both check their states in full (sr_check_state) and d for finiteness; they return SR_OK,
+ * SR_ERR_NULL, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION or SR_ERR_CONSTRAINT and write their
+ * output only on SR_OK (y may alias x in sr_retract). */
+int sr_retract(const sr_model *model, const sr_real x[SR_NX], const sr_real d[SR_NE], sr_real y[SR_NX]);
+int sr_local(const sr_model *model, const sr_real x[SR_NX], const sr_real y[SR_NX], sr_real d[SR_NE]);
+
+/* The same over n rows (x, y n x SR_NX, d n x SR_NE, row-major); stops at the first failing row,
+ * whose index goes to *failed_row (if not NULL; -1 when all rows succeed).  n < 0: SR_ERR_ARG. */
+int sr_retract_batch(const sr_model *model, long n, const sr_real *x, const sr_real *d, sr_real *y,
+                     long *failed_row);
+int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_real *y, sr_real *d,
+                   long *failed_row);
+
+/* ---- Derivatives of the dynamics (c/sr_jacobians.c) ------------------------------------------ */
+#ifdef SR_USE_FLOAT
+#define sr_accel_jacobian sr_accel_jacobian_f
+#define sr_accel_jacobian_batch sr_accel_jacobian_batch_f
+#endif
+
+/* Jacobians of the accelerations in the error coordinates:
+ *   nu'(x (+) d, u + w) = nu'(x, u) + Ja d + Jb w + O(|d|^2 + |w|^2),
+ * Ja row-major SR_NV x SR_NE, Jb row-major SR_NV x SR_NU.  Derived symbolically from the same
+ * derivation as sr_accel (derive/derivatives.py): d(nu') = M^-1 (df - (dM) nu'), one Cholesky
+ * factorisation of M for nu' and every column; cost SR_GEN_ACCEL_JACOBIAN_TERMS_FLOPS plus the
+ * solves.  Checks and status codes as sr_accel (u may be NULL: zero torque); the outputs are
+ * written only on SR_OK. */
+int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                      sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU]);
+
+/* The same over n rows (x n x SR_NX, u n x SR_NU or NULL, Ja n x SR_NV x SR_NE, Jb n x SR_NV x
+ * SR_NU); stops at the first failing row, its index in *failed_row (-1 when all succeed). */
+int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
+                            sr_real *Ja, sr_real *Jb, long *failed_row);
 
 #ifdef __cplusplus
 }

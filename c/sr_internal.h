@@ -27,6 +27,7 @@
 #define SR_COS cosf
 #define SR_FABS fabsf
 #define SR_POW powf
+#define SR_ATAN2 atan2f
 #define SR_EPSILON FLT_EPSILON
 #else
 #define SR_SQRT sqrt
@@ -34,6 +35,7 @@
 #define SR_COS cos
 #define SR_FABS fabs
 #define SR_POW pow
+#define SR_ATAN2 atan2
 #define SR_EPSILON DBL_EPSILON
 #endif
 

@@ -27,6 +27,12 @@ STATE_BLOCKS = (
 #: The entries of u: (name, index), emitted as SR_U_<name>.
 INPUT_NAMES = (("u_Y", 0), ("u_P", 1))
 
+#: The error (tangent) state d of issue 19, right-trivialised: x ⊕ d is R_S Exp(⟦d_xi_S⟧),
+#: R_Y Exp(d_th_Y Σ_Y), R_P Exp(d_th_P Σ_P), q + (d_q, 0), ν + d_nu.  (name, offset, length),
+#: emitted as SR_E_<name> and SR_GEN_NE; the Jacobians of the dynamics and the steps use it.
+ERROR_BLOCKS = (("xi_S", 0, 3), ("th_Y", 3, 1), ("th_P", 4, 1), ("q", 5, 2), ("nu", 7, 5))
+NE = 12
+
 
 def hat(w):
     """⟦w⟧ of eq. (2): the skew-symmetric matrix with ⟦w⟧ z = w × z."""

@@ -5,6 +5,8 @@ from bindings._fastcall import Kernels
 from bindings._sr import ffi, lib
 
 from .errors import KernelError, SimulationStopped
+from .derivatives import DerivativeMethods
+from .group import GroupMethods
 from .params import Params
 from .state import NU, NV, NX
 from .validation import ROTATION_TOL, check_finite, check_states, describe_state, project_state, real_array
@@ -61,12 +63,14 @@ _PARAM_MESSAGES = {
 }
 
 
-class Model:
+class Model(GroupMethods, DerivativeMethods):
     """The spherical robot with parameters `params` (default: `Params()`, Section 5.2 as printed).
 
     Every method validates its input in full (c/spherical_robot.h, `sr_check_state`; the rules
     are in runtime/validation.py) and raises ValueError naming the argument, the entry and the
-    rule; `KernelError` (a ValueError) carries the C status code.
+    rule; `KernelError` (a ValueError) carries the C status code.  `retract` and `local` (the
+    error coordinates of the Jacobians) come from `runtime.group.GroupMethods`, `accel_jacobian`
+    and `linearize` from `runtime.derivatives.DerivativeMethods`.
     """
 
     def __init__(self, params=None):

@@ -30,6 +30,15 @@ ROTATION_BLOCKS = {"R_S": IDX_RS, "R_Y": IDX_RY, "R_P": IDX_RP}
 #: Indices of the inputs u = (u_Y, u_P).
 IDX_UY, IDX_UP = lib.SR_U_u_Y, lib.SR_U_u_P
 
+#: The error state d (12,) of `Model.retract` / `Model.local` and of every Jacobian (issue 19,
+#: right-trivialised; generated SR_E_* offsets): shell rotation vector, yoke and pendulum
+#: angles, in-plane shift of q, change of ν.
+NE = lib.SR_NE
+IDX_E_XI_S = slice(lib.SR_E_xi_S, lib.SR_E_xi_S + 3)
+IDX_E_TH_Y, IDX_E_TH_P = lib.SR_E_th_Y, lib.SR_E_th_P
+IDX_E_Q = slice(lib.SR_E_q, lib.SR_E_q + 2)
+IDX_E_NU = slice(lib.SR_E_nu, lib.SR_E_nu + NV)
+
 
 def rotations(x):
     """(R_S, R_Y, R_P) of a state (35,) or of states (..., 35): arrays (..., 3, 3), views where possible."""

@@ -45,6 +45,8 @@ int main(void)
     suite_precision();
     suite_guards();
     suite_batch();
+    suite_group();
+    suite_jacobians();
     return sr_test_summary();
 }
 

@@ -67,6 +67,8 @@ void suite_buffers(void);
 void suite_precision(void);
 void suite_guards(void);
 void suite_batch(void);
+void suite_group(void);
+void suite_jacobians(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 

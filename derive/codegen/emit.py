@@ -123,6 +123,9 @@ def layout_macros():
     lines += [f"#define SR_X_{name} {offset}" for name, offset, _ in S.STATE_BLOCKS]
     lines += ["/* Layout of u[SR_GEN_NU]. */"]
     lines += [f"#define SR_U_{name} {index}" for name, index in S.INPUT_NAMES]
+    assert sum(n for _, _, n in S.ERROR_BLOCKS) == S.NE
+    lines += ["/* Layout of the error state d[SR_GEN_NE] (tangent coordinates of x, right-trivialised: x (+) d). */"]
+    lines += [f"#define SR_E_{name} {offset}" for name, offset, _ in S.ERROR_BLOCKS]
     lines += ["/* Layout of p[SR_GEN_NPARAM], the parameters of derive/parameters.py (SI). */"]
     lines += [f"#define SR_P_{s.name} {i}" for i, s in enumerate(P.PARAMETERS)]
     return "\n".join(lines)
@@ -152,6 +155,7 @@ def header_text(ks, flops, n_constants):
 #define SR_GEN_NX {S.NX}
 #define SR_GEN_NU {S.NU}
 #define SR_GEN_NV {S.NV}
+#define SR_GEN_NE {S.NE}
 
 {layout_macros()}
 

@@ -10,6 +10,7 @@ additionally solves M ν̇ = f, joint accelerations first (see
 `joint_first.emit_shell_solve`: M is symmetric positive definite, so no
 pivoting is needed and no square root is taken).
 """
+from .. import derivatives as J
 from .. import dynamics as D
 from .. import newton_euler as NE
 from .. import parameters as P
@@ -88,4 +89,24 @@ def kernels():
                ("c", "x"), (Output("res", tuple(D.equilibrium_residual()), "residual"),)),
         Kernel("accel", "ν̇ = (ω̇_S, ω̇_Y, ω̇_P) solving M ν̇ = f, joints first; SR_GEN_SINGULAR if M is not positive definite.",
                ("c", "x", "u"), accel_outputs, solve=True, definitions=accel_definitions),
+        accel_jacobian_terms(),
     )
+
+
+def accel_jacobian_terms():
+    """What the solves of sr_accel_jacobian (c/sr_jacobians.c) need, in one kernel so that CSE
+    shares M, f and their derivatives (derive.derivatives): ∂ν̇ = M⁻¹(∂f − (∂M) ν̇)."""
+    upper = [(i, j) for i in range(S.NV) for j in range(i, S.NV)]
+    M, f = D.inertia(), D.rhs()
+    dM = J.inertia_derivatives()
+    return Kernel(
+        "accel_jacobian_terms",
+        "M (upper triangle, row by row), f, ∂f/∂d (5 x SR_GEN_NE, row-major, error coordinates of"
+        " SR_E_*), ∂f/∂u (5 x 2) and ∂M/∂d along δξ_S, δθ_Y, δθ_P (5 upper triangles) for the"
+        " accel Jacobian ∂ν̇ = M⁻¹(∂f − (∂M) ν̇).",
+        ("c", "x", "u"),
+        (Output("M", tuple(M[i, j] for i, j in upper), "M, upper triangle row by row"),
+         Output("f", tuple(f), "f"),
+         Output("df", tuple(J.rhs_jacobian()), "df/dd, row-major 5 x SR_GEN_NE"),
+         Output("dfdu", tuple(J.rhs_input_jacobian()), "df/du, row-major 5 x 2"),
+         Output("dM", tuple(m[i, j] for m in dM for i, j in upper), "dM/dd_k, k < 5, upper triangles")))

@@ -13,6 +13,8 @@ Checks
   rolling       the contact point of the simulated motion does not slip
   equilibria    accel = 0 at eq. (108); linearization stable below, unstable above
   symmetry      planar motions stay planar
+  jacobians     accel_jacobian against CasADi AD of the reference and Richardson-extrapolated
+                central differences through retract (runtime.verification.jacobians)
 """
 import argparse
 import dataclasses
@@ -247,6 +249,11 @@ def planar_symmetry(steps=2000):
                         "q_x, ω_Sy, ω_Sz, ω_P")]
 
 
+def jacobian_rows(n_states=1000, seed=5):
+    from .jacobians import accel_jacobian_checks
+    return [CheckResult(*row) for row in accel_jacobian_checks(n_states, seed)]
+
+
 def run_all(n_states=1000, seed=0, progress=None):
     steps = [
         ("cross-check", lambda: cross_check(n_states, seed)),
@@ -255,6 +262,7 @@ def run_all(n_states=1000, seed=0, progress=None):
         ("rolling", lambda: [rolling_constraint(seed=seed + 3)]),
         ("equilibria", lambda: equilibria(seed=seed + 4)),
         ("symmetry", planar_symmetry),
+        ("jacobians", lambda: jacobian_rows(n_states, seed + 5)),
     ]
     results = []
     for i, (name, fn) in enumerate(steps):

@@ -73,7 +73,8 @@ def layout_mismatches(header):
         "SR_P_": {s.name: i for i, s in enumerate(P.PARAMETERS)},
         "SR_X_": {name: offset for name, offset, _ in S.STATE_BLOCKS},
         "SR_U_": dict(S.INPUT_NAMES),
-        "SR_GEN_N": {"PARAM": len(P.PARAMETERS), "X": S.NX, "U": S.NU, "V": S.NV},
+        "SR_E_": {name: offset for name, offset, _ in S.ERROR_BLOCKS},
+        "SR_GEN_N": {"PARAM": len(P.PARAMETERS), "X": S.NX, "U": S.NU, "V": S.NV, "E": S.NE},
     }
     found = {prefix: macros(header, prefix) for prefix in expected}
     found["SR_GEN_N"] = {k: v for k, v in found["SR_GEN_N"].items() if k in expected["SR_GEN_N"]}
@@ -89,7 +90,9 @@ def test_header_layout_macros_equal_the_derive_sources():
     lambda h: h.replace("#define SR_X_w_Y 33\n", ""),
     lambda h: h.replace("#define SR_U_u_P 1", "#define SR_U_u_P 0"),
     lambda h: h.replace("#define SR_GEN_NX 35", "#define SR_GEN_NX 36"),
-], ids=["parameter index", "missing state block", "input index", "state size"])
+    lambda h: h.replace("#define SR_E_q 5", "#define SR_E_q 6"),
+    lambda h: h.replace("#define SR_GEN_NE 12", "#define SR_GEN_NE 11"),
+], ids=["parameter index", "missing state block", "input index", "state size", "error block", "error size"])
 def test_header_layout_check_fails_for_a_perturbed_header(perturb):
     header = (ROOT / "generated" / "sr_generated.h").read_text()
     perturbed = perturb(header)

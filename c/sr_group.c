@@ -1,0 +1,149 @@
+/*
+ * sr_group.c -- the state as a point of the group SO(3) x SO(2)_x x SO(2)_y x R^2 x R^5 and its
+ * tangent (error) coordinates: x (+) d (sr_retract) and y (-) x (sr_local), right-trivialised
+ * (issue 19, as in manif and SymForce).  The Jacobians of the dynamics and of the steps are
+ * expressed in these coordinates, so they are the contract between them and their users.
+ */
+#include "sr_internal.h"
+
+#include <string.h>
+
+/* w = Log(R), |w| <= pi, for a rotation R (row-major), accurate for every angle: the axis comes
+ * from the skew part while the angle is at most pi/2 and from the symmetric part beyond, where
+ * sin(theta) loses the accuracy that (R + R^T)/2 - cos(theta) I = (1 - cos theta) n n^T keeps. */
+static void so3_log(const sr_real R[9], sr_real w[3])
+{
+    const sr_real s[3] = {SR_C(0.5) * (R[7] - R[5]), SR_C(0.5) * (R[2] - R[6]), SR_C(0.5) * (R[3] - R[1])};
+    const sr_real sin_t = SR_SQRT(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    sr_real cos_t = SR_C(0.5) * (R[0] + R[4] + R[8] - 1);
+    sr_real theta, scale;
+    int i;
+    cos_t = cos_t > 1 ? 1 : (cos_t < -1 ? -1 : cos_t);
+    theta = SR_ATAN2(sin_t, cos_t);
+    if (cos_t >= 0) {
+        /* theta / sin(theta); its series below 1e-4 rad (the next term, 7 t^4/360, is < 2e-18). */
+        scale = theta < SR_C(1e-4) ? 1 + theta * theta / 6 : theta / sin_t;
+        for (i = 0; i < 3; ++i) w[i] = scale * s[i];
+    } else {
+        /* The column of S = (R + R^T)/2 - cos(theta) I with the largest diagonal entry: that
+         * entry is (1 - cos theta) n_k^2 >= 1/3, so its direction is n to rounding. */
+        sr_real n[3], norm;
+        int k = 0;
+        for (i = 1; i < 3; ++i)
+            if (R[4 * i] > R[4 * k]) k = i;
+        for (i = 0; i < 3; ++i) n[i] = SR_C(0.5) * (R[3 * i + k] + R[3 * k + i]);
+        n[k] -= cos_t;
+        /* The sign of the axis from the skew part sin(theta) n (immaterial at theta = pi). */
+        if (n[0] * s[0] + n[1] * s[1] + n[2] * s[2] < 0)
+            for (i = 0; i < 3; ++i) n[i] = -n[i];
+        norm = SR_SQRT(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (i = 0; i < 3; ++i) w[i] = theta * n[i] / norm;
+    }
+}
+
+/* y = x (+) d without checks (y may alias x). */
+static void retract(const sr_real x[SR_NX], const sr_real d[SR_NE], sr_real y[SR_NX])
+{
+    sr_real D[9], RD[9], RY[9], RP[9];
+    int i;
+    /* R_S Exp(d_S) = R_S + R_S (Exp(d_S) - I): small steps keep full relative precision. */
+    so3_exp_minus_identity(d + SR_E_xi_S, D);
+    matmul3(x + SR_X_R_S, D, RD);
+    rotate_about_axis(x + SR_X_R_Y, 0, d[SR_E_th_Y], RY);
+    rotate_about_axis(x + SR_X_R_P, 1, d[SR_E_th_P], RP);
+    if (y != x) memcpy(y, x, sizeof(sr_real) * SR_NX);
+    for (i = 0; i < 9; ++i) {
+        y[SR_X_R_S + i] += RD[i];
+        y[SR_X_R_Y + i] = RY[i];
+        y[SR_X_R_P + i] = RP[i];
+    }
+    y[SR_X_q + 0] += d[SR_E_q + 0];
+    y[SR_X_q + 1] += d[SR_E_q + 1];
+    for (i = 0; i < SR_NV; ++i) y[SR_X_w_S + i] += d[SR_E_nu + i];
+}
+
+/* d = y (-) x without checks. */
+static void local(const sr_real x[SR_NX], const sr_real y[SR_NX], sr_real d[SR_NE])
+{
+    sr_real E[9], Rt[9];
+    int i, j;
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) Rt[3 * i + j] = x[SR_X_R_S + 3 * j + i];
+    matmul3(Rt, y + SR_X_R_S, E);
+    so3_log(E, d + SR_E_xi_S);
+    /* R_Y^T R_Y' is the rotation by the angle difference about x: its (cos, sin) in the (y, z)
+     * block; the same for R_P about y in the (z, x) block.  Both sums use the two copies. */
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) Rt[3 * i + j] = x[SR_X_R_Y + 3 * j + i];
+    matmul3(Rt, y + SR_X_R_Y, E);
+    d[SR_E_th_Y] = SR_ATAN2(E[7] - E[5], E[4] + E[8]);
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) Rt[3 * i + j] = x[SR_X_R_P + 3 * j + i];
+    matmul3(Rt, y + SR_X_R_P, E);
+    d[SR_E_th_P] = SR_ATAN2(E[2] - E[6], E[0] + E[8]);
+    d[SR_E_q + 0] = y[SR_X_q + 0] - x[SR_X_q + 0];
+    d[SR_E_q + 1] = y[SR_X_q + 1] - x[SR_X_q + 1];
+    for (i = 0; i < SR_NV; ++i) d[SR_E_nu + i] = y[SR_X_w_S + i] - x[SR_X_w_S + i];
+}
+
+int sr_retract(const sr_model *model, const sr_real x[SR_NX], const sr_real d[SR_NE], sr_real y[SR_NX])
+{
+    sr_real out[SR_NX];
+    int status;
+    if (!model || !x || !d || !y) return SR_ERR_NULL;
+    status = sr_check_state(model, x);
+    if (status != SR_OK) return status;
+    if (!all_finite(d, SR_NE)) return SR_ERR_NONFINITE;
+    retract(x, d, out);
+    if (!all_finite(out, SR_NX)) return SR_ERR_NONFINITE;
+    memcpy(y, out, sizeof out);
+    return SR_OK;
+}
+
+int sr_local(const sr_model *model, const sr_real x[SR_NX], const sr_real y[SR_NX], sr_real d[SR_NE])
+{
+    sr_real out[SR_NE];
+    int status;
+    if (!model || !x || !y || !d) return SR_ERR_NULL;
+    status = sr_check_state(model, x);
+    if (status == SR_OK) status = sr_check_state(model, y);
+    if (status != SR_OK) return status;
+    local(x, y, out);
+    if (!all_finite(out, SR_NE)) return SR_ERR_NONFINITE;
+    memcpy(d, out, sizeof out);
+    return SR_OK;
+}
+
+int sr_retract_batch(const sr_model *model, long n, const sr_real *x, const sr_real *d, sr_real *y,
+                     long *failed_row)
+{
+    long i;
+    if (failed_row) *failed_row = -1;
+    if (!model || (n > 0 && (!x || !d || !y))) return SR_ERR_NULL;
+    if (n < 0) return SR_ERR_ARG;
+    for (i = 0; i < n; ++i) {
+        const int status = sr_retract(model, x + i * SR_NX, d + i * SR_NE, y + i * SR_NX);
+        if (status != SR_OK) {
+            if (failed_row) *failed_row = i;
+            return status;
+        }
+    }
+    return SR_OK;
+}
+
+int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_real *y, sr_real *d,
+                   long *failed_row)
+{
+    long i;
+    if (failed_row) *failed_row = -1;
+    if (!model || (n > 0 && (!x || !y || !d))) return SR_ERR_NULL;
+    if (n < 0) return SR_ERR_ARG;
+    for (i = 0; i < n; ++i) {
+        const int status = sr_local(model, x + i * SR_NX, y + i * SR_NX, d + i * SR_NE);
+        if (status != SR_OK) {
+            if (failed_row) *failed_row = i;
+            return status;
+        }
+    }
+    return SR_OK;
+}

@@ -1,0 +1,70 @@
+/*
+ * test_jacobians.c -- sr_accel_jacobian (c/sr_jacobians.c): each column is the central difference
+ * of sr_accel along sr_retract (or along u); status codes and untouched outputs on error.
+ */
+#include "sr_test.h"
+
+#include <math.h>
+#include <string.h>
+
+static void test_accel_jacobian_columns_are_central_differences_along_retract(void)
+{
+    /* Step h: truncation ~h^2, rounding ~eps/h: 1e-4 in double, 3e-2 in float. */
+    const double h = TEST_EPS < 1e-10 ? 1e-4 : 3e-2, tol = TEST_EPS < 1e-10 ? 1e-6 : 3e-2;
+    sr_real p[SR_NPARAM], x[SR_NX], y[SR_NX], u[SR_NU] = {SR_C(0.05), SR_C(-0.02)}, up[SR_NU], d[SR_NE];
+    sr_real Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], ap[SR_NV], am[SR_NV];
+    test_rng rng = {23};
+    sr_model m;
+    double scale = 0;
+    int k, i, s;
+    paper_simulation_params(p);
+    CHECK_STATUS(sr_model_init(&m, p), SR_OK);
+    random_state(&rng, p[SR_P_r], 2.0, x);
+    CHECK_STATUS(sr_accel_jacobian(&m, x, u, Ja, Jb), SR_OK);
+    for (i = 0; i < SR_NV * SR_NE; ++i) scale = fabs((double)Ja[i]) > scale ? fabs((double)Ja[i]) : scale;
+    for (k = 0; k < SR_NE; ++k) {
+        for (s = -1; s <= 1; s += 2) {
+            memset(d, 0, sizeof d);
+            d[k] = (sr_real)(s * h);
+            CHECK_STATUS(sr_retract(&m, x, d, y), SR_OK);
+            CHECK_STATUS(sr_accel(&m, y, u, s > 0 ? ap : am), SR_OK);
+        }
+        for (i = 0; i < SR_NV; ++i)
+            CHECK_NEAR(Ja[SR_NE * i + k], ((double)ap[i] - (double)am[i]) / (2 * h), tol * scale);
+    }
+    for (k = 0; k < SR_NU; ++k) {
+        for (s = -1; s <= 1; s += 2) {
+            memcpy(up, u, sizeof up);
+            up[k] += (sr_real)(s * h);
+            CHECK_STATUS(sr_accel(&m, x, up, s > 0 ? ap : am), SR_OK);
+        }
+        for (i = 0; i < SR_NV; ++i)
+            CHECK_NEAR(Jb[SR_NU * i + k], ((double)ap[i] - (double)am[i]) / (2 * h), tol * scale);
+    }
+}
+
+static void test_accel_jacobian_bad_input_leaves_outputs_untouched(void)
+{
+    sr_real p[SR_NPARAM], x[SR_NX], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], keep[SR_NV * SR_NE];
+    test_rng rng = {29};
+    sr_model m;
+    long failed = 5;
+    paper_simulation_params(p);
+    CHECK_STATUS(sr_model_init(&m, p), SR_OK);
+    random_state(&rng, p[SR_P_r], 1.0, x);
+    memset(Ja, 0x5a, sizeof Ja);
+    memcpy(keep, Ja, sizeof Ja);
+    x[SR_X_w_P] = (sr_real)INFINITY;
+    CHECK_STATUS(sr_accel_jacobian(&m, x, NULL, Ja, Jb), SR_ERR_NONFINITE);
+    CHECK(memcmp(Ja, keep, sizeof Ja) == 0);
+    CHECK_STATUS(sr_accel_jacobian(&m, x, NULL, NULL, Jb), SR_ERR_NULL);
+    CHECK_STATUS(sr_accel_jacobian_batch(&m, 1, x, NULL, Ja, Jb, &failed), SR_ERR_NONFINITE);
+    CHECK(failed == 0);
+    CHECK_STATUS(sr_accel_jacobian_batch(&m, -1, x, NULL, Ja, Jb, &failed), SR_ERR_ARG);
+}
+
+void suite_jacobians(void)
+{
+    RUN_TEST(test_accel_jacobian_columns_are_central_differences_along_retract);
+    RUN_TEST(test_accel_jacobian_bad_input_leaves_outputs_untouched);
+}

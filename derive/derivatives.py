@@ -1,0 +1,79 @@
+"""Derivatives of the dynamics in the error coordinates of issue 19 (derive/state.py ERROR_BLOCKS).
+
+The accelerations solve M ν̇ = f (`derive.dynamics`: M of eqs. 97-99, f from eqs. 71/85, 78, 84).
+Along x ⊕ d the configuration moves on its group, right-trivialised:
+    γ = R_Sᵀ e_z  →  Exp(−⟦δξ⟧) γ,   so  ∂γ/∂δξ_k = −e_k × γ       (eq. 85's advection, with δξ for Ω_S dt)
+    R_Y → R_Y Exp(δθ_Y Σ_Y),  R_P → R_P Exp(δθ_P Σ_P)              (eqs. 39)
+q enters neither M nor f, and ν, u enter additively.  Differentiating M ν̇ = f gives
+    ∂ν̇ = M⁻¹ (∂f − (∂M) ν̇),
+so one factorisation of M serves ν̇ and every column (c/sr_jacobians.c does the solves).
+`derive.dynamics` reduced M and f modulo |γ| = 1 and cos² + sin² = 1; those forms agree with
+the derivation on the manifold, so their derivatives along its tangent directions (the only ones
+taken here) agree too.
+"""
+import functools
+
+import sympy as sp
+
+from . import dynamics as D
+from . import state as S
+
+
+def configuration_directions():
+    """The rates of the configuration symbols along δξ_x, δξ_y, δξ_z, δθ_Y, δθ_P (unit steps)."""
+    none, still = sp.zeros(3, 3), sp.zeros(3, 1)
+    directions = [S.configuration_rates(none, none, -S.hat([int(i == k) for i in range(3)]) * S.gamma)
+                  for k in range(3)]
+    directions.append(S.configuration_rates(S.R_Y * S.Sigma_Y, none, still))
+    directions.append(S.configuration_rates(none, S.R_P * S.Sigma_P, still))
+    return directions
+
+
+def _column(expr_matrix, block, k):
+    """∂/∂d of a matrix of expressions along error coordinate k of `block` (the full chain rule)."""
+    names = {name: (offset, length) for name, offset, length in S.ERROR_BLOCKS}
+    if block == "nu":
+        return expr_matrix.diff(S.nu[k])
+    if block == "q":                      # the dynamics does not depend on where the shell is
+        return sp.zeros(*expr_matrix.shape)
+    index = k if block == "xi_S" else {"th_Y": 3, "th_P": 4}[block]
+    assert names[block][1] > k
+    rates = configuration_directions()[index]
+    return expr_matrix.applyfunc(lambda e: S.directional_derivative(e, rates))
+
+
+def error_columns():
+    """(block, k) for the NE error coordinates, in the order of ERROR_BLOCKS."""
+    return [(name, k) for name, _, length in S.ERROR_BLOCKS for k in range(length)]
+
+
+@functools.lru_cache(maxsize=None)
+def rhs_jacobian():
+    """∂f/∂d (5×NE): f along x ⊕ d, at d = 0."""
+    f = D.rhs()
+    return sp.Matrix.hstack(*[_column(f, block, k) for block, k in error_columns()])
+
+
+@functools.lru_cache(maxsize=None)
+def rhs_input_jacobian():
+    """∂f/∂u (5×2): the motor torques enter the joint equations (eqs. 78, 84)."""
+    return D.rhs().jacobian(S.u)
+
+
+@functools.lru_cache(maxsize=None)
+def inertia_derivatives():
+    """∂M/∂d along the five configuration coordinates δξ_S (3), δθ_Y, δθ_P: five 5×5 matrices
+    (M depends on γ, R_Y, R_P only: its derivatives along q and ν are zero)."""
+    M = D.inertia()
+    return tuple(M.applyfunc(lambda e: S.directional_derivative(e, rates)) for rates in configuration_directions())
+
+
+def accel_jacobian(M=None, f=None):
+    """Ja = M⁻¹(∂f/∂d − Σ_k ∂M/∂d_k ν̇ e_kᵀ) symbolically (for the proofs and the tests; slow)."""
+    M = D.inertia() if M is None else M
+    f = D.rhs() if f is None else f
+    a = M.LUsolve(f)
+    dM_a = sp.zeros(5, S.NE)
+    for k, dM in enumerate(inertia_derivatives()):
+        dM_a[:, k] = dM * a
+    return M.LUsolve(rhs_jacobian() - dM_a)

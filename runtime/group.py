@@ -1,0 +1,48 @@
+"""The state as a point of SO(3) × SO(2) × SO(2) × ℝ² × ℝ⁵ and its error coordinates (issue 19).
+
+`x ⊕ d` (retract) and `y ⊖ x` (local) in the right-trivialised coordinates of
+`runtime.state.NE` (c/spherical_robot.h, c/sr_group.c): the contract in which the Jacobians of
+the dynamics and of the steps are expressed.  `Model` inherits these methods; loops run in C.
+"""
+import numpy as np
+
+from bindings._sr import ffi, lib
+
+from .state import NE, NX
+from .validation import check_finite, real_array
+
+
+def _ptr(arr):
+    return ffi.cast("double *", ffi.from_buffer(arr))
+
+
+class GroupMethods:
+    """`retract` and `local` of `Model` (which provides _model, _valid_states and _check)."""
+
+    def retract(self, x, d):
+        """x ⊕ d: state(s) (35,) / (B, 35) moved by error(s) d (12,) / (B, 12) (exact for every angle)."""
+        x = self._valid_states(x)
+        d = real_array(d, "d", (NE,))
+        if d.shape[:-1] != x.shape[:-1]:
+            raise ValueError(f"d: shape {d.shape} does not match x of shape {x.shape}")
+        check_finite(d, "d")
+        return self._group_call(lib.sr_retract, lib.sr_retract_batch, x, d, NX)
+
+    def local(self, x, y):
+        """y ⊖ x: the error(s) d (12,) / (B, 12) with x ⊕ d = y (|ξ_S| ≤ π, joint angles in (−π, π])."""
+        x = self._valid_states(x)
+        y = self._valid_states(y, "y")
+        if y.shape != x.shape:
+            raise ValueError(f"y: shape {y.shape} does not match x of shape {x.shape}")
+        return self._group_call(lib.sr_local, lib.sr_local_batch, x, y, NE)
+
+    def _group_call(self, single, batch, x, other, width):
+        if x.ndim == 1:
+            out = np.empty(width)
+            self._check("x", single(self._model, _ptr(x), _ptr(other), _ptr(out)))
+            return out
+        out = np.empty((x.shape[0], width))
+        failed = ffi.new("long *")
+        status = batch(self._model, x.shape[0], _ptr(x), _ptr(other), _ptr(out), failed)
+        self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
+        return out

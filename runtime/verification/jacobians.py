@@ -1,0 +1,87 @@
+"""Checks of the Jacobians (issue 19) against two independent sources.
+
+* CasADi AD of the independent reference (`runtime.verification.reference`, a Lagrange–d'Alembert
+  model in coordinates that imports neither derive/ nor the kernels): its accelerations at the
+  state x ⊕ d, written here with CasADi's own exponential, differentiated in d and w at 0.
+* Central differences of the kernels through `Model.retract`, Richardson-extrapolated (error
+  O(h⁴) instead of O(h²)).
+
+Each check takes the Jacobian under test as a function, so that a test can hand it a perturbed
+one and see the check fail.
+"""
+import casadi as ca
+import numpy as np
+
+from ..model import Model
+from ..params import Params
+from ..state import NE, NU, NV
+from .reference import _NU, _Q, _RP, _RS, _RY, STATE_DIM, ReferenceModel, _expm_series, _mat_rowmajor, _rot_x, _rot_y
+from .sampling import random_inputs, random_state
+
+
+def _rowmajor(R):
+    return ca.reshape(R.T, 9, 1)
+
+
+def reference_accel_jacobian(ref):
+    """CasADi Function (x, u) -> (Ja 5x12, Jb 5x2) by AD of the reference's accelerations at
+    x ⊕ d, u + w; ⊕ as issue 19 defines it (R_S Exp(⟦δξ⟧), R_Y rot_x(δθ_Y), R_P rot_y(δθ_P),
+    q + (δq, 0), ν + δν)."""
+    x0, u0 = ca.SX.sym("x", STATE_DIM), ca.SX.sym("u", 2)
+    d, w = ca.SX.sym("d", 12), ca.SX.sym("w", 2)
+    x = ca.vertcat(_rowmajor(_mat_rowmajor(x0[_RS]) @ _expm_series(d[0:3])),
+                   _rowmajor(_mat_rowmajor(x0[_RY]) @ _rot_x(d[3])),
+                   _rowmajor(_mat_rowmajor(x0[_RP]) @ _rot_y(d[4])),
+                   x0[_Q] + ca.vertcat(d[5], d[6], 0), x0[_NU] + d[7:12])
+    K, rhs = ref._f_kkt(x, u0 + w)
+    sol = ca.solve(K, rhs)
+    J, b0 = ref._f_conv(x)
+    accel = ca.vertcat(J @ sol[:7] + b0, sol[3:5])
+    at_zero = [ca.substitute(e, ca.vertcat(d, w), ca.DM.zeros(14))
+               for e in (ca.jacobian(accel, d), ca.jacobian(accel, w))]
+    return ca.Function("reference_accel_jacobian", [x0, u0], at_zero)
+
+
+def richardson_accel_jacobian(model, x, u, h=2e-3):
+    """(Ja, Jb) by central differences of model.accel along x ⊕ (±h e_k) and u ± h e_k,
+    Richardson-extrapolated from steps h and h/2."""
+    def central(f, n, step):
+        return np.column_stack([(f(step * e) - f(-step * e)) / (2 * step) for e in np.eye(n)])
+
+    def extrapolated(f, n):
+        return (4 * central(f, n, h / 2) - central(f, n, h)) / 3
+
+    Ja = extrapolated(lambda d: model.accel(model.retract(x, d), u), NE)
+    Jb = extrapolated(lambda w: model.accel(x, u + w), NU)
+    return Ja, Jb
+
+
+def _relative(ours, theirs):
+    err = float(np.abs(ours - theirs).max())
+    return err, err / max(float(np.abs(theirs).max()), 1e-300)
+
+
+def accel_jacobian_checks(n_states=1000, seed=5, jacobian=None, params=None, n_difference=50):
+    """Rows of `make verify`: accel_jacobian vs CasADi AD of the reference (n_states random
+    states and inputs, ≤ 1e-10 relative) and vs Richardson central differences (n_difference
+    of them, ≤ 1e-8 relative).  `jacobian(model, x, u)` is the function under test (default
+    Model.accel_jacobian).  Returns (name, worst abs, worst rel, tolerance) rows for verify.py."""
+    params = Params.paper_simulation() if params is None else params
+    model = Model(params)
+    jacobian = jacobian or (lambda m, x, u: m.accel_jacobian(x, u))
+    rng = np.random.default_rng(seed)
+    X = np.array([random_state(rng, params) for _ in range(n_states)])
+    U = random_inputs(rng, n_states)
+    Ja_ref, Jb_ref = reference_accel_jacobian(ReferenceModel(params.as_dict())).map(n_states)(X.T, U.T)
+    Ja_ref = np.asarray(Ja_ref).reshape(NV, n_states, NE).transpose(1, 0, 2)
+    Jb_ref = np.asarray(Jb_ref).reshape(NV, n_states, NU).transpose(1, 0, 2)
+    worst_ad, worst_fd = (0.0, 0.0), (0.0, 0.0)
+    for i in range(n_states):
+        Ja, Jb = jacobian(model, X[i], U[i])
+        worst_ad = max(worst_ad, _relative(np.hstack([Ja, Jb]), np.hstack([Ja_ref[i], Jb_ref[i]])), key=lambda e: e[1])
+        if i < n_difference:
+            fd = np.hstack(richardson_accel_jacobian(model, X[i], U[i]))
+            worst_fd = max(worst_fd, _relative(np.hstack([Ja, Jb]), fd), key=lambda e: e[1])
+    return [(f"accel_jacobian vs CasADi AD of the reference ({n_states} states)", *worst_ad, 1e-10),
+            (f"accel_jacobian vs Richardson central differences ({min(n_difference, n_states)} states)",
+             *worst_fd, 1e-8)]

@@ -1,0 +1,31 @@
+"""The Jacobian rows of `make verify` (runtime/verification/jacobians.py) pass for the kernel and
+fail for a slightly perturbed one."""
+import numpy as np
+import pytest
+
+from runtime.verification.jacobians import accel_jacobian_checks
+
+
+def rows_pass(rows):
+    return [rel <= tol for _, _, rel, tol in rows]
+
+
+def test_accel_jacobian_rows_pass_for_the_kernel():
+    assert rows_pass(accel_jacobian_checks(n_states=40, n_difference=5)) == [True, True]
+
+
+@pytest.mark.parametrize("entry", [(0, 1), (3, 4), (4, 9)])
+def test_accel_jacobian_rows_fail_for_a_perturbed_jacobian(entry):
+    def perturbed(model, x, u):
+        Ja, Jb = model.accel_jacobian(x, u)
+        Ja = Ja.copy()
+        Ja[entry] *= 1 + 1e-6
+        return Ja, Jb
+    assert rows_pass(accel_jacobian_checks(n_states=40, n_difference=5, jacobian=perturbed)) == [False, False]
+
+
+def test_accel_jacobian_rows_fail_for_a_perturbed_input_jacobian():
+    def perturbed(model, x, u):
+        Ja, Jb = model.accel_jacobian(x, u)
+        return Ja, Jb + 1e-6 * np.abs(Jb).max()
+    assert rows_pass(accel_jacobian_checks(n_states=40, n_difference=5, jacobian=perturbed)) == [False, False]
