@@ -1,4 +1,10 @@
-"""Issue 3: the kernels against the independent CasADi reference, and against the physics."""
+"""Issue 3: the kernels against the independent CasADi reference, and against the physics.
+
+Issue 17: every row of `make verify` has a test that it FAILS for a slightly perturbed kernel: a
+parameter off by 1e-6 relative in the kernel only (the reference keeps the true one), or the
+kernel's output wrapped with a small error of the kind the row is there to catch.
+"""
+import dataclasses
 import subprocess
 import sys
 
@@ -15,6 +21,25 @@ def assert_passed(results):
         assert r.passed, f"{r.name}: abs {r.abs_error:.3g}, rel {r.rel_error:.3g}, tol {r.tolerance:g}"
 
 
+@pytest.fixture
+def kernel_with(monkeypatch):
+    """kernel_with(m_P=1e-6): verify builds its models with those parameters scaled by (1 + 1e-6)."""
+    def perturb(**relative):
+        def perturbed_model(params):
+            return Model(dataclasses.replace(params, **{k: getattr(params, k) * (1 + v) for k, v in relative.items()}))
+        monkeypatch.setattr(verify, "Model", perturbed_model)
+    return perturb
+
+
+@pytest.fixture
+def accel_with(monkeypatch):
+    """accel_with(f): Model.accel returns f(x, true accel) instead."""
+    def perturb(error):
+        original = Model.accel
+        monkeypatch.setattr(Model, "accel", lambda self, x, u=None: error(np.asarray(x), original(self, x, u)))
+    return perturb
+
+
 def test_kernels_agree_with_the_reference_at_random_states_and_parameters():
     results = verify.cross_check(n_states=200, seed=11, n_param_sets=6)   # 1200 states
     assert_passed(results)
@@ -27,8 +52,19 @@ def test_cross_check_fails_for_a_slightly_wrong_kernel(monkeypatch):
     assert not results[0].passed
 
 
+@pytest.mark.parametrize("row", [0, 1, 2], ids=["accel", "inertia", "energy"])
+def test_each_cross_check_row_fails_for_a_kernel_with_a_mass_off_by_1e_6(kernel_with, row):
+    kernel_with(m_P=1e-6)
+    assert not verify.cross_check(n_states=5, seed=0, n_param_sets=1)[row].passed
+
+
 def test_energy_is_conserved_without_friction_and_torque():
     assert_passed([verify.energy_conservation(n_runs=2, seed=5, t_end=20.0)])
+
+
+def test_energy_conservation_fails_for_an_accel_off_by_1e_6_relative(accel_with):
+    accel_with(lambda x, a: a * (1 + 1e-6))
+    assert not verify.energy_conservation(n_runs=1, seed=5, t_end=5.0).passed
 
 
 def test_power_balance_holds_at_random_states():
@@ -45,16 +81,55 @@ def test_power_balance_detects_a_missing_damping_term(monkeypatch):
     assert not verify.power_balance(n_states=5, seed=6).passed
 
 
-def test_contact_point_of_the_simulated_motion_does_not_slip():
-    assert_passed([verify.rolling_constraint(seed=7)])
+def test_power_balance_fails_for_a_kernel_with_shell_damping_off_by_1e_6(kernel_with):
+    kernel_with(k_S=1e-6)
+    assert not verify.power_balance(n_states=5, seed=6).passed
+
+
+def test_c_stepped_motions_obey_the_contact_force_and_angular_momentum_balances():
+    assert_passed(verify.rolling_contact(seed=7))
+
+
+@pytest.mark.parametrize("row", [0, 1], ids=["contact force", "angular momentum"])
+@pytest.mark.parametrize("name", ["m_P", "k_S"])
+def test_rolling_rows_fail_for_a_kernel_with_a_parameter_off_by_1e_6(kernel_with, name, row):
+    kernel_with(**{name: 1e-6})
+    assert not verify.rolling_contact(n_runs=1, seed=7)[row].passed
 
 
 def test_equilibria_are_rest_points_stable_below_and_unstable_above():
     assert_passed(verify.equilibria(seed=8))
 
 
+def test_equilibrium_row_fails_for_a_spurious_accel_of_1e_10_at_rest(accel_with):
+    accel_with(lambda x, a: a + 1e-10)
+    assert not verify.equilibria(seed=8)[0].passed
+
+
+def test_pendulum_down_row_fails_for_an_accel_of_the_wrong_sign(accel_with):
+    accel_with(lambda x, a: -a)
+    assert not verify.equilibria(seed=8)[1].passed
+
+
+def test_pendulum_up_row_fails_for_a_kernel_with_gravity_too_weak(kernel_with):
+    kernel_with(g=-1 + 1e-4)
+    assert not verify.equilibria(seed=8)[2].passed
+
+
 def test_planar_motions_stay_planar():
     assert_passed(verify.planar_symmetry(steps=1000))
+
+
+@pytest.mark.parametrize("row", [0, 1], ids=["x-z plane", "y-z plane"])
+def test_symmetry_rows_fail_for_a_motion_that_leaks_1e_9_out_of_its_plane(monkeypatch, row):
+    original = Model.simulate
+
+    def leaking(self, x0, dt, steps, **kwargs):
+        X = original(self, x0, dt, steps, **kwargs)
+        X[:, 30:33] += 1e-9 * X[:, [31, 30, 30]]      # ω_S couples x<->y by 1e-9
+        return X
+    monkeypatch.setattr(Model, "simulate", leaking)
+    assert not verify.planar_symmetry(steps=200)[row].passed
 
 
 def test_verify_command_prints_a_table_and_exits_zero():
