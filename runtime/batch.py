@@ -91,9 +91,7 @@ def simulate_many(params, x0, dt, steps, u=None, method="lie-euler", energy_tol=
     its status instead, and the others run as if it were not there.
     """
     dt = _model.Model._dt(dt)
-    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 0:
-        raise ValueError(f"steps: expected a non-negative integer, got {steps!r}")
-    steps = int(steps)
+    steps = _model.step_count(steps)
     code = _model._method(method)
     tol = _model.Model._energy_tol(energy_tol)
     p = _params_array(params)

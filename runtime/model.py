@@ -33,6 +33,21 @@ ENERGY_TOL = 0.5
 #: Steps per C call of `Model.simulate` (between calls the progress callback runs).
 CHUNK_STEPS = 2000
 
+#: Largest number of steps of one run (`Model.simulate`, `simulate_many`, scenario files, the
+#: CLI): the trajectory is held in memory (35 float64 a row, so 10^7 steps take 2.8 GB).  A
+#: larger count is a ValueError naming `steps`, not a MemoryError.
+MAX_STEPS = 10_000_000
+
+
+def step_count(steps, name="steps"):
+    """`steps` as an int in 0..MAX_STEPS, else ValueError naming `name`."""
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 0:
+        raise ValueError(f"{name}: expected a non-negative integer, got {steps!r}")
+    if steps > MAX_STEPS:
+        raise ValueError(f"{name}: {int(steps)} is more than MAX_STEPS = {MAX_STEPS} (the trajectory is kept "
+                         f"in memory: {int(steps) + 1} rows of 35 float64)")
+    return int(steps)
+
 
 def _address(cdata):
     """The address of a cffi pointer as an int (handed to bindings._fastcall)."""
@@ -195,9 +210,7 @@ class Model(GroupMethods, DerivativeMethods):
         """
         x0 = self._valid_states(x0, "x0", batch=False)
         dt = self._dt(dt)
-        if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 0:
-            raise ValueError(f"steps: expected a non-negative integer, got {steps!r}")
-        steps = int(steps)
+        steps = step_count(steps)
         code = _method(method)
         guard = ffi.new("sr_energy_guard *")
         guard.tol = self._energy_tol(energy_tol)
@@ -282,6 +295,9 @@ class Model(GroupMethods, DerivativeMethods):
         x0 = self._valid_states(x0, "x0", batch=False)
         dt_out = self._dt(dt_out, "dt_out")
         t_end = self._dt(t_end, "t_end", allow_zero=True)
+        if t_end / dt_out > MAX_STEPS + 0.5:
+            raise ValueError(f"t_end: {t_end:g} s at dt_out = {dt_out:g} s is more than MAX_STEPS = {MAX_STEPS} rows "
+                             f"(the trajectory is kept in memory)")
         n_out = int(round(t_end / dt_out))
         if abs(n_out * dt_out - t_end) > 1e-9 * max(t_end, dt_out):
             raise ValueError(f"t_end: must be a whole multiple of dt_out = {dt_out:g}, got {t_end:g}")
@@ -344,6 +360,8 @@ class Model(GroupMethods, DerivativeMethods):
     def _dt(value, name="dt", allow_zero=False):
         """A time argument as a float: finite and positive (or non-negative with allow_zero)."""
         kind = "non-negative" if allow_zero else "positive"
+        if isinstance(value, (str, bytes, bool, np.bool_)):    # float("0.01") and float(True) would pass
+            raise ValueError(f"{name}: expected a {kind} number, got {value!r}")
         try:
             value = float(value)
         except (TypeError, ValueError):

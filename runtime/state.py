@@ -5,11 +5,13 @@ SR_X_* offsets the generator emitted from derive/state.py (the one place that
 decides it).  Every other runtime module indexes states through the names
 below, never through raw numbers.
 """
+import math
+
 import numpy as np
 
 from bindings._sr import lib
 
-from .so3 import rot_x, rot_y, rot_z  # noqa: F401  (re-exported: the constructors' rotation forms)
+from .so3 import orthonormality, rot_x, rot_y, rot_z  # noqa: F401  (rot_z re-exported: the constructors' rotation forms)
 
 NX, NU, NV = lib.SR_NX, lib.SR_NU, lib.SR_NV
 
@@ -54,14 +56,56 @@ def gamma(x):
     return rotations(x)[0][..., 2, :]
 
 
+def _finite_number(value, name):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{name}: expected a real number, got {value!r} ({type(value).__name__})")
+    if not math.isfinite(value):
+        raise ValueError(f"{name}: {float(value)!r}, expected a finite number")
+    return float(value)
+
+
+def _finite_array(value, name, shape):
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError) as exc:          # ragged nested lists
+        raise ValueError(f"{name}: expected an array of real numbers ({exc})") from None
+    if raw.dtype.kind not in "iuf":
+        raise ValueError(f"{name}: expected real numbers (integer or float dtype), got dtype {raw.dtype}")
+    if raw.shape != shape and not (raw.size == math.prod(shape) and raw.ndim == 1 and len(shape) == 2):
+        raise ValueError(f"{name}: expected shape {shape}, got {raw.shape}")
+    arr = raw.astype(np.float64).reshape(shape)
+    if not np.isfinite(arr).all():
+        raise ValueError(f"{name}: entry {tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])} is "
+                         f"{float(arr[~np.isfinite(arr)][0])!r}, expected finite numbers")
+    return arr
+
+
 def initial_state(theta_Y=0.0, theta_P=0.0, R_S=None, q=None, w_S=(0.0, 0.0, 0.0), w_Y=0.0, w_P=0.0, *, r=0.3):
-    """A state vector: R_Y = rot_x(theta_Y), R_P = rot_y(theta_P), R_S (default I), q (default (0, 0, r))."""
+    """A state vector: R_Y = rot_x(theta_Y), R_P = rot_y(theta_P), R_S (default I), q (default (0, 0, r)).
+
+    Every argument is checked, and a bad one raises ValueError naming it: angles, speeds and r
+    finite real numbers (r > 0), R_S a rotation (orthonormal with det +1 to ROTATION_TOL, the
+    rule of the C state check), q with q_z = r (the shell rests on the plane), shapes (3, 3) and (3,).
+    """
+    r = _finite_number(r, "r")
+    if not r > 0:
+        raise ValueError(f"r: {r!r}, expected a positive radius")
+    theta_Y, theta_P = _finite_number(theta_Y, "theta_Y"), _finite_number(theta_P, "theta_P")
+    w_Y, w_P = _finite_number(w_Y, "w_Y"), _finite_number(w_P, "w_P")
+    R = np.eye(3) if R_S is None else _finite_array(R_S, "R_S", (3, 3))
+    defect, det = orthonormality(R)
+    if defect > lib.SR_ROTATION_TOL or abs(det - 1) > lib.SR_ROTATION_TOL:
+        raise ValueError(f"R_S: not a rotation: max |RᵀR − I| = {defect:.3g}, det = {det:.6g} (needs orthonormal "
+                         f"with det +1 to {lib.SR_ROTATION_TOL:g})")
+    position = np.array([0.0, 0.0, r]) if q is None else _finite_array(q, "q", (3,))
+    if abs(position[2] - r) > lib.SR_ROTATION_TOL * r:
+        raise ValueError(f"q: q_z = {float(position[2])!r} must equal r = {r:g} (the shell rests on the plane)")
     x = np.zeros(NX)
-    x[IDX_RS] = (np.eye(3) if R_S is None else np.asarray(R_S, dtype=np.float64).reshape(3, 3)).ravel()
+    x[IDX_RS] = R.ravel()
     x[IDX_RY] = rot_x(theta_Y).ravel()
     x[IDX_RP] = rot_y(theta_P).ravel()
-    x[IDX_Q] = (0.0, 0.0, r) if q is None else np.asarray(q, dtype=np.float64).reshape(3)
-    x[IDX_WS] = np.asarray(w_S, dtype=np.float64).reshape(3)
+    x[IDX_Q] = position
+    x[IDX_WS] = _finite_array(w_S, "w_S", (3,))
     x[IDX_WY], x[IDX_WP] = w_Y, w_P
     return x
 

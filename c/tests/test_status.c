@@ -270,6 +270,31 @@ static void test_check_state_rejects_every_non_rotation(void)
     CHECK_STATUS(sr_check_state(&m, x), SR_OK);
 }
 
+/* sr_step gives the full check too: a loop of single steps (firmware) must not carry a
+ * corrupt state on.  Each corruption below passes the kernels' cheap checks. */
+static void test_step_checks_the_state_in_full(void)
+{
+    sr_model m;
+    sr_real x[SR_NX], u[SR_NU], next[SR_NX];
+    int i, k;
+    paper_simulation_model(&m);
+    for (k = 0; k < 5; ++k) {
+        int expected = SR_ERR_NOT_ROTATION;
+        good_input(x, u);
+        switch (k) {
+        case 0: x[0] = SR_C(2.0); break;                          /* a row of R_S of length 2 */
+        case 1: x[0] = -x[0]; x[1] = -x[1]; x[2] = -x[2]; break;  /* R_S a reflection */
+        case 2: x[1] = SR_C(0.01); break;                         /* R_S sheared */
+        case 3: x[10] = SR_C(1e-3); break;                        /* R_Y not about x */
+        default: x[29] = SR_C(0.31); expected = SR_ERR_CONSTRAINT; /* q_z != r */
+        }
+        for (i = 0; i < SR_NX; ++i) next[i] = SR_C(-7.0);
+        CHECK_STATUS(sr_step(&m, SR_LIE_EULER, x, u, SR_C(0.01), next), expected);
+        CHECK_STATUS(sr_step(&m, SR_RKMK4, x, u, SR_C(0.01), next), expected);
+        for (i = 0; i < SR_NX; ++i) CHECK(next[i] == SR_C(-7.0));
+    }
+}
+
 static void test_rolling_constraint(void)
 {
     sr_model m;
@@ -475,6 +500,7 @@ void suite_status(void)
     RUN_TEST(test_nonfinite_torques);
     RUN_TEST(test_bad_rotations_seen_by_every_function);
     RUN_TEST(test_check_state_rejects_every_non_rotation);
+    RUN_TEST(test_step_checks_the_state_in_full);
     RUN_TEST(test_rolling_constraint);
     RUN_TEST(test_invalid_parameters);
     RUN_TEST(test_check_params_names_the_rule_and_the_parameter);

@@ -37,9 +37,9 @@ PAPER_SCENARIOS = ("tilted-pendulum", "tilted-yoke", "t-shape")
 #: Named parameter sets a scenario may start from (`[params] preset = ...`).
 PRESETS = {"paper": Params.paper, "paper_simulation": Params.paper_simulation}
 
-#: Largest number of steps of a run: the trajectory is held in memory (35 float64 a row, so
-#: 10^7 steps take 2.8 GB).  A larger `steps` (or duration / dt) is an error, not a MemoryError.
-MAX_STEPS = 10_000_000
+#: Largest number of steps of a run (runtime.model.MAX_STEPS, the one limit): a larger `steps`
+#: (or duration / dt) is an error, not a MemoryError.
+MAX_STEPS = _model_module.MAX_STEPS
 
 _TOP_KEYS = {"description", "dt", "steps", "duration", "method", "params", "initial", "torque"}
 _INITIAL_KEYS = {"theta_Y", "theta_P", "R_S", "R_Y", "R_P", "q", "w_S", "w_Y", "w_P"}
