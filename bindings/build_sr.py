@@ -98,9 +98,8 @@ static int sr_py_accel(const sr_model *model, const void *x, const void *u, void
 
 static int sr_py_step(const sr_model *model, int method, const void *x, const void *u, double dt, void *x_next)
 {
-    int status = sr_check_state(model, (const sr_real *)x);
-    return status != SR_OK ? status
-                           : sr_step(model, method, (const sr_real *)x, (const sr_real *)u, dt, (sr_real *)x_next);
+    /* sr_step checks x in full itself (sr_check_state): no second check here. */
+    return sr_step(model, method, (const sr_real *)x, (const sr_real *)u, dt, (sr_real *)x_next);
 }
 """
 

@@ -5,7 +5,7 @@
  * the kernel itself.  This module takes the arrays as Python objects instead, reads their data
  * pointers with the NumPy C API and makes the output array in C: one crossing from Python, no
  * Python-level checks.  It decides nothing itself: it calls the binding's sr_py_accel /
- * sr_py_step (bindings/build_sr.py: sr_check_state, then the checked kernel), whose addresses
+ * sr_py_step (bindings/build_sr.py: sr_check_state, then the checked kernel; sr_step checks in full itself), whose addresses
  * cffi hands over.  Anything that is not a float64, C-contiguous, aligned, native-endian array
  * of the exact shape, and any non-zero status of C, returns None: runtime/model.py then takes
  * the full path, which checks in Python's terms and raises the precise message.
