@@ -62,7 +62,7 @@ def test_a_swapped_table_is_reported():
 
 def test_the_reference_builds_the_same_state_as_the_runtime(rng):
     R_S = random_rotation(rng)
-    ours = initial_state(0.3, -1.1, R_S=R_S, q=(0.5, -0.25, 0.4), w_S=(1.0, 2.0, 3.0), w_Y=4.0, w_P=5.0)
+    ours = initial_state(0.3, -1.1, R_S=R_S, q=(0.5, -0.25, 0.4), w_S=(1.0, 2.0, 3.0), w_Y=4.0, w_P=5.0, r=0.4)
     theirs = reference.make_state(R_S=R_S, theta_Y=0.3, theta_P=-1.1, q_xy=(0.5, -0.25), omega_S=(1.0, 2.0, 3.0),
                                   omega_Y=4.0, omega_P=5.0, r=0.4)
     assert np.array_equal(ours, theirs)
