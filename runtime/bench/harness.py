@@ -10,7 +10,8 @@ import subprocess
 import numpy as np
 
 from ..verification.reference import ReferenceModel
-from .checks import check_close
+from ..verification.steppers import STEPPERS
+from .checks import WrongNumbers, check_close
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
@@ -68,20 +69,44 @@ def run_harness(exe, params, X, U, repeats, kane_inputs=None):
     return json.loads(out.stdout)
 
 
-def check_harness(result, model, X, U):
-    """The C loop's outputs against the Python-visible kernels and the reference, before any time is believed."""
+def check_harness(result, model, X, U, step_dt=0.01):
+    """Every state's outputs of the C loop against independent numbers, before any time is believed.
+
+    All n states: accel (checked and raw) and the CasADi-generated reference's against the
+    reference (runtime.verification.reference), inertia against the reference's, and each
+    stepper's step against the NumPy transcription of its tableau (runtime.verification.steppers)
+    driven by the reference's accel, so that no check compares the C with itself.  Then the
+    outputs (n rows per kernel) are dropped from `result` and the worst relative differences
+    kept under result["checked"]; raises WrongNumbers on the first failure.
+    """
     ref = ReferenceModel(model.params.as_dict())
-    n = len(result["accel"]["check"])
-    for i in range(n):
-        check_close("C accel vs reference", result["accel"]["check"][i], ref.accel(X[i], U[i]), 1e-10)
-        check_close("C raw accel", result["accel_unchecked"]["check"][i], model.accel(X[i], U[i]), 1e-12)
-        check_close("C inertia", np.reshape(result["inertia"]["check"][i], (5, 5)), model.inertia(X[i]), 1e-13)
-        for key, method in [("step_lie_euler", "lie-euler"), ("step_rkmk4", "rkmk4"), ("step_cf4", "cf4")]:
-            if key in result:
-                check_close(f"C {key}", result[key]["check"][i], model.step(X[i], U[i], 0.01, method), 1e-12)
-        for key in ("kane_casadi_c_accel", "kane_sympy_c_accel", "kane_pydy_c_accel"):
-            if key in result:
-                check_close(f"C loop {key}", result[key]["check"][i], model.accel(X[i], U[i]), 1e-10)
-        if "casadi_generated_reference_accel" in result:
-            check_close("CasADi-generated reference", result["casadi_generated_reference_accel"]["check"][i],
-                        ref.accel(X[i], U[i]), 1e-10)
+    n = len(X)
+    worst = {}
+
+    def check(name, key, expected, rtol):
+        got = result[key]["check"]
+        if len(got) != n:
+            raise WrongNumbers(f"{name}: the C loop returned {len(got)} of its {n} states")
+        for i in range(n):
+            err = check_close(f"{name} (state {i})", np.reshape(got[i], np.shape(expected(i))), expected(i), rtol)
+            worst[name] = max(worst.get(name, 0.0), err)
+
+    accel = ref.accel_batch(X, U)
+    check("C accel vs reference", "accel", lambda i: accel[i], 1e-10)
+    check("C raw accel vs reference", "accel_unchecked", lambda i: accel[i], 1e-10)
+    check("C inertia vs reference", "inertia", lambda i: ref.inertia(X[i]), 1e-10)
+    for key, method in [("step_lie_euler", "lie-euler"), ("step_rkmk4", "rkmk4"), ("step_cf4", "cf4")]:
+        if key in result:
+            step = STEPPERS[method]
+            check(f"C {method} step vs NumPy tableau on the reference", key,
+                  lambda i, step=step: step(ref.accel, ref.params["r"], X[i], U[i], step_dt), 1e-10)
+    for key in ("kane_casadi_c_accel", "kane_sympy_c_accel", "kane_pydy_c_accel"):
+        if key in result:
+            check(f"C loop {key} vs reference", key, lambda i: accel[i], 1e-10)
+    if "casadi_generated_reference_accel" in result:
+        check("CasADi-generated reference vs reference", "casadi_generated_reference_accel", lambda i: accel[i], 1e-10)
+    for value in result.values():
+        if isinstance(value, dict):
+            value.pop("check", None)
+    result["checked"] = {"states": n, "worst_relative_difference": worst}
+    return worst

@@ -8,8 +8,13 @@ erratum is a switch (`Errata`), so `docs/errata.md` can show the error with
 the printed form and with the corrected one.  It also serves the benchmark as
 "what a user would write in NumPy from the paper".
 
-Units: the paper's pairing doubles every non-conservative term, so the
-physical torque u and damping k enter its equations as τ = u/2 and k/2.
+Units: the non-conservative terms are transcribed literally from eq. (42),
+⟨−k_S Ω_S, δΩ_S⟩ + ⟨τ_Y − k_Y Ω_Y, δΩ_Y⟩ + ⟨τ_P − k_P Ω_P, δΩ_P⟩ with
+⟨A, B⟩ = tr(AᵀB), in the paper's own coefficients (`accel_paper_units`).
+`accel(x, u)` takes physical u and k and finds the paper's coefficients by
+equal virtual work (`paper_coefficient`): the factor 1/2 comes out of the
+pairing, ⟨Σ, Σ⟩ = 2, and is written nowhere by hand (docs/errata.md,
+"The factor 2").
 """
 import dataclasses
 
@@ -23,6 +28,23 @@ E_X, E_Y, E_Z = np.eye(3)
 
 
 SIGMA_Y, SIGMA_P, SIGMA_C = hat(E_X), hat(E_Y), hat(E_Z)
+
+
+def pairing(A, B):
+    """⟨A, B⟩ = tr(AᵀB), the inner product of so(3) with which eq. (42) pairs forces and variations."""
+    return float(np.trace(A.T @ B))
+
+
+def paper_coefficient(physical, axis):
+    """The paper's coefficient (τ or k of eq. 42) of a physical torque or damping coefficient about `axis`.
+
+    `axis` is the unit generator Σ of the rotation (Σ_Y for the yoke, Σ_P for the pendulum, any
+    unit ⟦e⟧ for the shell).  A physical torque u about the axis does the virtual work u·ε on a
+    virtual rotation by the angle ε about it, δΩ = ε Σ; in eq. (42) the paper's term τ Σ does
+    ⟨τ Σ, ε Σ⟩ = τ ε ⟨Σ, Σ⟩.  Equal for every ε: τ = u / ⟨Σ, Σ⟩.  A damping torque −k ω does
+    −k ω ε, the paper's −k' Ω = −k' ω Σ does −k' ω ε ⟨Σ, Σ⟩: k' = k / ⟨Σ, Σ⟩ likewise.
+    """
+    return physical / pairing(axis, axis)
 
 
 def sigma(M):
@@ -170,17 +192,30 @@ class PaperModel:
                 - p.m_P * p.g * gamma @ xi)
 
     # -- equations of motion ----------------------------------------------------------
-    def forces(self, gamma, R_Y, R_P, O_S, O_Y, O_P, u):
-        """Right-hand sides of eq. (85) with Λ̇ moved left: the terms in braces of eq. (105)."""
+    @staticmethod
+    def nonconservative(O_S, O_Y, O_P, tau, k):
+        """The forces of eq. (42) as printed: (−k_S Ω_S, τ_Y − k_Y Ω_Y, τ_P − k_P Ω_P), τ_Y = τ[0] Σ_Y,
+        τ_P = τ[1] Σ_P; tau = (τ_Y, τ_P) and k = (k_S, k_Y, k_P) in the paper's coefficients."""
+        return -k[0] * O_S, tau[0] * SIGMA_Y - k[1] * O_Y, tau[1] * SIGMA_P - k[2] * O_P
+
+    def paper_units(self, u):
+        """(τ, k) of eq. (42) for physical torques u and the physical damping of the parameters."""
+        p = self.p
+        tau = (paper_coefficient(u[0], SIGMA_Y), paper_coefficient(u[1], SIGMA_P))
+        k = (paper_coefficient(p.k_S, SIGMA_C), paper_coefficient(p.k_Y, SIGMA_Y), paper_coefficient(p.k_P, SIGMA_P))
+        return tau, k
+
+    def forces(self, gamma, R_Y, R_P, O_S, O_Y, O_P, tau, k):
+        """Right-hand sides of eq. (85) with Λ̇ moved left: the terms in braces of eq. (105); τ, k the paper's."""
         p, e = self.p, self.errata
         L_S, _, _ = self.momenta(gamma, R_Y, R_P, O_S, O_Y, O_P)
         gamma_dot = -O_S @ gamma
         nonholonomic = gamma if e.eq71_gamma else gamma_dot
-        tau_Y, tau_P = u[0] / 2 * SIGMA_Y, u[1] / 2 * SIGMA_P       # physical -> paper pairing
+        N_S, N_Y, N_P = self.nonconservative(O_S, O_Y, O_P, tau, k)
         F_S = (ad_star(O_S, L_S) - diamond(gamma, self.dl_dgamma(R_Y, R_P))
-               + p.r * diamond(nonholonomic, self.dl_dv(gamma, R_Y, R_P, O_S, O_Y, O_P)) - p.k_S / 2 * O_S)
-        F_Y = sigma_axis(R_Y.T @ self.dlc_dRY(gamma, R_Y, R_P, O_S, O_Y, O_P), SIGMA_Y) + tau_Y - p.k_Y / 2 * O_Y
-        F_P = sigma_axis(R_P.T @ self.dlc_dRP(gamma, R_Y, R_P, O_S, O_Y, O_P), SIGMA_P) + tau_P - p.k_P / 2 * O_P
+               + p.r * diamond(nonholonomic, self.dl_dv(gamma, R_Y, R_P, O_S, O_Y, O_P)) + N_S)
+        F_Y = sigma_axis(R_Y.T @ self.dlc_dRY(gamma, R_Y, R_P, O_S, O_Y, O_P), SIGMA_Y) + N_Y
+        F_P = sigma_axis(R_P.T @ self.dlc_dRP(gamma, R_Y, R_P, O_S, O_Y, O_P), SIGMA_P) + N_P
         return F_S, F_Y, F_P
 
     def momentum_rate_at_fixed_speed(self, gamma, R_Y, R_P, O_S, O_Y, O_P):
@@ -196,12 +231,17 @@ class PaperModel:
         return [L.imag / h for L in self.momenta(g_c, RY_c, RP_c, O_S, O_Y, O_P)]
 
     def accel(self, x, u=None):
-        """ν̇ from eq. (105) with 𝕁 inverted through the Appendix C system."""
+        """ν̇ from eq. (105) for physical torques u (2,) and the parameters' physical damping."""
         u = np.zeros(2) if u is None else np.asarray(u, dtype=float)
+        return self.accel_paper_units(x, *self.paper_units(u))
+
+    def accel_paper_units(self, x, tau, k):
+        """ν̇ from eq. (105) with 𝕁 inverted through the Appendix C system; τ = (τ_Y, τ_P) and
+        k = (k_S, k_Y, k_P) are the paper's coefficients of eq. (42), used as printed."""
         R_S, R_Y, R_P, _, O_S, O_Y, O_P = self.unpack(x)
         gamma = R_S[2]
         A = self.appendix_c_matrix(gamma, R_Y, R_P)
-        rhs = self.coefficients(*self.forces(gamma, R_Y, R_P, O_S, O_Y, O_P, u))
+        rhs = self.coefficients(*self.forces(gamma, R_Y, R_P, O_S, O_Y, O_P, tau, k))
         if self.errata.eq102_Jdot:
             rate = self.momenta(gamma, R_Y, R_P, O_S, O_Y, O_P)
         else:
