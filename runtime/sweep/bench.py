@@ -175,8 +175,9 @@ def format_report(result):
 
 def main(argv=None):
     p = argparse.ArgumentParser(prog="python -m runtime.sweep.bench", description=__doc__.split("\n\n")[0])
-    p.add_argument("--samples", type=int, default=2000, help="samples of the shipped sweep (default 2000)")
-    p.add_argument("--samples-per-task", type=int, default=125, help="task size (default 125: 16 tasks, ~0.5 s each)")
+    p.add_argument("--samples", type=int, default=4000, help="samples of the shipped sweep (default 4000)")
+    p.add_argument("--samples-per-task", type=int, default=250,
+                   help="task size (default 250: 16 tasks of ~0.5 s; real sweeps size them to ~2 s)")
     p.add_argument("--noop-tasks", type=int, default=1000, help="no-op tasks for Dask's per-task cost")
     p.add_argument("--rounds", type=int, default=3, help="rounds; every time is the best of them (default 3)")
     p.add_argument("--out", default="bench/results/sweep", help="results folder (default bench/results/sweep)")
