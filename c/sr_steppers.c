@@ -75,21 +75,25 @@ int sr_internal_vector_field(const sr_model *model, const sr_real x[SR_NX], cons
  * R <- R + R D: the remaining rounding is that of one addition per entry, which does not
  * repeat from step to step. */
 
-/* delta = R Exp(angle [[e_k]]) - R for R a rotation about axis k (0 = x, 1 = y): only the
- * (i, j) plane changes, by R (Exp - I) with cos(angle) - 1 = -2 sin^2(angle/2); the other
- * entries (exact zeros and ones) get a zero increment. */
+/* The increment of a one-axis rotation R = Exp(theta [[e_k]]) (k = 0: R_Y about x, entries
+ * c = R[4], s = R[7]; k = 1: R_P about y, c = R[0], s = R[2]) by angle: R (Exp - I) changes
+ * only (c, s), by (c (cos - 1) - s sin, s (cos - 1) + c sin), and the exact zeros and ones get
+ * a zero increment.  The state check has made sure R has this form. */
 static void axis_increment(const sr_real R[9], int k, sr_real angle, sr_real delta[9])
 {
-    const sr_real sh = SR_SIN(SR_C(0.5) * angle);
-    const sr_real cm1 = SR_C(-2.0) * sh * sh, s = SR_SIN(angle);
-    const int i = (k + 1) % 3, j = (k + 2) % 3; /* Exp(t[[e_k]]) rotates the (i, j) plane */
+    const int ic = k == 0 ? 4 : 0, is = k == 0 ? 7 : 2;      /* where c and s stand */
+    const int ims = k == 0 ? 5 : 6, ic2 = 8;                   /* -s and the second c */
+    const sr_real c = R[ic], s = R[is];
+    sr_real sn, cm1, dc, ds;
     int m;
+    sin_and_cos_minus_one(angle, &sn, &cm1);
+    dc = c * cm1 - s * sn;
+    ds = s * cm1 + c * sn;
     for (m = 0; m < 9; ++m) delta[m] = 0;
-    for (m = 0; m < 3; ++m) { /* row m: (R_mi, R_mj) <- (R_mi, R_mj) [[c, -s], [s, c]] */
-        const sr_real a = R[3 * m + i], b = R[3 * m + j];
-        delta[3 * m + i] = a * cm1 + b * s;
-        delta[3 * m + j] = b * cm1 - a * s;
-    }
+    delta[ic] = dc;
+    delta[ic2] = dc;
+    delta[is] = ds;
+    delta[ims] = -ds;
 }
 
 /* delta = x . exp(th1) . exp(th2) - x, written as increments (th2 may be NULL: one exponential).

@@ -69,6 +69,28 @@ static void test_so3_exp_matches_taylor_series(void)
         }
 }
 
+/* sin t and cos t - 1 from sr_so3_exp about one axis, where the series of sin(t)/t and
+ * (1 - cos t)/t^2 serve (|t| < 1/4, sr_internal.h) and just above, against libm, to a few ulp
+ * of each entry (not of 1: cos t - 1 is read as E - I).  The control: the same series without
+ * its last two terms misses that bound near t = 1/4, so the check can see a wrong series. */
+static void test_so3_exp_small_angle_series_match_libm_to_a_few_ulp(void)
+{
+    int n, worst_truncated_ok = 1;
+    for (n = 1; n <= 300; ++n) {
+        const sr_real t = (sr_real)(0.26 * n / 300.0);
+        const double td = (double)t, s = sin(td), cm1 = -2 * sin(td / 2) * sin(td / 2);
+        sr_real w[3] = {t, 0, 0}, R[9];
+        CHECK_STATUS(sr_so3_exp(w, R), SR_OK);
+        CHECK_NEAR(R[7], s, 4 * TEST_EPS * fabs(s));
+        CHECK_NEAR(R[4] - (sr_real)1, cm1, 4 * TEST_EPS + 4 * TEST_EPS * fabs(cm1));
+        if (td > 0.2) { /* truncated: sin t/t = 1 - t^2/6 (1 - t^2/20 (1 - t^2/42)) */
+            const double t2 = td * td, truncated = td * (1 - t2 / 6 * (1 - t2 / 20 * (1 - t2 / 42)));
+            if (fabs(truncated - s) > 4 * DBL_EPSILON * fabs(s)) worst_truncated_ok = 0;
+        }
+    }
+    CHECK(!worst_truncated_ok); /* the truncated series fails the bound the C passes */
+}
+
 static void test_so3_exp_of_zero_is_identity(void)
 {
     const sr_real w[3] = {0, 0, 0};
@@ -375,6 +397,7 @@ static void test_interleaved_models_do_not_interfere(void)
 void suite_numerics(void)
 {
     RUN_TEST(test_so3_exp_matches_taylor_series);
+    RUN_TEST(test_so3_exp_small_angle_series_match_libm_to_a_few_ulp);
     RUN_TEST(test_so3_exp_of_zero_is_identity);
     RUN_TEST(test_so3_exp_inverse_is_exp_of_minus_w);
     RUN_TEST(test_accel_at_identity_equilibrium_is_zero);
