@@ -186,8 +186,42 @@ def write(out_dir):
     emitted = [emit_kernel(k, layouts) for k in ks]
     flops = {k.name: n for k, (_, n) in zip(ks, emitted)}
     files = {HEADER_NAME: header_text(ks, flops, len(constants)), SOURCE_NAME: source_text(emitted)}
+    files.update(casadi_files())
     for name, text in files.items():
-        tmp = out_dir / (name + ".tmp")
+        path = out_dir / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(path.name + ".tmp")
         tmp.write_text(text)
-        tmp.replace(out_dir / name)
+        tmp.replace(path)
     return [out_dir / n for n in files]
+
+
+def file_format(function):
+    """What casadi.Function.save writes (and Function.load reads), as text."""
+    import casadi
+
+    serializer = casadi.StringSerializer()
+    serializer.pack(function)
+    return serializer.encode()
+
+
+def casadi_files():
+    """The model as CasADi Functions (derive/casadi_model.py), serialized: casadi/<name>.casadi,
+    and casadi/README.txt, which says they are generated and from what (a serialized Function
+    has no room for a comment)."""
+    import casadi
+
+    from .. import casadi_model
+    functions = casadi_model.functions()
+    files = {f"casadi/{name}.casadi": file_format(f) for name, f in functions.items()}
+    lines = [f"GENERATED FILES, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package "
+             f"[sha256 of its sources {provenance()}], SymPy {sp.__version__}, CasADi {casadi.__version__}.",
+             "", "The model as CasADi Functions (derive/casadi_model.py); load one with casadi.Function.load(path)",
+             "or runtime.casadi_model.load(name).  p is the parameter vector in SR_P_* order "
+             "(runtime.Params(...).as_array()).", ""]
+    for name, f in functions.items():
+        ins = ", ".join(f"{f.name_in(i)}[{f.size1_in(i)}]" for i in range(f.n_in()))
+        outs = ", ".join(f"{f.name_out(i)}[{f.size1_out(i)}]" for i in range(f.n_out()))
+        lines.append(f"    {name}.casadi: {name}({ins}) -> {outs}")
+    files["casadi/README.txt"] = "\n".join(lines) + "\n"
+    return files

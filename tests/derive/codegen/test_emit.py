@@ -12,7 +12,8 @@ from derive import parameters as P
 from derive import state as S
 from derive.codegen import emit
 
-GENERATED = ["sr_generated.c", "sr_generated.h"]
+GENERATED = ["sr_generated.c", "sr_generated.h", "casadi/README.txt", "casadi/sr_accel.casadi",
+             "casadi/sr_step_lie_euler.casadi", "casadi/sr_step_rkmk4.casadi", "casadi/sr_step_cf4.casadi"]
 WARNINGS = ["-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror"]
 
 
@@ -40,7 +41,7 @@ def test_committed_generated_files_are_up_to_date(fresh):
 
 
 def test_generated_files_say_they_are_generated():
-    for name in GENERATED:
+    for name in [n for n in GENERATED if not n.endswith(".casadi")]:   # README.txt speaks for those
         first = (ROOT / "generated" / name).read_text().splitlines()[0]
         assert "GENERATED FILE, DO NOT EDIT" in first and "derive" in first
 
