@@ -214,7 +214,7 @@ def casadi_files():
     from .. import casadi_model
     functions = casadi_model.functions()
     files = {f"casadi/{name}.casadi": file_format(f) for name, f in functions.items()}
-    lines = [f"GENERATED FILES, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package "
+    lines = [f"GENERATED FILE, DO NOT EDIT (nor the .casadi files beside it): written by `make generate` (python -m derive) from the derive/ package "
              f"[sha256 of its sources {provenance()}], SymPy {sp.__version__}, CasADi {casadi.__version__}.",
              "", "The model as CasADi Functions (derive/casadi_model.py); load one with casadi.Function.load(path)",
              "or runtime.casadi_model.load(name).  p is the parameter vector in SR_P_* order "
