@@ -6,6 +6,7 @@ from bindings._sr import ffi, lib
 
 from .errors import KernelError, SimulationStopped
 from .derivatives import DerivativeMethods
+from .step_jacobian import StepJacobianMethods
 from .group import GroupMethods
 from .params import Params
 from .state import NU, NV, NX
@@ -78,7 +79,7 @@ _PARAM_MESSAGES = {
 }
 
 
-class Model(GroupMethods, DerivativeMethods):
+class Model(GroupMethods, DerivativeMethods, StepJacobianMethods):
     """The spherical robot with parameters `params` (default: `Params()`, Section 5.2 as printed).
 
     Every method validates its input in full (c/spherical_robot.h, `sr_check_state`; the rules

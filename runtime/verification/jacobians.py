@@ -85,3 +85,57 @@ def accel_jacobian_checks(n_states=1000, seed=5, jacobian=None, params=None, n_d
     return [(f"accel_jacobian vs CasADi AD of the reference ({n_states} states)", *worst_ad, 1e-10),
             (f"accel_jacobian vs Richardson central differences ({min(n_difference, n_states)} states)",
              *worst_fd, 1e-8)]
+
+
+def richardson_step_jacobian(model, x, u, dt, method, h=1e-3):
+    """(F, G) by central differences of the C step through model.retract and model.local,
+    Richardson-extrapolated from steps h and h/2."""
+    y0 = model.step(x, u, dt, method)
+
+    def error(d, w):
+        return model.local(y0, model.step(model.retract(x, d), u + w, dt, method))
+
+    def central(f, n, step):
+        return np.column_stack([(f(step * e) - f(-step * e)) / (2 * step) for e in np.eye(n)])
+
+    def extrapolated(f, n):
+        return (4 * central(f, n, h / 2) - central(f, n, h)) / 3
+
+    return (extrapolated(lambda d: error(d, np.zeros(NU)), NE), extrapolated(lambda w: error(np.zeros(NE), w), NU))
+
+
+STEP_METHODS = ("lie-euler", "rkmk4", "cf4")
+
+
+def step_jacobian_checks(n_states=20, seed=7, jacobian=None, params=None, dt=0.01):
+    """Rows of `make verify` for step_jacobian (issue 19), per method:
+
+    * against Richardson central differences of the C step through retract/local (≤ 1e-8
+      relative; the Jacobian under test is CasADi's AD of the exported SX step, so the two sides
+      share only the model);
+    * its derivative in dt at 0 against `linearize` (C accel_jacobian plus the kinematics):
+      (F(h) − I)/h → A and G(h)/h → B as h → 0, Richardson-extrapolated from h = 1e-5 and 5e-6
+      (≤ 1e-6 relative: truncation O(h²|A|²), rounding 1e-16/h).
+    `jacobian(model, x, u, dt, method)` is the function under test (default Model.step_jacobian)."""
+    params = Params.paper_simulation() if params is None else params
+    model = Model(params)
+    jacobian = jacobian or (lambda m, x, u, dt_, method: m.step_jacobian(x, u, dt_, method))
+    rng = np.random.default_rng(seed)
+    X = np.array([random_state(rng, params) for _ in range(n_states)])
+    U = random_inputs(rng, n_states)
+    rows = []
+    for method in STEP_METHODS:
+        worst_fd, worst_lin = (0.0, 0.0), (0.0, 0.0)
+        for x, u in zip(X, U):
+            F, G = jacobian(model, x, u, dt, method)
+            worst_fd = max(worst_fd, _relative(np.hstack([F, G]), np.hstack(richardson_step_jacobian(model, x, u, dt, method))),
+                           key=lambda e: e[1])
+            derivative = [np.hstack([(Fh - np.eye(NE)) / h, Gh / h]) for h in (1e-5, 5e-6)
+                          for Fh, Gh in [jacobian(model, x, u, h, method)]]
+            A, B = model.linearize(x, u)
+            worst_lin = max(worst_lin, _relative(2 * derivative[1] - derivative[0], np.hstack([A, B])),
+                            key=lambda e: e[1])
+        rows.append((f"step_jacobian {method} vs Richardson central differences of the C step ({n_states} states)",
+                     *worst_fd, 1e-8))
+        rows.append((f"step_jacobian {method}: d/dt at 0 vs linearize ({n_states} states)", *worst_lin, 1e-6))
+    return rows

@@ -15,7 +15,9 @@ Checks
   equilibria    accel = 0 at eq. (108); linearization stable below, unstable above
   symmetry      planar motions stay planar
   jacobians     accel_jacobian against CasADi AD of the reference and Richardson-extrapolated
-                central differences through retract (runtime.verification.jacobians)
+                central differences through retract (runtime.verification.jacobians); step_jacobian
+                of each method against Richardson differences of the C step through retract/local,
+                and its derivative in dt at 0 against linearize
 """
 import argparse
 import dataclasses
@@ -270,8 +272,9 @@ def planar_symmetry(steps=2000):
 
 
 def jacobian_rows(n_states=1000, seed=5):
-    from .jacobians import accel_jacobian_checks
-    return [CheckResult(*row) for row in accel_jacobian_checks(n_states, seed)]
+    from .jacobians import accel_jacobian_checks, step_jacobian_checks
+    return ([CheckResult(*row) for row in accel_jacobian_checks(n_states, seed)]
+            + [CheckResult(*row) for row in step_jacobian_checks(min(n_states, 20), seed + 1)])
 
 
 def run_all(n_states=1000, seed=0, progress=None):

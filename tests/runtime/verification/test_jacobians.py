@@ -3,7 +3,7 @@ fail for a slightly perturbed one."""
 import numpy as np
 import pytest
 
-from runtime.verification.jacobians import accel_jacobian_checks
+from runtime.verification.jacobians import accel_jacobian_checks, step_jacobian_checks
 
 
 def rows_pass(rows):
@@ -29,3 +29,22 @@ def test_accel_jacobian_rows_fail_for_a_perturbed_input_jacobian():
         Ja, Jb = model.accel_jacobian(x, u)
         return Ja, Jb + 1e-6 * np.abs(Jb).max()
     assert rows_pass(accel_jacobian_checks(n_states=40, n_difference=5, jacobian=perturbed)) == [False, False]
+
+
+def test_step_jacobian_rows_pass_for_every_method():
+    assert all(rows_pass(step_jacobian_checks(n_states=4)))
+
+
+@pytest.mark.parametrize("block", ["F", "G"])
+def test_step_jacobian_rows_fail_for_a_perturbed_jacobian(block):
+    """An error of 1e-6 of the Jacobian's largest entry (that of F) in one entry of F or of G fails both rows of
+    every method."""
+    def perturbed(model, x, u, dt, method):
+        F, G = model.step_jacobian(x, u, dt, method)
+        F, G = F.copy(), G.copy()
+        if block == "F":
+            F[2, 8] += 1e-6 * np.abs(F).max()
+        else:
+            G[9, 1] += 1e-6 * np.abs(F).max()
+        return F, G
+    assert rows_pass(step_jacobian_checks(n_states=4, jacobian=perturbed)) == [False] * 6
