@@ -18,6 +18,9 @@ Checks
                 central differences through retract (runtime.verification.jacobians); step_jacobian
                 of each method against Richardson differences of the C step through retract/local,
                 and its derivative in dt at 0 against linearize
+  linearizations eigenvalues at rest against the reference's AD Jacobian, steady rolling against
+                power balance and statics, the Floquet exponent of rolling against a perturbed
+                simulation (runtime.verification.linearizations)
 """
 import argparse
 import dataclasses
@@ -273,8 +276,17 @@ def planar_symmetry(steps=2000):
 
 def jacobian_rows(n_states=1000, seed=5):
     from .jacobians import accel_jacobian_checks, step_jacobian_checks
-    return ([CheckResult(*row) for row in accel_jacobian_checks(n_states, seed)]
-            + [CheckResult(*row) for row in step_jacobian_checks(min(n_states, 20), seed + 1)])
+    return ([CheckResult(*row, catches="a Jacobian entry off by 1e-6") for row in accel_jacobian_checks(n_states, seed)]
+            + [CheckResult(*row, catches="an entry of F or G off by 1e-6 of the largest")
+               for row in step_jacobian_checks(min(n_states, 20), seed + 1)])
+
+
+def linearization_rows():
+    from .linearizations import equilibrium_checks, rolling_stability_checks, steady_rolling_checks
+    return ([CheckResult(*row, catches="the pendulum's stiffness in A off by 1e-6") for row in equilibrium_checks()]
+            + [CheckResult(*row, catches="an acceleration off by 1e-6 rad/s²") for row in steady_rolling_checks()]
+            + [CheckResult(*row, catches="snapshot eigenvalues of a periodic motion; step Jacobians of a 2 % longer step")
+               for row in rolling_stability_checks()])
 
 
 def run_all(n_states=1000, seed=0, progress=None):
@@ -286,6 +298,7 @@ def run_all(n_states=1000, seed=0, progress=None):
         ("equilibria", lambda: equilibria(seed=seed + 4)),
         ("symmetry", planar_symmetry),
         ("jacobians", lambda: jacobian_rows(n_states, seed + 5)),
+        ("linearizations", linearization_rows),
     ]
     results = []
     for i, (name, fn) in enumerate(steps):
