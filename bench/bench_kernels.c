@@ -27,7 +27,8 @@
 
 #define NMAX 4096
 
-static sr_real X[NMAX][SR_NX], U[NMAX][SR_NU], OUT[NMAX][SR_NX];
+#define NOUT (SR_NV * (SR_NE + SR_NU)) /* the widest output: accel_jacobian's Ja and Jb */
+static sr_real X[NMAX][SR_NX], U[NMAX][SR_NU], OUT[NMAX][NOUT];
 static double sink;
 
 static double now_ns(void)
@@ -44,12 +45,14 @@ static int k_accel(const sr_model *m, int i, int arg) { (void)arg; return sr_acc
 static int k_gen_accel(const sr_model *m, int i, int arg) { (void)arg; return sr_gen_accel(m->c, X[i], U[i], OUT[i]); }
 static int k_inertia(const sr_model *m, int i, int arg) { (void)arg; return sr_inertia(m, X[i], OUT[i]); }
 static int k_step(const sr_model *m, int i, int method) { return sr_step(m, method, X[i], U[i], 0.01, OUT[i]); }
+static int k_accel_jacobian(const sr_model *m, int i, int arg) { (void)arg; return sr_accel_jacobian(m, X[i], U[i], OUT[i], OUT[i] + SR_NV * SR_NE); }
 
 #ifdef WITH_KANE
 static double KANE[NMAX][12], KANE_P[SR_NPARAM];
 static int k_kane_casadi(const sr_model *m, int i, int arg) { (void)m; (void)arg; return kane_casadi_c(KANE[i], U[i], KANE_P, OUT[i]); }
 static int k_kane_sympy(const sr_model *m, int i, int arg) { (void)m; (void)arg; return kane_sympy_c(KANE[i], U[i], KANE_P, OUT[i]); }
 static int k_kane_pydy(const sr_model *m, int i, int arg) { (void)m; (void)arg; return kane_pydy_c(KANE[i], U[i], KANE_P, OUT[i]); }
+static int k_kane_casadi_jac(const sr_model *m, int i, int arg) { (void)m; (void)arg; return kane_casadi_jac_c(KANE[i], U[i], KANE_P, OUT[i]); }
 #endif
 
 #ifdef WITH_CASADI
@@ -152,6 +155,7 @@ int main(int argc, char **argv)
             {k_step, SR_LIE_EULER, SR_NX, 1, "step_lie_euler", 0},
             {k_step, SR_RKMK4, SR_NX, 1, "step_rkmk4", 0},
             {k_step, SR_CF4, SR_NX, 1, "step_cf4", 0},
+            {k_accel_jacobian, 0, NOUT, 1, "accel_jacobian", 0},
 #ifdef WITH_CASADI
             {k_casadi, 0, SR_NV, 10, "casadi_generated_reference_accel", 0},
 #endif
@@ -159,6 +163,7 @@ int main(int argc, char **argv)
             {k_kane_casadi, 0, SR_NV, 4, "kane_casadi_c_accel", 0},
             {k_kane_sympy, 0, SR_NV, 4, "kane_sympy_c_accel", 0},
             {k_kane_pydy, 0, SR_NV, 4, "kane_pydy_c_accel", 0},
+            {k_kane_casadi_jac, 0, NOUT, 4, "kane_casadi_c_accel_jacobian", 0},
 #endif
         };
         const int ncases = (int)(sizeof cases / sizeof cases[0]);

@@ -9,6 +9,7 @@ import subprocess
 
 import numpy as np
 
+from ..state import NV
 from ..verification.reference import ReferenceModel
 from ..verification.steppers import STEPPERS
 from .checks import WrongNumbers, check_close
@@ -69,6 +70,14 @@ def run_harness(exe, params, X, U, repeats, kane_inputs=None):
     return json.loads(out.stdout)
 
 
+def _reference_jacobians(ref, X, U):
+    """(Ja (n, 5, 12), Jb (n, 5, 2)) by CasADi AD of the reference at x ⊕ d (runtime.verification.jacobians)."""
+    from ..verification.jacobians import reference_accel_jacobian
+    n = len(X)
+    Ja, Jb = reference_accel_jacobian(ref).map(n)(np.asarray(X).T, np.asarray(U).T)
+    return (np.asarray(Ja).reshape(NV, n, 12).transpose(1, 0, 2), np.asarray(Jb).reshape(NV, n, 2).transpose(1, 0, 2))
+
+
 def check_harness(result, model, X, U, step_dt=0.01):
     """Every state's outputs of the C loop against independent numbers, before any time is believed.
 
@@ -103,6 +112,20 @@ def check_harness(result, model, X, U, step_dt=0.01):
     for key in ("kane_casadi_c_accel", "kane_sympy_c_accel", "kane_pydy_c_accel"):
         if key in result:
             check(f"C loop {key} vs reference", key, lambda i: accel[i], 1e-10)
+    if "accel_jacobian" in result or "kane_casadi_c_accel_jacobian" in result:
+        Ja, Jb = _reference_jacobians(ref, X, U)
+        if "accel_jacobian" in result:
+            check("C accel_jacobian vs CasADi AD of the reference", "accel_jacobian",
+                  lambda i: np.concatenate([Ja[i].ravel(), Jb[i].ravel()]), 1e-10)
+        if "kane_casadi_c_accel_jacobian" in result:
+            # The Kane Jacobian is column-major 5 x 14 in (qw, u); its speed columns (7..11) are our ν block.
+            rows = result["kane_casadi_c_accel_jacobian"]["check"]
+            result["kane_casadi_c_accel_jacobian"]["check"] = [
+                list(np.concatenate([np.reshape(r, (14, NV)).T[:, 7:12].ravel(), np.reshape(r, (14, NV)).T[:, 12:14].ravel()]))
+                for r in rows]
+            check("C loop Kane Jacobian by CasADi AD (speed and torque columns) vs CasADi AD of the reference",
+                  "kane_casadi_c_accel_jacobian",
+                  lambda i: np.concatenate([Ja[i][:, 7:12].ravel(), Jb[i].ravel()]), 1e-9)
     if "casadi_generated_reference_accel" in result:
         check("CasADi-generated reference vs reference", "casadi_generated_reference_accel", lambda i: accel[i], 1e-10)
     for value in result.values():

@@ -63,6 +63,8 @@ HEADER = """/* The Kane model's accel compiled three ways (written by runtime/be
 int kane_casadi_c(const double qw[12], const double u[2], const double p[12], double a[5]);
 int kane_sympy_c(const double qw[12], const double u[2], const double p[12], double a[5]);
 int kane_pydy_c(const double qw[12], const double u[2], const double p[12], double a[5]);
+/* d(accel)/d(qw, u), 5 x 14 column-major, by CasADi's AD of kane_casadi, through its code generator. */
+int kane_casadi_jac_c(const double qw[12], const double u[2], const double p[12], double J[70]);
 """
 
 
@@ -98,12 +100,23 @@ def casadi_kane_function():
     return ca.Function("kane_casadi", [qw, u, p], [accel])
 
 
-def write_casadi_c(build):
+def casadi_kane_jacobian_function():
+    """d(accel)/d(qw, u) of the Kane model by CasADi's AD (what a CasADi user would ship for MPC):
+    kane_casadi_jac(qw, u, p) -> J (5 x 14).  Its columns of the speeds (w1, w2, w3, w_Y, w_P: our
+    ν, in the shell frame) and of u are those of our accel_jacobian's ν and u blocks."""
+    import casadi as ca
     fn = casadi_kane_function()
+    qw, u, p = ca.SX.sym("qw", 12), ca.SX.sym("u", 2), ca.SX.sym("p", 12)
+    return ca.Function("kane_casadi_jac", [qw, u, p], [ca.densify(ca.jacobian(fn(qw, u, p), ca.vertcat(qw, u)))])
+
+
+def write_casadi_c(build):
+    fn, jac = casadi_kane_function(), casadi_kane_jacobian_function()
     cwd = os.getcwd()
     try:
         os.chdir(build)
         fn.generate("kane_casadi.c", {"with_header": True, "casadi_real": "double"})
+        jac.generate("kane_casadi_jac.c", {"with_header": True, "casadi_real": "double"})
     finally:
         os.chdir(cwd)
     (build / "kane_casadi_wrapper.c").write_text("""#include "kane_casadi.h"
@@ -119,9 +132,24 @@ int kane_casadi_c(const double qw[12], const double u[2], const double p[12], do
     return kane_casadi(arg, res, iw, w, 0);
 }
 """)
-    n_arg, n_res, n_iw, n_w = fn.sz_arg(), fn.sz_res(), fn.sz_iw(), fn.sz_w()
-    return [build / "kane_casadi.c", build / "kane_casadi_wrapper.c"], {
-        "KANE_CASADI_SZ_ARG": n_arg, "KANE_CASADI_SZ_RES": n_res, "KANE_CASADI_SZ_IW": n_iw, "KANE_CASADI_SZ_W": n_w}
+    (build / "kane_casadi_jac_wrapper.c").write_text("""#include "kane_casadi_jac.h"
+#include "kane_baselines.h"
+int kane_casadi_jac_c(const double qw[12], const double u[2], const double p[12], double J[70])
+{
+    const casadi_real *arg[KANE_CASADI_JAC_SZ_ARG];
+    casadi_real *res[KANE_CASADI_JAC_SZ_RES];
+    casadi_int iw[KANE_CASADI_JAC_SZ_IW + 1];
+    casadi_real w[KANE_CASADI_JAC_SZ_W + 1];
+    arg[0] = qw; arg[1] = u; arg[2] = p; res[0] = J;
+    return kane_casadi_jac(arg, res, iw, w, 0);
+}
+""")
+    defines = {}
+    for prefix, f in (("KANE_CASADI", fn), ("KANE_CASADI_JAC", jac)):
+        defines.update({f"{prefix}_SZ_ARG": f.sz_arg(), f"{prefix}_SZ_RES": f.sz_res(),
+                        f"{prefix}_SZ_IW": f.sz_iw(), f"{prefix}_SZ_W": f.sz_w()})
+    return [build / "kane_casadi.c", build / "kane_casadi_wrapper.c", build / "kane_casadi_jac.c",
+            build / "kane_casadi_jac_wrapper.c"], defines
 
 
 # -- SymPy's C printer ----------------------------------------------------------------------------

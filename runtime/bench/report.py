@@ -10,6 +10,7 @@ C_BASELINES = [
     ("kane_sympy_c_accel", "Kane model, SymPy's C printer (cse) + generic LU"),
     ("kane_pydy_c_accel", "Kane model, PyDy's C (its Cython ODE function's code) + generic LU"),
     ("casadi_generated_reference_accel", "CasADi C of our 9x9 KKT reference (a verification model)"),
+    ("kane_casadi_c_accel_jacobian", "Kane model's accel Jacobian (5x14) by CasADi AD, CasADi C (vs our accel)"),
 ]
 #: The Python-call baselines: key, label.
 PYTHON_BASELINES = [
@@ -44,6 +45,11 @@ def targets(res):
     for key in ("step_rkmk4", "step_cf4"):
         if key in c:
             out.append((f"{key[5:]} step <= 6x one checked accel (C loop)", c[key]["ns"] <= 6 * ours))
+    if "accel_jacobian" in c:
+        out.append(("accel_jacobian <= 8x one checked accel (C loop)", c["accel_jacobian"]["ns"] <= 8 * ours))
+        if "kane_casadi_c_accel_jacobian" in c:
+            out.append(("accel_jacobian >= 10x faster than CasADi AD C of the Kane Jacobian",
+                        10 * c["accel_jacobian"]["ns"] <= c["kane_casadi_c_accel_jacobian"]["ns"]))
     if "t_shape_rkmk4_ms" in py:
         out.append(("t-shape rkmk4 end to end <= 4 ms", py["t_shape_rkmk4_ms"] <= 4))
     return out
@@ -62,6 +68,9 @@ def sections(res):
     for key in STEPS:
         if key in c:
             rows.append((f"our {key.replace('_', ' ')}", f"{c[key]['ns']:,.1f} ns", f"{c[key]['ns'] / ours:.1f}x"))
+    if "accel_jacobian" in c:
+        rows.append(("our accel_jacobian (Ja 5x12 and Jb 5x2)", f"{c['accel_jacobian']['ns']:,.1f} ns",
+                     f"{c['accel_jacobian']['ns'] / ours:.1f}x"))
     if res.get("c_loop_native"):
         rows.append(("our accel, checked API, -march=native", f"{res['c_loop_native']['accel']['ns']:,.1f} ns", ""))
     for key, label in C_BASELINES:

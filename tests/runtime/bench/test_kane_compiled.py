@@ -75,3 +75,14 @@ def test_compiled_kane_from_python_is_checked_against_our_accel_and_timed(model)
     out = baselines.compiled_kane_timings(
         model, list(zip(X, U)), lambda msg: None, min_seconds=1e-4, rounds=1)
     assert out["pydy_cython_rhs_ns"] > 0 and out["kane_casadi_function_ns"] > 0
+
+
+@pytest.mark.parametrize("key, entry", [("accel_jacobian", 2), ("kane_casadi_c_accel_jacobian", 8 * 5 + 2)])
+def test_the_bench_refuses_a_jacobian_off_by_1e_6(c_loop, model, key, entry):
+    """Our accel_jacobian and the Kane Jacobian by CasADi AD are checked against CasADi AD of the reference
+    before their times count (the Kane one in its speed and torque columns, entry 42 = column 8, row 2)."""
+    result, X, U = c_loop
+    bad = copy.deepcopy(result)
+    bad[key]["check"][3][entry] *= 1 + 1e-6
+    with pytest.raises(WrongNumbers, match="Jacobian|jacobian"):
+        harness.check_harness(bad, model, X, U)
