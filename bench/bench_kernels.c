@@ -27,7 +27,7 @@
 
 #define NMAX 4096
 
-#define NOUT (SR_NV * (SR_NE + SR_NU)) /* the widest output: accel_jacobian's Ja and Jb */
+#define NOUT (SR_NE * (SR_NE + SR_NU)) /* the widest output: a step Jacobian's F and G */
 static sr_real X[NMAX][SR_NX], U[NMAX][SR_NU], OUT[NMAX][NOUT];
 static double sink;
 
@@ -46,6 +46,7 @@ static int k_gen_accel(const sr_model *m, int i, int arg) { (void)arg; return sr
 static int k_inertia(const sr_model *m, int i, int arg) { (void)arg; return sr_inertia(m, X[i], OUT[i]); }
 static int k_step(const sr_model *m, int i, int method) { return sr_step(m, method, X[i], U[i], 0.01, OUT[i]); }
 static int k_accel_jacobian(const sr_model *m, int i, int arg) { (void)arg; return sr_accel_jacobian(m, X[i], U[i], OUT[i], OUT[i] + SR_NV * SR_NE); }
+static int k_step_jacobian_lie_euler(const sr_model *m, int i, int arg) { (void)arg; return sr_step_jacobian_lie_euler(m, X[i], U[i], 0.01, OUT[i], OUT[i] + SR_NE * SR_NE); }
 
 #ifdef WITH_KANE
 static double KANE[NMAX][12], KANE_P[SR_NPARAM];
@@ -155,7 +156,8 @@ int main(int argc, char **argv)
             {k_step, SR_LIE_EULER, SR_NX, 1, "step_lie_euler", 0},
             {k_step, SR_RKMK4, SR_NX, 1, "step_rkmk4", 0},
             {k_step, SR_CF4, SR_NX, 1, "step_cf4", 0},
-            {k_accel_jacobian, 0, NOUT, 1, "accel_jacobian", 0},
+            {k_accel_jacobian, 0, SR_NV * (SR_NE + SR_NU), 1, "accel_jacobian", 0},
+            {k_step_jacobian_lie_euler, 0, NOUT, 1, "step_jacobian_lie_euler", 0},
 #ifdef WITH_CASADI
             {k_casadi, 0, SR_NV, 10, "casadi_generated_reference_accel", 0},
 #endif
@@ -163,7 +165,7 @@ int main(int argc, char **argv)
             {k_kane_casadi, 0, SR_NV, 4, "kane_casadi_c_accel", 0},
             {k_kane_sympy, 0, SR_NV, 4, "kane_sympy_c_accel", 0},
             {k_kane_pydy, 0, SR_NV, 4, "kane_pydy_c_accel", 0},
-            {k_kane_casadi_jac, 0, NOUT, 4, "kane_casadi_c_accel_jacobian", 0},
+            {k_kane_casadi_jac, 0, SR_NV * (SR_NE + SR_NU), 4, "kane_casadi_c_accel_jacobian", 0},
 #endif
         };
         const int ncases = (int)(sizeof cases / sizeof cases[0]);

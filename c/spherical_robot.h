@@ -372,6 +372,7 @@ int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 #ifdef SR_USE_FLOAT
 #define sr_accel_jacobian sr_accel_jacobian_f
 #define sr_accel_jacobian_batch sr_accel_jacobian_batch_f
+#define sr_step_jacobian_lie_euler sr_step_jacobian_lie_euler_f
 #endif
 
 /* Jacobians of the accelerations in the error coordinates:
@@ -388,6 +389,16 @@ int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_re
  * SR_NU); stops at the first failing row, its index in *failed_row (-1 when all succeed). */
 int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
                             sr_real *Ja, sr_real *Jb, long *failed_row);
+
+/* Jacobians of one Lie-Euler step (sr_step_lie_euler) in the error coordinates:
+ *   step(x (+) d, u + w) (-) step(x, u) = F d + G w + O(|d|^2 + |w|^2),
+ * F row-major SR_NE x SR_NE, G row-major SR_NE x SR_NU: the exact derivative of the map as
+ * implemented (R_S Exp(h w_S) through the right Jacobian of SO(3), the joint angles, q by the
+ * rolling kinematics, nu by sr_accel_jacobian).  Checks and status codes as sr_step_lie_euler
+ * (the full state check; dt > 0 and finite, else SR_ERR_ARG; u may be NULL); outputs written
+ * only on SR_OK.  (RKMK4 and CF4: runtime.step_jacobian, by CasADi AD, for now.) */
+int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+                               sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU]);
 
 #ifdef __cplusplus
 }

@@ -103,3 +103,84 @@ int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, con
     }
     return SR_OK;
 }
+
+/* The right Jacobian of SO(3), Exp(phi + e) = Exp(phi) Exp(Jr(phi) e) + O(|e|^2):
+ * Jr = I - a [[phi]] + b [[phi]]^2, a = (1 - cos t)/t^2, b = (t - sin t)/t^3 (series below t = 1/4). */
+static void so3_right_jacobian(const sr_real phi[3], sr_real Jr[9])
+{
+    const sr_real t2 = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2];
+    sr_real a, b, W[9], W2[9];
+    int i;
+    if (t2 < SR_SERIES_T2) {
+        a = cosc_series(t2);
+        b = (SR_C(1.0) / 6) * (1 - t2 * (SR_C(1.0) / 20) * (1 - t2 * (SR_C(1.0) / 42) * (1 - t2 * (SR_C(1.0) / 72) *
+            (1 - t2 * (SR_C(1.0) / 110) * (1 - t2 * (SR_C(1.0) / 156))))));
+    } else {
+        const sr_real t = SR_SQRT(t2), s_half = SR_SIN(SR_C(0.5) * t);
+        a = SR_C(2.0) * s_half * s_half / t2;
+        b = (t - SR_SIN(t)) / (t2 * t);
+    }
+    W[0] = 0;       W[1] = -phi[2]; W[2] = phi[1];
+    W[3] = phi[2];  W[4] = 0;       W[5] = -phi[0];
+    W[6] = -phi[1]; W[7] = phi[0];  W[8] = 0;
+    matmul3(W, W, W2);
+    for (i = 0; i < 9; ++i) Jr[i] = (i % 4 == 0 ? 1 : 0) - a * W[i] + b * W2[i];
+}
+
+int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+                               sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
+{
+    const sr_real *w = x + SR_X_w_S, *R = x + SR_X_R_S;
+    sr_real Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], phi[3], D[9], Jr[9], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
+    sr_real v[2][3], r;
+    int status, i, j;
+    if (!F || !G) return SR_ERR_NULL;
+    status = sr_check_state(model, x);
+    if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
+    if (status != SR_OK) return status;
+    if (!(dt > 0) || !isfinite(dt)) return SR_ERR_ARG;
+    status = sr_accel_jacobian(model, x, u, Ja, Jb);
+    if (status != SR_OK) return status;
+    r = model->p[SR_P_r];
+    memset(f, 0, sizeof f);
+    memset(g, 0, sizeof g);
+    for (i = 0; i < 3; ++i) phi[i] = dt * w[i];
+    so3_exp_minus_identity(phi, D);
+    so3_right_jacobian(phi, Jr);
+    /* R_S Exp(d_xi) Exp(h(w + d_w)) = R_S Exp(h w) Exp(Exp(h w)^T d_xi + h Jr(h w) d_w): */
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) {
+            f[SR_NE * (SR_E_xi_S + i) + SR_E_xi_S + j] = (i == j ? 1 : 0) + D[3 * j + i];
+            f[SR_NE * (SR_E_xi_S + i) + SR_E_nu + j] = dt * Jr[3 * i + j];
+        }
+    /* the joint angles advance by h w_Y, h w_P */
+    f[SR_NE * SR_E_th_Y + SR_E_th_Y] = 1;
+    f[SR_NE * SR_E_th_Y + SR_E_nu + 3] = dt;
+    f[SR_NE * SR_E_th_P + SR_E_th_P] = 1;
+    f[SR_NE * SR_E_th_P + SR_E_nu + 4] = dt;
+    /* q advances by h r ((R_S w) x e_z) in the plane: d(R_S w) = R_S (d_w - w x d_xi); the rows
+     * (v_y, -v_x) of that, v[k] = row k of r R_S (k = 0, 1). */
+    for (j = 0; j < 3; ++j) {
+        v[0][j] = r * R[3 + j];       /* q_x' = r (R_S w)_y */
+        v[1][j] = -r * R[j];          /* q_y' = -r (R_S w)_x */
+    }
+    for (i = 0; i < 2; ++i) {
+        const sr_real *p = v[i];
+        f[SR_NE * (SR_E_q + i) + SR_E_q + i] = 1;
+        for (j = 0; j < 3; ++j) f[SR_NE * (SR_E_q + i) + SR_E_nu + j] = dt * p[j];
+        /* -p . (w x d_xi) = (w x p) . d_xi */
+        f[SR_NE * (SR_E_q + i) + SR_E_xi_S + 0] = dt * (w[1] * p[2] - w[2] * p[1]);
+        f[SR_NE * (SR_E_q + i) + SR_E_xi_S + 1] = dt * (w[2] * p[0] - w[0] * p[2]);
+        f[SR_NE * (SR_E_q + i) + SR_E_xi_S + 2] = dt * (w[0] * p[1] - w[1] * p[0]);
+    }
+    /* nu advances by h nu'(x, u) */
+    for (i = 0; i < SR_NV; ++i) {
+        for (j = 0; j < SR_NE; ++j) f[SR_NE * (SR_E_nu + i) + j] = dt * Ja[SR_NE * i + j];
+        f[SR_NE * (SR_E_nu + i) + SR_E_nu + i] += 1;
+        for (j = 0; j < SR_NU; ++j) g[SR_NU * (SR_E_nu + i) + j] = dt * Jb[SR_NU * i + j];
+    }
+    if (!all_finite(f, SR_NE * SR_NE) || !all_finite(g, SR_NE * SR_NU)) return SR_ERR_NONFINITE;
+    memcpy(F, f, sizeof f);
+    memcpy(G, g, sizeof g);
+    return SR_OK;
+}

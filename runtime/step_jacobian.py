@@ -7,7 +7,9 @@ The derivative of the discrete map as the C implements it (the SX steps agree wi
 to round-off), every exponential, one-axis rotation and dexp⁻¹ differentiated exactly.  ⊖ enters
 only through its derivative at y = step(x, u), where Log(R₀ᵀR) = vee(skew(R₀ᵀR)) + O(|ε|²) and a
 joint angle difference is sin(θ − θ₀) + O(|ε|³): the first-order forms below give F and G exactly.
-This is the Python path; a C kernel of its own (issue 19) is not written yet.
+Lie–Euler has a C kernel of its own (sr_step_jacobian_lie_euler: the right Jacobian of SO(3), the
+rolling kinematics and sr_accel_jacobian), which the tests compare with this AD; RKMK4 and CF4
+are AD only for now.
 """
 import functools
 
@@ -84,16 +86,38 @@ def jacobian_function(method):
 
 
 class StepJacobianMethods:
-    """`step_jacobian` of `Model` (which provides params, _state_and_input, _dt, _valid_method)."""
+    """`step_jacobian` of `Model` (which provides params, _model, _check, _state_and_input, _dt)."""
 
     def step_jacobian(self, x, u=None, dt=0.01, method="lie-euler"):
         """(F, G), (12, 12) and (12, 2): step(x ⊕ d, u + w) ⊖ step(x, u) = F d + G w + O(2), the
         exact derivative of one step of `method` as implemented.  Batches: x (B, 35), u (B, 2)
-        or None give (B, 12, 12), (B, 12, 2).  Needs CasADi (the dev or casadi extra)."""
+        or None give (B, 12, 12), (B, 12, 2).  Lie–Euler is C (sr_step_jacobian_lie_euler);
+        RKMK4 and CF4 are CasADi's AD of the exported steps (needs the dev or casadi extra)."""
         if method not in STEPS:
             raise ValueError(f"method: unknown integrator {method!r}; choose one of {sorted(STEPS)}")
         x, u = self._state_and_input(x, u)
         dt = self._dt(dt)
+        if method == "lie-euler":
+            return self._lie_euler_step_jacobian(x, u, dt)
+        return self.casadi_step_jacobian(x, u, dt, method)
+
+    def _lie_euler_step_jacobian(self, x, u, dt):
+        from bindings._sr import ffi, lib
+        lead = x.shape[:-1]
+        F, G = np.empty(lead + (NE, NE)), np.empty(lead + (NE, NU))
+        for i in np.ndindex(lead):
+            xi, ui = np.ascontiguousarray(x[i]), np.ascontiguousarray(u[i])
+            Fi, Gi = F[i], G[i]
+            status = lib.sr_step_jacobian_lie_euler(self._model, ffi.cast("double *", ffi.from_buffer(xi)),
+                                                    ffi.cast("double *", ffi.from_buffer(ui)), dt,
+                                                    ffi.cast("double *", ffi.from_buffer(Fi)),
+                                                    ffi.cast("double *", ffi.from_buffer(Gi)))
+            self._check("x" if not lead else f"x[{i[0]}]", status)
+        return F, G
+
+    def casadi_step_jacobian(self, x, u, dt, method):
+        """(F, G) by CasADi's AD of the exported step of `method` (any of the three; arguments as
+        step_jacobian's, already checked)."""
         p = self.params.as_array()
         f = jacobian_function(method)
         if x.ndim == 1:

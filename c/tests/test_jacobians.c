@@ -63,8 +63,58 @@ static void test_accel_jacobian_bad_input_leaves_outputs_untouched(void)
     CHECK_STATUS(sr_accel_jacobian_batch(&m, -1, x, NULL, Ja, Jb, &failed), SR_ERR_ARG);
 }
 
+static void test_lie_euler_step_jacobian_columns_are_central_differences_through_retract_and_local(void)
+{
+    const double h = TEST_EPS < 1e-10 ? 1e-4 : 3e-2, tol = TEST_EPS < 1e-10 ? 1e-6 : 3e-2;
+    const sr_real dt = SR_C(0.05);
+    sr_real p[SR_NPARAM], x[SR_NX], y[SR_NX], y0[SR_NX], ys[SR_NX], u[SR_NU] = {SR_C(0.05), SR_C(-0.02)}, up[SR_NU];
+    sr_real d[SR_NE], F[SR_NE * SR_NE], G[SR_NE * SR_NU], ep[SR_NE], em[SR_NE];
+    test_rng rng = {31};
+    sr_model m;
+    double scale = 0;
+    int k, i, s;
+    paper_simulation_params(p);
+    CHECK_STATUS(sr_model_init(&m, p), SR_OK);
+    random_state(&rng, p[SR_P_r], 2.0, x);
+    CHECK_STATUS(sr_step_jacobian_lie_euler(&m, x, u, dt, F, G), SR_OK);
+    CHECK_STATUS(sr_step_lie_euler(&m, x, u, dt, y0), SR_OK);
+    for (i = 0; i < SR_NE * SR_NE; ++i) scale = fabs((double)F[i]) > scale ? fabs((double)F[i]) : scale;
+    for (k = 0; k < SR_NE + SR_NU; ++k) {
+        for (s = -1; s <= 1; s += 2) {
+            memset(d, 0, sizeof d);
+            memcpy(up, u, sizeof up);
+            if (k < SR_NE) d[k] = (sr_real)(s * h); else up[k - SR_NE] += (sr_real)(s * h);
+            CHECK_STATUS(sr_retract(&m, x, d, y), SR_OK);
+            CHECK_STATUS(sr_step_lie_euler(&m, y, up, dt, ys), SR_OK);
+            CHECK_STATUS(sr_local(&m, y0, ys, s > 0 ? ep : em), SR_OK);
+        }
+        for (i = 0; i < SR_NE; ++i)
+            CHECK_NEAR(k < SR_NE ? F[SR_NE * i + k] : G[SR_NU * i + k - SR_NE],
+                       ((double)ep[i] - (double)em[i]) / (2 * h), tol * scale);
+    }
+}
+
+static void test_lie_euler_step_jacobian_bad_input_gives_status_and_leaves_outputs_untouched(void)
+{
+    sr_real p[SR_NPARAM], x[SR_NX], F[SR_NE * SR_NE], G[SR_NE * SR_NU], keep[SR_NE * SR_NE];
+    test_rng rng = {37};
+    sr_model m;
+    paper_simulation_params(p);
+    CHECK_STATUS(sr_model_init(&m, p), SR_OK);
+    random_state(&rng, p[SR_P_r], 1.0, x);
+    memset(F, 0x5a, sizeof F);
+    memcpy(keep, F, sizeof F);
+    CHECK_STATUS(sr_step_jacobian_lie_euler(&m, x, NULL, 0, F, G), SR_ERR_ARG);
+    CHECK_STATUS(sr_step_jacobian_lie_euler(&m, x, NULL, SR_C(0.01), NULL, G), SR_ERR_NULL);
+    x[SR_X_R_S] = 2;
+    CHECK_STATUS(sr_step_jacobian_lie_euler(&m, x, NULL, SR_C(0.01), F, G), SR_ERR_NOT_ROTATION);
+    CHECK(memcmp(F, keep, sizeof F) == 0);
+}
+
 void suite_jacobians(void)
 {
     RUN_TEST(test_accel_jacobian_columns_are_central_differences_along_retract);
     RUN_TEST(test_accel_jacobian_bad_input_leaves_outputs_untouched);
+    RUN_TEST(test_lie_euler_step_jacobian_columns_are_central_differences_through_retract_and_local);
+    RUN_TEST(test_lie_euler_step_jacobian_bad_input_gives_status_and_leaves_outputs_untouched);
 }

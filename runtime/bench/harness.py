@@ -9,7 +9,7 @@ import subprocess
 
 import numpy as np
 
-from ..state import NV
+from ..state import NE, NU, NV
 from ..verification.reference import ReferenceModel
 from ..verification.steppers import STEPPERS
 from .checks import WrongNumbers, check_close
@@ -126,6 +126,14 @@ def check_harness(result, model, X, U, step_dt=0.01):
             check("C loop Kane Jacobian by CasADi AD (speed and torque columns) vs CasADi AD of the reference",
                   "kane_casadi_c_accel_jacobian",
                   lambda i: np.concatenate([Ja[i][:, 7:12].ravel(), Jb[i].ravel()]), 1e-9)
+    if "step_jacobian_lie_euler" in result:
+        from ..step_jacobian import jacobian_function
+        n = len(X)
+        F, G = jacobian_function("lie-euler").map(n)(np.asarray(X).T, np.asarray(U).T, step_dt, model.params.as_array())
+        F = np.asarray(F).reshape(NE, n, NE).transpose(1, 0, 2)
+        G = np.asarray(G).reshape(NE, n, NU).transpose(1, 0, 2)
+        check("C Lie-Euler step_jacobian vs CasADi AD of the exported SX step", "step_jacobian_lie_euler",
+              lambda i: np.concatenate([F[i].ravel(), G[i].ravel()]), 1e-10)
     if "casadi_generated_reference_accel" in result:
         check("CasADi-generated reference vs reference", "casadi_generated_reference_accel", lambda i: accel[i], 1e-10)
     for value in result.values():

@@ -47,6 +47,9 @@ def targets(res):
             out.append((f"{key[5:]} step <= 6x one checked accel (C loop)", c[key]["ns"] <= 6 * ours))
     if "accel_jacobian" in c:
         out.append(("accel_jacobian <= 8x one checked accel (C loop)", c["accel_jacobian"]["ns"] <= 8 * ours))
+        if "step_jacobian_lie_euler" in c:
+            out.append(("Lie-Euler step_jacobian <= 2x accel_jacobian (C loop)",
+                        c["step_jacobian_lie_euler"]["ns"] <= 2 * c["accel_jacobian"]["ns"]))
         if "kane_casadi_c_accel_jacobian" in c:
             out.append(("accel_jacobian >= 10x faster than CasADi AD C of the Kane Jacobian",
                         10 * c["accel_jacobian"]["ns"] <= c["kane_casadi_c_accel_jacobian"]["ns"]))
@@ -71,6 +74,9 @@ def sections(res):
     if "accel_jacobian" in c:
         rows.append(("our accel_jacobian (Ja 5x12 and Jb 5x2)", f"{c['accel_jacobian']['ns']:,.1f} ns",
                      f"{c['accel_jacobian']['ns'] / ours:.1f}x"))
+    if "step_jacobian_lie_euler" in c:
+        rows.append(("our Lie-Euler step_jacobian (F 12x12 and G 12x2)", f"{c['step_jacobian_lie_euler']['ns']:,.1f} ns",
+                     f"{c['step_jacobian_lie_euler']['ns'] / ours:.1f}x"))
     if res.get("c_loop_native"):
         rows.append(("our accel, checked API, -march=native", f"{res['c_loop_native']['accel']['ns']:,.1f} ns", ""))
     for key, label in C_BASELINES:

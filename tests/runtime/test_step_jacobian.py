@@ -61,3 +61,15 @@ def test_step_jacobian_refuses_a_state_that_is_no_state(model, samples):
     x[0] = 2.0
     with pytest.raises(ValueError, match="R_S"):
         model.step_jacobian(x, None, 0.01, "rkmk4")
+
+
+@pytest.mark.parametrize("dt", [0.01, 0.5])
+def test_c_lie_euler_step_jacobian_equals_casadi_ad_of_the_exported_step(model, samples, dt):
+    """Two derivations: the C kernel by hand (right Jacobian of SO(3), rolling kinematics, accel_jacobian)
+    and CasADi's AD of the SX step; dt = 0.5 s takes the closed forms rather than the series."""
+    X, U = samples
+    for x, u in zip(X, U):
+        F, G = model.step_jacobian(x, u, dt, "lie-euler")
+        F_ad, G_ad = model.casadi_step_jacobian(x, u, dt, "lie-euler")
+        scale = np.abs(F_ad).max()
+        assert np.abs(F - F_ad).max() <= 1e-13 * scale and np.abs(G - G_ad).max() <= 1e-13 * scale
