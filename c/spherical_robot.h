@@ -373,6 +373,7 @@ int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 #define sr_accel_jacobian sr_accel_jacobian_f
 #define sr_accel_jacobian_batch sr_accel_jacobian_batch_f
 #define sr_step_jacobian_lie_euler sr_step_jacobian_lie_euler_f
+#define sr_step_jacobian_lie_euler_batch sr_step_jacobian_lie_euler_batch_f
 #endif
 
 /* Jacobians of the accelerations in the error coordinates:
@@ -399,6 +400,11 @@ int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, con
  * only on SR_OK.  (RKMK4 and CF4: runtime.step_jacobian, by CasADi AD, for now.) */
 int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                                sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU]);
+
+/* The same over n rows (x n x SR_NX, u n x SR_NU or NULL, F n x SR_NE x SR_NE, G n x SR_NE x SR_NU),
+ * one dt; stops at the first failing row, its index in *failed_row (-1 when all succeed). */
+int sr_step_jacobian_lie_euler_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real dt,
+                                     sr_real *F, sr_real *G, long *failed_row);
 
 #ifdef __cplusplus
 }

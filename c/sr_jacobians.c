@@ -184,3 +184,21 @@ int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], co
     memcpy(G, g, sizeof g);
     return SR_OK;
 }
+
+int sr_step_jacobian_lie_euler_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real dt,
+                                     sr_real *F, sr_real *G, long *failed_row)
+{
+    long i;
+    if (failed_row) *failed_row = -1;
+    if (!model || (n > 0 && (!x || !F || !G))) return SR_ERR_NULL;
+    if (n < 0) return SR_ERR_ARG;
+    for (i = 0; i < n; ++i) {
+        const int status = sr_step_jacobian_lie_euler(model, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt,
+                                                      F + i * SR_NE * SR_NE, G + i * SR_NE * SR_NU);
+        if (status != SR_OK) {
+            if (failed_row) *failed_row = i;
+            return status;
+        }
+    }
+    return SR_OK;
+}

@@ -103,16 +103,17 @@ class StepJacobianMethods:
 
     def _lie_euler_step_jacobian(self, x, u, dt):
         from bindings._sr import ffi, lib
+
+        def ptr(arr):
+            return ffi.cast("double *", ffi.from_buffer(arr))
         lead = x.shape[:-1]
         F, G = np.empty(lead + (NE, NE)), np.empty(lead + (NE, NU))
-        for i in np.ndindex(lead):
-            xi, ui = np.ascontiguousarray(x[i]), np.ascontiguousarray(u[i])
-            Fi, Gi = F[i], G[i]
-            status = lib.sr_step_jacobian_lie_euler(self._model, ffi.cast("double *", ffi.from_buffer(xi)),
-                                                    ffi.cast("double *", ffi.from_buffer(ui)), dt,
-                                                    ffi.cast("double *", ffi.from_buffer(Fi)),
-                                                    ffi.cast("double *", ffi.from_buffer(Gi)))
-            self._check("x" if not lead else f"x[{i[0]}]", status)
+        if x.ndim == 1:
+            self._check("x", lib.sr_step_jacobian_lie_euler(self._model, ptr(x), ptr(u), dt, ptr(F), ptr(G)))
+            return F, G
+        failed = ffi.new("long *")
+        status = lib.sr_step_jacobian_lie_euler_batch(self._model, x.shape[0], ptr(x), ptr(u), dt, ptr(F), ptr(G), failed)
+        self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
         return F, G
 
     def casadi_step_jacobian(self, x, u, dt, method):

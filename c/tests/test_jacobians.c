@@ -111,10 +111,32 @@ static void test_lie_euler_step_jacobian_bad_input_gives_status_and_leaves_outpu
     CHECK(memcmp(F, keep, sizeof F) == 0);
 }
 
+static void test_lie_euler_step_jacobian_batch_equals_single_calls_and_names_the_failing_row(void)
+{
+    sr_real p[SR_NPARAM], x[3][SR_NX], F[3][SR_NE * SR_NE], G[3][SR_NE * SR_NU], Fs[SR_NE * SR_NE], Gs[SR_NE * SR_NU];
+    test_rng rng = {41};
+    sr_model m;
+    long failed = 7;
+    int i;
+    paper_simulation_params(p);
+    CHECK_STATUS(sr_model_init(&m, p), SR_OK);
+    for (i = 0; i < 3; ++i) random_state(&rng, p[SR_P_r], 1.0, x[i]);
+    CHECK_STATUS(sr_step_jacobian_lie_euler_batch(&m, 3, x[0], NULL, SR_C(0.01), F[0], G[0], &failed), SR_OK);
+    CHECK(failed == -1);
+    for (i = 0; i < 3; ++i) {
+        CHECK_STATUS(sr_step_jacobian_lie_euler(&m, x[i], NULL, SR_C(0.01), Fs, Gs), SR_OK);
+        CHECK(memcmp(Fs, F[i], sizeof Fs) == 0 && memcmp(Gs, G[i], sizeof Gs) == 0);
+    }
+    x[1][SR_X_w_Y] = (sr_real)NAN;
+    CHECK_STATUS(sr_step_jacobian_lie_euler_batch(&m, 3, x[0], NULL, SR_C(0.01), F[0], G[0], &failed), SR_ERR_NONFINITE);
+    CHECK(failed == 1);
+}
+
 void suite_jacobians(void)
 {
     RUN_TEST(test_accel_jacobian_columns_are_central_differences_along_retract);
     RUN_TEST(test_accel_jacobian_bad_input_leaves_outputs_untouched);
     RUN_TEST(test_lie_euler_step_jacobian_columns_are_central_differences_through_retract_and_local);
     RUN_TEST(test_lie_euler_step_jacobian_bad_input_gives_status_and_leaves_outputs_untouched);
+    RUN_TEST(test_lie_euler_step_jacobian_batch_equals_single_calls_and_names_the_failing_row);
 }

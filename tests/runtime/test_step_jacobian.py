@@ -73,3 +73,11 @@ def test_c_lie_euler_step_jacobian_equals_casadi_ad_of_the_exported_step(model, 
         F_ad, G_ad = model.casadi_step_jacobian(x, u, dt, "lie-euler")
         scale = np.abs(F_ad).max()
         assert np.abs(F - F_ad).max() <= 1e-13 * scale and np.abs(G - G_ad).max() <= 1e-13 * scale
+
+
+def test_lie_euler_step_jacobian_batch_names_the_row_that_fails(model, samples):
+    X, U = samples
+    X = X.copy()
+    X[1, 33] = np.nan
+    with pytest.raises(ValueError, match=r"x\[1\]"):
+        model.step_jacobian(X, U, 0.01, "lie-euler")
