@@ -42,16 +42,20 @@ static double now_ns(void)
 
 typedef int (*kernel_fn)(const sr_model *, int, int);
 static sr_model model;
+/* A robot of none of the paper's special geometry (issue 18): the general kernels, same states. */
+static sr_model general_model;
 
 static int k_accel(const sr_model *m, int i, int arg) { (void)arg; return sr_accel(m, X[i], U[i], OUT[i]); }
 static int k_gen_accel(const sr_model *m, int i, int arg) { (void)arg; return sr_gen_accel(m->c, X[i], U[i], OUT[i]); }
 static int k_inertia(const sr_model *m, int i, int arg) { (void)arg; return sr_inertia(m, X[i], OUT[i]); }
 static int k_step(const sr_model *m, int i, int method) { return sr_step(m, method, X[i], U[i], 0.01, OUT[i]); }
+static int k_accel_general(const sr_model *m, int i, int arg) { (void)m; (void)arg; return sr_accel(&general_model, X[i], U[i], OUT[i]); }
+static int k_step_general(const sr_model *m, int i, int method) { (void)m; return sr_step(&general_model, method, X[i], U[i], 0.01, OUT[i]); }
 static int k_accel_jacobian(const sr_model *m, int i, int arg) { (void)arg; return sr_accel_jacobian(m, X[i], U[i], JOUT[i], JOUT[i] + SR_NV * SR_NE); }
 static int k_step_jacobian_lie_euler(const sr_model *m, int i, int arg) { (void)arg; return sr_step_jacobian_lie_euler(m, X[i], U[i], 0.01, JOUT[i], JOUT[i] + SR_NE * SR_NE); }
 
 #ifdef WITH_KANE
-static double KANE[NMAX][12], KANE_P[SR_NPARAM];
+static double KANE[NMAX][12], KANE_P[12]; /* the Kane model: its coordinates, the paper's twelve parameters */
 static int k_kane_casadi(const sr_model *m, int i, int arg) { (void)m; (void)arg; return kane_casadi_c(KANE[i], U[i], KANE_P, OUT[i]); }
 static int k_kane_sympy(const sr_model *m, int i, int arg) { (void)m; (void)arg; return kane_sympy_c(KANE[i], U[i], KANE_P, OUT[i]); }
 static int k_kane_pydy(const sr_model *m, int i, int arg) { (void)m; (void)arg; return kane_pydy_c(KANE[i], U[i], KANE_P, OUT[i]); }
@@ -125,23 +129,24 @@ int main(int argc, char **argv)
 {
     FILE *f;
     int n, repeats;
-    sr_real p[SR_NPARAM];
-#ifdef WITH_KANE
-    int n_p;
-#endif
+    sr_real p[SR_NPARAM], gp[SR_NPARAM];
     if (argc != 3) { fprintf(stderr, "usage: %s INPUT.bin REPEATS\n", argv[0]); return 2; }
     f = fopen(argv[1], "rb");
     if (!f || fread(&n, sizeof n, 1, f) != 1 || n < 1 || n > NMAX) { fprintf(stderr, "bad input\n"); return 2; }
     if (fread(p, sizeof(sr_real), SR_NPARAM, f) != SR_NPARAM
         || fread(X, sizeof(sr_real) * SR_NX, (size_t)n, f) != (size_t)n
-        || fread(U, sizeof(sr_real) * SR_NU, (size_t)n, f) != (size_t)n) { fprintf(stderr, "short input\n"); return 2; }
+        || fread(U, sizeof(sr_real) * SR_NU, (size_t)n, f) != (size_t)n
+        || fread(gp, sizeof(sr_real), SR_NPARAM, f) != SR_NPARAM) { fprintf(stderr, "short input\n"); return 2; }
 #ifdef WITH_KANE
-    if (fread(KANE, sizeof(double) * 12, (size_t)n, f) != (size_t)n) { fprintf(stderr, "short input\n"); return 2; }
-    for (n_p = 0; n_p < SR_NPARAM; ++n_p) KANE_P[n_p] = (double)p[n_p];
+    if (fread(KANE, sizeof(double) * 12, (size_t)n, f) != (size_t)n
+        || fread(KANE_P, sizeof(double), 12, f) != 12) { fprintf(stderr, "short input\n"); return 2; }
 #endif
     fclose(f);
     repeats = atoi(argv[2]);
-    if (sr_model_init(&model, p) != SR_OK) { fprintf(stderr, "bad params\n"); return 2; }
+    if (sr_model_init(&model, p) != SR_OK || sr_model_init(&general_model, gp) != SR_OK || !general_model.general) {
+        fprintf(stderr, "bad params\n");
+        return 2;
+    }
 #ifdef WITH_CASADI
     {
         casadi_int sz_arg, sz_res, sz_iw, sz_w;
@@ -158,6 +163,8 @@ int main(int argc, char **argv)
             {k_step, SR_LIE_EULER, SR_NX, 1, "step_lie_euler", 0},
             {k_step, SR_RKMK4, SR_NX, 1, "step_rkmk4", 0},
             {k_step, SR_CF4, SR_NX, 1, "step_cf4", 0},
+            {k_accel_general, 0, SR_NV, 1, "accel_general_robot", 0},
+            {k_step_general, SR_RKMK4, SR_NX, 1, "step_rkmk4_general_robot", 0},
             {k_accel_jacobian, 0, SR_NV * (SR_NE + SR_NU), 1, "accel_jacobian", 0},
             {k_step_jacobian_lie_euler, 0, NOUT, 1, "step_jacobian_lie_euler", 0},
 #ifdef WITH_CASADI
@@ -176,6 +183,7 @@ int main(int argc, char **argv)
         printf("{\n");
         for (k = 0; k < ncases; ++k) print_case(&cases[k], n);
     }
-    printf("  \"accel_flops\": %d,\n  \"sink\": %g\n}\n", SR_GEN_ACCEL_FLOPS, sink);
+    printf("  \"accel_flops\": %d,\n  \"general_system_flops\": %d,\n  \"sink\": %g\n}\n", SR_GEN_ACCEL_FLOPS,
+           SR_GEN_GENERAL_SYSTEM_FLOPS, sink);
     return 0;
 }

@@ -16,12 +16,21 @@
  * Scalar type: sr_real is double, or float when compiled with -DSR_USE_FLOAT.
  *
  * Units and frames (SI throughout):
- *   params  [SR_NPARAM] = (r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g)
- *           (index of each: SR_P_r ... SR_P_g in sr_generated.h)
- *           r shell radius [m], m_S shell mass [kg], b, h yoke sides [m]
- *           (b-rods along y, h-rods along x), m_b, m_h rod masses [kg],
- *           l pendulum length [m], m_P pendulum mass [kg], g gravity [m/s^2],
+ *   params  [SR_NPARAM] = the robot (issue 18; index of each: SR_P_r ... SR_P_slope in
+ *           sr_generated.h):
+ *           r shell radius [m], m_S shell mass [kg], j_S its isotropic inertia [kg m^2],
+ *           m_Y yoke mass, c_Y (c_Y_x, c_Y_y, c_Y_z) its centre of mass [m] in the yoke
+ *           frame from the shell centre, J_Y (J_Y_xx, J_Y_yy, J_Y_zz, J_Y_xy, J_Y_xz, J_Y_yz)
+ *           its inertia tensor about that centre [kg m^2]; m_P, c_P, J_P the same for the
+ *           pendulum (pendulum frame, from its hinge at the shell centre); j_mY, j_mP the
+ *           motor rotors' inertias about their axes [kg m^2], n_Y, n_P their gear ratios
+ *           (rotor speed relative to its carrier = n * joint speed; the yoke motor's rotor
+ *           sits on the shell, the pendulum motor's on the yoke); g gravity [m/s^2]; slope
+ *           the floor's inclination [rad] (the inertial frame lies in the plane, x up the
+ *           slope: gravity is -g (sin(slope), 0, cos(slope)));
  *           k_S, k_Y, k_P physical damping [N m s/rad]: torque -k*omega.
+ *           The paper's robot: sr_paper_params from (r, m_S, k_S, b, h, m_b, m_h, k_Y, l,
+ *           m_P, k_P, g) (SR_PAPER_r ... SR_PAPER_g).
  *   x       [SR_NX] = 35 state entries (offset of each block: SR_X_R_S ... SR_X_w_P in
  *           sr_generated.h):
  *           x[0..8]   R_S row-major, shell frame -> inertial frame
@@ -51,6 +60,9 @@ extern "C" {
 #define sr_status_string sr_status_string_f
 #define sr_param_rule_string sr_param_rule_string_f
 #define sr_check_params sr_check_params_f
+#define sr_check_paper_params sr_check_paper_params_f
+#define sr_paper_params sr_paper_params_f
+#define sr_paper_params_unchecked sr_paper_params_unchecked_f
 #define sr_model_init sr_model_init_f
 #define sr_check_state sr_check_state_f
 #define sr_check_state_batch sr_check_state_batch_f
@@ -71,6 +83,7 @@ extern "C" {
 #endif
 
 #define SR_NPARAM SR_GEN_NPARAM
+#define SR_NPAPER SR_GEN_NPAPER
 #define SR_NX SR_GEN_NX
 #define SR_NU SR_GEN_NU
 #define SR_NV SR_GEN_NV
@@ -122,10 +135,18 @@ extern "C" {
                                   biased, e.g. a robot at rest for ~10^5+ steps, whose tiny
                                   constant increments round the same way every step */
 
-/* Model: the parameters and the constants derived from them. Fill with sr_model_init. */
+/* Model: the parameters and the constants derived from them. Fill with sr_model_init.
+ * A robot of the paper's geometry (c_Y = 0, J_Y_zz = J_Y_xx + J_Y_yy, J_Y diagonal, c_P on
+ * the pendulum's z axis, J_P = diag(a, a, 0), no rotors, level floor) is evaluated by the
+ * paper-geometry kernels (constants c, general = 0), any other by the general kernels
+ * (constants cg, general = 1); sr_model_init chooses.  A library compiled with -DSR_PAPER_ONLY
+ * has no general kernels (smaller firmware): sr_model_init refuses other robots (SR_ERR_PARAM).  Both give the same numbers for the
+ * paper's robot, to rounding (tests/runtime/test_general_robot.py). */
 typedef struct sr_model {
     sr_real p[SR_NPARAM];
+    int general;
     sr_real c[SR_GEN_NCONST];
+    sr_real cg[SR_GEN_GENERAL_NCONST];
 } sr_model;
 
 /* Human-readable name of a status code (static string, never NULL). */
@@ -134,24 +155,44 @@ const char *sr_status_string(int status);
 /* The rules a parameter vector must obey, in the order sr_check_params tests them. */
 #define SR_PARAM_RULE_NONE 0         /* no rule broken */
 #define SR_PARAM_RULE_FINITE 1       /* every parameter finite */
-#define SR_PARAM_RULE_POSITIVE 2     /* r, m_S, b, h, m_b, m_h, l, m_P > 0 */
-#define SR_PARAM_RULE_NONNEGATIVE 3  /* k_S, k_Y, k_P, g >= 0 */
-#define SR_PARAM_RULE_YOKE_FITS 4    /* yoke half-diagonal sqrt(b^2 + h^2)/2 <= r */
-#define SR_PARAM_RULE_PENDULUM_FITS 5 /* l <= r */
+#define SR_PARAM_RULE_POSITIVE 2     /* general: r, m_S, j_S, m_Y, m_P > 0; paper: r, m_S, b, h, m_b, m_h, l, m_P > 0 */
+#define SR_PARAM_RULE_NONNEGATIVE 3  /* k_S, k_Y, k_P, g >= 0; general also j_mY, j_mP >= 0 */
+#define SR_PARAM_RULE_YOKE_FITS 4    /* paper: yoke half-diagonal sqrt(b^2 + h^2)/2 <= r */
+#define SR_PARAM_RULE_PENDULUM_FITS 5 /* paper: l <= r */
+#define SR_PARAM_RULE_NONZERO 6      /* general: gear ratios n_Y, n_P != 0 */
+#define SR_PARAM_RULE_INERTIA 7      /* general: J_Y, J_P physical: tr(J)/2 I - J (the second
+                                        moment of the mass) positive semidefinite, i.e. J positive
+                                        semidefinite with the triangle inequalities */
+#define SR_PARAM_RULE_INSIDE 8       /* general: centres of mass inside the shell, |c_Y|, |c_P| < r */
+#define SR_PARAM_RULE_SLOPE 9        /* general: |slope| < pi/2 */
 
 /* The one place that decides whether params are in their physical range (sr_model_init and
  * the Python runtime's Params call it).  Tests the rules above in order and, for the first
  * one broken, writes its SR_PARAM_RULE_* code to *rule and the index (SR_P_*) of the first
- * parameter that breaks it to *bad_index (for the yoke rule SR_P_b, for the pendulum rule
- * SR_P_l); with every rule kept, SR_PARAM_RULE_NONE and -1.  bad_index and rule may be NULL.
+ * parameter that breaks it to *bad_index (for a tensor, its J_*_xx; for a centre, its c_*_x);
+ * with every rule kept, SR_PARAM_RULE_NONE and -1.  bad_index and rule may be NULL.
  * Returns SR_OK, SR_ERR_NULL (params), SR_ERR_NONFINITE (rule FINITE) or SR_ERR_PARAM. */
 int sr_check_params(const sr_real params[SR_NPARAM], int *bad_index, int *rule);
+
+/* The same for the paper's twelve parameters (index SR_PAPER_*; the yoke rule reports
+ * SR_PAPER_b, the pendulum rule SR_PAPER_l). */
+int sr_check_paper_params(const sr_real paper[SR_NPAPER], int *bad_index, int *rule);
+
+/* The paper's robot (Section 2.3: a yoke of four uniform rods, a slender pendulum rod, a thin
+ * shell, massless motors, level floor) as params: checks paper (sr_check_paper_params) and
+ * writes params.  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_PARAM. */
+int sr_paper_params(const sr_real paper[SR_NPAPER], sr_real params[SR_NPARAM]);
+
+/* The conversion of sr_paper_params without the paper's rules: for batch tools that hand each
+ * sample to sr_simulate_batch, whose sr_model_init then judges it (a negative rod mass gives a
+ * negative m_Y, SR_ERR_PARAM for that sample alone).  Returns SR_OK, SR_ERR_NULL or
+ * SR_ERR_NONFINITE (a result not finite; params untouched). */
+int sr_paper_params_unchecked(const sr_real paper[SR_NPAPER], sr_real params[SR_NPARAM]);
 
 /* The text of a rule of sr_check_params ("must be > 0", ...; static string, never NULL). */
 const char *sr_param_rule_string(int rule);
 
-/* Validate params (sr_check_params: all finite; r, m_S, b, h, m_b, m_h, l, m_P > 0; k_S, k_Y,
- * k_P, g >= 0; yoke half-diagonal sqrt(b^2+h^2)/2 <= r and l <= r) and fill *model.  The derived
+/* Validate params (sr_check_params) and fill *model, choosing the kernels (see sr_model).  The derived
  * constants, M and the energy at the reference state (R_S = R_Y = R_P = I, q = (0, 0, r), at
  * rest) must be finite (else SR_ERR_PARAM: a value so large that it overflows), and M there
  * positive definite (else SR_ERR_SINGULAR: values so small that the inertias underflow).

@@ -15,11 +15,19 @@ static int energies(const sr_model *model, const sr_real x[SR_NX], sr_real *kine
     sr_real rest[SR_NX], potential;
     int i, status;
     for (i = 0; i < SR_NX; ++i) rest[i] = i < SR_X_w_S ? x[i] : 0; /* nu = 0 */
-    status = sr_gen_energy(model->c, x, total);
-    if (status == SR_OK) status = sr_gen_energy(model->c, rest, &potential);
+    status = sr_internal_energy(model, x, total);
+    if (status == SR_OK) status = sr_internal_energy(model, rest, &potential);
     if (status != SR_OK) return status;
     *kinetic = *total - potential;
     return isfinite(*total) && isfinite(*kinetic) ? SR_OK : SR_ERR_NONFINITE;
+}
+
+/* How far the shape potential can range: 2 g (m_Y |c_Y| + m_P |c_P|) (m_P g l for the paper's robot). */
+static sr_real potential_range(const sr_real *p)
+{
+    const sr_real *cY = p + SR_P_c_Y_x, *cP = p + SR_P_c_P_x;
+    return 2 * p[SR_P_g] * (p[SR_P_m_Y] * SR_SQRT(cY[0] * cY[0] + cY[1] * cY[1] + cY[2] * cY[2])
+                            + p[SR_P_m_P] * SR_SQRT(cP[0] * cP[0] + cP[1] * cP[1] + cP[2] * cP[2]));
 }
 
 /* The energy guard at row n of a run (the state x after n steps of this call); step_u is the
@@ -36,7 +44,7 @@ static int energy_guard(const sr_model *model, sr_energy_guard *guard, const sr_
     if (prev_u && (prev_u[0] != 0 || prev_u[1] != 0)) guard->in_stretch = 0;
     if (guard->in_stretch && check_row) {
         sr_real limit;
-        status = sr_gen_energy(model->c, x, &total);
+        status = sr_internal_energy(model, x, &total);
         if (status != SR_OK) return status;
         if (!isfinite(total)) return SR_ERR_NONFINITE;
         guard->energy = total;
@@ -49,7 +57,7 @@ static int energy_guard(const sr_model *model, sr_energy_guard *guard, const sr_
         if (status != SR_OK) return status;
         guard->in_stretch = 1;
         guard->e_start = guard->energy = total;
-        guard->scale = kinetic + p[SR_P_m_P] * p[SR_P_g] * p[SR_P_l];
+        guard->scale = kinetic + potential_range(p);
     }
     return SR_OK;
 }

@@ -8,31 +8,6 @@
 
 #include <string.h>
 
-/* Index of M[i][j] (either order) in the row-by-row upper triangle of a 5x5 matrix. */
-static const unsigned char UPPER[SR_NV][SR_NV] = {
-    {0, 1, 2, 3, 4}, {1, 5, 6, 7, 8}, {2, 6, 9, 10, 11}, {3, 7, 10, 12, 13}, {4, 8, 11, 13, 14}};
-
-/* M = L L^T (L lower, row-major) and the reciprocals of L's diagonal; each pivot must exceed
- * SR_GEN_PIVOT_TOL times M's diagonal entry, as in the accel kernel's test, else SR_ERR_SINGULAR. */
-static int cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real inv[SR_NV])
-{
-    int i, j, k;
-    memset(L, 0, sizeof(sr_real) * SR_NV * SR_NV);
-    for (j = 0; j < SR_NV; ++j) {
-        sr_real d = Mu[UPPER[j][j]];
-        for (k = 0; k < j; ++k) d -= L[SR_NV * j + k] * L[SR_NV * j + k];
-        if (!(d > SR_GEN_PIVOT_TOL * Mu[UPPER[j][j]])) return SR_ERR_SINGULAR;
-        L[SR_NV * j + j] = SR_SQRT(d);
-        inv[j] = 1 / L[SR_NV * j + j];
-        for (i = j + 1; i < SR_NV; ++i) {
-            sr_real s = Mu[UPPER[i][j]];
-            for (k = 0; k < j; ++k) s -= L[SR_NV * i + k] * L[SR_NV * j + k];
-            L[SR_NV * i + j] = s * inv[j];
-        }
-    }
-    return SR_OK;
-}
-
 #define NCOL (SR_NE + SR_NU)
 
 /* B <- M^-1 B for the first n columns of B (SR_NV rows of NCOL), M = L L^T: all columns at once,
@@ -63,9 +38,9 @@ int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_re
     if (!Ja || !Jb) return SR_ERR_NULL;
     status = checks(model, x, u);
     if (status != SR_OK) return status;
-    status = sr_gen_accel_jacobian_terms(model->c, x, u ? u : zero_u, Mu, f, df, dfdu, dM);
+    status = sr_internal_accel_jacobian_terms(model, x, u ? u : zero_u, Mu, f, df, dfdu, dM);
     if (status != SR_OK) return status;
-    status = cholesky(Mu, L, inv);
+    status = sr_internal_cholesky(Mu, L, inv);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NV; ++i) a[i][0] = f[i];
     solve(L, inv, a, 1);                                  /* a = nu' */
@@ -73,7 +48,7 @@ int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_re
         for (k = 0; k < SR_NE; ++k) B[i][k] = df[SR_NE * i + k];
         for (k = 0; k < SR_NU; ++k) B[i][SR_NE + k] = dfdu[SR_NU * i + k];
         for (k = 0; k < 5; ++k) /* the configuration directions d_xi_S, d_th_Y, d_th_P move M */
-            for (j = 0; j < SR_NV; ++j) B[i][k] -= dM[15 * k + UPPER[i][j]] * a[j][0];
+            for (j = 0; j < SR_NV; ++j) B[i][k] -= dM[15 * k + SR_UPPER[i][j]] * a[j][0];
     }
     solve(L, inv, B, NCOL);
     for (i = 0; i < SR_NV; ++i) {

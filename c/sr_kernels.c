@@ -3,6 +3,98 @@
 #include "sr_internal.h" /* spherical_robot.h, math macros, shared helpers */
 
 #include <stddef.h>
+#include <string.h>
+
+/* ---- the kernels of the model's kind (sr_model: paper geometry or general) ----------------
+ * Compiled with -DSR_PAPER_ONLY, the library leaves the general robot's kernels out (a firmware
+ * for a robot of the paper's geometry links about 6 KB less on a Cortex-M4): sr_model_init then
+ * refuses any other robot with SR_ERR_PARAM, and model->general is never set. */
+#ifdef SR_PAPER_ONLY
+#define GENERAL(call) SR_ERR_PARAM
+#else
+#define GENERAL(call) (call)
+#endif
+
+int sr_internal_cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real inv[SR_NV])
+{
+    int i, j, k;
+    memset(L, 0, sizeof(sr_real) * SR_NV * SR_NV);
+    for (j = 0; j < SR_NV; ++j) {
+        sr_real d = Mu[SR_UPPER[j][j]];
+        for (k = 0; k < j; ++k) d -= L[SR_NV * j + k] * L[SR_NV * j + k];
+        if (!(d > SR_GEN_PIVOT_TOL * Mu[SR_UPPER[j][j]])) return SR_ERR_SINGULAR;
+        L[SR_NV * j + j] = SR_SQRT(d);
+        inv[j] = 1 / L[SR_NV * j + j];
+        for (i = j + 1; i < SR_NV; ++i) {
+            sr_real s = Mu[SR_UPPER[i][j]];
+            for (k = 0; k < j; ++k) s -= L[SR_NV * i + k] * L[SR_NV * j + k];
+            L[SR_NV * i + j] = s * inv[j];
+        }
+    }
+    return SR_OK;
+}
+
+/* The general robot: M and f from the generated kernel, M a = f by Cholesky (with rotors and
+ * general tensors every entry of M may be nonzero, so the paper's joint-first solve does not apply). */
+#ifndef SR_PAPER_ONLY
+static int general_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV])
+{
+    sr_real Mu[15], f[SR_NV], L[SR_NV * SR_NV], inv[SR_NV], y[SR_NV];
+    int i, k, status = sr_gen_general_system(model->cg, x, u, Mu, f);
+    if (status != SR_OK) return status;
+    status = sr_internal_cholesky(Mu, L, inv);
+    if (status != SR_OK) return status;
+    for (i = 0; i < SR_NV; ++i) {
+        sr_real s = f[i];
+        for (k = 0; k < i; ++k) s -= L[SR_NV * i + k] * y[k];
+        y[i] = s * inv[i];
+    }
+    for (i = SR_NV - 1; i >= 0; --i) {
+        sr_real s = y[i];
+        for (k = i + 1; k < SR_NV; ++k) s -= L[SR_NV * k + i] * y[k];
+        y[i] = s * inv[i];
+    }
+    if (!all_finite(y, SR_NV)) return SR_ERR_NONFINITE;
+    for (i = 0; i < SR_NV; ++i) a[i] = y[i];
+    return SR_OK;
+}
+#endif
+
+int sr_internal_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV])
+{
+    return model->general ? GENERAL(general_accel(model, x, u, a)) : sr_gen_accel(model->c, x, u, a);
+}
+
+int sr_internal_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * SR_NV])
+{
+    return model->general ? GENERAL(sr_gen_general_inertia(model->cg, x, M)) : sr_gen_inertia(model->c, x, M);
+}
+
+int sr_internal_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NV])
+{
+    return model->general ? GENERAL(sr_gen_general_rhs(model->cg, x, u, f)) : sr_gen_rhs(model->c, x, u, f);
+}
+
+int sr_internal_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy)
+{
+    return model->general ? GENERAL(sr_gen_general_energy(model->cg, x, energy)) : sr_gen_energy(model->c, x, energy);
+}
+
+int sr_internal_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV])
+{
+    return model->general ? GENERAL(sr_gen_general_equilibrium_residual(model->cg, x, res))
+                          : sr_gen_equilibrium_residual(model->c, x, res);
+}
+
+int sr_internal_accel_jacobian_terms(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                     sr_real Mu[15], sr_real f[SR_NV], sr_real df[SR_NV * SR_NE],
+                                     sr_real dfdu[SR_NV * SR_NU], sr_real dM[5 * 15])
+{
+    return model->general ? GENERAL(sr_gen_general_accel_jacobian_terms(model->cg, x, u, Mu, f, df, dfdu, dM))
+                          : sr_gen_accel_jacobian_terms(model->c, x, u, Mu, f, df, dfdu, dM);
+}
+
+/* ---- the checked API ------------------------------------------------------------------------ */
 
 int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV])
 {
@@ -10,7 +102,7 @@ int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_N
     if (!a) return SR_ERR_NULL;
     status = checks(model, x, u);
     if (status != SR_OK) return status;
-    return sr_gen_accel(model->c, x, u ? u : sr_zero_u, a);
+    return sr_internal_accel(model, x, u ? u : sr_zero_u, a);
 }
 
 int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
@@ -36,7 +128,7 @@ int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * 
     if (!M) return SR_ERR_NULL;
     status = checks(model, x, NULL);
     if (status != SR_OK) return status;
-    return sr_gen_inertia(model->c, x, M);
+    return sr_internal_inertia(model, x, M);
 }
 
 int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NV])
@@ -45,7 +137,7 @@ int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU]
     if (!f) return SR_ERR_NULL;
     status = checks(model, x, u);
     if (status != SR_OK) return status;
-    return sr_gen_rhs(model->c, x, u ? u : sr_zero_u, f);
+    return sr_internal_rhs(model, x, u ? u : sr_zero_u, f);
 }
 
 int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy)
@@ -54,7 +146,7 @@ int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy)
     if (!energy) return SR_ERR_NULL;
     status = checks(model, x, NULL);
     if (status != SR_OK) return status;
-    return sr_gen_energy(model->c, x, energy);
+    return sr_internal_energy(model, x, energy);
 }
 
 int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV])
@@ -63,7 +155,7 @@ int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_re
     if (!res) return SR_ERR_NULL;
     status = checks(model, x, NULL);
     if (status != SR_OK) return status;
-    return sr_gen_equilibrium_residual(model->c, x, res);
+    return sr_internal_equilibrium_residual(model, x, res);
 }
 
 int sr_so3_exp(const sr_real w[3], sr_real R[9])

@@ -9,6 +9,9 @@
  *   SR_C(v)           a numeric literal in sr_real (1.5 -> 1.5f in the float
  *                     build), so that both builds are clean under
  *                     -Wall -Wextra -Wpedantic -Werror (no double promotion).
+ *   SR_GEN_SIN, SR_GEN_COS
+ *                     the sine and cosine of sr_real (sr_gen_general_constants
+ *                     takes those of the slope, once per model).
  *   SR_GEN_PIVOT_TOL  relative pivot tolerance of the joint-first solve in
  *                     sr_gen_accel: each pivot of M (M_33, M_44, the leading
  *                     minors of the Schur complement) must exceed it times
@@ -29,10 +32,14 @@
 typedef float sr_real;
 #define SR_C(v) ((sr_real)(v##f))
 #define SR_GEN_PIVOT_TOL SR_C(1e-6)
+#define SR_GEN_SIN sinf
+#define SR_GEN_COS cosf
 #else
 typedef double sr_real;
 #define SR_C(v) ((sr_real)(v))
 #define SR_GEN_PIVOT_TOL SR_C(1e-13)
+#define SR_GEN_SIN sin
+#define SR_GEN_COS cos
 #endif
 
 #define SR_GEN_OK 0

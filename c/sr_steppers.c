@@ -61,7 +61,7 @@ int sr_internal_vector_field(const sr_model *model, const sr_real x[SR_NX], cons
     f[SR_T_Q + 1] = r * (R[3] * v[0] + R[4] * v[1] + R[5] * v[2]);
     f[SR_T_Q + 2] = 0;
     if (evaluations) ++*evaluations;
-    i = sr_gen_accel(model->c, x, u, f + SR_T_V);
+    i = sr_internal_accel(model, x, u, f + SR_T_V);
     /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
     if (i == SR_ERR_SINGULAR && !all_finite(x, SR_NX)) return SR_ERR_NONFINITE;
     return i;

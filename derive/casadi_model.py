@@ -21,6 +21,7 @@ import sympy as sp
 
 from . import dynamics
 from . import parameters as P
+from . import robot as R
 from . import state as S
 
 # The series thresholds of c/sr_internal.h (SR_SERIES_T2) and of sr_internal_dexpinv.
@@ -55,6 +56,8 @@ def sympy_to_casadi(exprs, values):
         if e.is_Pow and e.exp.is_Integer:
             n = int(e.exp)
             return args[0] ** n if n > 0 else 1 / args[0] ** (-n)
+        if e.func in (sp.sin, sp.cos):
+            return {sp.sin: ca.sin, sp.cos: ca.cos}[e.func](args[0])
         raise ValueError(f"sympy_to_casadi: cannot convert {e.func.__name__} ({e})")
 
     for symbol, expr in replacements:
@@ -63,22 +66,22 @@ def sympy_to_casadi(exprs, values):
 
 
 def symbol_values(x, u, p):
-    """Every symbol of the derivation as an SX entry of x, u, p (the layouts of derive/state.py and
-    derive/parameters.py), the derived constants as their expressions in p."""
+    """Every symbol of the general robot's derivation as an SX entry of x, u, p (the layouts of
+    derive/state.py and derive/parameters.py), its constants (derive.robot.general_constants) as
+    their expressions in p."""
     values = {s: x[i] for s, i in S.STATE_LAYOUT.items()}
     values.update({s: u[i] for s, i in S.INPUT_LAYOUT.items()})
-    values.update({s: p[i] for i, s in enumerate(P.PARAMETERS)})
-    derived = P.derived_constants()
     params = {s: p[i] for i, s in enumerate(P.PARAMETERS)}
-    for c, expr in derived.items():
-        values[c] = sympy_to_casadi([expr], params)[0]
+    constants = R.general_constants()
+    converted = sympy_to_casadi([expr for _, expr in constants], params)
+    values.update({c: value for (c, _), value in zip(constants, converted)})
     return values
 
 
 def accel_function():
-    """sr_accel(x, u, p) = M⁻¹ f, M and f as derived (derive.dynamics.inertia, rhs)."""
+    """sr_accel(x, u, p) = M⁻¹ f, M and f as derived for the general robot (derive.dynamics.inertia, rhs)."""
     x, u, p = ca.SX.sym("x", S.NX), ca.SX.sym("u", S.NU), ca.SX.sym("p", len(P.PARAMETERS))
-    M, f = dynamics.inertia(), dynamics.rhs()
+    M, f = dynamics.inertia(R.GENERAL), dynamics.rhs(R.GENERAL)
     n = S.NV
     converted = sympy_to_casadi(list(M) + list(f), symbol_values(x, u, p))
     M_sx = ca.reshape(ca.vertcat(*converted[:n * n]), n, n).T

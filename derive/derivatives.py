@@ -3,6 +3,7 @@
 The accelerations solve M ν̇ = f (`derive.dynamics`: M of eqs. 97-99, f from eqs. 71/85, 78, 84).
 Along x ⊕ d the configuration moves on its group, right-trivialised:
     γ = R_Sᵀ e_z  →  Exp(−⟦δξ⟧) γ,   so  ∂γ/∂δξ_k = −e_k × γ       (eq. 85's advection, with δξ for Ω_S dt)
+    χ = R_Sᵀ e_x  likewise (the general robot on a slope, issue 18)
     R_Y → R_Y Exp(δθ_Y Σ_Y),  R_P → R_P Exp(δθ_P Σ_P)              (eqs. 39)
 q enters neither M nor f, and ν, u enter additively.  Differentiating M ν̇ = f gives
     ∂ν̇ = M⁻¹ (∂f − (∂M) ν̇),
@@ -16,14 +17,15 @@ import functools
 import sympy as sp
 
 from . import dynamics as D
+from . import robot as R
 from . import state as S
 
 
 def configuration_directions():
     """The rates of the configuration symbols along δξ_x, δξ_y, δξ_z, δθ_Y, δθ_P (unit steps)."""
     none, still = sp.zeros(3, 3), sp.zeros(3, 1)
-    directions = [S.configuration_rates(none, none, -S.hat([int(i == k) for i in range(3)]) * S.gamma)
-                  for k in range(3)]
+    units = [S.hat([int(i == k) for i in range(3)]) for k in range(3)]
+    directions = [S.configuration_rates(none, none, -E * S.gamma, -E * S.chi) for E in units]
     directions.append(S.configuration_rates(S.R_Y * S.Sigma_Y, none, still))
     directions.append(S.configuration_rates(none, S.R_P * S.Sigma_P, still))
     return directions
@@ -48,23 +50,23 @@ def error_columns():
 
 
 @functools.lru_cache(maxsize=None)
-def rhs_jacobian():
+def rhs_jacobian(robot=R.PAPER):
     """∂f/∂d (5×NE): f along x ⊕ d, at d = 0."""
-    f = D.rhs()
+    f = D.rhs(robot)
     return sp.Matrix.hstack(*[_column(f, block, k) for block, k in error_columns()])
 
 
 @functools.lru_cache(maxsize=None)
-def rhs_input_jacobian():
+def rhs_input_jacobian(robot=R.PAPER):
     """∂f/∂u (5×2): the motor torques enter the joint equations (eqs. 78, 84)."""
-    return D.rhs().jacobian(S.u)
+    return D.rhs(robot).jacobian(S.u)
 
 
 @functools.lru_cache(maxsize=None)
-def inertia_derivatives():
+def inertia_derivatives(robot=R.PAPER):
     """∂M/∂d along the five configuration coordinates δξ_S (3), δθ_Y, δθ_P: five 5×5 matrices
     (M depends on γ, R_Y, R_P only: its derivatives along q and ν are zero)."""
-    M = D.inertia()
+    M = D.inertia(robot)
     return tuple(M.applyfunc(lambda e: S.directional_derivative(e, rates)) for rates in configuration_directions())
 
 

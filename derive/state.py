@@ -51,12 +51,15 @@ Sigma_C = hat([0, 0, 1])
 
 # γ = R_Sᵀ e_z is the third row of R_S.
 gamma = sp.Matrix(sp.symbols("gamma_x gamma_y gamma_z", real=True))
+# χ = R_Sᵀ e_x, the first row of R_S: the up-slope direction in the shell frame.  On a slope
+# gravity has a component along e_x, so the potential depends on χ as well as γ (issue 18).
+chi = sp.Matrix(sp.symbols("chi_x chi_y chi_z", real=True))
 # Entries of R_Y (rotation about x) and R_P (rotation about y).
 RY_c, RY_s = sp.symbols("RY_11 RY_21", real=True)
 RP_c, RP_s = sp.symbols("RP_00 RP_02", real=True)
 R_Y = sp.Matrix([[1, 0, 0], [0, RY_c, -RY_s], [0, RY_s, RY_c]])
 R_P = sp.Matrix([[RP_c, 0, RP_s], [0, 1, 0], [-RP_s, 0, RP_c]])
-q_z = sp.Symbol("q_z", real=True)
+q_x, q_z = sp.symbols("q_x q_z", real=True)
 
 w_S = sp.Matrix(sp.symbols("w_Sx w_Sy w_Sz", real=True))
 w_Y, w_P = sp.symbols("w_Y w_P", real=True)
@@ -72,22 +75,23 @@ u = sp.Matrix([u_Y, u_P])
 v = sp.Matrix(sp.symbols("v_x v_y v_z", real=True))  # v = R_Sᵀ q̇ (Section 2.6)
 
 #: The configuration symbols that the reduced dynamics depends on.
-CONFIGURATION = (gamma[0], gamma[1], gamma[2], RY_c, RY_s, RP_c, RP_s)
+CONFIGURATION = (gamma[0], gamma[1], gamma[2], RY_c, RY_s, RP_c, RP_s, chi[0], chi[1], chi[2])
 
 #: Where each symbol lives in x (or u); the code generator reads this table.
 STATE_LAYOUT = {
     gamma[0]: OFFSET_RS + 6, gamma[1]: OFFSET_RS + 7, gamma[2]: OFFSET_RS + 8,
     RY_c: OFFSET_RY + 4, RY_s: OFFSET_RY + 7,
     RP_c: OFFSET_RP + 0, RP_s: OFFSET_RP + 2,
-    q_z: OFFSET_Q + 2,
+    chi[0]: OFFSET_RS + 0, chi[1]: OFFSET_RS + 1, chi[2]: OFFSET_RS + 2,
+    q_x: OFFSET_Q, q_z: OFFSET_Q + 2,
     w_S[0]: OFFSET_W, w_S[1]: OFFSET_W + 1, w_S[2]: OFFSET_W + 2,
     w_Y: OFFSET_W + 3, w_P: OFFSET_W + 4,
 }
 INPUT_LAYOUT = {u_Y: 0, u_P: 1}
 
 
-def configuration_rates(dR_Y, dR_P, dgamma):
-    """Rates of the configuration symbols given matrix rates Ṙ_Y, Ṙ_P, γ̇.
+def configuration_rates(dR_Y, dR_P, dgamma, dchi=None):
+    """Rates of the configuration symbols given matrix rates Ṙ_Y, Ṙ_P, γ̇ (and χ̇, zero if None).
 
     The entries are read off the matrix rates at the positions the symbols
     occupy, so any tangent vector (a time derivative or a virtual
@@ -97,12 +101,14 @@ def configuration_rates(dR_Y, dR_P, dgamma):
         gamma[0]: dgamma[0], gamma[1]: dgamma[1], gamma[2]: dgamma[2],
         RY_c: dR_Y[1, 1], RY_s: dR_Y[2, 1],
         RP_c: dR_P[0, 0], RP_s: dR_P[0, 2],
+        **{c: (0 if dchi is None else dchi[i]) for i, c in enumerate(chi)},
     }
 
 
 def time_rates():
-    """Reconstruction and advection equations: Ṙ_Y = R_Y Ω_Y, Ṙ_P = R_P Ω_P, γ̇ = -Ω_S γ (eqs. 39, 85)."""
-    return configuration_rates(R_Y * Omega_Y, R_P * Omega_P, -Omega_S * gamma)
+    """Reconstruction and advection equations: Ṙ_Y = R_Y Ω_Y, Ṙ_P = R_P Ω_P, γ̇ = -Ω_S γ (eqs. 39, 85),
+    and χ̇ = -Ω_S χ (χ is advected like γ)."""
+    return configuration_rates(R_Y * Omega_Y, R_P * Omega_P, -Omega_S * gamma, -Omega_S * chi)
 
 
 def directional_derivative(expr, rates):

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources c3fc8b42fe5ac388], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 0b95be48c3edc4ad], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -12,9 +12,12 @@
 /* sr_real, SR_C, SR_GEN_PIVOT_TOL and the SR_GEN_ status codes: hand-written, in c/. */
 #include "sr_real.h"
 
-#define SR_GEN_NPARAM 12
+#define SR_GEN_NPARAM 32
+#define SR_GEN_NPAPER 12
 #define SR_GEN_NCONST 40
 #define SR_GEN_NCONST_NAMED 12
+#define SR_GEN_GENERAL_NCONST 98
+#define SR_GEN_GENERAL_NCONST_NAMED 31
 #define SR_GEN_NX 35
 #define SR_GEN_NU 2
 #define SR_GEN_NV 5
@@ -37,28 +40,69 @@
 #define SR_E_th_P 4
 #define SR_E_q 5
 #define SR_E_nu 7
-/* Layout of p[SR_GEN_NPARAM], the parameters of derive/parameters.py (SI). */
+/* Layout of p[SR_GEN_NPARAM], the parameters of the general robot, derive/parameters.py (SI). */
 #define SR_P_r 0
 #define SR_P_m_S 1
-#define SR_P_k_S 2
-#define SR_P_b 3
-#define SR_P_h 4
-#define SR_P_m_b 5
-#define SR_P_m_h 6
-#define SR_P_k_Y 7
-#define SR_P_l 8
-#define SR_P_m_P 9
-#define SR_P_k_P 10
-#define SR_P_g 11
+#define SR_P_j_S 2
+#define SR_P_k_S 3
+#define SR_P_m_Y 4
+#define SR_P_c_Y_x 5
+#define SR_P_c_Y_y 6
+#define SR_P_c_Y_z 7
+#define SR_P_J_Y_xx 8
+#define SR_P_J_Y_yy 9
+#define SR_P_J_Y_zz 10
+#define SR_P_J_Y_xy 11
+#define SR_P_J_Y_xz 12
+#define SR_P_J_Y_yz 13
+#define SR_P_k_Y 14
+#define SR_P_m_P 15
+#define SR_P_c_P_x 16
+#define SR_P_c_P_y 17
+#define SR_P_c_P_z 18
+#define SR_P_J_P_xx 19
+#define SR_P_J_P_yy 20
+#define SR_P_J_P_zz 21
+#define SR_P_J_P_xy 22
+#define SR_P_J_P_xz 23
+#define SR_P_J_P_yz 24
+#define SR_P_k_P 25
+#define SR_P_j_mY 26
+#define SR_P_n_Y 27
+#define SR_P_j_mP 28
+#define SR_P_n_P 29
+#define SR_P_g 30
+#define SR_P_slope 31
+/* Layout of pp[SR_GEN_NPAPER], the paper's parameters (Section 5.2, SI), for sr_gen_paper_params. */
+#define SR_PAPER_r 0
+#define SR_PAPER_m_S 1
+#define SR_PAPER_k_S 2
+#define SR_PAPER_b 3
+#define SR_PAPER_h 4
+#define SR_PAPER_m_b 5
+#define SR_PAPER_m_h 6
+#define SR_PAPER_k_Y 7
+#define SR_PAPER_l 8
+#define SR_PAPER_m_P 9
+#define SR_PAPER_k_P 10
+#define SR_PAPER_g 11
 
 /* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
-#define SR_GEN_CONSTANTS_FLOPS 69
+#define SR_GEN_CONSTANTS_FLOPS 50
 #define SR_GEN_INERTIA_FLOPS 107
 #define SR_GEN_RHS_FLOPS 168
 #define SR_GEN_ENERGY_FLOPS 136
 #define SR_GEN_EQUILIBRIUM_RESIDUAL_FLOPS 23
 #define SR_GEN_ACCEL_FLOPS 261
 #define SR_GEN_ACCEL_JACOBIAN_TERMS_FLOPS 1779
+#define SR_GEN_PAPER_PARAMS_FLOPS 52
+#define SR_GEN_GENERAL_CONSTANTS_FLOPS 319
+#define SR_GEN_GENERAL_INERTIA_FLOPS 219
+#define SR_GEN_GENERAL_RHS_FLOPS 1028
+#define SR_GEN_GENERAL_SYSTEM_FLOPS 1139
+#define SR_GEN_GENERAL_ENERGY_FLOPS 336
+#define SR_GEN_GENERAL_EQUILIBRIUM_RESIDUAL_FLOPS 126
+#define SR_GEN_GENERAL_ACCEL_JACOBIAN_TERMS_FLOPS 4398
 
 /* The float build's symbols carry _f, so a float/double mismatch fails at link time. */
 #ifdef SR_USE_FLOAT
@@ -69,6 +113,14 @@
 #define sr_gen_equilibrium_residual sr_gen_equilibrium_residual_f
 #define sr_gen_accel sr_gen_accel_f
 #define sr_gen_accel_jacobian_terms sr_gen_accel_jacobian_terms_f
+#define sr_gen_paper_params sr_gen_paper_params_f
+#define sr_gen_general_constants sr_gen_general_constants_f
+#define sr_gen_general_inertia sr_gen_general_inertia_f
+#define sr_gen_general_rhs sr_gen_general_rhs_f
+#define sr_gen_general_system sr_gen_general_system_f
+#define sr_gen_general_energy sr_gen_general_energy_f
+#define sr_gen_general_equilibrium_residual sr_gen_general_equilibrium_residual_f
+#define sr_gen_general_accel_jacobian_terms sr_gen_general_accel_jacobian_terms_f
 #endif
 
 /* Derived constants of Section 2.3 from the twelve parameters, c[0..11] = (r, l, g, m_P, m_R, j_S, j_xx, j_yy, j_P, k_S, k_Y, k_P), then the parameter-only subexpressions of the kernels, computed once per model:
@@ -113,5 +165,88 @@ int sr_gen_equilibrium_residual(const sr_real c[SR_GEN_NCONST], const sr_real x[
 int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real a[SR_GEN_NV]);
 /* M (upper triangle, row by row), f, ∂f/∂d (5 x SR_GEN_NE, row-major, error coordinates of SR_E_*), ∂f/∂u (5 x 2) and ∂M/∂d along δξ_S, δθ_Y, δθ_P (5 upper triangles) for the accel Jacobian ∂ν̇ = M⁻¹(∂f − (∂M) ν̇). */
 int sr_gen_accel_jacobian_terms(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real M[15], sr_real f[5], sr_real df[60], sr_real dfdu[10], sr_real dM[75]);
+/* The paper's robot (Section 2.3) as a general one: p[SR_P_*] from the paper's twelve parameters (derive.parameters.from_paper). */
+int sr_gen_paper_params(const sr_real pp[SR_GEN_NPAPER], sr_real p[SR_GEN_NPARAM]);
+/* Constants of the general kernels from the parameters, cg[0..] = (r, m_R, m_P, j_S, k_S, k_Y, k_P, h_Y_x, h_Y_y, h_Y_z, h_P_x, h_P_y, h_P_z, Jh_Y_xx, Jh_Y_yy, Jh_Y_zz, Jh_Y_xy, Jh_Y_xz, Jh_Y_yz, Jh_P_xx, Jh_P_yy, Jh_P_zz, Jh_P_xy, Jh_P_xz, Jh_P_yz, j_mY, n_Y, j_mP, n_P, g_x, g_z), then the parameter-only subexpressions of the kernels:
+ *   cg[31] kg_0 = Jh_P_xx - Jh_P_zz
+ *   cg[32] kg_1 = 2*h_P_y*r + 2*h_Y_y*r
+ *   cg[33] kg_2 = m_R*r**2
+ *   cg[34] kg_3 = 2*Jh_P_xz
+ *   cg[35] kg_4 = 2*h_Y_z*r
+ *   cg[36] kg_5 = 2*h_P_z*r
+ *   cg[37] kg_6 = 2*h_P_x*r
+ *   cg[38] kg_7 = Jh_P_yy + Jh_P_zz + Jh_Y_yy + Jh_Y_zz + j_S + j_mY
+ *   cg[39] kg_8 = Jh_P_xz + Jh_Y_xz
+ *   cg[40] kg_9 = h_P_y*r + h_Y_y*r
+ *   cg[41] kg_10 = h_Y_x*r
+ *   cg[42] kg_11 = h_Y_z*r
+ *   cg[43] kg_12 = h_P_x*r
+ *   cg[44] kg_13 = h_P_z*r
+ *   cg[45] kg_14 = Jh_P_yy + Jh_P_zz + Jh_Y_yy + Jh_Y_zz + j_mY*n_Y
+ *   cg[46] kg_15 = -Jh_P_yy + Jh_P_zz - Jh_Y_yy + Jh_Y_zz + j_mP
+ *   cg[47] kg_16 = 2*Jh_Y_yz
+ *   cg[48] kg_17 = 2*h_Y_x*r
+ *   cg[49] kg_18 = 2*Jh_P_xy
+ *   cg[50] kg_19 = 2*Jh_P_yz
+ *   cg[51] kg_20 = Jh_P_xx + Jh_P_zz + Jh_Y_xx + Jh_Y_zz + j_S + j_mP + m_R*r**2
+ *   cg[52] kg_21 = Jh_P_xx + Jh_P_zz + j_mP*n_P
+ *   cg[53] kg_22 = Jh_P_xx + Jh_P_yy + Jh_Y_xx + Jh_Y_yy + j_S + m_R*r**2
+ *   cg[54] kg_23 = Jh_P_yy + Jh_P_zz + Jh_Y_yy + Jh_Y_zz + j_mY*n_Y**2
+ *   cg[55] kg_24 = Jh_P_xx + Jh_P_zz + j_mP*n_P**2
+ *   cg[56] kg_25 = g_x*h_P_y + g_x*h_Y_y
+ *   cg[57] kg_26 = g_z*h_P_y + g_z*h_Y_y
+ *   cg[58] kg_27 = g_x*h_Y_z
+ *   cg[59] kg_28 = g_z*h_Y_z
+ *   cg[60] kg_29 = 2*Jh_P_zz + j_mP*n_P
+ *   cg[61] kg_30 = -2*Jh_P_yy + 2*Jh_P_zz - 2*Jh_Y_yy + 2*Jh_Y_zz + 2*j_mP
+ *   cg[62] kg_31 = 4*Jh_P_xz
+ *   cg[63] kg_32 = 2*Jh_P_xx - 2*Jh_P_zz
+ *   cg[64] kg_33 = g_x*h_P_z
+ *   cg[65] kg_34 = g_z*h_P_z
+ *   cg[66] kg_35 = g_x*m_R*r
+ *   cg[67] kg_36 = g_x*h_P_x
+ *   cg[68] kg_37 = g_z*h_P_x
+ *   cg[69] kg_38 = 4*Jh_Y_yz
+ *   cg[70] kg_39 = 4*Jh_P_xy
+ *   cg[71] kg_40 = 4*Jh_P_yz
+ *   cg[72] kg_41 = g_x*h_Y_x
+ *   cg[73] kg_42 = g_z*h_Y_x
+ *   cg[74] kg_43 = -Jh_P_xx + Jh_P_zz - Jh_Y_xx + Jh_Y_zz + j_mY
+ *   cg[75] kg_44 = 2*Jh_P_zz + 2*Jh_Y_zz + j_mP + j_mY*n_Y
+ *   cg[76] kg_45 = 2*Jh_P_xz + 2*Jh_Y_xz
+ *   cg[77] kg_46 = 2*Jh_P_xx + j_mP*n_P
+ *   cg[78] kg_47 = 2*Jh_Y_xy
+ *   cg[79] kg_48 = Jh_P_xx - Jh_P_yy + Jh_Y_xx - Jh_Y_yy + j_mP - j_mY
+ *   cg[80] kg_49 = 2*Jh_P_yy + 2*Jh_Y_yy - j_mP + j_mY*n_Y
+ *   cg[81] kg_50 = Jh_P_xx/2 + Jh_P_zz/2 + j_mP*n_P**2/2
+ *   cg[82] kg_51 = Jh_P_yy/2 + Jh_P_zz/2 + Jh_Y_yy/2 + Jh_Y_zz/2 + j_S/2 + j_mY/2
+ *   cg[83] kg_52 = Jh_P_xx/2 + Jh_P_zz/2 + Jh_Y_xx/2 + Jh_Y_zz/2 + j_S/2 + j_mP/2 + m_R*r**2/2
+ *   cg[84] kg_53 = Jh_P_xx/2 + Jh_P_yy/2 + Jh_Y_xx/2 + Jh_Y_yy/2 + j_S/2 + m_R*r**2/2
+ *   cg[85] kg_54 = Jh_P_yy/2 + Jh_P_zz/2 + Jh_Y_yy/2 + Jh_Y_zz/2 + j_mY*n_Y**2/2
+ *   cg[86] kg_55 = g_x*m_R
+ *   cg[87] kg_56 = g_z*m_P
+ *   cg[88] kg_57 = Jh_P_xx/2 - Jh_P_zz/2
+ *   cg[89] kg_58 = -Jh_P_yy/2 + Jh_P_zz/2 - Jh_Y_yy/2 + Jh_Y_zz/2 + j_mP/2
+ *   cg[90] kg_59 = m_R*r**2/2
+ *   cg[91] kg_60 = -4*Jh_P_yy + 4*Jh_P_zz - 4*Jh_Y_yy + 4*Jh_Y_zz + 4*j_mP
+ *   cg[92] kg_61 = 4*Jh_P_xx - 4*Jh_P_zz
+ *   cg[93] kg_62 = 8*Jh_P_xz
+ *   cg[94] kg_63 = 8*Jh_Y_yz
+ *   cg[95] kg_64 = 8*Jh_P_xy
+ *   cg[96] kg_65 = 8*Jh_P_yz
+ *   cg[97] kg_66 = 2*m_R*r**2 */
+int sr_gen_general_constants(const sr_real p[SR_GEN_NPARAM], sr_real cg[SR_GEN_GENERAL_NCONST]);
+/* Generalized inertia M of the general robot, row-major 5x5. */
+int sr_gen_general_inertia(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], sr_real M[25]);
+/* Right-hand side f of M ν̇ = f for the general robot. */
+int sr_gen_general_rhs(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real f[5]);
+/* M (upper triangle, row by row) and f of the general robot, for the solve of sr_accel. */
+int sr_gen_general_system(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real M[15], sr_real f[5]);
+/* Total energy of the general robot: ½νᵀMν + m_R g_x q_x + m_P g_z q_z + the shape potential [J] (derive.lagrangian.total_energy). */
+int sr_gen_general_energy(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], sr_real E[1]);
+/* f at ν = 0, u = 0 for the general robot. */
+int sr_gen_general_equilibrium_residual(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], sr_real res[5]);
+/* M (upper triangle, row by row), f, ∂f/∂d (5 x SR_GEN_NE, row-major, error coordinates of SR_E_*), ∂f/∂u (5 x 2) and ∂M/∂d along δξ_S, δθ_Y, δθ_P (5 upper triangles) for the accel Jacobian ∂ν̇ = M⁻¹(∂f − (∂M) ν̇). */
+int sr_gen_general_accel_jacobian_terms(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real M[15], sr_real f[5], sr_real df[60], sr_real dfdu[10], sr_real dM[75]);
 
 #endif /* SR_GENERATED_H */

@@ -18,7 +18,6 @@ import numpy as np
 from bindings._sr import ffi, lib
 
 from . import model as _model
-from .params import NAMES as PARAM_NAMES
 from .params import Params
 from .state import NU, NX
 from .validation import real_array
@@ -59,12 +58,13 @@ class BatchResult:
 
 
 def _params_array(params):
-    """(B, 12) or (12,) float64 from a Params, a sequence of Params, or an array by PARAM_NAMES."""
+    """(B, SR_NPARAM) or (SR_NPARAM,) float64 from a Params, a sequence of Params, or an array in
+    the C library's order (SR_P_*)."""
     if isinstance(params, Params):
         return params.as_array()
     if isinstance(params, (list, tuple)) and params and all(isinstance(p, Params) for p in params):
         return np.stack([p.as_array() for p in params])
-    return real_array(params, "params", (len(PARAM_NAMES),))
+    return real_array(params, "params", (lib.SR_NPARAM,))
 
 
 def _sample_count(arrays):

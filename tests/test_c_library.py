@@ -211,11 +211,13 @@ target_link_libraries(firmware PRIVATE sphericalrobot::sphericalrobot)
 CONSUMER_MAIN = """#include "spherical_robot.h"
 #include <stdio.h>
 int main(void) {
-    const sr_real p[SR_NPARAM] = {0.3, 2, 0.16, 0.2, 0.5, 2, 5, 0.04, 0.2, 1, 0.1, 9.81};
+    const sr_real paper[SR_NPAPER] = {0.3, 2, 0.16, 0.2, 0.5, 2, 5, 0.04, 0.2, 1, 0.1, 9.81};
     sr_real x[SR_NX] = {1,0,0, 0,1,0, 0,0,1,  1,0,0, 0,1,0, 0,0,1,  1,0,0, 0,1,0, 0,0,1,  0,0,0.3};
     const sr_real u[SR_NU] = {0.1, 0};
+    sr_real p[SR_NPARAM];
     sr_model m;
-    int status = sr_model_init(&m, p);
+    int status = sr_paper_params(paper, p);
+    if (status == SR_OK) status = sr_model_init(&m, p);
     if (status == SR_OK) status = sr_step(&m, SR_LIE_EULER, x, u, 0.01, x);
     printf("%s %d\\n", sr_status_string(status), (int)sizeof(sr_real));
     return status;
@@ -296,3 +298,45 @@ def test_a_float_double_mismatch_fails_at_link_time(build, tmp_path, app_scalar,
                "-o", str(tmp_path / "mixed")], check=False)
     assert out.returncode != 0
     assert "undefined reference" in out.stderr + out.stdout
+
+
+# ---- the paper-only build (-DSR_PAPER_ONLY) -------------------------------------------------------
+PAPER_ONLY_PROBE = """#include "spherical_robot.h"
+#include <stdio.h>
+int main(void) {
+    const sr_real paper[SR_NPAPER] = {0.3, 2, 0.16, 0.2, 0.5, 2, 5, 0.04, 0.2, 1, 0.1, 9.81};
+    sr_real p[SR_NPARAM];
+    sr_model m;
+    int paper_robot, other_robot;
+    if (sr_paper_params(paper, p) != SR_OK) return 2;
+    paper_robot = sr_model_init(&m, p);
+    p[SR_P_slope] = (sr_real)0.01;
+    other_robot = sr_model_init(&m, p);
+    printf("%d %d\\n", paper_robot, other_robot);
+    return 0;
+}
+"""
+
+
+@pytest.mark.parametrize("paper_only", [True, False], ids=["paper-only", "full"])
+def test_a_paper_only_build_refuses_other_robots_and_links_no_general_kernel(tmp_path, paper_only):
+    """-DSR_PAPER_ONLY leaves the general kernels out (firmware flash); the full build is the control."""
+    probe = tmp_path / "probe.c"
+    probe.write_text(PAPER_ONLY_PROBE)
+    sources = [str(p) for p in sorted(C_DIR.glob("sr_*.c"))] + [str(ROOT / "generated" / "sr_generated.c")]
+    flags = ["-DSR_PAPER_ONLY"] if paper_only else []
+    run([CC, "-std=c99", "-O1", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-ffunction-sections", *flags,
+         f"-I{C_DIR}", f"-I{ROOT / 'generated'}", str(probe), *sources, "-lm", "-Wl,--gc-sections",
+         "-o", str(tmp_path / "probe")])
+    out = run([tmp_path / "probe"]).stdout.split()
+    linked = {name for _, name in nm_symbols(tmp_path / "probe")}
+    general = {name for name in linked if name.startswith("sr_gen_general_")}
+    if paper_only:
+        assert out == ["0", str(run_status("SR_ERR_PARAM"))] and not general
+    else:
+        assert out == ["0", "0"] and "sr_gen_general_system" in general
+
+
+def run_status(name):
+    from bindings._sr import lib
+    return getattr(lib, name)

@@ -22,11 +22,12 @@
 #define PAINT_BYTES 8192u       /* painted below main's frame: far more than any entry point uses */
 #define PAINT_WORD 0xA5C3E10Fu
 
-/* runtime.Params.paper_simulation() (SI), each value at its index SR_P_<name>. */
-static const sr_real PARAMS[SR_NPARAM] = {
-    [SR_P_r] = SR_C(0.3),   [SR_P_m_S] = SR_C(2.0), [SR_P_k_S] = SR_C(0.16), [SR_P_b] = SR_C(0.2),
-    [SR_P_h] = SR_C(0.5),   [SR_P_m_b] = SR_C(2.0), [SR_P_m_h] = SR_C(5.0),  [SR_P_k_Y] = SR_C(0.04),
-    [SR_P_l] = SR_C(0.2),   [SR_P_m_P] = SR_C(1.0), [SR_P_k_P] = SR_C(0.10), [SR_P_g] = SR_C(9.81),
+/* runtime.Params.paper_simulation() (SI): the paper's twelve parameters, each value at its index
+ * SR_PAPER_<name>; sr_paper_params turns them into the robot's parameters (SR_P_*). */
+static const sr_real PAPER[SR_NPAPER] = {
+    [SR_PAPER_r] = SR_C(0.3), [SR_PAPER_m_S] = SR_C(2.0), [SR_PAPER_k_S] = SR_C(0.16), [SR_PAPER_b] = SR_C(0.2),
+    [SR_PAPER_h] = SR_C(0.5), [SR_PAPER_m_b] = SR_C(2.0), [SR_PAPER_m_h] = SR_C(5.0), [SR_PAPER_k_Y] = SR_C(0.04),
+    [SR_PAPER_l] = SR_C(0.2), [SR_PAPER_m_P] = SR_C(1.0), [SR_PAPER_k_P] = SR_C(0.10), [SR_PAPER_g] = SR_C(9.81),
 };
 
 static uintptr_t stack_pointer(void)
@@ -81,17 +82,18 @@ static void report(const char *name, unsigned long bytes)
 int main(void)
 {
     static sr_model model; /* static: keep main's frame small and the measured calls honest */
-    static sr_real x[SR_NX], a[SR_NV];
+    static sr_real x[SR_NX], a[SR_NV], params[SR_NPARAM];
     sr_real u[SR_NU] = {SR_C(0.1), SR_C(0.0)};
     const uintptr_t top = stack_pointer();
     int status, n, i;
 
     for (i = 0; i < 3; ++i) /* R_S = R_Y = R_P = I (row-major 3x3 blocks) */
         x[SR_X_R_S + 4 * i] = x[SR_X_R_Y + 4 * i] = x[SR_X_R_P + 4 * i] = 1;
-    x[SR_X_q + 2] = PARAMS[SR_P_r]; /* q = (0, 0, r) */
+    x[SR_X_q + 2] = PAPER[SR_PAPER_r]; /* q = (0, 0, r) */
 
     paint_stack(top);
-    status = sr_model_init(&model, PARAMS);
+    status = sr_paper_params(PAPER, params);
+    if (status == SR_OK) status = sr_model_init(&model, params);
     report("sr_model_init", stack_used(top));
 
     paint_stack(top);

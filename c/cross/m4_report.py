@@ -74,12 +74,19 @@ def per_function(tools, build):
         lines.append(f"| `{title[:-2]}` | {o2['own']} / {o2['total']} | {os_['own']} / {os_['total']} "
                      f"| {o2['frame']} / {o2['worst']} | {os_['frame']} / {os_['worst']} "
                      f"| {', '.join(e.removesuffix('_f') if e.startswith('sr_') else e for e in ext) or '-'} |")
-    # accel + a Lie-Euler step: the union of what the two reach, each function once.
+    # accel + a Lie-Euler step: the union of what the two reach, each function once; and the same
+    # for the library built with -DSR_PAPER_ONLY (no general kernels: a paper-geometry firmware).
     union = {}
     for opt, lib in libs.items():
         step = lie_euler_step(lib)
         seen = lib.reachable(ACCEL_ENTRY)[0] | lib.reachable(step)[0]
-        union[opt] = (sum(lib.size(t) for t in seen), lib.worst_stack(step), step)
+        out = build / f"objs{opt}-paper-only"
+        out.mkdir(parents=True, exist_ok=True)
+        paper = size_report.Library(size_report.compile_variant(tools["cc"], [*CPU_FLAGS, "-DSR_PAPER_ONLY"], opt,
+                                                                True, out), tools["nm"])
+        paper_seen = paper.reachable(ACCEL_ENTRY)[0] | paper.reachable(step)[0]
+        union[opt] = (sum(lib.size(t) for t in seen), lib.worst_stack(step), step,
+                      sum(paper.size(t) for t in paper_seen))
     return lines, union
 
 
@@ -183,7 +190,7 @@ def report(tools, build):
            "it reaches (what `--gc-sections` keeps if only that function is called; libm not "
            "included); stack in bytes, own frame / worst case through its callees (libm counted 0). "
            "No function has static RAM: its RAM is its stack plus the caller's `sr_model` "
-           "(24 floats, 96 bytes) and arrays (a state is 35 floats, 140 bytes).", "", *lines_fn, ""]
+           "(170 floats and an int, 684 bytes) and arrays (a state is 35 floats, 140 bytes).", "", *lines_fn, ""]
     origins = ["library", "libm", "libgcc", "newlib + semihosting", "start-up + main"]
     out += ["**A Lie–Euler-only firmware** (`c/cross/lie_euler_firmware.c`: `sr_model_init`, "
             "`sr_check_state`, then `sr_accel` and a Lie–Euler step per tick; linked with "
@@ -204,6 +211,12 @@ def report(tools, build):
             f"libm's single-precision functions as linked in this image ({libm['-O2']} bytes: `sinf` and "
             f"`cosf` carry their argument reduction and its 2/π table) {union['-O2'][0] + libm['-O2']} "
             f"and {union['-Os'][0] + libm['-Os']}: {verdict['-O2']} at -O2, {verdict['-Os']} at -Os.  "
+            "The library built with `-DSR_PAPER_ONLY` (the paper-geometry kernels only, for a robot of "
+            "the paper's geometry; docs/robots.md) reaches "
+            f"{union['-O2'][3]} bytes at -O2 and {union['-Os'][3]} at -Os, with libm "
+            f"{union['-O2'][3] + libm['-O2']} and {union['-Os'][3] + libm['-Os']}: "
+            f"{'met' if union['-O2'][3] + libm['-O2'] <= FLASH_TARGET else 'missed'} at -O2, "
+            f"{'met' if union['-Os'][3] + libm['-Os'] <= FLASH_TARGET else 'missed'} at -Os.  "
             "No software double routine (`__aeabi_d*`) is linked (checked).", ""]
     out += ["**Stack measured under QEMU** (mps2-an386; the free stack painted, one call made, the "
             "deepest changed word found; libm included, resolution 4 bytes, at least 64):", "",

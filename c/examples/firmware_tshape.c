@@ -49,11 +49,12 @@ static const torque_window TSHAPE_PROGRAM[] = {
 };
 #define N_WINDOWS (sizeof TSHAPE_PROGRAM / sizeof TSHAPE_PROGRAM[0])
 
-/* runtime.Params.paper_simulation() (SI), each value at its index SR_P_<name>. */
-static const sr_real PARAMS[SR_NPARAM] = {
-    [SR_P_r] = SR_C(0.3),   [SR_P_m_S] = SR_C(2.0), [SR_P_k_S] = SR_C(0.16), [SR_P_b] = SR_C(0.2),
-    [SR_P_h] = SR_C(0.5),   [SR_P_m_b] = SR_C(2.0), [SR_P_m_h] = SR_C(5.0),  [SR_P_k_Y] = SR_C(0.04),
-    [SR_P_l] = SR_C(0.2),   [SR_P_m_P] = SR_C(1.0), [SR_P_k_P] = SR_C(0.10), [SR_P_g] = SR_C(9.81),
+/* runtime.Params.paper_simulation() (SI): the paper's twelve parameters, each value at its index
+ * SR_PAPER_<name>; sr_paper_params turns them into the robot's parameters (SR_P_*). */
+static const sr_real PAPER[SR_NPAPER] = {
+    [SR_PAPER_r] = SR_C(0.3), [SR_PAPER_m_S] = SR_C(2.0), [SR_PAPER_k_S] = SR_C(0.16), [SR_PAPER_b] = SR_C(0.2),
+    [SR_PAPER_h] = SR_C(0.5), [SR_PAPER_m_b] = SR_C(2.0), [SR_PAPER_m_h] = SR_C(5.0), [SR_PAPER_k_Y] = SR_C(0.04),
+    [SR_PAPER_l] = SR_C(0.2), [SR_PAPER_m_P] = SR_C(1.0), [SR_PAPER_k_P] = SR_C(0.10), [SR_PAPER_g] = SR_C(9.81),
 };
 
 /* The motor torques held during step n (1-based). */
@@ -92,15 +93,16 @@ static void print_row(double t, const sr_real x[SR_NX])
 int main(void)
 {
     sr_model model;
-    sr_real x[SR_NX] = {0}, u[SR_NU];
+    sr_real x[SR_NX] = {0}, u[SR_NU], params[SR_NPARAM];
     long n;
     int status;
 
     /* Initial state: at rest, all rotations identity, centre at q = (0, 0, r). */
     for (n = 0; n < 3; ++n) x[SR_X_R_S + 4 * n] = x[SR_X_R_Y + 4 * n] = x[SR_X_R_P + 4 * n] = 1;
-    x[SR_X_q + 2] = PARAMS[SR_P_r];
+    x[SR_X_q + 2] = PAPER[SR_PAPER_r];
 
-    status = sr_model_init(&model, PARAMS);
+    status = sr_paper_params(PAPER, params);
+    if (status == SR_OK) status = sr_model_init(&model, params);
     if (status == SR_OK) status = sr_check_state(&model, x);
     if (status != SR_OK) {
         fprintf(stderr, "firmware_tshape: setup failed: %s\n", sr_status_string(status));

@@ -145,8 +145,16 @@ static void expect_status(const char *fn, int status, const int *allowed, int n)
 /* ---- the fuzzed inputs --------------------------------------------------------------------- */
 static void read_params(reader *r, sr_real p[SR_NPARAM])
 {
-    /* r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g: Section 5.2 with doubled damping */
-    static const double base[SR_NPARAM] = {0.3, 2.0, 0.16, 0.2, 0.5, 2.0, 5.0, 0.04, 0.2, 1.0, 0.10, 9.81};
+    /* A general robot near Section 5.2's (doubled damping), every field nonzero somewhere. */
+    static const double base[SR_NPARAM] = {
+        [SR_P_r] = 0.3, [SR_P_m_S] = 2.0, [SR_P_j_S] = 0.12, [SR_P_k_S] = 0.16, [SR_P_m_Y] = 14.0,
+        [SR_P_c_Y_x] = 0.01, [SR_P_c_Y_y] = -0.02, [SR_P_c_Y_z] = 0.03, [SR_P_J_Y_xx] = 0.2,
+        [SR_P_J_Y_yy] = 0.5, [SR_P_J_Y_zz] = 0.6, [SR_P_J_Y_xy] = 0.01, [SR_P_J_Y_xz] = 0.02,
+        [SR_P_J_Y_yz] = -0.03, [SR_P_k_Y] = 0.04, [SR_P_m_P] = 1.0, [SR_P_c_P_x] = 0.02, [SR_P_c_P_y] = 0.01,
+        [SR_P_c_P_z] = -0.1, [SR_P_J_P_xx] = 0.004, [SR_P_J_P_yy] = 0.0035, [SR_P_J_P_zz] = 0.0015,
+        [SR_P_J_P_xy] = 0.0005, [SR_P_J_P_xz] = 0.0002, [SR_P_J_P_yz] = 0.0001, [SR_P_k_P] = 0.1,
+        [SR_P_j_mY] = 0.01, [SR_P_n_Y] = 20.0, [SR_P_j_mP] = 0.005, [SR_P_n_P] = -15.0, [SR_P_g] = 9.81,
+        [SR_P_slope] = 0.1};
     int i;
     for (i = 0; i < SR_NPARAM; ++i) p[i] = pick(r, base[i]);
 }
@@ -211,15 +219,19 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         const unsigned char *b = (const unsigned char *)&model;
         for (i = 0; i < (int)sizeof model; ++i)
             if (b[i] != CANARY) fail("sr_model_init", status, "wrote the model on error");
-        static const double paper[SR_NPARAM] = {[SR_P_r] = 0.3, [SR_P_m_S] = 2, [SR_P_k_S] = 0.16, [SR_P_b] = 0.2,
-                                                [SR_P_h] = 0.5, [SR_P_m_b] = 2, [SR_P_m_h] = 5, [SR_P_k_Y] = 0.04,
-                                                [SR_P_l] = 0.2, [SR_P_m_P] = 1, [SR_P_k_P] = 0.1, [SR_P_g] = 9.81};
-        for (i = 0; i < SR_NPARAM; ++i) p[i] = (sr_real)paper[i];
-        if (sr_model_init(&fallback, p) != SR_OK) abort();
+        static const double paper[SR_NPAPER] = {
+            [SR_PAPER_r] = 0.3, [SR_PAPER_m_S] = 2, [SR_PAPER_k_S] = 0.16, [SR_PAPER_b] = 0.2,
+            [SR_PAPER_h] = 0.5, [SR_PAPER_m_b] = 2, [SR_PAPER_m_h] = 5, [SR_PAPER_k_Y] = 0.04,
+            [SR_PAPER_l] = 0.2, [SR_PAPER_m_P] = 1, [SR_PAPER_k_P] = 0.1, [SR_PAPER_g] = 9.81};
+        sr_real pp[SR_NPAPER];
+        for (i = 0; i < SR_NPAPER; ++i) pp[i] = (sr_real)paper[i];
+        if (sr_paper_params(pp, p) != SR_OK || sr_model_init(&fallback, p) != SR_OK) abort();
         model = fallback; /* keep fuzzing the state paths */
     } else {
-        for (i = 0; i < SR_GEN_NCONST; ++i)
+        for (i = 0; i < SR_GEN_NCONST && !model.general; ++i)
             if (!isfinite(model.c[i])) fail("sr_model_init", status, "non-finite constant with SR_OK");
+        for (i = 0; i < SR_GEN_GENERAL_NCONST && model.general; ++i)
+            if (!isfinite(model.cg[i])) fail("sr_model_init", status, "non-finite constant with SR_OK");
     }
 
     read_state(&rd, model.p[SR_P_r], x);

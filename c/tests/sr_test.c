@@ -46,6 +46,7 @@ int main(void)
     suite_guards();
     suite_batch();
     suite_group();
+    suite_general();
     suite_jacobians();
     return sr_test_summary();
 }
@@ -61,14 +62,34 @@ double rng_uniform(test_rng *rng, double lo, double hi)
     return lo + (hi - lo) * ((double)(z >> 11) * (1.0 / 9007199254740992.0));
 }
 
+void paper_simulation_paper(sr_real pp[SR_NPAPER])
+{
+    const sr_real values[SR_NPAPER] = {
+        [SR_PAPER_r] = SR_C(0.3), [SR_PAPER_m_S] = SR_C(2.0), [SR_PAPER_k_S] = SR_C(0.16), [SR_PAPER_b] = SR_C(0.2),
+        [SR_PAPER_h] = SR_C(0.5), [SR_PAPER_m_b] = SR_C(2.0), [SR_PAPER_m_h] = SR_C(5.0), [SR_PAPER_k_Y] = SR_C(0.04),
+        [SR_PAPER_l] = SR_C(0.2), [SR_PAPER_m_P] = SR_C(1.0), [SR_PAPER_k_P] = SR_C(0.10), [SR_PAPER_g] = SR_C(9.81)};
+    int i;
+    for (i = 0; i < SR_NPAPER; ++i) pp[i] = values[i];
+}
+
 void paper_simulation_params(sr_real p[SR_NPARAM])
 {
-    const sr_real values[SR_NPARAM] = {
-        [SR_P_r] = SR_C(0.3),  [SR_P_m_S] = SR_C(2.0), [SR_P_k_S] = SR_C(0.16), [SR_P_b] = SR_C(0.2),
-        [SR_P_h] = SR_C(0.5),  [SR_P_m_b] = SR_C(2.0), [SR_P_m_h] = SR_C(5.0),  [SR_P_k_Y] = SR_C(0.04),
-        [SR_P_l] = SR_C(0.2),  [SR_P_m_P] = SR_C(1.0), [SR_P_k_P] = SR_C(0.10), [SR_P_g] = SR_C(9.81)};
-    int i;
-    for (i = 0; i < SR_NPARAM; ++i) p[i] = values[i];
+    sr_real pp[SR_NPAPER];
+    paper_simulation_paper(pp);
+    CHECK_STATUS(sr_paper_params(pp, p), SR_OK);
+}
+
+void general_robot_params(sr_real p[SR_NPARAM])
+{
+    paper_simulation_params(p);
+    p[SR_P_c_Y_x] = SR_C(0.01), p[SR_P_c_Y_y] = SR_C(-0.02), p[SR_P_c_Y_z] = SR_C(0.03);
+    p[SR_P_J_Y_xx] = SR_C(0.2), p[SR_P_J_Y_yy] = SR_C(0.5), p[SR_P_J_Y_zz] = SR_C(0.6);
+    p[SR_P_J_Y_xy] = SR_C(0.01), p[SR_P_J_Y_xz] = SR_C(0.02), p[SR_P_J_Y_yz] = SR_C(-0.03);
+    p[SR_P_c_P_x] = SR_C(0.02), p[SR_P_c_P_y] = SR_C(0.01);
+    p[SR_P_J_P_xx] = SR_C(0.004), p[SR_P_J_P_yy] = SR_C(0.0035), p[SR_P_J_P_zz] = SR_C(0.0015);
+    p[SR_P_J_P_xy] = SR_C(0.0005), p[SR_P_J_P_xz] = SR_C(0.0002), p[SR_P_J_P_yz] = SR_C(0.0001);
+    p[SR_P_j_mY] = SR_C(0.01), p[SR_P_n_Y] = SR_C(20.0), p[SR_P_j_mP] = SR_C(0.005), p[SR_P_n_P] = SR_C(-15.0);
+    p[SR_P_slope] = SR_C(0.1);
 }
 
 void paper_simulation_model(sr_model *model)

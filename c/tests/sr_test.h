@@ -68,6 +68,7 @@ void suite_precision(void);
 void suite_guards(void);
 void suite_batch(void);
 void suite_group(void);
+void suite_general(void);
 void suite_jacobians(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
@@ -78,8 +79,13 @@ typedef struct test_rng {
 } test_rng;
 double rng_uniform(test_rng *rng, double lo, double hi);
 
-/* Runtime's Params.paper_simulation(): Section 5.2 with the damping doubled. */
+/* Runtime's Params.paper_simulation(): Section 5.2 with the damping doubled, the paper's twelve
+ * parameters (SR_PAPER_*) and the general robot they describe (SR_P_*). */
+void paper_simulation_paper(sr_real pp[SR_NPAPER]);
 void paper_simulation_params(sr_real p[SR_NPARAM]);
+/* A robot of none of the paper's special geometry (off-centre masses, full tensors, geared
+ * rotors, a 0.1 rad slope), near the paper's: sr_model_init chooses the general kernels. */
+void general_robot_params(sr_real p[SR_NPARAM]);
 /* Fills *model from paper_simulation_params (checks SR_OK). */
 void paper_simulation_model(sr_model *model);
 /* R = rotation by theta about x / y / z, row-major. */

@@ -17,22 +17,27 @@
 #define TINY_LENGTH SR_C(1e-200)
 #endif
 
-static void scale_lengths(sr_real p[SR_NPARAM], sr_real s)
+/* The paper's robot with every length scaled by s (r, b, h, l), as the general parameters; the
+ * conversion itself may overflow (SR_ERR_PARAM) or underflow (inertias 0: SR_ERR_PARAM later). */
+static int scale_lengths(sr_real p[SR_NPARAM], sr_real s)
 {
-    p[SR_P_r] *= s; /* r */
-    p[SR_P_b] *= s; /* b */
-    p[SR_P_h] *= s; /* h */
-    p[SR_P_l] *= s; /* l */
+    sr_real pp[SR_NPAPER];
+    paper_simulation_paper(pp);
+    pp[SR_PAPER_r] *= s;
+    pp[SR_PAPER_b] *= s;
+    pp[SR_PAPER_h] *= s;
+    pp[SR_PAPER_l] *= s;
+    return sr_paper_params(pp, p);
 }
 
 static void test_model_init_rejects_lengths_whose_inertias_underflow(void)
 {
     sr_model m;
     sr_real p[SR_NPARAM];
-    paper_simulation_params(p);
-    scale_lengths(p, TINY_LENGTH);
+    CHECK_STATUS(scale_lengths(p, TINY_LENGTH), SR_OK);
     memset(&m, 0x5A, sizeof m);
-    CHECK_STATUS(sr_model_init(&m, p), SR_ERR_SINGULAR);
+    CHECK(p[SR_P_j_S] == 0); /* 2/3 m_S r^2 underflowed */
+    CHECK_STATUS(sr_model_init(&m, p), SR_ERR_PARAM);
     CHECK(((unsigned char *)&m)[0] == 0x5A); /* untouched */
 }
 
@@ -41,7 +46,9 @@ static void test_model_init_rejects_lengths_whose_inertias_overflow(void)
     sr_model m;
     sr_real p[SR_NPARAM];
     paper_simulation_params(p);
-    scale_lengths(p, HUGE_LENGTH);
+    CHECK_STATUS(scale_lengths(p, HUGE_LENGTH), SR_ERR_PARAM); /* the conversion's squares overflow */
+    p[SR_P_r] = HUGE_LENGTH; /* and the general robot's own check: r^2 m_R overflows in M */
+    p[SR_P_j_S] = HUGE_LENGTH;
     CHECK_STATUS(sr_model_init(&m, p), SR_ERR_PARAM);
 }
 

@@ -309,38 +309,51 @@ static void test_rolling_constraint(void)
 
 static void test_invalid_parameters(void)
 {
-    const int positive[] = {SR_P_r, SR_P_m_S, SR_P_b, SR_P_h, SR_P_m_b, SR_P_m_h, SR_P_l, SR_P_m_P};
-    const int nonnegative[] = {SR_P_k_S, SR_P_k_Y, SR_P_k_P, SR_P_g};
+    const int positive[] = {SR_P_r, SR_P_m_S, SR_P_j_S, SR_P_m_Y, SR_P_m_P};
+    const int nonnegative[] = {SR_P_k_S, SR_P_k_Y, SR_P_k_P, SR_P_j_mY, SR_P_j_mP, SR_P_g};
     sr_model m;
-    sr_real p[SR_NPARAM];
+    sr_real p[SR_NPARAM], pp[SR_NPAPER];
     int i;
     for (i = 0; i < SR_NPARAM; ++i) {
-        paper_simulation_params(p);
+        general_robot_params(p);
         p[i] = (sr_real)NAN;
         CHECK_STATUS(sr_model_init(&m, p), SR_ERR_NONFINITE);
         p[i] = (sr_real)INFINITY;
         CHECK_STATUS(sr_model_init(&m, p), SR_ERR_NONFINITE);
     }
     for (i = 0; i < (int)(sizeof positive / sizeof positive[0]); ++i) {
-        paper_simulation_params(p);
+        general_robot_params(p);
         p[positive[i]] = 0;
         CHECK_STATUS(sr_model_init(&m, p), SR_ERR_PARAM);
         p[positive[i]] = SR_C(-1.0);
         CHECK_STATUS(sr_model_init(&m, p), SR_ERR_PARAM);
     }
     for (i = 0; i < (int)(sizeof nonnegative / sizeof nonnegative[0]); ++i) {
-        paper_simulation_params(p);
+        general_robot_params(p);
         p[nonnegative[i]] = SR_C(-0.01);
         CHECK_STATUS(sr_model_init(&m, p), SR_ERR_PARAM);
-        p[nonnegative[i]] = 0; /* no damping, no gravity: allowed */
+        p[nonnegative[i]] = 0; /* no damping, no rotor, no gravity: allowed */
         CHECK_STATUS(sr_model_init(&m, p), SR_OK);
     }
-    paper_simulation_params(p); /* the yoke's corners stick out of the shell */
-    p[SR_P_h] = SR_C(0.6);
+    general_robot_params(p); /* a principal moment above the sum of the other two */
+    p[SR_P_J_Y_zz] = SR_C(0.7);
     CHECK_STATUS(sr_model_init(&m, p), SR_ERR_PARAM);
-    paper_simulation_params(p); /* the pendulum is longer than the radius */
-    p[SR_P_l] = SR_C(0.31);
+    general_robot_params(p); /* the pendulum's centre of mass outside the shell */
+    p[SR_P_c_P_z] = SR_C(-0.31);
     CHECK_STATUS(sr_model_init(&m, p), SR_ERR_PARAM);
+    general_robot_params(p);
+    p[SR_P_slope] = SR_C(1.6);
+    CHECK_STATUS(sr_model_init(&m, p), SR_ERR_PARAM);
+    paper_simulation_paper(pp); /* the paper's robot: the yoke's corners stick out of the shell */
+    pp[SR_PAPER_h] = SR_C(0.6);
+    CHECK_STATUS(sr_paper_params(pp, p), SR_ERR_PARAM);
+    paper_simulation_paper(pp); /* the pendulum is longer than the radius */
+    pp[SR_PAPER_l] = SR_C(0.31);
+    CHECK_STATUS(sr_paper_params(pp, p), SR_ERR_PARAM);
+    pp[SR_PAPER_l] = (sr_real)NAN;
+    CHECK_STATUS(sr_paper_params(pp, p), SR_ERR_NONFINITE);
+    CHECK_STATUS(sr_paper_params(NULL, p), SR_ERR_NULL);
+    CHECK_STATUS(sr_paper_params(pp, NULL), SR_ERR_NULL);
 }
 
 /* sr_check_params(p) must give (status, bad_index, rule); prints the case when it does not. */
@@ -353,58 +366,101 @@ static void expect_param_verdict(const sr_real p[SR_NPARAM], int status, int bad
                      got_index, got_rule, status, bad_index, rule);
 }
 
+/* The same for sr_check_paper_params. */
+static void expect_paper_verdict(const sr_real pp[SR_NPAPER], int status, int bad_index, int rule, const char *what)
+{
+    int got_index = -7, got_rule = -7;
+    const int got = sr_check_paper_params(pp, &got_index, &got_rule);
+    if (got != status || got_index != bad_index || got_rule != rule)
+        sr_test_fail(__FILE__, __LINE__, "%s: got status %d, index %d, rule %d; want %d, %d, %d", what, got,
+                     got_index, got_rule, status, bad_index, rule);
+}
+
 /* sr_check_params names the first rule broken and the parameter that breaks it, in the order
  * of spherical_robot.h, and keeps its outputs at "none" for valid parameters. */
 static void test_check_params_names_the_rule_and_the_parameter(void)
 {
-    const int positive[] = {SR_P_r, SR_P_m_S, SR_P_b, SR_P_h, SR_P_m_b, SR_P_m_h, SR_P_l, SR_P_m_P};
-    const int nonnegative[] = {SR_P_k_S, SR_P_k_Y, SR_P_k_P, SR_P_g};
+    const int positive[] = {SR_P_r, SR_P_m_S, SR_P_j_S, SR_P_m_Y, SR_P_m_P};
+    const int nonnegative[] = {SR_P_k_S, SR_P_k_Y, SR_P_k_P, SR_P_j_mY, SR_P_j_mP, SR_P_g};
+    const int nonzero[] = {SR_P_n_Y, SR_P_n_P};
     sr_real p[SR_NPARAM];
     int i, rule;
-    paper_simulation_params(p);
+    general_robot_params(p);
     expect_param_verdict(p, SR_OK, -1, SR_PARAM_RULE_NONE, "valid");
     CHECK_STATUS(sr_check_params(p, NULL, NULL), SR_OK);
     CHECK_STATUS(sr_check_params(NULL, NULL, NULL), SR_ERR_NULL);
     for (i = 0; i < SR_NPARAM; ++i) {
-        paper_simulation_params(p);
+        general_robot_params(p);
         p[i] = (sr_real)NAN;
         expect_param_verdict(p, SR_ERR_NONFINITE, i, SR_PARAM_RULE_FINITE, "NaN");
         p[SR_P_m_S] = -1; /* a later rule broken too: the first one is reported */
         if (i != SR_P_m_S) expect_param_verdict(p, SR_ERR_NONFINITE, i, SR_PARAM_RULE_FINITE, "NaN first");
     }
     for (i = 0; i < (int)(sizeof positive / sizeof positive[0]); ++i) {
-        paper_simulation_params(p);
+        general_robot_params(p);
         p[positive[i]] = 0;
         expect_param_verdict(p, SR_ERR_PARAM, positive[i], SR_PARAM_RULE_POSITIVE, "zero");
     }
     for (i = 0; i < (int)(sizeof nonnegative / sizeof nonnegative[0]); ++i) {
-        paper_simulation_params(p);
+        general_robot_params(p);
         p[nonnegative[i]] = SR_C(-0.01);
         expect_param_verdict(p, SR_ERR_PARAM, nonnegative[i], SR_PARAM_RULE_NONNEGATIVE, "negative");
     }
-    paper_simulation_params(p);
-    p[SR_P_b] = SR_C(0.4); /* half-diagonal sqrt(0.16 + 0.25)/2 = 0.32 > r = 0.3 */
-    expect_param_verdict(p, SR_ERR_PARAM, SR_P_b, SR_PARAM_RULE_YOKE_FITS, "yoke");
-    p[SR_P_b] = SR_C(0.33); /* 0.2996 <= 0.3: fits */
-    expect_param_verdict(p, SR_OK, -1, SR_PARAM_RULE_NONE, "yoke just fits");
-    paper_simulation_params(p);
-    p[SR_P_l] = SR_C(0.31);
-    expect_param_verdict(p, SR_ERR_PARAM, SR_P_l, SR_PARAM_RULE_PENDULUM_FITS, "pendulum");
-    p[SR_P_l] = p[SR_P_r]; /* touching the shell: allowed */
-    expect_param_verdict(p, SR_OK, -1, SR_PARAM_RULE_NONE, "pendulum just fits");
+    for (i = 0; i < (int)(sizeof nonzero / sizeof nonzero[0]); ++i) {
+        general_robot_params(p);
+        p[nonzero[i]] = 0;
+        expect_param_verdict(p, SR_ERR_PARAM, nonzero[i], SR_PARAM_RULE_NONZERO, "gear ratio zero");
+    }
+    general_robot_params(p);
+    p[SR_P_J_P_zz] = SR_C(0.008); /* 0.008 > 0.004 + 0.0035 */
+    expect_param_verdict(p, SR_ERR_PARAM, SR_P_J_P_xx, SR_PARAM_RULE_INERTIA, "triangle inequality");
+    p[SR_P_J_P_zz] = SR_C(0.0074); /* 0.0074 < 0.0075 */
+    expect_param_verdict(p, SR_OK, -1, SR_PARAM_RULE_NONE, "triangle inequality kept");
+    general_robot_params(p);
+    p[SR_P_J_Y_xy] = SR_C(0.3); /* diagonal fine, not positive semidefinite */
+    expect_param_verdict(p, SR_ERR_PARAM, SR_P_J_Y_xx, SR_PARAM_RULE_INERTIA, "indefinite tensor");
+    general_robot_params(p);
+    p[SR_P_c_Y_x] = SR_C(0.3);
+    expect_param_verdict(p, SR_ERR_PARAM, SR_P_c_Y_x, SR_PARAM_RULE_INSIDE, "yoke's centre on the shell");
+    general_robot_params(p);
+    p[SR_P_slope] = SR_C(-1.5708);
+    expect_param_verdict(p, SR_ERR_PARAM, SR_P_slope, SR_PARAM_RULE_SLOPE, "slope");
+    p[SR_P_slope] = SR_C(-1.5707);
+    expect_param_verdict(p, SR_OK, -1, SR_PARAM_RULE_NONE, "steep slope");
+    /* The paper's twelve: their own rules. */
+    {
+        const int paper_positive[] = {SR_PAPER_r, SR_PAPER_m_S, SR_PAPER_b, SR_PAPER_h, SR_PAPER_m_b,
+                                      SR_PAPER_m_h, SR_PAPER_l, SR_PAPER_m_P};
+        sr_real pp[SR_NPAPER];
+        for (i = 0; i < (int)(sizeof paper_positive / sizeof paper_positive[0]); ++i) {
+            paper_simulation_paper(pp);
+            pp[paper_positive[i]] = 0;
+            expect_paper_verdict(pp, SR_ERR_PARAM, paper_positive[i], SR_PARAM_RULE_POSITIVE, "paper zero");
+        }
+        paper_simulation_paper(pp);
+        pp[SR_PAPER_b] = SR_C(0.4); /* half-diagonal sqrt(0.16 + 0.25)/2 = 0.32 > r = 0.3 */
+        expect_paper_verdict(pp, SR_ERR_PARAM, SR_PAPER_b, SR_PARAM_RULE_YOKE_FITS, "yoke");
+        pp[SR_PAPER_b] = SR_C(0.33); /* 0.2996 <= 0.3: fits */
+        expect_paper_verdict(pp, SR_OK, -1, SR_PARAM_RULE_NONE, "yoke just fits");
+        paper_simulation_paper(pp);
+        pp[SR_PAPER_l] = SR_C(0.31);
+        expect_paper_verdict(pp, SR_ERR_PARAM, SR_PAPER_l, SR_PARAM_RULE_PENDULUM_FITS, "pendulum");
+        pp[SR_PAPER_l] = pp[SR_PAPER_r]; /* touching the shell: allowed */
+        expect_paper_verdict(pp, SR_OK, -1, SR_PARAM_RULE_NONE, "pendulum just fits");
+    }
     /* Every rule has its own text. */
-    for (rule = SR_PARAM_RULE_NONE; rule <= SR_PARAM_RULE_PENDULUM_FITS; ++rule) {
+    for (rule = SR_PARAM_RULE_NONE; rule <= SR_PARAM_RULE_SLOPE; ++rule) {
         int other;
         CHECK(strcmp(sr_param_rule_string(rule), "unknown rule") != 0);
         for (other = SR_PARAM_RULE_NONE; other < rule; ++other)
             CHECK(strcmp(sr_param_rule_string(rule), sr_param_rule_string(other)) != 0);
     }
-    CHECK(strcmp(sr_param_rule_string(SR_PARAM_RULE_PENDULUM_FITS + 1), "unknown rule") == 0);
+    CHECK(strcmp(sr_param_rule_string(SR_PARAM_RULE_SLOPE + 1), "unknown rule") == 0);
 }
 
-/* Parameters that pass the range checks but make M singular: a shell so small that
- * every inertia underflows to zero.  sr_model_init evaluates M at its reference state
- * and reports SR_ERR_SINGULAR (the kernels keep their own pivot check). */
+/* Parameters that pass the range checks but whose evaluation underflows: a robot so small that
+ * the paper's conversion gives j_S = 0 (rejected by the positivity rule, SR_ERR_PARAM).  The
+ * kernels keep their own pivot check (SR_ERR_SINGULAR). */
 static void test_singular_inertia(void)
 {
 #ifdef SR_USE_FLOAT
@@ -413,10 +469,11 @@ static void test_singular_inertia(void)
     const sr_real tiny = SR_C(1e-200); /* tiny^2 underflows in double */
 #endif
     sr_model m;
-    sr_real p[SR_NPARAM];
-    paper_simulation_params(p);
-    p[SR_P_r] = p[SR_P_b] = p[SR_P_h] = p[SR_P_l] = tiny; /* r, b, h, l */
-    CHECK_STATUS(sr_model_init(&m, p), SR_ERR_SINGULAR);
+    sr_real p[SR_NPARAM], pp[SR_NPAPER];
+    paper_simulation_paper(pp);
+    pp[SR_PAPER_r] = pp[SR_PAPER_b] = pp[SR_PAPER_h] = pp[SR_PAPER_l] = tiny; /* r, b, h, l */
+    CHECK_STATUS(sr_paper_params(pp, p), SR_OK);
+    CHECK_STATUS(sr_model_init(&m, p), SR_ERR_PARAM);
 }
 
 static void test_bad_time_step(void)

@@ -50,14 +50,16 @@ static void rotation(const double w[3], sr_real R[9])
 
 int main(int argc, char **argv)
 {
-    static const sr_real params[SR_NPARAM] = {
+    static const sr_real paper[SR_NPAPER] = { /* the paper's twelve, in SR_PAPER_* order */
         SR_C(0.3), SR_C(2.0), SR_C(0.16), SR_C(0.2), SR_C(0.5), SR_C(2.0),
         SR_C(5.0), SR_C(0.04), SR_C(0.2), SR_C(1.0), SR_C(0.10), SR_C(9.81),
     };
+    sr_real params[SR_NPARAM];
     unsigned long long seed = 20241122ULL;
     long n = argc > 1 ? strtol(argv[1], NULL, 10) : 1000, k;
     sr_model model;
-    int status = sr_model_init(&model, params);
+    int status = sr_paper_params(paper, params);
+    if (status == SR_OK) status = sr_model_init(&model, params);
     if (status != SR_OK || n < 0) {
         fprintf(stderr, "usage: accel_dump [N >= 0] (%s)\n", sr_status_string(status));
         return 2;

@@ -74,7 +74,9 @@ class Scheduler:
     dependent operations.  `ready` maps each local already assigned to the
     modelled cycle at which its value is available; inputs are ready at 0.
     """
-    ADD, MUL, DIV = 3, 3, 13
+    ADD, MUL, DIV, CALL = 3, 3, 13, 40
+    #: Functions of one argument that a kernel may call (the sine and cosine of the slope, per model).
+    FUNCTIONS = {sp.sin: "SR_GEN_SIN", sp.cos: "SR_GEN_COS"}
 
     def __init__(self, printer):
         self.printer = printer
@@ -94,6 +96,9 @@ class Scheduler:
             return expr.name, self.ready.get(expr.name, 0), False
         if expr.is_Number:
             return self.printer.doprint(abs(expr)), 0, bool(expr < 0)
+        if expr.func in self.FUNCTIONS:
+            text, time, negative = self._operand(expr.args[0])
+            return f"{self.FUNCTIONS[expr.func]}({'-' if negative else ''}{text})", time + self.CALL, False
         if expr.is_Add:
             terms = []
             for term in expr.args:
@@ -112,7 +117,7 @@ class Scheduler:
                 base, exp = factor.as_base_exp()
                 if not (exp.is_Integer and 0 < abs(exp) <= 6):
                     base, exp = factor, sp.Integer(1)
-                if exp == 1 and not (base.is_Symbol or base.is_Add or base.is_Number):
+                if exp == 1 and not (base.is_Symbol or base.is_Add or base.is_Number or base.func in self.FUNCTIONS):
                     raise ValueError(f"unsupported expression in generated code: {factor}")
                 text, time, neg = self._operand(base)
                 negative ^= neg and exp % 2 == 1

@@ -16,8 +16,9 @@ class ConstantPool:
     deterministic.
     """
 
-    def __init__(self, base):
+    def __init__(self, base, prefix="k_"):
         self.base = frozenset(base)
+        self.prefix = prefix
         self.table = {}            # expression -> symbol, in insertion order
 
     def _name(self, expr):
@@ -26,7 +27,7 @@ class ConstantPool:
         if expr.could_extract_minus_sign():
             return -self._name(-expr)
         if expr not in self.table:
-            self.table[expr] = sp.Symbol(f"k_{len(self.table)}", real=True)
+            self.table[expr] = sp.Symbol(f"{self.prefix}{len(self.table)}", real=True)
         return self.table[expr]
 
     def hoist(self, expr):
@@ -62,28 +63,44 @@ class ConstantPool:
         return tuple(self.table)
 
 
-def pool_constants(ks):
+@dataclasses.dataclass(frozen=True)
+class ConstantsArray:
+    """One per-model constants array: the input name the kernels read it by, the kernel that computes
+    it, its named constants (symbol, expression in the parameters) and the pool symbols' prefix."""
+    array: str
+    kernel: str
+    named: tuple
+    prefix: str
+
+
+PAPER_CONSTANTS = ConstantsArray("c", "constants", tuple(zip(P.CONSTANTS, P.constant_expressions())), "k_")
+
+
+def pool_constants(ks, spec=PAPER_CONSTANTS):
     """The kernels with their parameter-only subexpressions moved into the constants kernel.
 
     Returns (kernels, constants): `constants` is the layout of the constants
-    array, the twelve named constants of `parameters.CONSTANTS` first.
+    array `spec.array`, its named constants first (for the paper's kernels the
+    twelve of `parameters.CONSTANTS`).
     """
-    pool = ConstantPool(P.CONSTANTS)
+    names = tuple(symbol for symbol, _ in spec.named)
+    expressions = tuple(expr for _, expr in spec.named)
+    pool = ConstantPool(names, spec.prefix)
 
     def hoisted(kernel):
-        if "c" not in kernel.inputs:
+        if spec.array not in kernel.inputs:
             return kernel
         outputs = tuple(dataclasses.replace(o, exprs=tuple(pool.hoist(e) for e in o.exprs)) for o in kernel.outputs)
         definitions = tuple((symbol, pool.hoist(value)) for symbol, value in kernel.definitions)
         return dataclasses.replace(kernel, outputs=outputs, definitions=definitions)
 
     ks = tuple(hoisted(k) for k in ks)
-    in_parameters = dict(zip(P.CONSTANTS, P.constant_expressions()))
+    in_parameters = dict(zip(names, expressions))
     pooled = tuple(e.xreplace(in_parameters) for e in pool.expressions())
-    first = len(P.CONSTANTS)
-    listing = "".join(f"\n *   c[{first + i}] {k} = {sp.sstr(e)}"
+    first = len(names)
+    listing = "".join(f"\n *   {spec.array}[{first + i}] {k} = {sp.sstr(e)}"
                       for i, (k, e) in enumerate(zip(pool.symbols(), pool.expressions())))
-    constants = tuple(P.constant_expressions()) + pooled
+    constants = expressions + pooled
     ks = tuple(dataclasses.replace(k, doc=k.doc + listing, outputs=(dataclasses.replace(k.outputs[0], exprs=constants),))
-               if k.name == "constants" else k for k in ks)
-    return ks, tuple(P.CONSTANTS) + pool.symbols()
+               if k.name == spec.kernel else k for k in ks)
+    return ks, names + pool.symbols()

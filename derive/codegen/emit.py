@@ -12,7 +12,8 @@ import sympy as sp
 from .. import parameters as P
 from .. import state as S
 from .c_printer import Printer, Scheduler, count_flops, dependency_order
-from .constant_pool import pool_constants
+from .. import robot as R
+from .constant_pool import ConstantsArray, pool_constants
 from .joint_first import emit_shell_solve
 from .kernels import INPUT_DOCS, array_layouts, input_symbols, kernels
 
@@ -70,7 +71,8 @@ def signature(kernel):
     if kernel.solve:
         args.append("sr_real a[SR_GEN_NV]")
     else:
-        args += [f"sr_real {o.name}[{'SR_GEN_NCONST' if o.name == 'c' else len(o.exprs)}]" for o in kernel.outputs]
+        sizes = {"c": "SR_GEN_NCONST", "cg": "SR_GEN_GENERAL_NCONST", "p": "SR_GEN_NPARAM"}
+        args += [f"sr_real {o.name}[{sizes.get(o.name, len(o.exprs))}]" for o in kernel.outputs]
     return f"int {PREFIX}{kernel.name}({', '.join(args)})"
 
 
@@ -126,12 +128,14 @@ def layout_macros():
     assert sum(n for _, _, n in S.ERROR_BLOCKS) == S.NE
     lines += ["/* Layout of the error state d[SR_GEN_NE] (tangent coordinates of x, right-trivialised: x (+) d). */"]
     lines += [f"#define SR_E_{name} {offset}" for name, offset, _ in S.ERROR_BLOCKS]
-    lines += ["/* Layout of p[SR_GEN_NPARAM], the parameters of derive/parameters.py (SI). */"]
+    lines += ["/* Layout of p[SR_GEN_NPARAM], the parameters of the general robot, derive/parameters.py (SI). */"]
     lines += [f"#define SR_P_{s.name} {i}" for i, s in enumerate(P.PARAMETERS)]
+    lines += ["/* Layout of pp[SR_GEN_NPAPER], the paper's parameters (Section 5.2, SI), for sr_gen_paper_params. */"]
+    lines += [f"#define SR_PAPER_{s.name} {i}" for i, s in enumerate(P.PAPER_PARAMETERS)]
     return "\n".join(lines)
 
 
-def header_text(ks, flops, n_constants):
+def header_text(ks, flops, n_constants, n_general_constants):
     guard = "SR_GENERATED_H"
     protos = "\n".join(f"/* {k.doc} */\n{signature(k)};" for k in ks)
     flop_macros = "\n".join(f"#define SR_GEN_{k.name.upper()}_FLOPS {flops[k.name]}" for k in ks)
@@ -150,8 +154,11 @@ def header_text(ks, flops, n_constants):
 #include "{HAND_WRITTEN_HEADER}"
 
 #define SR_GEN_NPARAM {len(P.PARAMETERS)}
+#define SR_GEN_NPAPER {len(P.PAPER_PARAMETERS)}
 #define SR_GEN_NCONST {n_constants}
 #define SR_GEN_NCONST_NAMED {len(P.CONSTANTS)}
+#define SR_GEN_GENERAL_NCONST {n_general_constants}
+#define SR_GEN_GENERAL_NCONST_NAMED {len(R.general_constants())}
 #define SR_GEN_NX {S.NX}
 #define SR_GEN_NU {S.NU}
 #define SR_GEN_NV {S.NV}
@@ -177,15 +184,20 @@ def source_text(emitted):
     return banner() + f'#include "{HEADER_NAME}"\n\n#include <math.h>\n\n' + "\n".join(text for text, _ in emitted)
 
 
+GENERAL_CONSTANTS = ConstantsArray("cg", "general_constants", R.general_constants(), "kg_")
+
+
 def write(out_dir):
     """The one place that writes files: generated/sr_generated.{{h,c}}."""
     out_dir = pathlib.Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     ks, constants = pool_constants(kernels())
-    layouts = array_layouts(constants)
+    ks, general_constants = pool_constants(ks, GENERAL_CONSTANTS)
+    layouts = array_layouts(constants, general_constants)
     emitted = [emit_kernel(k, layouts) for k in ks]
     flops = {k.name: n for k, (_, n) in zip(ks, emitted)}
-    files = {HEADER_NAME: header_text(ks, flops, len(constants)), SOURCE_NAME: source_text(emitted)}
+    files = {HEADER_NAME: header_text(ks, flops, len(constants), len(general_constants)),
+             SOURCE_NAME: source_text(emitted)}
     files.update(casadi_files())
     for name, text in files.items():
         path = out_dir / name

@@ -14,6 +14,7 @@ from .. import derivatives as J
 from .. import dynamics as D
 from .. import newton_euler as NE
 from .. import parameters as P
+from .. import robot as R
 from .. import state as S
 from .. import yoke_frame as YF
 from .joint_first import joint_first_system
@@ -21,18 +22,23 @@ from .spec import Kernel, Output
 
 
 INPUT_DOCS = {
-    "p": ("const sr_real p[SR_GEN_NPARAM]", "parameters (r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g), SI"),
+    "pp": ("const sr_real pp[SR_GEN_NPAPER]", "the paper's parameters (r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g), SI"),
+    "p": ("const sr_real p[SR_GEN_NPARAM]", "parameters of the general robot (SR_P_*), SI"),
     "c": ("const sr_real c[SR_GEN_NCONST]", "constants from sr_gen_constants"),
+    "cg": ("const sr_real cg[SR_GEN_GENERAL_NCONST]", "constants from sr_gen_general_constants"),
     "x": ("const sr_real x[SR_GEN_NX]", "state [R_S | R_Y | R_P | q | w_S | w_Y | w_P]"),
     "u": ("const sr_real u[SR_GEN_NU]", "motor torques (yoke, pendulum) [N m]"),
 }
 
 
-def array_layouts(constants):
-    """Symbol -> index for each input array; `constants` is the full constants array (named, then pooled)."""
+def array_layouts(constants, general_constants):
+    """Symbol -> index for each input array; `constants`, `general_constants`: the full constants
+    arrays of the paper's and the general kernels (named, then pooled)."""
     return {
+        "pp": {s: i for i, s in enumerate(P.PAPER_PARAMETERS)},
         "p": {s: i for i, s in enumerate(P.PARAMETERS)},
         "c": {s: i for i, s in enumerate(constants)},
+        "cg": {s: i for i, s in enumerate(general_constants)},
         "x": S.STATE_LAYOUT,
         "u": S.INPUT_LAYOUT,
     }
@@ -70,7 +76,8 @@ def accel_program():
 
 
 def kernels():
-    """The functions to emit."""
+    """The functions to emit: the paper-geometry kernels (`c`), the conversion of the paper's
+    parameters, and the general robot's kernels (`cg`, `general_kernels`)."""
     M = D.inertia()
     rhs_definitions, f = rhs_program()
     accel_definitions, accel_outputs = accel_program()
@@ -90,23 +97,56 @@ def kernels():
         Kernel("accel", "ν̇ = (ω̇_S, ω̇_Y, ω̇_P) solving M ν̇ = f, joints first; SR_GEN_SINGULAR if M is not positive definite.",
                ("c", "x", "u"), accel_outputs, solve=True, definitions=accel_definitions),
         accel_jacobian_terms(),
+        Kernel("paper_params", "The paper's robot (Section 2.3) as a general one: p[SR_P_*] from the"
+               " paper's twelve parameters (derive.parameters.from_paper).",
+               ("pp",), (Output("p", tuple(P.from_paper()), "parameters of the general robot"),)),
+    ) + general_kernels()
+
+
+UPPER = tuple((i, j) for i in range(S.NV) for j in range(i, S.NV))
+
+
+def general_kernels():
+    """The general robot of issue 18 (derive.robot.GENERAL), straight from the derivation: M and f
+    of derive.dynamics with CSE; the solve of M ν̇ = f is hand-written (c/sr_kernels.c), since with
+    rotors and general tensors every entry of M may be non-zero."""
+    robot = R.GENERAL
+    M, f = D.inertia(robot), D.rhs(robot)
+    return (
+        Kernel("general_constants", "Constants of the general kernels from the parameters, cg[0..] ="
+               f" ({', '.join(s.name for s, _ in R.general_constants())}), then the parameter-only"
+               " subexpressions of the kernels:",
+               ("p",), (Output("cg", tuple(e for _, e in R.general_constants()), "constants"),), finite_or_untouched=False),
+        Kernel("general_inertia", "Generalized inertia M of the general robot, row-major 5x5.",
+               ("cg", "x"), (Output("M", tuple(M), "M, row-major 5x5"),)),
+        Kernel("general_rhs", "Right-hand side f of M ν̇ = f for the general robot.",
+               ("cg", "x", "u"), (Output("f", tuple(f), "f"),)),
+        Kernel("general_system", "M (upper triangle, row by row) and f of the general robot, for the solve of sr_accel.",
+               ("cg", "x", "u"), (Output("M", tuple(M[i, j] for i, j in UPPER), "M, upper triangle row by row"),
+                                  Output("f", tuple(f), "f"))),
+        Kernel("general_energy", "Total energy of the general robot: ½νᵀMν + m_R g_x q_x + m_P g_z q_z"
+               " + the shape potential [J] (derive.lagrangian.total_energy).",
+               ("cg", "x"), (Output("E", (D.energy(robot),), "energy"),)),
+        Kernel("general_equilibrium_residual", "f at ν = 0, u = 0 for the general robot.",
+               ("cg", "x"), (Output("res", tuple(D.equilibrium_residual(robot)), "residual"),)),
+        accel_jacobian_terms(robot, "general_accel_jacobian_terms", ("cg", "x", "u")),
     )
 
 
-def accel_jacobian_terms():
+def accel_jacobian_terms(robot=R.PAPER, name="accel_jacobian_terms", inputs=("c", "x", "u")):
     """What the solves of sr_accel_jacobian (c/sr_jacobians.c) need, in one kernel so that CSE
     shares M, f and their derivatives (derive.derivatives): ∂ν̇ = M⁻¹(∂f − (∂M) ν̇)."""
-    upper = [(i, j) for i in range(S.NV) for j in range(i, S.NV)]
-    M, f = D.inertia(), D.rhs()
-    dM = J.inertia_derivatives()
+    upper = UPPER
+    M, f = D.inertia(robot), D.rhs(robot)
+    dM = J.inertia_derivatives(robot)
     return Kernel(
-        "accel_jacobian_terms",
+        name,
         "M (upper triangle, row by row), f, ∂f/∂d (5 x SR_GEN_NE, row-major, error coordinates of"
         " SR_E_*), ∂f/∂u (5 x 2) and ∂M/∂d along δξ_S, δθ_Y, δθ_P (5 upper triangles) for the"
         " accel Jacobian ∂ν̇ = M⁻¹(∂f − (∂M) ν̇).",
-        ("c", "x", "u"),
+        inputs,
         (Output("M", tuple(M[i, j] for i, j in upper), "M, upper triangle row by row"),
          Output("f", tuple(f), "f"),
-         Output("df", tuple(J.rhs_jacobian()), "df/dd, row-major 5 x SR_GEN_NE"),
-         Output("dfdu", tuple(J.rhs_input_jacobian()), "df/du, row-major 5 x 2"),
+         Output("df", tuple(J.rhs_jacobian(robot)), "df/dd, row-major 5 x SR_GEN_NE"),
+         Output("dfdu", tuple(J.rhs_input_jacobian(robot)), "df/du, row-major 5 x 2"),
          Output("dM", tuple(m[i, j] for m in dM for i, j in upper), "dM/dd_k, k < 5, upper triangles")))

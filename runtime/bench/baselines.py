@@ -90,7 +90,7 @@ def compiled_kane_timings(model, calls, progress, min_seconds=0.2, rounds=7):
     import tempfile
 
     from .kane_compiled import casadi_kane_function, dependent_speeds, kane_inputs, pydy_cython_rhs
-    p = model.params.as_array()
+    p = model.params.paper_params.as_array()   # the Kane model reads the paper's twelve parameters
     qw = kane_inputs(np.array([x for x, _ in calls]))
     ud = dependent_speeds(qw, p)
     with tempfile.TemporaryDirectory() as tmp:

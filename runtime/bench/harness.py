@@ -57,6 +57,14 @@ def build_harness(build, native, with_casadi, kane=None):
     return exe
 
 
+def general_robot(params):
+    """The general robot the C loop times beside `params` (issue 18): the same radius, so the same
+    states are valid, with an off-centre battery, full tensors, geared rotors and a slope (its
+    kernels are the general ones)."""
+    from ..scenarios.scenario import load_scenario
+    return load_scenario("battery-geared").params.replace(r=params.r, slope=0.05)
+
+
 def run_harness(exe, params, X, U, repeats, kane_inputs=None):
     data = build_dir_input = exe.parent / "input.bin"
     with open(build_dir_input, "wb") as f:
@@ -64,8 +72,10 @@ def run_harness(exe, params, X, U, repeats, kane_inputs=None):
         f.write(np.ascontiguousarray(params.as_array()).tobytes())
         f.write(np.ascontiguousarray(X).tobytes())
         f.write(np.ascontiguousarray(U).tobytes())
-        if kane_inputs is not None:
+        f.write(np.ascontiguousarray(general_robot(params).as_array()).tobytes())
+        if kane_inputs is not None:     # the Kane model's coordinates, then its (the paper's) parameters
             f.write(np.ascontiguousarray(kane_inputs, dtype=np.float64).tobytes())
+            f.write(np.ascontiguousarray(params.paper_params.as_array(), dtype=np.float64).tobytes())
     out = subprocess.run([str(exe), str(data), str(repeats)], check=True, capture_output=True, text=True)
     return json.loads(out.stdout)
 
@@ -134,6 +144,12 @@ def check_harness(result, model, X, U, step_dt=0.01):
         G = np.asarray(G).reshape(NE, n, NU).transpose(1, 0, 2)
         check("C Lie-Euler step_jacobian vs CasADi AD of the exported SX step", "step_jacobian_lie_euler",
               lambda i: np.concatenate([F[i].ravel(), G[i].ravel()]), 1e-10)
+    if "accel_general_robot" in result:
+        general = ReferenceModel(general_robot(model.params).as_dict())
+        general_accel = general.accel_batch(X, U)
+        check("C accel of a general robot vs reference", "accel_general_robot", lambda i: general_accel[i], 1e-10)
+        check("C RKMK4 step of a general robot vs NumPy tableau on the reference", "step_rkmk4_general_robot",
+              lambda i: STEPPERS["rkmk4"](general.accel, general.params["r"], X[i], U[i], step_dt), 1e-10)
     if "casadi_generated_reference_accel" in result:
         check("CasADi-generated reference vs reference", "casadi_generated_reference_accel", lambda i: accel[i], 1e-10)
     for value in result.values():

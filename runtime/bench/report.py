@@ -53,6 +53,9 @@ def targets(res):
         if "kane_casadi_c_accel_jacobian" in c:
             out.append(("accel_jacobian >= 10x faster than CasADi AD C of the Kane Jacobian",
                         10 * c["accel_jacobian"]["ns"] <= c["kane_casadi_c_accel_jacobian"]["ns"]))
+    if "accel_general_robot" in c:
+        out.append(("accel of a general robot <= 1.3x the paper-geometry kernel (C loop; paper robots are "
+                    "given that kernel automatically)", c["accel_general_robot"]["ns"] <= 1.3 * ours))
     if "t_shape_rkmk4_ms" in py:
         out.append(("t-shape rkmk4 end to end <= 4 ms", py["t_shape_rkmk4_ms"] <= 4))
     return out
@@ -77,6 +80,11 @@ def sections(res):
     if "step_jacobian_lie_euler" in c:
         rows.append(("our Lie-Euler step_jacobian (F 12x12 and G 12x2)", f"{c['step_jacobian_lie_euler']['ns']:,.1f} ns",
                      f"{c['step_jacobian_lie_euler']['ns'] / ours:.1f}x"))
+    if "accel_general_robot" in c:
+        rows.append(("our accel of a general robot (issue 18: general kernels)", f"{c['accel_general_robot']['ns']:,.1f} ns",
+                     f"{c['accel_general_robot']['ns'] / ours:.1f}x"))
+        rows.append(("our rkmk4 step of a general robot", f"{c['step_rkmk4_general_robot']['ns']:,.1f} ns",
+                     f"{c['step_rkmk4_general_robot']['ns'] / c['step_rkmk4']['ns']:.1f}x our rkmk4 step"))
     if res.get("c_loop_native"):
         rows.append(("our accel, checked API, -march=native", f"{res['c_loop_native']['accel']['ns']:,.1f} ns", ""))
     for key, label in C_BASELINES:

@@ -16,6 +16,7 @@ import tomllib
 import numpy as np
 
 from ..params import NAMES as PARAM_NAMES
+from ..params import PAPER_NAMES, SHAPES
 from ..scenarios.scenario import parse_scenario
 from .closed_loop import Noise
 from .controller import DEFAULT_U_MAX
@@ -191,10 +192,11 @@ def _parse_controller(table, source):
 
 def _parse_plant(table, params, source):
     where = f"{source}: plant"
-    _table(table, where, set(PARAM_NAMES) | set(_NOISE_KEYS))
-    overrides = {k: _real(v, f"{where}.{k}") for k, v in table.items() if k in PARAM_NAMES}
+    _table(table, where, set(PARAM_NAMES) | set(PAPER_NAMES) | set(_NOISE_KEYS))
+    overrides = {k: (_real(v, f"{where}.{k}") if SHAPES.get(k, ()) == () else v)
+                 for k, v in table.items() if k not in _NOISE_KEYS}
     try:
-        plant = dataclasses.replace(params, **overrides)
+        plant = params.with_changes(**overrides)
     except ValueError as exc:
         raise ValueError(f"{where}: {exc}") from None
     noise = {}

@@ -20,6 +20,7 @@ from PIL import Image, ImageDraw, ImageFont  # noqa: E402
 
 from ..state import IDX_Q, rotations  # noqa: E402
 from .atomic import atomic_path  # noqa: E402
+from .outline import rod_tip, yoke_outline  # noqa: E402
 
 GIF_SECONDS = 10.0
 GIF_FPS = 20           # 50 ms per frame: GIF delays are whole centiseconds
@@ -64,9 +65,8 @@ class RobotScene:
         q = self.q
         self.wire = _sphere_wireframe(p.r)
         self.marker_body = p.r * np.array([[1.0, 1.0, 1.0]]) / np.sqrt(3.0)
-        self.yoke_body = np.array([[p.h / 2, p.b / 2, 0], [-p.h / 2, p.b / 2, 0], [-p.h / 2, -p.b / 2, 0],
-                                   [p.h / 2, -p.b / 2, 0], [p.h / 2, p.b / 2, 0]])
-        self.rod_body = np.array([[0, 0, 0], [0, 0, -p.l]])
+        self.yoke_body = yoke_outline(p)
+        self.rod_body = np.array([np.zeros(3), rod_tip(p)])
 
         lo = q[:, :2].min(axis=0) - 1.2 * p.r
         hi = q[:, :2].max(axis=0) + 1.2 * p.r

@@ -28,6 +28,7 @@ from ..state import IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, absol
     yoke_angle
 from .animation import _sphere_wireframe
 from .atomic import write_text
+from .outline import rod_tip, yoke_outline
 
 #: At most this many samples go into the page (a 100 s run at dt = 0.01 s: every 5th step).
 MAX_FRAMES = 2001
@@ -99,9 +100,8 @@ def replay_data(result, max_frames=MAX_FRAMES):
             # Sphere wireframe: polylines separated by NaN rows (breaks); JSON has no NaN, so null.
             "wire": [[None if np.isnan(v) else float(v) for v in point] for point in _sphere_wireframe(p.r)],
             "marker": (p.r * np.ones(3) / np.sqrt(3.0)).tolist(),
-            "yoke": [[p.h / 2, p.b / 2, 0], [-p.h / 2, p.b / 2, 0], [-p.h / 2, -p.b / 2, 0],
-                     [p.h / 2, -p.b / 2, 0], [p.h / 2, p.b / 2, 0]],
-            "bob": [0.0, 0.0, -p.l],
+            "yoke": yoke_outline(p).tolist(),
+            "bob": rod_tip(p).tolist(),
         },
     }
 

@@ -60,7 +60,7 @@ def summary(result, extra_wall_time=None):
         "dt_s": s.dt,
         "steps": s.steps,
         "duration_s": s.duration,
-        "params": s.params.as_dict(),
+        "params": s.params.as_json(),
         "start_position_m": q[0, :2].tolist(),
         "final_position_m": q[-1, :2].tolist(),
         "final_displacement_m": float(excursion[-1]),

@@ -26,7 +26,7 @@ from .. import model as _model_module
 from ..errors import SimulationStopped
 from ..model import Model
 from ..params import NAMES as PARAM_NAMES
-from ..params import Params
+from ..params import PAPER_NAMES, SHAPES, Params
 from ..so3 import rot_x, rot_y
 from ..state import IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NU, NX
 from ..validation import ROTATION_TOL, describe_state
@@ -193,18 +193,43 @@ def _scenario_dir():
 
 
 def _parse_params(table, source):
+    """The robot: a preset (or a `robot` file, relative to the scenario's), then changes by the
+    paper's names or the general ones (`Params.with_changes`); c_* as [x, y, z], J_* as 3x3 lists."""
     where = f"{source}: params"
-    _check_table(table, {"preset"} | set(PARAM_NAMES), where)
+    _check_table(table, {"preset", "robot"} | set(PARAM_NAMES) | set(PAPER_NAMES), where)
+    if "preset" in table and "robot" in table:
+        raise ValueError(f"{where}: give a preset or a robot file, not both")
     preset = table.get("preset", "paper")
     if preset not in PRESETS:
         raise ValueError(f"{where}.preset: unknown preset {_show(preset)}; choose one of {sorted(PRESETS)}")
-    overrides = {key: _real(value, f"{where}.{key}") for key, value in table.items() if key != "preset"}
+    changes = {key: (_real(value, f"{where}.{key}") if SHAPES.get(key, ()) == () else value)
+               for key, value in table.items() if key not in ("preset", "robot")}
     try:
-        params = PRESETS[preset](**overrides)
+        base = _load_robot(table["robot"], source) if "robot" in table else PRESETS[preset]()
+        params = base.with_changes(**changes) if changes else base
         Model(params)                  # C's checks too: M positive definite, no overflow
     except ValueError as exc:          # Params names the parameter ("Params.r: must be > 0")
         raise ValueError(f"{where}: {exc}") from None
     return params
+
+
+def _load_robot(path, source):
+    """A robot file: a TOML table of general parameters (missing ones: the paper's robot's)."""
+    if not isinstance(path, str):
+        raise ValueError(f"robot: expected a file name, got {_show(path)}")
+    full = pathlib.Path(source).parent / path
+    try:
+        table = tomllib.loads(full.read_text())
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise ValueError(f"robot: cannot read {full}: {exc}") from None
+    unknown = sorted(set(table) - set(PARAM_NAMES))
+    if unknown:
+        raise ValueError(f"robot: {full}: unknown key(s) {', '.join(map(repr, unknown))}; allowed: "
+                         f"{', '.join(PARAM_NAMES)}")
+    try:
+        return Params(**table)
+    except ValueError as exc:
+        raise ValueError(f"robot: {full}: {exc}") from None
 
 
 def _parse_initial(table, params, source):

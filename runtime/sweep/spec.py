@@ -6,7 +6,7 @@
     seed = 20261123
     samples_per_task = 500        # optional; default: tasks of about TASK_SECONDS (measured)
 
-    [params.m_P]                  # a parameter by the paper's name
+    [params.m_P]                  # a parameter by the paper's name (or a general one: PARAM_KEYS)
     uniform = [0.9, 1.1]
     relative = true               # a factor on the scenario's value (default: the value itself)
 
@@ -32,10 +32,17 @@ import tomllib
 
 import numpy as np
 
-from ..params import NAMES as PARAM_NAMES
-from ..params import Params
+from bindings._sr import lib
+
+from ..params import PAPER_NAMES, Params, paper_rows_to_params
 from ..scenarios.scenario import Scenario, load_scenario
 from ..state import IDX_QZ, IDX_RP, IDX_RY, IDX_WP, IDX_WY, IDX_UP, IDX_UY, pendulum_angle, rot_x, rot_y, yoke_angle
+
+#: A sweep varies parameters by the paper's names (r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P,
+#: g: each sample's robot is then built from them) or by the entries of the C parameter vector
+#: (m_Y, c_P_z, J_Y_xx, slope, ...: the general robot's fields).
+GENERAL_KEYS = tuple(n[len("SR_P_"):] for n in sorted(dir(lib)) if n.startswith("SR_P_"))
+PARAM_KEYS = tuple(sorted(set(PAPER_NAMES) | set(GENERAL_KEYS)))
 
 _TOP_KEYS = {"description", "scenario", "samples", "seed", "samples_per_task", "params", "initial", "torque"}
 _KINDS = ("values", "uniform", "normal")
@@ -81,7 +88,7 @@ class SweepSpec:
     def identity(self):
         """What makes two runs the same sweep (the resume check compares it): JSON-ready."""
         s = self.scenario
-        return {"scenario": {"name": s.name, "params": s.params.as_dict(), "x0": s.x0.tolist(), "dt": s.dt,
+        return {"scenario": {"name": s.name, "params": s.params.as_json(), "x0": s.x0.tolist(), "dt": s.dt,
                              "steps": s.steps, "method": s.method,
                              "torques": [dataclasses.asdict(w) for w in s.torques]},
                 "samples": self.samples, "seed": self.seed,
@@ -134,17 +141,32 @@ def parse_sweep(data, source="<sweep>", name="sweep", folder=None):
     if per_task is not None:
         per_task = _count(per_task, f"{source}: samples_per_task")
     quantities = []
-    groups = {"params": PARAM_NAMES, "initial": INITIAL_KEYS, "torque": TORQUE_KEYS}
+    groups = {"params": PARAM_KEYS, "initial": INITIAL_KEYS, "torque": TORQUE_KEYS}
     for group, allowed in groups.items():
         table = data.get(group, {})
         _check_keys(table, set(allowed), f"{source}: {group}")
         for key, spec in table.items():
             quantities.append(_quantity(f"{group}.{key}", spec, f"{source}: {group}.{key}"))
+    _check_param_names(data.get("params", {}), scenario, f"{source}: params")
     quantities.sort(key=lambda q: q.name)
     spec = SweepSpec(name=name, source=source, scenario=scenario, samples=samples, seed=seed,
                      quantities=tuple(quantities), samples_per_task=per_task, description=description)
     _check_grid_values(spec, source)
     return spec
+
+
+def _check_param_names(table, scenario, where):
+    """Either the paper's names (for a scenario of the paper's robot) or the general entries, not both."""
+    paper_only = sorted(set(table) - set(GENERAL_KEYS))
+    if not paper_only:
+        return
+    if scenario.params.paper_params is None:
+        raise ValueError(f"{where}.{paper_only[0]}: a parameter of the paper's robot, and the scenario's "
+                         "robot is not built from the paper's parameters")
+    general_only = sorted(set(table) - set(PAPER_NAMES))
+    if general_only:
+        raise ValueError(f"{where}: vary the paper's parameters ({', '.join(paper_only)}) or the general "
+                         f"ones ({', '.join(general_only)}), not both")
 
 
 def _quantity(name, table, where):
@@ -178,9 +200,16 @@ def _check_grid_values(spec, source):
         for v in q.numbers:
             if q.name.startswith("params."):
                 key = q.name.split(".", 1)[1]
-                base = getattr(spec.scenario.params, key)
+                robot = spec.scenario.params
                 try:
-                    Params(**(spec.scenario.params.as_dict() | {key: v * base if q.relative else v}))
+                    if key in PAPER_NAMES and robot.paper_params is not None and _paper_quantities(spec):
+                        base = getattr(robot.paper_params, key)
+                        robot.with_changes(**{key: v * base if q.relative else v})
+                    else:
+                        values = robot.as_array()
+                        column = getattr(lib, f"SR_P_{key}")
+                        values[column] = v * values[column] if q.relative else v
+                        Params.from_array(values)
                 except ValueError as exc:
                     raise ValueError(f"{source}: {q.name}.values: {v:g} gives invalid parameters ({exc})") from None
 
@@ -229,27 +258,44 @@ def sample_inputs(spec, start, stop):
     values = quantity_values(spec, start, stop)
     base = spec.scenario
     n = stop - start
-    params = np.tile(base.params.as_array(), (n, 1))
+    paper = _paper_quantities(spec)
+    if paper:       # the paper's names: vary them, then build each sample's robot (C: sr_paper_params)
+        rows = np.tile(base.params.paper_params.as_array(), (n, 1))
+        for q in paper:
+            col = PAPER_NAMES.index(q.name.split(".", 1)[1])
+            rows[:, col] = values[q.name] * rows[:, col] if q.relative else values[q.name]
+        params = paper_rows_to_params(rows)
+    else:
+        params = np.tile(base.params.as_array(), (n, 1))
     x0 = np.tile(base.x0, (n, 1))
     u = base.torque_at_step_starts()
     factors = {}
     for q in spec.quantities:
         group, key = q.name.split(".", 1)
         v = values[q.name]
-        if group == "params":
-            col = PARAM_NAMES.index(key)
+        if group == "params" and not paper:
+            col = getattr(lib, f"SR_P_{key}")
             params[:, col] = v * params[:, col] if q.relative else v
         elif group == "initial":
             _set_initial(x0, key, v, q.relative)
         else:
             factors[key] = v * 1.0 if q.relative else v
-    x0[:, IDX_QZ] = params[:, PARAM_NAMES.index("r")]     # the shell rests on the plane: q_z = r
+    x0[:, IDX_QZ] = params[:, lib.SR_P_r]     # the shell rests on the plane: q_z = r
     if factors:
         scale = np.ones((n, 1, 2))
         scale[:, 0, IDX_UY] = factors.get("u_Y_scale", 1.0)
         scale[:, 0, IDX_UP] = factors.get("u_P_scale", 1.0)
         u = u[None, :, :] * scale
     return params, x0, u, values
+
+
+def _paper_quantities(spec):
+    """The params quantities, if they are to be read by the paper's names (see `PARAM_KEYS`), else ()."""
+    params = [q for q in spec.quantities if q.name.startswith("params.")]
+    if params and spec.scenario.params.paper_params is not None and all(
+            q.name.split(".", 1)[1] in PAPER_NAMES for q in params):
+        return params
+    return ()
 
 
 def _set_initial(x0, key, v, relative):

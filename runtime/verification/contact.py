@@ -24,7 +24,7 @@ in time by an 8th-order central difference:
 import casadi as ca
 import numpy as np
 
-from .reference import (PARAM_NAMES, STATE_DIM, ReferenceModel, _NU, _Q, _RP, _RS, _RY, _WP, _WS, _WY,
+from .reference import (checked_params, STATE_DIM, ReferenceModel, _NU, _Q, _RP, _RS, _RY, _WP, _WS, _WY,
                         _expm_series, _mat_rowmajor, _rot_x, _rot_y, _time_derivative, _vee_skew)
 
 #: 8th-order central first-derivative weights w_k for (f(t + k h) − f(t − k h)) / h.
@@ -42,14 +42,16 @@ class ReferenceContact:
 
     def _build(self):
         p = self.params
-        r, g, k_S, k_Y, k_P = p["r"], p["g"], p["k_S"], p["k_Y"], p["k_P"]
+        r, k_S, k_Y, k_P = p["r"], p["k_S"], p["k_Y"], p["k_P"]
         ez = ca.DM([0, 0, 1])
         x0, u = ca.SX.sym("x", STATE_DIM), ca.SX.sym("u", 2)
         RS0, RY0, RP0 = _mat_rowmajor(x0[_RS]), _mat_rowmajor(x0[_RY]), _mat_rowmajor(x0[_RP])
         s, sd = ca.SX.sym("s", 8), ca.SX.sym("sd", 8)      # (φ, dθ_Y, dθ_P, dx, dy, dz)
         RS = RS0 @ _expm_series(s[0:3])
-        frames = {"S": RS, "Y": RS @ RY0 @ _rot_x(s[3])}
+        frames = {"S": RS, "Y": RS @ RY0 @ _rot_x(s[3]), "mY": RS @ _rot_x(p["n_Y"] * s[3])}
         frames["P"] = frames["Y"] @ RP0 @ _rot_y(s[4])
+        frames["mP"] = frames["Y"] @ _rot_y(p["n_P"] * s[4])
+        gravity = ca.DM(gravity_vector(p))
         q = x0[_Q] + s[5:8]
         lagr = 0
         for body in self._ref._bodies():
@@ -58,7 +60,7 @@ class ReferenceContact:
             vel = ca.jtimes(pos, s, sd)
             w_body = _vee_skew(Rb.T @ _time_derivative(Rb, s, sd))
             lagr += 0.5 * body.mass * ca.dot(vel, vel) + 0.5 * ca.dot(w_body, ca.DM(body.inertia) @ w_body)
-            lagr -= body.mass * g * pos[2]
+            lagr += body.mass * ca.dot(gravity, pos)
         wS = _vee_skew(RS.T @ _time_derivative(RS, s, sd))
         con = sd[5:8] + ca.cross(RS @ wS, -r * ez)         # the contact point's velocity, all of it
         A = ca.jacobian(con, sd)
@@ -92,6 +94,11 @@ def _body_kinematics(X, params):
     omega = {"S": np.einsum("nij,nj->ni", R_S, X[:, _WS])}
     omega["Y"] = omega["S"] + frames["Y"][:, :, 0] * X[:, [_WY]]
     omega["P"] = omega["Y"] + frames["P"][:, :, 1] * X[:, [_WP]]
+    # The rotors' inertias are axial (about e_x, e_y of their carriers), so their frames' angles
+    # about those axes do not matter: the carriers' frames, with the rotors' angular velocities.
+    frames["mY"], frames["mP"] = frames["S"], frames["Y"]
+    omega["mY"] = omega["S"] + frames["S"][:, :, 0] * (float(params["n_Y"]) * X[:, [_WY]])
+    omega["mP"] = omega["Y"] + frames["Y"][:, :, 1] * (float(params["n_P"]) * X[:, [_WP]])
     q = X[:, _Q]
     qdot = params["r"] * np.cross(omega["S"], [0.0, 0.0, 1.0])
     bodies = []
@@ -107,7 +114,12 @@ class _BodyParams:
     """Lets `ReferenceModel._bodies` (pure data: masses, inertias, centres) run without building CasADi."""
 
     def __init__(self, params):
-        self.params = {k: float(params[k]) for k in PARAM_NAMES}
+        self.params = checked_params(params)
+
+
+def gravity_vector(params):
+    """-g (sin(slope), 0, cos(slope)): gravity in the plane's frame (x up the slope)."""
+    return -float(params["g"]) * np.array([np.sin(float(params["slope"])), 0.0, np.cos(float(params["slope"]))])
 
 
 def _derivative(values, dt):
@@ -124,7 +136,8 @@ def momentum_residuals(X, dt, params):
     dH_c/dt + q̇ × P − Σ (p_i − c) × m_i g_vec + k_S Ω_S, zero for a motion that obeys the physics.
     """
     X = np.asarray(X, dtype=float)
-    g_vec = np.array([0.0, 0.0, -float(params["g"])])
+    params = checked_params(params)
+    g_vec = gravity_vector(params)
     q, qdot, omega_S, bodies = _body_kinematics(X, params)
     contact = q - [0.0, 0.0, float(params["r"])]
     P = sum(m * v for m, _, v, _ in bodies)

@@ -50,7 +50,7 @@ def steady_rolling_checks(params=None, speeds=(0.3, 1.0, 1.5)):
         x, u = stability.steady_rolling(model, v)
         w = v / params.r
         worst = max(worst, abs(u[0] + (params.k_S + params.k_Y) * w) / abs(u[0]),
-                    abs(x[stability.SIN_ALPHA] + params.k_S * w / (params.m_P * params.g * params.l / 2)))
+                    abs(x[stability.SIN_ALPHA] + params.k_S * w / (params.m_P * params.g * -params.c_P[2])))
     return [(f"steady rolling ({len(speeds)} speeds): holding torque and tilt vs power balance and statics",
              worst, worst, 1e-10)]
 

@@ -80,8 +80,12 @@ class PaperModel:
     """Eqs. (41)-(105) of the paper in NumPy; same API subset as `runtime.Model`."""
 
     def __init__(self, params=None, errata=Errata()):
-        p = Params() if params is None else params
-        self.p, self.errata = p, errata
+        robot = Params() if params is None else params
+        if robot.paper_params is None:
+            raise ValueError("PaperModel: params must be the paper's robot (Params.paper(...)), "
+                             "whose formulas these are")
+        p = robot.paper_params
+        self.p, self.errata = robot, errata
         j_S = 2 / 3 * p.m_S * p.r**2
         j_xx = (p.m_b / 6 + p.m_h / 2) * p.b**2
         j_yy = (p.m_b / 2 + p.m_h / 6) * p.h**2

@@ -111,7 +111,11 @@ from ..so3 import hat as _hat_np
 from ..so3 import rot_x as _rot_x_np
 from ..so3 import rot_y as _rot_y_np
 
-PARAM_NAMES = ("r", "m_S", "k_S", "b", "h", "m_b", "m_h", "k_Y", "l", "m_P", "k_P", "g")
+#: The general robot (issue 18): scalars, c_* 3-vectors, J_* 3x3 tensors about the centre of mass.
+PARAM_NAMES = ("r", "m_S", "j_S", "k_S", "m_Y", "c_Y", "J_Y", "k_Y", "m_P", "c_P", "J_P", "k_P",
+               "j_mY", "n_Y", "j_mP", "n_P", "g", "slope")
+#: The paper's robot (Section 5.2), built here from its rods (`paper_robot`).
+PAPER_PARAM_NAMES = ("r", "m_S", "k_S", "b", "h", "m_b", "m_h", "k_Y", "l", "m_P", "k_P", "g")
 
 STATE_DIM = 35
 # Slices of the state vector.
@@ -172,7 +176,51 @@ class _Body:
         self.mass = mass            # float
         self.inertia = inertia_body  # 3x3 numpy, about the centre of mass
         self.c_local = c_local      # centre of mass in `frame` coordinates
-        self.frame = frame          # 'S', 'Y' or 'P'
+        self.frame = frame          # 'S', 'Y', 'P', or a motor rotor's: 'mY', 'mP'
+
+
+def paper_robot(paper):
+    """The paper's robot from its twelve parameters, by composing its rods (Section 2.3) with the
+    parallel-axis theorem here, independently of the kernels' conversion (derive/parameters.py):
+    a general parameter dict for ReferenceModel."""
+    r, mS, b, h, mb, mh, l, mP = (float(paper[k]) for k in ("r", "m_S", "b", "h", "m_b", "m_h", "l", "m_P"))
+    ex, ey, ez = np.eye(3)
+
+    def rod(m, length, axis, centre):
+        """(mass, first moment, inertia about the yoke's origin) of a thin uniform rod."""
+        centre = np.asarray(centre, dtype=float)
+        about_centre = m * length**2 / 12.0 * (np.eye(3) - np.outer(axis, axis))
+        return m, m * centre, about_centre + m * (centre @ centre * np.eye(3) - np.outer(centre, centre))
+
+    rods = [rod(mb, b, ey, +h / 2 * ex), rod(mb, b, ey, -h / 2 * ex),
+            rod(mh, h, ex, +b / 2 * ey), rod(mh, h, ex, -b / 2 * ey)]
+    m_Y = sum(m for m, _, _ in rods)
+    c_Y = sum(moment for _, moment, _ in rods) / m_Y
+    J_Y = sum(J for _, _, J in rods) - m_Y * (c_Y @ c_Y * np.eye(3) - np.outer(c_Y, c_Y))
+    return {"r": r, "m_S": mS, "j_S": 2.0 / 3.0 * mS * r**2, "k_S": float(paper["k_S"]),
+            "m_Y": m_Y, "c_Y": c_Y, "J_Y": J_Y, "k_Y": float(paper["k_Y"]),
+            "m_P": mP, "c_P": -l / 2 * ez, "J_P": mP * l**2 / 12.0 * (np.eye(3) - np.outer(ez, ez)),
+            "k_P": float(paper["k_P"]), "j_mY": 0.0, "n_Y": 1.0, "j_mP": 0.0, "n_P": 1.0,
+            "g": float(paper["g"]), "slope": 0.0}
+
+
+def checked_params(params):
+    """The general parameter dict (floats, (3,) and (3, 3) arrays) from params: a dict of the
+    general names, or of the paper's twelve (then built by `paper_robot`)."""
+    if set(params) == set(PAPER_PARAM_NAMES):
+        params = paper_robot(params)
+    missing = [k for k in PARAM_NAMES if k not in params]
+    extra = [k for k in params if k not in PARAM_NAMES]
+    if missing or extra:
+        raise ValueError(f"bad parameter set: missing={missing}, unknown={extra}")
+    shapes = {"c_Y": (3,), "c_P": (3,), "J_Y": (3, 3), "J_P": (3, 3)}
+    out = {}
+    for k in PARAM_NAMES:
+        value = np.asarray(params[k], dtype=float)
+        if value.shape != shapes.get(k, ()):
+            raise ValueError(f"bad parameter {k}: shape {value.shape}, expected {shapes.get(k, ())}")
+        out[k] = value if k in shapes else float(value)
+    return out
 
 
 # --------------------------------------------------------------------------- #
@@ -184,42 +232,40 @@ class ReferenceModel:
     Parameters
     ----------
     params : dict
-        The 12 physical parameters named in ``PARAM_NAMES`` (SI units).
+        The general robot's parameters named in ``PARAM_NAMES`` (SI units; c_* of shape (3,),
+        J_* of shape (3, 3)), or the paper's twelve of ``PAPER_PARAM_NAMES`` (built from rods
+        by ``paper_robot``).
 
     All public methods take the 35-element state described in the module
     docstring and return numpy arrays.
     """
 
     def __init__(self, params: dict):
-        missing = [k for k in PARAM_NAMES if k not in params]
-        extra = [k for k in params if k not in PARAM_NAMES]
-        if missing or extra:
-            raise ValueError(f"bad parameter set: missing={missing}, unknown={extra}")
-        self.params = {k: float(params[k]) for k in PARAM_NAMES}
+        #: The paper's twelve parameters when the robot was given by them, else None.
+        self.paper = {k: float(params[k]) for k in PAPER_PARAM_NAMES} if set(params) == set(PAPER_PARAM_NAMES) else None
+        self.params = checked_params(params)
         self._build()
 
     # ------------------------------------------------------------------ build
     def _bodies(self):
+        """Shell, yoke, pendulum and the motors' rotors (axial inertia only; a rotor turns n times
+        its joint's angle relative to its carrier: frames 'mY' on the shell, 'mP' on the yoke)."""
         p = self.params
-        r, mS, b, h, mb, mh, l, mP = (p[k] for k in ("r", "m_S", "b", "h", "m_b", "m_h", "l", "m_P"))
-        ex, ey, ez = np.eye(3)
-
-        def rod(m, length, axis, centre, frame):
-            return _Body(m, m * length**2 / 12.0 * (np.eye(3) - np.outer(axis, axis)), centre, frame)
-
+        ex, ey = np.eye(3)[0], np.eye(3)[1]
         return [
-            _Body(mS, 2.0 / 3.0 * mS * r**2 * np.eye(3), np.zeros(3), "S"),
-            rod(mb, b, ey, +h / 2 * ex, "Y"),
-            rod(mb, b, ey, -h / 2 * ex, "Y"),
-            rod(mh, h, ex, +b / 2 * ey, "Y"),
-            rod(mh, h, ex, -b / 2 * ey, "Y"),
-            rod(mP, l, ez, -l / 2 * ez, "P"),
+            _Body(p["m_S"], p["j_S"] * np.eye(3), np.zeros(3), "S"),
+            _Body(p["m_Y"], p["J_Y"], p["c_Y"], "Y"),
+            _Body(p["m_P"], p["J_P"], p["c_P"], "P"),
+            _Body(0.0, p["j_mY"] * np.outer(ex, ex), np.zeros(3), "mY"),
+            _Body(0.0, p["j_mP"] * np.outer(ey, ey), np.zeros(3), "mP"),
         ]
 
     def _build(self):
         p = self.params
         r, g = p["r"], p["g"]
         kS, kY, kP = p["k_S"], p["k_Y"], p["k_P"]
+        # Gravity in the plane's frame (x up the slope): -g (sin(slope) e_x + cos(slope) e_z).
+        gravity = -g * ca.DM([np.sin(p["slope"]), 0.0, np.cos(p["slope"])])
         ez = ca.DM([0, 0, 1])
 
         # Current state (the chart's base point) and inputs.
@@ -237,7 +283,8 @@ class ReferenceModel:
         RY = RY0 @ _rot_x(s[3])
         RP = RP0 @ _rot_y(s[4])
         q = q0 + ca.vertcat(s[5], s[6], 0)
-        frames = {"S": RS, "Y": RS @ RY, "P": RS @ RY @ RP}
+        frames = {"S": RS, "Y": RS @ RY, "P": RS @ RY @ RP,
+                  "mY": RS @ _rot_x(p["n_Y"] * s[3]), "mP": RS @ RY @ _rot_y(p["n_P"] * s[4])}
 
         # Body kinematics and Lagrangian.
         kinetic = 0
@@ -249,7 +296,7 @@ class ReferenceModel:
             w_body = _vee_skew(Rb.T @ _time_derivative(Rb, s, sd))
             kinetic += 0.5 * body.mass * ca.dot(vel, vel)
             kinetic += 0.5 * ca.dot(w_body, ca.DM(body.inertia) @ w_body)
-            potential += body.mass * g * pos[2]
+            potential -= body.mass * ca.dot(gravity, pos)
         lagr = kinetic - potential
 
         # Shell body angular velocity, contact-point velocity (constraint).

@@ -38,7 +38,7 @@ def energy_scale(model, x):
     rest = x.copy()
     rest[IDX_NU] = 0
     p = model.params
-    return model.energy(x) - model.energy(rest) + p.m_P * p.g * p.l
+    return model.energy(x) - model.energy(rest) + p.potential_range()
 
 
 def soak_one(model, x0, steps, dt, method, chunk):

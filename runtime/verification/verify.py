@@ -34,7 +34,7 @@ from ..params import Params
 from ..so3 import exp, hat, rot_x, rot_y, rot_z, vee
 from ..state import IDX_NU, IDX_Q, IDX_QZ, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NX, initial_state, rotations
 from ..validation import project_state
-from .sampling import random_inputs, random_params, random_state
+from .sampling import random_general_params, random_inputs, random_params, random_state
 
 
 @dataclasses.dataclass
@@ -91,7 +91,7 @@ def cross_check(n_states=1000, seed=0, n_param_sets=6):
     worst = {k: [0.0, 0.0, ""] for k in ("accel", "inertia", "energy")}
     for params in parameter_sets(rng, n_param_sets - 1):
         model, ref = Model(params), ReferenceModel(params.as_dict())
-        constant_potential = (params.m_S + 2 * (params.m_b + params.m_h)) * params.g
+        constant_potential = (params.m_S + params.m_Y) * params.g * np.cos(params.slope)
         for _ in range(n_states):
             x, u = random_state(rng, params), random_inputs(rng, 1)[0]
             pairs = {
@@ -113,29 +113,72 @@ def cross_check(n_states=1000, seed=0, n_param_sets=6):
                         catches=catches[k]) for k, v in worst.items()]
 
 
-# -- physics invariants ------------------------------------------------------------------
-def energy_conservation(n_runs=3, seed=1, t_end=20.0):
+def general_cross_check(n_states=200, seed=6, n_robots=5):
+    """The general kernels (issue 18) on random general robots against both independent models:
+    the CasADi reference (accel, inertia, energy) and the Kane model (accel)."""
+    from .alternatives.kane import KaneModel
+    from .reference import ReferenceModel
     rng = np.random.default_rng(seed)
-    model = Model(Params(k_S=0.0, k_Y=0.0, k_P=0.0))
+    worst = {k: [0.0, 0.0, ""] for k in ("accel vs reference", "accel vs Kane", "inertia", "energy")}
+    for _ in range(n_robots):
+        params = random_general_params(rng)
+        model, ref, kane = Model(params), ReferenceModel(params.as_dict()), KaneModel(params)
+        constant_potential = (params.m_S + params.m_Y) * params.g * np.cos(params.slope)
+        for _ in range(n_states):
+            x, u = random_state(rng, params), random_inputs(rng, 1)[0]
+            a = model.accel(x, u)
+            pairs = {"accel vs reference": (a, ref.accel(x, u)), "accel vs Kane": (a, kane.accel(x, u)),
+                     "inertia": (model.inertia(x), ref.inertia(x)),
+                     "energy": (model.energy(x), ref.energy(x) - constant_potential * x[IDX_QZ])}
+            for key, (ours, theirs) in pairs.items():
+                err = float(np.abs(np.asarray(ours) - theirs).max())
+                rel = err / max(float(np.abs(theirs).max()), 1e-300)
+                if rel > worst[key][1]:
+                    worst[key] = [err, rel, f"slope {params.slope:.2f} rad, gears {params.n_Y:.0f}/{params.n_P:.0f}"]
+    catches = {"accel vs reference": "an error in the general robot's ν̇: a centre, a tensor entry, a rotor, the slope",
+               "accel vs Kane": "the same, against a third derivation (KanesMethod, Euler angles)",
+               "inertia": "an error in the general robot's M (rotors, products of inertia)",
+               "energy": "an error in the general robot's energy (the slope's potential)"}
+    total = n_states * n_robots
+    return [CheckResult(f"general robots: {k} ({total} states, {n_robots} robots)", *v[:2], 1e-12, v[2],
+                        catches=catches[k]) for k, v in worst.items()]
+
+
+# -- physics invariants ------------------------------------------------------------------
+def energy_conservation(n_runs=3, seed=1, t_end=20.0, general=False):
+    """Energy along motions without damping or torque: the paper's robot, or (general=True) random
+    general robots of issue 18 on their slopes (the climb's potential m_R g_x q_x included)."""
+    rng = np.random.default_rng(seed)
     worst = (0.0, 0.0)
     for _ in range(n_runs):
+        params = random_general_params(rng) if general else Params()
+        model = Model(params.replace(k_S=0.0, k_Y=0.0, k_P=0.0))
         x0 = random_state(rng, model.params, max_speed=3.0)
         sol = integrate(model, x0, t_end)
         E0 = model.energy(x0)
+        scale = abs(E0) + abs(model.energy(x0) - model.energy(configuration_flow(x0, 0.0, speeds=0.0))) + model.params.potential_range()
         drift = max(abs(model.energy(project_state(x, model.params.r)) - E0) for x in sol.y.T)
-        if drift / abs(E0) > worst[1]:
-            worst = (drift, drift / abs(E0))
-    return CheckResult(f"energy conserved without friction ({n_runs} runs, {t_end:g} s)", *worst, 1e-9,
+        if drift / scale > worst[1]:
+            worst = (drift, drift / scale)
+    robots = "random general robots on slopes" if general else "the paper's robot"
+    return CheckResult(f"energy conserved without friction ({n_runs} runs, {t_end:g} s, {robots})", *worst, 1e-9,
+                       "relative to |E| + the kinetic energy + the shape potential's range",
                        catches="accel and energy that do not belong to one Lagrangian")
 
 
-def configuration_flow(x, t):
-    """The state moved for time t along the exact kinematics with the speeds frozen."""
+def configuration_flow(x, t, r=0.0, speeds=None):
+    """The state moved for time t along the exact kinematics with the speeds frozen, rolling on a
+    shell of radius r (q moves at the constant r (R_S ω_S) × e_z, since R_S Exp(tω_S) ω_S = R_S ω_S);
+    speeds=0.0 returns x with ν = 0 instead."""
     y = x.copy()
+    if speeds is not None:
+        y[IDX_NU] = speeds
+        return y
     R_S, R_Y, R_P = rotations(x)
     y[IDX_RS] = (R_S @ exp(t * x[IDX_WS])).ravel()
     y[IDX_RY] = (R_Y @ rot_x(t * x[IDX_WY])).ravel()
     y[IDX_RP] = (R_P @ rot_y(t * x[IDX_WP])).ravel()
+    y[IDX_Q] = x[IDX_Q] + t * r * np.cross(R_S @ x[IDX_WS], [0.0, 0.0, 1.0])
     return y
 
 
@@ -143,14 +186,16 @@ def energy_rate(model, x, u):
     """dE/dt = νᵀ M ν̇ (kernel inertia and accel) + ∂E/∂(configuration)·(kinematics).
 
     The configuration part is an 8th-order central difference of E along the
-    exact configuration flow (q does not enter E except through q_z, which is
-    constant), accurate to rounding.
+    exact configuration flow (q rolling with the shell: on a slope E depends on
+    q_x), accurate to rounding.
     """
     nu = x[IDX_NU]
     kinetic_part = nu @ model.inertia(x) @ model.accel(x, u)
     h = 1e-3
     weights = {1: 4 / 5, 2: -1 / 5, 3: 4 / 105, 4: -1 / 280}
-    config_part = sum(w * (model.energy(configuration_flow(x, k * h)) - model.energy(configuration_flow(x, -k * h)))
+    params = getattr(model, "params", None)     # a model without params (the paper's formulas): no slope
+    r = params.r if params is not None else 0.0
+    config_part = sum(w * (model.energy(configuration_flow(x, k * h, r)) - model.energy(configuration_flow(x, -k * h, r)))
                       for k, w in weights.items()) / h
     return kinetic_part + config_part
 
@@ -158,7 +203,7 @@ def energy_rate(model, x, u):
 def power_balance(n_states=200, seed=2):
     rng = np.random.default_rng(seed)
     worst = (0.0, 0.0)
-    for params in parameter_sets(rng, 2):
+    for params in parameter_sets(rng, 2) + [random_general_params(rng) for _ in range(2)]:
         model = Model(params)
         for _ in range(n_states):
             x, u = random_state(rng, params), random_inputs(rng, 1)[0]
@@ -169,7 +214,8 @@ def power_balance(n_states=200, seed=2):
             scale = abs(supplied) + dissipated + abs(w @ model.inertia(x) @ model.accel(x, u))
             if err / scale > worst[1]:
                 worst = (err, err / scale)
-    return CheckResult(f"power balance dE/dt = u·ω − Σ k ω² ({3 * n_states} states)", *worst, 1e-9,
+    return CheckResult(f"power balance dE/dt = u·ω − Σ k ω² ({5 * n_states} states, 2 general robots on slopes)",
+                       *worst, 1e-9,
                        "relative to |u·ω| + Σ k ω² + |νᵀMν̇|",
                        catches="wrong or missing torque or damping terms (the non-conservative forces)")
 
@@ -199,7 +245,7 @@ def rolling_contact(n_runs=3, seed=3, t_end=1.0, dt=2.5e-4, samples=20):
         err = float(np.abs(implied[rows] - expected).max())
         if err / np.abs(expected).max() > worst_force[1]:
             worst_force = (err, err / float(np.abs(expected).max()))
-        weight_moment = (params.m_S + 2 * (params.m_b + params.m_h) + params.m_P) * params.g * params.r
+        weight_moment = params.m_R * params.g * params.r
         err = float(np.abs(moment_residual).max())
         if err / weight_moment > worst_moment[1]:
             worst_moment = (err, err / weight_moment)
@@ -276,7 +322,12 @@ def planar_symmetry(steps=2000):
 
 def jacobian_rows(n_states=1000, seed=5):
     from .jacobians import accel_jacobian_checks, step_jacobian_checks
-    return ([CheckResult(*row, catches="a Jacobian entry off by 1e-6") for row in accel_jacobian_checks(n_states, seed)]
+    general = random_general_params(np.random.default_rng(seed + 2))
+    general_rows = [(f"{name} on a general robot", *rest)
+                    for name, *rest in accel_jacobian_checks(max(n_states // 5, 20), seed + 3, params=general,
+                                                             n_difference=10)]
+    return ([CheckResult(*row, catches="a Jacobian entry off by 1e-6")
+             for row in accel_jacobian_checks(n_states, seed) + general_rows]
             + [CheckResult(*row, catches="an entry of F or G off by 1e-6 of the largest")
                for row in step_jacobian_checks(min(n_states, 20), seed + 1)])
 
@@ -292,7 +343,8 @@ def linearization_rows():
 def run_all(n_states=1000, seed=0, progress=None):
     steps = [
         ("cross-check", lambda: cross_check(n_states, seed)),
-        ("energy", lambda: [energy_conservation(seed=seed + 1)]),
+        ("general robots", lambda: general_cross_check(max(n_states // 5, 20), seed + 6)),
+        ("energy", lambda: [energy_conservation(seed=seed + 1), energy_conservation(seed=seed + 7, t_end=5.0, general=True)]),
         ("power", lambda: [power_balance(max(n_states // 5, 20), seed=seed + 2)]),
         ("rolling", lambda: rolling_contact(seed=seed + 3)),
         ("equilibria", lambda: equilibria(seed=seed + 4)),

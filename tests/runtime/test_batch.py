@@ -10,7 +10,6 @@ from bindings._sr import lib
 from runtime import Model, Params, initial_state, simulate_many
 from runtime.batch import METRIC_NAMES
 from runtime.model import CHUNK_STEPS
-from runtime.params import NAMES as PARAM_NAMES
 from runtime.state import IDX_Q, IDX_QZ, IDX_WS, NX
 
 STEPS = CHUNK_STEPS + 300     # crosses a chunk boundary: the energy guard and Kahan sums restart there
@@ -38,7 +37,7 @@ def test_every_sample_equals_model_simulate_bit_for_bit(method, rng):
 
 def test_the_bit_for_bit_comparison_sees_a_one_ulp_change_of_one_parameter(rng):
     params, x0, u = samples(1, rng)
-    nudged = Params(**{**params[0].as_dict(), "m_P": np.nextafter(params[0].m_P, 2.0)})
+    nudged = params[0].with_changes(m_P=np.nextafter(params[0].m_P, 2.0))
     result = simulate_many(params, x0, 0.01, STEPS, u)
     assert not np.array_equal(result.final[0], Model(nudged).simulate(x0[0], 0.01, STEPS, u[0])[-1])
 
@@ -77,7 +76,7 @@ def test_shared_arguments_equal_the_same_values_repeated(rng):
 def test_a_bad_sample_fails_alone_with_its_status(rng):
     params, x0, u = samples(5, rng, steps=300)
     p = np.stack([q.as_array() for q in params])
-    p[1, PARAM_NAMES.index("m_P")] = -1.0          # m_P < 0
+    p[1, lib.SR_P_m_P] = -1.0          # m_P < 0
     x0[2, 0] = np.nan                               # non-finite initial state
     x0[3, IDX_QZ] *= 1.01                           # q_z != r
     u[4, 99, 0] = np.inf                            # a bad torque at step 100

@@ -75,7 +75,7 @@ def test_dynamics_depend_on_R_S_only_through_gamma(model, rng):
 
 
 def test_equilibrium_residual_vanishes_at_both_configurations_of_eq_108(model, rng):
-    scale = model.params.m_P * model.params.g * model.params.l
+    scale = model.params.potential_range()
     for _ in range(50):
         theta_Y, theta_P = rng.uniform(-np.pi, np.pi, size=2)
         R_YP = rot_x(theta_Y) @ rot_y(theta_P)

@@ -132,16 +132,21 @@ def test_project_state_refuses_non_finite_entries(x):
 
 
 # -- parameters -----------------------------------------------------------------------------------
-def test_parameters_whose_inertias_underflow_are_rejected():
+def test_paper_parameters_whose_inertias_underflow_are_rejected():
     tiny = 1e-200
-    with pytest.raises(KernelError, match="^params: the generalized inertia M is not positive definite"):
-        Model(Params(r=tiny, b=tiny, h=tiny, l=tiny))
+    with pytest.raises(ValueError, match="^Params.j_S: must be > 0, got 0.0"):
+        Params.paper(r=tiny, b=tiny, h=tiny, l=tiny)
 
 
-def test_parameters_that_overflow_are_rejected():
+def test_paper_parameters_whose_inertias_overflow_are_rejected():
     big = 1e200
+    with pytest.raises(ValueError, match="^Params: the paper's parameters .* give no valid robot"):
+        Params.paper(r=big, b=0.2 * big, h=0.5 * big, l=0.2 * big)
+
+
+def test_parameters_that_overflow_the_model_are_rejected():
     with pytest.raises(KernelError, match="^params: the model overflows"):
-        Model(Params(r=big, b=0.2 * big, h=0.5 * big, l=0.2 * big))
+        Model(Params().replace(r=1e200, j_S=1e200))
 
 
 # -- simulation guards ------------------------------------------------------------------------------

@@ -83,6 +83,11 @@ import numpy as np
 # with derive/ or the kernels); tests/runtime/verification/test_tables.py checks them against
 # the generated SR_P_* and SR_X_* macros.
 PARAM_NAMES = ("r", "m_S", "k_S", "b", "h", "m_b", "m_h", "k_Y", "l", "m_P", "k_P", "g")
+#: The general robot of issue 18, flattened (centres x, y, z; tensors xx, yy, zz, xy, xz, yz).
+_TENSOR = ("xx", "yy", "zz", "xy", "xz", "yz")
+GENERAL_PARAM_NAMES = ("r", "m_S", "j_S", "k_S", "m_Y", "c_Y_x", "c_Y_y", "c_Y_z", *(f"J_Y_{k}" for k in _TENSOR),
+                       "k_Y", "m_P", "c_P_x", "c_P_y", "c_P_z", *(f"J_P_{k}" for k in _TENSOR), "k_P",
+                       "j_mY", "n_Y", "j_mP", "n_P", "g", "slope")
 STATE_DIM = 35
 #: Offsets of the blocks of the state: R_S, R_Y, R_P row-major (9 each), q (3), nu = (w_S, w_Y, w_P).
 X_R_S, X_R_Y, X_R_P, X_Q, X_NU = 0, 9, 18, 27, 30
@@ -91,14 +96,18 @@ _LOCK = threading.Lock()
 _DERIVED = {}  # "symbolic" and (cse, module) -> derived functions, filled once per process
 
 
-def _derive():
-    """Symbolic derivation with sympy.physics.mechanics; returns a dict of the expressions to lambdify."""
+def _derive(general=False):
+    """Symbolic derivation with sympy.physics.mechanics; returns a dict of the expressions to lambdify.
+
+    general=False: the paper's robot by its twelve parameters (rods); True: the general robot of
+    issue 18 (bodies by mass, centre and tensor, motor rotors, a slope)."""
     import sympy as sm
     import sympy.physics.mechanics as me
 
     t0 = time.perf_counter()
-    par = sm.symbols(" ".join(PARAM_NAMES), real=True)
-    r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g = par
+    par = sm.symbols(" ".join(GENERAL_PARAM_NAMES if general else PARAM_NAMES), real=True)
+    named = dict(zip(GENERAL_PARAM_NAMES if general else PARAM_NAMES, par))
+    r, m_S, k_S, k_Y, m_P, k_P, g = (named[k] for k in ("r", "m_S", "k_S", "k_Y", "m_P", "k_P", "g"))
     u_Y, u_P = sm.symbols("u_Y u_P", real=True)
 
     psi, theta, phi, thY, thP, xq, yq = me.dynamicsymbols("psi theta phi th_Y th_P x y")
@@ -141,18 +150,47 @@ def _derive():
         ixx, iyy, izz = [mass * length**2 / 12 * (1 - a) for a in axis]
         return me.RigidBody(name, pt, frame, mass, (me.inertia(frame, ixx, iyy, izz), pt))
 
-    shell = me.RigidBody("shell", O, S, m_S, (me.inertia(S, *(3 * [sm.Rational(2, 3) * m_S * r**2])), O))
-    bodies = [
-        shell,
-        rod("b_plus", Y, m_b, b, (0, 1, 0), +h / 2 * Y.x),
-        rod("b_minus", Y, m_b, b, (0, 1, 0), -h / 2 * Y.x),
-        rod("h_plus", Y, m_h, h, (1, 0, 0), +b / 2 * Y.y),
-        rod("h_minus", Y, m_h, h, (1, 0, 0), -b / 2 * Y.y),
-        rod("pendulum", P, m_P, l, (0, 0, 1), -l / 2 * P.z),
-    ]
+    def body(name, frame, mass, c, J):
+        pt = O.locatenew(name + "_cm", c[0] * frame.x + c[1] * frame.y + c[2] * frame.z)
+        pt.v2pt_theory(O, N, frame)
+        return me.RigidBody(name, pt, frame, mass, (me.inertia(frame, *J), pt))
+
+    if general:
+        def centre(prefix):
+            return [named[f"{prefix}_{a}"] for a in "xyz"]
+
+        def tensor(prefix):
+            """me.inertia's argument order: ixx, iyy, izz, ixy, iyz, izx."""
+            return [named[f"{prefix}_{k}"] for k in ("xx", "yy", "zz", "xy", "yz", "xz")]
+
+        shell = me.RigidBody("shell", O, S, m_S, (me.inertia(S, *(3 * [named["j_S"]])), O))
+        # The motors' rotors: only their axial inertias count; each turns n times its joint
+        # relative to its carrier (the yoke motor's on the shell, the pendulum motor's on the yoke).
+        RmY, RmP = me.ReferenceFrame("RmY"), me.ReferenceFrame("RmP")
+        RmY.orient_axis(S, S.x, named["n_Y"] * thY)
+        RmY.set_ang_vel(S, named["n_Y"] * wY * S.x)
+        RmP.orient_axis(Y, Y.y, named["n_P"] * thP)
+        RmP.set_ang_vel(Y, named["n_P"] * wP * Y.y)
+        bodies = [shell, body("yoke", Y, named["m_Y"], centre("c_Y"), tensor("J_Y")),
+                  body("pendulum", P, m_P, centre("c_P"), tensor("J_P")),
+                  me.RigidBody("rotor_Y", O, RmY, 0, (me.inertia(RmY, named["j_mY"], 0, 0), O)),
+                  me.RigidBody("rotor_P", O, RmP, 0, (me.inertia(RmP, 0, named["j_mP"], 0), O))]
+        gravity = -g * (sm.sin(named["slope"]) * N.x + sm.cos(named["slope"]) * N.z)
+    else:
+        b, h, m_b, m_h, l = (named[k] for k in ("b", "h", "m_b", "m_h", "l"))
+        shell = me.RigidBody("shell", O, S, m_S, (me.inertia(S, *(3 * [sm.Rational(2, 3) * m_S * r**2])), O))
+        bodies = [
+            shell,
+            rod("b_plus", Y, m_b, b, (0, 1, 0), +h / 2 * Y.x),
+            rod("b_minus", Y, m_b, b, (0, 1, 0), -h / 2 * Y.x),
+            rod("h_plus", Y, m_h, h, (1, 0, 0), +b / 2 * Y.y),
+            rod("h_minus", Y, m_h, h, (1, 0, 0), -b / 2 * Y.y),
+            rod("pendulum", P, m_P, l, (0, 0, 1), -l / 2 * P.z),
+        ]
+        gravity = -g * N.z
     tau_Y = u_Y - k_Y * wY
     tau_P = u_P - k_P * wP
-    loads = [(body.masscenter, -body.mass * g * N.z) for body in bodies]
+    loads = [(body.masscenter, body.mass * gravity) for body in bodies if body.mass != 0]
     loads += [
         (Y, tau_Y * Y.x), (S, -tau_Y * S.x),
         (P, tau_P * Y.y), (Y, -tau_P * Y.y),
@@ -223,21 +261,21 @@ def _broadcast_array(rows):
     return np.array([[np.broadcast_to(e, shape) for e in row] for row in rows])
 
 
-def _derivation():
-    """The symbolic derivation, once per process."""
+def _derivation(general=False):
+    """The symbolic derivation, once per process (per variant)."""
     with _LOCK:
-        if "symbolic" not in _DERIVED:
-            _DERIVED["symbolic"] = _derive()
-        return _DERIVED["symbolic"]
+        if ("symbolic", general) not in _DERIVED:
+            _DERIVED[("symbolic", general)] = _derive(general)
+        return _DERIVED[("symbolic", general)]
 
 
-def _lambdified(cse, module):
-    """The lambdified functions for (cse, module), once per process."""
-    d = _derivation()
+def _lambdified(cse, module, general=False):
+    """The lambdified functions for (cse, module), once per process (per variant)."""
+    d = _derivation(general)
     with _LOCK:
-        if (cse, module) not in _DERIVED:
-            _DERIVED[(cse, module)] = _lambdify(d, cse, module)
-        return _DERIVED[(cse, module)]
+        if (cse, module, general) not in _DERIVED:
+            _DERIVED[(cse, module, general)] = _lambdify(d, cse, module)
+        return _DERIVED[(cse, module, general)]
 
 
 def euler_zyx(R_S):
@@ -248,6 +286,20 @@ def euler_zyx(R_S):
     if c < 1e-12:                          # gimbal lock: only phi -+ psi is defined
         return 0.0, theta, math.atan2(-R[1, 2], R[1, 1])
     return math.atan2(R[1, 0], R[0, 0]), theta, math.atan2(R[2, 1], R[2, 2])
+
+
+def flat_general(params):
+    """A general parameter dict with c_* (3,) and J_* (3, 3) arrays, flattened to GENERAL_PARAM_NAMES."""
+    out = {}
+    for k, v in params.items():
+        v = np.asarray(v, dtype=float)
+        if v.shape == (3,):
+            out.update({f"{k}_{a}": float(v[i]) for i, a in enumerate("xyz")})
+        elif v.shape == (3, 3):
+            out.update({f"{k}_{t}": float(v["xyz".index(t[0]), "xyz".index(t[1])]) for t in _TENSOR})
+        else:
+            out[k] = float(v)
+    return out
 
 
 class KaneModel:
@@ -269,21 +321,27 @@ class KaneModel:
         if module not in MODULES:
             raise ValueError(f"module: expected one of {sorted(MODULES)}, got {module!r}")
         self.module = module
-        if not isinstance(params, dict):
-            params = {k: getattr(params, k) for k in PARAM_NAMES}
-        missing = [k for k in PARAM_NAMES if k not in params]
-        extra = [k for k in params if k not in PARAM_NAMES]
+        if not isinstance(params, dict):     # a runtime.Params: the paper's names if it is the paper's robot
+            paper = getattr(params, "paper_params", None)
+            params = ({k: getattr(paper, k) for k in PARAM_NAMES} if paper is not None
+                      else flat_general(params.as_dict()))
+        elif "c_Y" in params:
+            params = flat_general(params)
+        self.general = set(params) != set(PARAM_NAMES)
+        names = GENERAL_PARAM_NAMES if self.general else PARAM_NAMES
+        missing = [k for k in names if k not in params]
+        extra = [k for k in params if k not in names]
         if missing or extra:
             raise ValueError(f"bad parameter set: missing={missing}, unknown={extra}")
-        self.params = {k: float(params[k]) for k in PARAM_NAMES}
-        self._p = tuple(self.params[k] for k in PARAM_NAMES)
-        d = _lambdified(self.cse, self.module)
+        self.params = {k: float(params[k]) for k in names}
+        self._p = tuple(self.params[k] for k in names)
+        d = _lambdified(self.cse, self.module, self.general)
         self._f_MF, self._f_udep = d["f_MF"], d["f_udep"]
 
     @property
     def derivation_seconds(self) -> float:
         """Wall time of the symbolic derivation (KanesMethod) plus lambdify, once per process."""
-        return _derivation()["seconds"] + _lambdified(self.cse, self.module)["seconds"]
+        return _derivation(self.general)["seconds"] + _lambdified(self.cse, self.module, self.general)["seconds"]
 
     @staticmethod
     def coordinates(x):
@@ -332,7 +390,7 @@ class KaneModel:
         (what a NumPy user would do with a batch) and one batched solve."""
         if self.module != "numpy":
             raise ValueError(f"accel_batch: needs module='numpy', this model has module={self.module!r}")
-        d = _lambdified(self.cse, self.module)
+        d = _lambdified(self.cse, self.module, self.general)
         qv, w = self.coordinates_batch(X)
         U = np.asarray(U, dtype=float)
         if U.shape != (len(qv[0]), 2):

@@ -87,7 +87,7 @@ def test_header_layout_macros_equal_the_derive_sources():
 
 
 @pytest.mark.parametrize("perturb", [
-    lambda h: h.replace("#define SR_P_m_P 9", "#define SR_P_m_P 10"),
+    lambda h: h.replace("#define SR_P_m_P 15", "#define SR_P_m_P 16"),
     lambda h: h.replace("#define SR_X_w_Y 33\n", ""),
     lambda h: h.replace("#define SR_U_u_P 1", "#define SR_U_u_P 0"),
     lambda h: h.replace("#define SR_GEN_NX 35", "#define SR_GEN_NX 36"),

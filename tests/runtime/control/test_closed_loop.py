@@ -60,7 +60,7 @@ def test_a_smaller_torque_limit_is_respected_and_counted():
 
 def test_mismatched_noisy_plant_still_tracks_the_speed():
     task = load_task("speed-step")
-    plant = dataclasses.replace(task.plant_params, m_P=1.1, m_h=4.5, k_S=0.176, k_Y=0.036)
+    plant = task.plant_params.with_changes(m_P=1.1, m_h=4.5, k_S=0.176, k_Y=0.036)
     task = dataclasses.replace(short("speed-step", 8.0), plant_params=plant,
                                noise=Noise(position_m=0.002, attitude_rad=0.002, rate_rad_s=0.01, seed=1))
     result, _, _ = run_task(task)

@@ -97,12 +97,12 @@ def test_slider_shows_the_csv_row_at_that_time(page, csv_rows):
     shown = page.execute_script("return window.replay.time")
     assert shown == 37.5
     row = int(np.flatnonzero(csv_rows["t"] == shown)[0])
-    drawn, expected = drawn_points(page), expected_points(csv_rows, row, p.r, p.l)
+    drawn, expected = drawn_points(page), expected_points(csv_rows, row, p.r, p.paper_params.l)
     np.testing.assert_array_equal(drawn[0], expected[0])                   # the centre: the CSV's doubles
     for got, want in zip(drawn[1:], expected[1:]):                         # marker and bob: R p + q in JS
         np.testing.assert_allclose(got, want, rtol=0, atol=1e-12)
     # The comparison can fail: the previous frame (5 steps earlier) is elsewhere.
-    earlier = expected_points(csv_rows, row - 5, p.r, p.l)
+    earlier = expected_points(csv_rows, row - 5, p.r, p.paper_params.l)
     assert all(np.abs(got - want).max() > 1e-6 for got, want in zip(drawn, earlier))
     assert "t = 37.50 s" in page.execute_script("return document.getElementById('readout').textContent")
     assert browser.console_errors(page) == []

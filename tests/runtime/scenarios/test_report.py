@@ -18,7 +18,7 @@ def test_summary_energy_balance_for_the_tilted_pendulum(results):
     therefore vanish at first order: halve with dt (measured ratios 2.12, 2.06).
     """
     p = Params.paper_simulation()
-    expected = p.m_P * p.g * (p.l / 2) * (1 - math.cos(math.pi / 4))
+    expected = p.m_P * p.g * (p.paper_params.l / 2) * (1 - math.cos(math.pi / 4))
     energy = report.summary(results["tilted-pendulum"])["energy_J"]
     assert energy["initial"] - energy["final"] == pytest.approx(expected, rel=1e-9)
     assert energy["motor_work"] == 0.0

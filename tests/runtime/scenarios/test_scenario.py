@@ -234,7 +234,7 @@ theta_P = 0.5
     (VALID.replace("steps = 10", "duration = 1e9"), "duration", "MAX_STEPS"),
     (VALID + "[[torque]]\nfrom_time = 0.1\nto_time = 0.2\nu_P = 1.0\n", "torque[1].from_time", "past the end"),
     (VALID.replace('preset = "paper"', 'preset = "paper"\nr = 1e-200\nb = 1e-200\nh = 1e-200\nl = 1e-200'),
-     "params", "not positive definite"),
+     "params", "Params.j_S: must be > 0"),
 ])
 def test_invalid_files_name_the_file_the_key_and_the_problem(tmp_path, text, key, what):
     path = tmp_path / "bad.toml"

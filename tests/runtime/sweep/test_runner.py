@@ -18,7 +18,7 @@ from runtime.state import IDX_Q, IDX_WS
 from runtime.sweep.runner import SERIAL, run_sweep
 from runtime.sweep.spec import load_sweep, sample_inputs
 from runtime.sweep.store import RESULTS
-from runtime.params import NAMES as PARAM_NAMES
+
 
 from .conftest import SWEEP, write_sweep
 
@@ -52,7 +52,7 @@ def test_serial_rows_equal_independent_runs_sample_by_sample(serial):
     failures = 0
     for i in range(spec.samples):
         try:
-            model = Model(Params(**dict(zip(PARAM_NAMES, params[i]))))
+            model = Model(Params.from_array(params[i]))
         except ValueError:
             failures += 1
             assert rows["status"][i] != 0 and rows["steps_done"][i] == 0

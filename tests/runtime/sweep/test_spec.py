@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from runtime.params import NAMES as PARAM_NAMES
+from bindings._sr import lib
 from runtime.state import IDX_QZ, IDX_UP, IDX_UY, pendulum_angle
 from runtime.sweep.spec import load_sweep, quantity_values, sample_inputs, shipped_sweeps
 
@@ -36,11 +36,11 @@ def test_a_sample_s_inputs_do_not_depend_on_the_chunk_it_is_in(spec):
 def test_inputs_apply_relative_factors_angles_and_torque_scales(spec):
     params, x0, u, values = sample_inputs(spec, 0, 4)
     base = spec.scenario
-    k_S = PARAM_NAMES.index("k_S")
+    k_S = lib.SR_P_k_S
     assert np.array_equal(params[:, k_S], values["params.k_S"] * base.params.k_S)
-    assert np.array_equal(params[:, PARAM_NAMES.index("m_P")], values["params.m_P"])
+    assert np.array_equal(params[:, lib.SR_P_m_P], values["params.m_P"])
     assert np.allclose(pendulum_angle(x0), values["initial.theta_P"], atol=1e-15)
-    assert np.array_equal(x0[:, IDX_QZ], params[:, PARAM_NAMES.index("r")])
+    assert np.array_equal(x0[:, IDX_QZ], params[:, lib.SR_P_r])
     program = base.torque_at_step_starts()
     assert u.shape == (4, base.steps, 2)
     assert np.array_equal(u[:, :, IDX_UY], values["torque.u_Y_scale"][:, None] * program[:, IDX_UY])

@@ -7,7 +7,7 @@ from runtime.verification.contact import DIFF_HALF_WIDTH, ReferenceContact, mome
 from runtime.verification.sampling import random_state
 
 PARAMS = Params.paper_simulation()
-TOTAL_MASS = PARAMS.m_S + 2 * (PARAMS.m_b + PARAMS.m_h) + PARAMS.m_P
+TOTAL_MASS = PARAMS.m_S + 2 * (PARAMS.paper_params.m_b + PARAMS.paper_params.m_h) + PARAMS.m_P
 
 
 def test_reference_contact_force_at_rest_carries_the_weight_and_nothing_sideways():
@@ -33,5 +33,5 @@ def test_a_robot_at_rest_implies_the_weight_as_contact_force_and_balanced_moment
 def test_a_tilted_pendulum_at_rest_shows_an_unbalanced_moment():
     X = np.tile(initial_state(theta_P=0.3, r=PARAMS.r), (2 * DIFF_HALF_WIDTH + 1, 1))
     moment = momentum_residuals(X, 0.01, PARAMS.as_dict())[1]
-    expected = PARAMS.m_P * PARAMS.g * PARAMS.l / 2 * np.sin(0.3)
+    expected = PARAMS.m_P * PARAMS.g * PARAMS.paper_params.l / 2 * np.sin(0.3)
     assert np.isclose(np.abs(moment).max(), expected, rtol=1e-12)

@@ -48,3 +48,24 @@ def test_step_jacobian_rows_fail_for_a_perturbed_jacobian(block):
             G[9, 1] += 1e-6 * np.abs(F).max()
         return F, G
     assert rows_pass(step_jacobian_checks(n_states=4, jacobian=perturbed)) == [False] * 6
+
+
+def general_robot():
+    from runtime.verification.sampling import random_general_params
+    return random_general_params(np.random.default_rng(21))
+
+
+def test_accel_jacobian_rows_pass_for_a_general_robot():
+    assert rows_pass(accel_jacobian_checks(n_states=20, n_difference=3, params=general_robot())) == [True, True]
+
+
+def test_accel_jacobian_rows_fail_for_a_perturbed_jacobian_of_a_general_robot():
+    """The general kernel's Jacobian (rotors, slope, full tensors), an entry of the slope's column
+    direction δξ off by 1e-6."""
+    def perturbed(model, x, u):
+        Ja, Jb = model.accel_jacobian(x, u)
+        Ja = Ja.copy()
+        Ja[1, 0] *= 1 + 1e-6
+        return Ja, Jb
+    rows = accel_jacobian_checks(n_states=20, n_difference=3, params=general_robot(), jacobian=perturbed)
+    assert rows_pass(rows) == [False, False]

@@ -175,7 +175,7 @@ def test_inertia_is_symmetric_positive_definite(model, rng):
 
 
 def test_inertia_reproduces_kinetic_energy(model, rng):
-    p = model.params
+    p = model.paper
     for _ in range(10):
         x = _random_state(rng, p["r"])
         nu = x[30:35]
@@ -207,7 +207,7 @@ def test_contact_point_is_at_rest_under_rolling_velocity(model, rng):
 
 
 def test_power_balance_matches_input_minus_dissipation(model, rng):
-    p = model.params
+    p = model.paper
     worst = 0.0
     for _ in range(10):
         x = _random_state(rng, p["r"])
@@ -237,7 +237,7 @@ def test_energy_is_conserved_without_damping_or_torque():
 
 
 def test_accel_matches_kane_equations_in_3d(model, rng):
-    p = model.params
+    p = model.paper
     for _ in range(8):
         x = _random_state(rng, p["r"], speed=5.0)
         u = rng.uniform(-2, 2, 2)
@@ -253,7 +253,7 @@ def test_accel_matches_planar_rolling_pendulum(model, rng):
     Coordinates: shell angle alpha about y (x = r alpha), absolute pendulum
     angle psi = alpha + theta_P.  Hand-derived Lagrangian equations.
     """
-    p = model.params
+    p = model.paper
     r, l, mP, g = p["r"], p["l"], p["m_P"], p["g"]
     mY = 2 * (p["m_b"] + p["m_h"])
     JS = 2 / 3 * p["m_S"] * r**2

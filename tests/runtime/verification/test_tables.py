@@ -14,6 +14,24 @@ def generated_parameter_order():
     return tuple(sorted(indices, key=indices.get))
 
 
+def generated_paper_order():
+    indices = {name[len("SR_PAPER_"):]: getattr(lib, name) for name in dir(lib) if name.startswith("SR_PAPER_")}
+    return tuple(sorted(indices, key=indices.get))
+
+
+def flattened(names):
+    """The reference's grouped names (c_Y, J_Y, ...) as the entries of the C vector."""
+    out = []
+    for n in names:
+        if n.startswith("c_"):
+            out += [f"{n}_{a}" for a in "xyz"]
+        elif n.startswith("J_"):
+            out += [f"{n}_{k}" for k in ("xx", "yy", "zz", "xy", "xz", "yz")]
+        else:
+            out.append(n)
+    return tuple(out)
+
+
 def generated_state_offsets():
     return {name[len("SR_X_"):]: getattr(lib, name) for name in dir(lib) if name.startswith("SR_X_")}
 
@@ -41,23 +59,25 @@ def test_the_generated_tables_are_complete():
 def test_the_reference_tables_follow_the_generated_order():
     offsets = {"R_S": reference._RS.start, "R_Y": reference._RY.start, "R_P": reference._RP.start,
                "q": reference._Q.start, "w_S": reference._WS.start, "w_Y": reference._WY, "w_P": reference._WP}
-    assert layout_mismatches(reference.PARAM_NAMES, reference.STATE_DIM, offsets) == []
+    assert layout_mismatches(flattened(reference.PARAM_NAMES), reference.STATE_DIM, offsets) == []
     assert reference._NU.start == lib.SR_X_w_S
+    assert reference.PAPER_PARAM_NAMES == generated_paper_order()
 
 
 def test_the_kane_tables_follow_the_generated_order():
     offsets = {"R_S": kane.X_R_S, "R_Y": kane.X_R_Y, "R_P": kane.X_R_P, "q": kane.X_Q,
                "w_S": kane.X_NU, "w_Y": kane.X_NU + 3, "w_P": kane.X_NU + 4}
-    assert layout_mismatches(kane.PARAM_NAMES, kane.STATE_DIM, offsets) == []
+    assert layout_mismatches(kane.GENERAL_PARAM_NAMES, kane.STATE_DIM, offsets) == []
+    assert kane.PARAM_NAMES == generated_paper_order()
 
 
 def test_a_swapped_table_is_reported():
-    names = list(reference.PARAM_NAMES)
+    names = list(flattened(reference.PARAM_NAMES))
     names[0], names[1] = names[1], names[0]
     offsets = dict(generated_state_offsets(), w_Y=lib.SR_X_w_P, w_P=lib.SR_X_w_Y)
     problems = layout_mismatches(names, lib.SR_NX, offsets)
     assert len(problems) == 3 and "parameter order" in problems[0]
-    assert layout_mismatches(reference.PARAM_NAMES, lib.SR_NX + 1, generated_state_offsets()) != []
+    assert layout_mismatches(flattened(reference.PARAM_NAMES), lib.SR_NX + 1, generated_state_offsets()) != []
 
 
 def test_the_reference_builds_the_same_state_as_the_runtime(rng):

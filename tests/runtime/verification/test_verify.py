@@ -58,6 +58,28 @@ def test_each_cross_check_row_fails_for_a_kernel_with_a_mass_off_by_1e_6(kernel_
     assert not verify.cross_check(n_states=5, seed=0, n_param_sets=1)[row].passed
 
 
+def test_general_robots_agree_with_both_independent_models():
+    assert_passed(verify.general_cross_check(n_states=40, seed=12, n_robots=3))
+
+
+@pytest.mark.parametrize("name, rows", [("m_Y", [0, 1, 2, 3]), ("slope", [0, 1, 3]), ("n_Y", [0, 1, 2, 3]),
+                                        ("j_mP", [0, 1, 2, 3])])
+def test_general_rows_fail_for_a_kernel_with_a_parameter_off_by_1e_6(kernel_with, name, rows):
+    """The slope enters ν̇ and the energy, not M; a rotor and the yoke's mass everything."""
+    kernel_with(**{name: 1e-6})
+    results = verify.general_cross_check(n_states=5, seed=12, n_robots=1)
+    assert [i for i, r in enumerate(results) if not r.passed] == rows
+
+
+def test_general_robots_conserve_energy_on_their_slopes():
+    assert_passed([verify.energy_conservation(n_runs=2, seed=7, t_end=3.0, general=True)])
+
+
+def test_general_energy_row_fails_for_an_accel_off_by_1e_6_relative(accel_with):
+    accel_with(lambda x, a: a * (1 + 1e-6))
+    assert not verify.energy_conservation(n_runs=1, seed=7, t_end=3.0, general=True).passed
+
+
 def test_energy_is_conserved_without_friction_and_torque():
     assert_passed([verify.energy_conservation(n_runs=2, seed=5, t_end=20.0)])
 

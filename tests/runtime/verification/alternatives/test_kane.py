@@ -26,7 +26,7 @@ def _rel(a, b):
 
 @pytest.fixture(scope="module")
 def models():
-    params = dataclasses.asdict(Params.paper_simulation())
+    params = Params.paper_simulation().paper_params.as_dict()
     return KaneModel(params), ReferenceModel(params)
 
 
@@ -46,7 +46,7 @@ def test_agrees_with_reference_at_random_states(models, rng):
 def test_agrees_with_reference_for_other_parameters(rng):
     for _ in range(3):
         p = random_params(rng)
-        km, ref = KaneModel(p), ReferenceModel(dataclasses.asdict(p))
+        km, ref = KaneModel(p), ReferenceModel(p.as_dict())
         for _ in range(5):
             x = random_state(rng, p)
             u = rng.uniform(-1.0, 1.0, size=2)
