@@ -29,6 +29,7 @@ import sympy as sp
 
 from . import dynamics as D
 from . import parameters as P
+from . import robot as R
 from . import state as S
 
 _e_x = sp.Matrix([1, 0, 0])
@@ -121,3 +122,50 @@ def rhs():
 def check_equal_to_rhs():
     """Residuals rhs() − dynamics.rhs() reduced modulo the unit-norm identities: all zero."""
     return [D.on_manifold(sp.expand(x - y)) for x, y in zip(rhs(), D.rhs())]
+
+
+def general_program():
+    """f of the general robot (issue 18, derive.robot.GENERAL) body by body, in the shell frame:
+    (program, f).  The same d'Alembert principle about O as `program`, with what the general robot
+    adds: first moments h = R c m and tensors about O of any shape (I = R J_O Rᵀ with
+    J_O = tr(Ĵ_O) I − Ĵ_O), gravity G = R_Sᵀg⃗ = −(g_x χ + g_z γ) on a slope (as an acceleration −G
+    of O: moments −h × G, and the whole mass's −m_R G through the rolling constraint), and the two
+    rotors (axial inertia j e eᵀ about their axes e_x on the shell and e = R_Y e_y on the yoke,
+    angular velocities ω + n_Y ω_Y e_x and ω_y + n_P ω_P e, partial velocities n_Y e_x, n_P e)."""
+    rb = R.GENERAL
+    p = Program()
+    w, e = S.w_S, joint_axis(S.R_Y)
+    G = p.let("G", -(rb.g_x * S.chi + rb.g_z * S.gamma))
+    w_y = p.let("w_y", w + S.w_Y * _e_x)
+    w_p = p.let("w_p", w_y + S.w_P * e)
+    alpha_Y = p.let("alpha_Y", S.w_Y * w.cross(_e_x))
+    alpha_P = p.let("alpha_P", alpha_Y + S.w_P * w_y.cross(e))
+
+    def about_O(rotation, Jhat):
+        """R J_O Rᵀ: the standard tensor about O of a non-standard one, in the shell frame."""
+        Jhat = sp.Matrix(Jhat)
+        return rotation * (Jhat.trace() * sp.eye(3) - Jhat) * rotation.T
+
+    R_YP = S.R_Y * S.R_P
+    I_Y, I_P = about_O(S.R_Y, rb.Jhat_Y), about_O(R_YP, rb.Jhat_P)
+    h_Y, h_P = p.let("hY", S.R_Y * sp.Matrix(rb.h_Y)), p.let("hP", R_YP * sp.Matrix(rb.h_P))
+    tau_Y = p.let("tau_Y", I_Y * alpha_Y + w_y.cross(I_Y * w_y) - h_Y.cross(G))
+    tau_P = p.let("tau_P", I_P * alpha_P + w_p.cross(I_P * w_p) - h_P.cross(G))
+    w_rY, w_rP = w + rb.n_Y * S.w_Y * _e_x, w_y + rb.n_P * S.w_P * e
+    a_rY, a_rP = rb.n_Y * S.w_Y * w.cross(_e_x), alpha_Y + rb.n_P * S.w_P * w_y.cross(e)
+    s_rY = p.let("s_rY", rb.j_mY * (_e_x.dot(a_rY) * _e_x + _e_x.dot(w_rY) * w_rY.cross(_e_x)))
+    s_rP = p.let("s_rP", rb.j_mP * (e.dot(a_rP) * e + e.dot(w_rP) * w_rP.cross(e)))
+    F = p.let("F", alpha_Y.cross(h_Y) + w_y.cross(w_y.cross(h_Y)) + alpha_P.cross(h_P)
+              + w_p.cross(w_p.cross(h_P)) - rb.m_R * G)
+    T = p.let("T", tau_Y + tau_P + s_rY + s_rP)
+    shell = -rb.k_S * w - (T + rb.r * S.gamma.cross(F))
+    yoke = S.u_Y - rb.k_Y * S.w_Y - _e_x.dot(tau_Y + tau_P + s_rP) - rb.n_Y * _e_x.dot(s_rY)
+    pendulum = S.u_P - rb.k_P * S.w_P - e.dot(tau_P) - rb.n_P * e.dot(s_rP)
+    return p, sp.Matrix([*shell, yoke, pendulum])
+
+
+def check_general_equal_to_rhs():
+    """Residuals of `general_program` − dynamics.rhs(GENERAL), reduced modulo the unit-norm
+    identities (|γ| = |χ| = 1, γ·χ = 0, cos² + sin² = 1): all zero."""
+    p, f = general_program()
+    return [D.on_manifold(sp.expand(x - y)) for x, y in zip(p.inline(f), D.rhs(R.GENERAL))]

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 0b95be48c3edc4ad], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 1a5996603be42750], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -16,7 +16,7 @@
 #define SR_GEN_NPAPER 12
 #define SR_GEN_NCONST 40
 #define SR_GEN_NCONST_NAMED 12
-#define SR_GEN_GENERAL_NCONST 98
+#define SR_GEN_GENERAL_NCONST 104
 #define SR_GEN_GENERAL_NCONST_NAMED 31
 #define SR_GEN_NX 35
 #define SR_GEN_NU 2
@@ -96,10 +96,10 @@
 #define SR_GEN_ACCEL_FLOPS 261
 #define SR_GEN_ACCEL_JACOBIAN_TERMS_FLOPS 1779
 #define SR_GEN_PAPER_PARAMS_FLOPS 52
-#define SR_GEN_GENERAL_CONSTANTS_FLOPS 319
+#define SR_GEN_GENERAL_CONSTANTS_FLOPS 324
 #define SR_GEN_GENERAL_INERTIA_FLOPS 219
-#define SR_GEN_GENERAL_RHS_FLOPS 1028
-#define SR_GEN_GENERAL_SYSTEM_FLOPS 1139
+#define SR_GEN_GENERAL_RHS_FLOPS 398
+#define SR_GEN_GENERAL_SYSTEM_FLOPS 615
 #define SR_GEN_GENERAL_ENERGY_FLOPS 336
 #define SR_GEN_GENERAL_EQUILIBRIUM_RESIDUAL_FLOPS 126
 #define SR_GEN_GENERAL_ACCEL_JACOBIAN_TERMS_FLOPS 4398
@@ -193,52 +193,58 @@ int sr_gen_paper_params(const sr_real pp[SR_GEN_NPAPER], sr_real p[SR_GEN_NPARAM
  *   cg[53] kg_22 = Jh_P_xx + Jh_P_yy + Jh_Y_xx + Jh_Y_yy + j_S + m_R*r**2
  *   cg[54] kg_23 = Jh_P_yy + Jh_P_zz + Jh_Y_yy + Jh_Y_zz + j_mY*n_Y**2
  *   cg[55] kg_24 = Jh_P_xx + Jh_P_zz + j_mP*n_P**2
- *   cg[56] kg_25 = g_x*h_P_y + g_x*h_Y_y
- *   cg[57] kg_26 = g_z*h_P_y + g_z*h_Y_y
- *   cg[58] kg_27 = g_x*h_Y_z
- *   cg[59] kg_28 = g_z*h_Y_z
- *   cg[60] kg_29 = 2*Jh_P_zz + j_mP*n_P
- *   cg[61] kg_30 = -2*Jh_P_yy + 2*Jh_P_zz - 2*Jh_Y_yy + 2*Jh_Y_zz + 2*j_mP
- *   cg[62] kg_31 = 4*Jh_P_xz
- *   cg[63] kg_32 = 2*Jh_P_xx - 2*Jh_P_zz
- *   cg[64] kg_33 = g_x*h_P_z
- *   cg[65] kg_34 = g_z*h_P_z
- *   cg[66] kg_35 = g_x*m_R*r
- *   cg[67] kg_36 = g_x*h_P_x
- *   cg[68] kg_37 = g_z*h_P_x
- *   cg[69] kg_38 = 4*Jh_Y_yz
- *   cg[70] kg_39 = 4*Jh_P_xy
- *   cg[71] kg_40 = 4*Jh_P_yz
- *   cg[72] kg_41 = g_x*h_Y_x
- *   cg[73] kg_42 = g_z*h_Y_x
- *   cg[74] kg_43 = -Jh_P_xx + Jh_P_zz - Jh_Y_xx + Jh_Y_zz + j_mY
- *   cg[75] kg_44 = 2*Jh_P_zz + 2*Jh_Y_zz + j_mP + j_mY*n_Y
- *   cg[76] kg_45 = 2*Jh_P_xz + 2*Jh_Y_xz
- *   cg[77] kg_46 = 2*Jh_P_xx + j_mP*n_P
- *   cg[78] kg_47 = 2*Jh_Y_xy
- *   cg[79] kg_48 = Jh_P_xx - Jh_P_yy + Jh_Y_xx - Jh_Y_yy + j_mP - j_mY
- *   cg[80] kg_49 = 2*Jh_P_yy + 2*Jh_Y_yy - j_mP + j_mY*n_Y
- *   cg[81] kg_50 = Jh_P_xx/2 + Jh_P_zz/2 + j_mP*n_P**2/2
- *   cg[82] kg_51 = Jh_P_yy/2 + Jh_P_zz/2 + Jh_Y_yy/2 + Jh_Y_zz/2 + j_S/2 + j_mY/2
- *   cg[83] kg_52 = Jh_P_xx/2 + Jh_P_zz/2 + Jh_Y_xx/2 + Jh_Y_zz/2 + j_S/2 + j_mP/2 + m_R*r**2/2
- *   cg[84] kg_53 = Jh_P_xx/2 + Jh_P_yy/2 + Jh_Y_xx/2 + Jh_Y_yy/2 + j_S/2 + m_R*r**2/2
- *   cg[85] kg_54 = Jh_P_yy/2 + Jh_P_zz/2 + Jh_Y_yy/2 + Jh_Y_zz/2 + j_mY*n_Y**2/2
- *   cg[86] kg_55 = g_x*m_R
- *   cg[87] kg_56 = g_z*m_P
- *   cg[88] kg_57 = Jh_P_xx/2 - Jh_P_zz/2
- *   cg[89] kg_58 = -Jh_P_yy/2 + Jh_P_zz/2 - Jh_Y_yy/2 + Jh_Y_zz/2 + j_mP/2
- *   cg[90] kg_59 = m_R*r**2/2
- *   cg[91] kg_60 = -4*Jh_P_yy + 4*Jh_P_zz - 4*Jh_Y_yy + 4*Jh_Y_zz + 4*j_mP
- *   cg[92] kg_61 = 4*Jh_P_xx - 4*Jh_P_zz
- *   cg[93] kg_62 = 8*Jh_P_xz
- *   cg[94] kg_63 = 8*Jh_Y_yz
- *   cg[95] kg_64 = 8*Jh_P_xy
- *   cg[96] kg_65 = 8*Jh_P_yz
- *   cg[97] kg_66 = 2*m_R*r**2 */
+ *   cg[56] kg_25 = Jh_Y_xx + Jh_Y_zz
+ *   cg[57] kg_26 = Jh_Y_xx + Jh_Y_yy
+ *   cg[58] kg_27 = Jh_Y_yy + Jh_Y_zz
+ *   cg[59] kg_28 = Jh_P_yy + Jh_P_zz
+ *   cg[60] kg_29 = Jh_P_xx + Jh_P_yy
+ *   cg[61] kg_30 = Jh_P_xx + Jh_P_zz
+ *   cg[62] kg_31 = Jh_P_xx/2 + Jh_P_zz/2 + j_mP*n_P**2/2
+ *   cg[63] kg_32 = Jh_P_yy/2 + Jh_P_zz/2 + Jh_Y_yy/2 + Jh_Y_zz/2 + j_S/2 + j_mY/2
+ *   cg[64] kg_33 = Jh_P_xx/2 + Jh_P_zz/2 + Jh_Y_xx/2 + Jh_Y_zz/2 + j_S/2 + j_mP/2 + m_R*r**2/2
+ *   cg[65] kg_34 = Jh_P_xx/2 + Jh_P_yy/2 + Jh_Y_xx/2 + Jh_Y_yy/2 + j_S/2 + m_R*r**2/2
+ *   cg[66] kg_35 = Jh_P_yy/2 + Jh_P_zz/2 + Jh_Y_yy/2 + Jh_Y_zz/2 + j_mY*n_Y**2/2
+ *   cg[67] kg_36 = g_x*h_P_y + g_x*h_Y_y
+ *   cg[68] kg_37 = g_z*h_P_y + g_z*h_Y_y
+ *   cg[69] kg_38 = g_x*h_Y_x
+ *   cg[70] kg_39 = g_x*m_R
+ *   cg[71] kg_40 = g_z*h_Y_x
+ *   cg[72] kg_41 = g_z*m_P
+ *   cg[73] kg_42 = Jh_P_xx/2 - Jh_P_zz/2
+ *   cg[74] kg_43 = -Jh_P_yy/2 + Jh_P_zz/2 - Jh_Y_yy/2 + Jh_Y_zz/2 + j_mP/2
+ *   cg[75] kg_44 = g_x*h_P_x
+ *   cg[76] kg_45 = g_z*h_P_x
+ *   cg[77] kg_46 = g_x*h_P_z
+ *   cg[78] kg_47 = g_z*h_P_z
+ *   cg[79] kg_48 = g_x*h_Y_z
+ *   cg[80] kg_49 = g_z*h_Y_z
+ *   cg[81] kg_50 = m_R*r**2/2
+ *   cg[82] kg_51 = g_x*m_R*r
+ *   cg[83] kg_52 = 2*Jh_P_zz + j_mP*n_P
+ *   cg[84] kg_53 = -2*Jh_P_yy + 2*Jh_P_zz - 2*Jh_Y_yy + 2*Jh_Y_zz + 2*j_mP
+ *   cg[85] kg_54 = 4*Jh_P_xz
+ *   cg[86] kg_55 = 2*Jh_P_xx - 2*Jh_P_zz
+ *   cg[87] kg_56 = 4*Jh_Y_yz
+ *   cg[88] kg_57 = 4*Jh_P_xy
+ *   cg[89] kg_58 = 4*Jh_P_yz
+ *   cg[90] kg_59 = -Jh_P_xx + Jh_P_zz - Jh_Y_xx + Jh_Y_zz + j_mY
+ *   cg[91] kg_60 = 2*Jh_P_zz + 2*Jh_Y_zz + j_mP + j_mY*n_Y
+ *   cg[92] kg_61 = 2*Jh_P_xz + 2*Jh_Y_xz
+ *   cg[93] kg_62 = 2*Jh_P_xx + j_mP*n_P
+ *   cg[94] kg_63 = 2*Jh_Y_xy
+ *   cg[95] kg_64 = Jh_P_xx - Jh_P_yy + Jh_Y_xx - Jh_Y_yy + j_mP - j_mY
+ *   cg[96] kg_65 = 2*Jh_P_yy + 2*Jh_Y_yy - j_mP + j_mY*n_Y
+ *   cg[97] kg_66 = -4*Jh_P_yy + 4*Jh_P_zz - 4*Jh_Y_yy + 4*Jh_Y_zz + 4*j_mP
+ *   cg[98] kg_67 = 4*Jh_P_xx - 4*Jh_P_zz
+ *   cg[99] kg_68 = 8*Jh_P_xz
+ *   cg[100] kg_69 = 8*Jh_Y_yz
+ *   cg[101] kg_70 = 8*Jh_P_xy
+ *   cg[102] kg_71 = 8*Jh_P_yz
+ *   cg[103] kg_72 = 2*m_R*r**2 */
 int sr_gen_general_constants(const sr_real p[SR_GEN_NPARAM], sr_real cg[SR_GEN_GENERAL_NCONST]);
 /* Generalized inertia M of the general robot, row-major 5x5. */
 int sr_gen_general_inertia(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], sr_real M[25]);
-/* Right-hand side f of M ν̇ = f for the general robot. */
+/* Right-hand side f of M ν̇ = f for the general robot (body by body, derive.newton_euler.general_program, proven equal to the derivation). */
 int sr_gen_general_rhs(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real f[5]);
 /* M (upper triangle, row by row) and f of the general robot, for the solve of sr_accel. */
 int sr_gen_general_system(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real M[15], sr_real f[5]);

@@ -107,11 +107,15 @@ UPPER = tuple((i, j) for i in range(S.NV) for j in range(i, S.NV))
 
 
 def general_kernels():
-    """The general robot of issue 18 (derive.robot.GENERAL), straight from the derivation: M and f
-    of derive.dynamics with CSE; the solve of M ν̇ = f is hand-written (c/sr_kernels.c), since with
-    rotors and general tensors every entry of M may be non-zero."""
+    """The general robot of issue 18 (derive.robot.GENERAL): M of derive.dynamics with CSE, f body
+    by body (derive.newton_euler.general_program, proven equal to dynamics.rhs first); the solve of
+    M ν̇ = f is hand-written (c/sr_kernels.c), since with rotors and general tensors every entry of
+    M may be non-zero."""
     robot = R.GENERAL
-    M, f = D.inertia(robot), D.rhs(robot)
+    M = D.inertia(robot)
+    proven("newton_euler (general robot)", NE.check_general_equal_to_rhs())
+    program, f = NE.general_program()
+    definitions = tuple(program.definitions)
     return (
         Kernel("general_constants", "Constants of the general kernels from the parameters, cg[0..] ="
                f" ({', '.join(s.name for s, _ in R.general_constants())}), then the parameter-only"
@@ -119,11 +123,12 @@ def general_kernels():
                ("p",), (Output("cg", tuple(e for _, e in R.general_constants()), "constants"),), finite_or_untouched=False),
         Kernel("general_inertia", "Generalized inertia M of the general robot, row-major 5x5.",
                ("cg", "x"), (Output("M", tuple(M), "M, row-major 5x5"),)),
-        Kernel("general_rhs", "Right-hand side f of M ν̇ = f for the general robot.",
-               ("cg", "x", "u"), (Output("f", tuple(f), "f"),)),
+        Kernel("general_rhs", "Right-hand side f of M ν̇ = f for the general robot (body by body,"
+               " derive.newton_euler.general_program, proven equal to the derivation).",
+               ("cg", "x", "u"), (Output("f", tuple(f), "f"),), definitions=definitions),
         Kernel("general_system", "M (upper triangle, row by row) and f of the general robot, for the solve of sr_accel.",
                ("cg", "x", "u"), (Output("M", tuple(M[i, j] for i, j in UPPER), "M, upper triangle row by row"),
-                                  Output("f", tuple(f), "f"))),
+                                  Output("f", tuple(f), "f")), definitions=definitions),
         Kernel("general_energy", "Total energy of the general robot: ½νᵀMν + m_R g_x q_x + m_P g_z q_z"
                " + the shape potential [J] (derive.lagrangian.total_energy).",
                ("cg", "x"), (Output("E", (D.energy(robot),), "energy"),)),
