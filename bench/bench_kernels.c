@@ -53,6 +53,8 @@ static int k_accel_general(const sr_model *m, int i, int arg) { (void)m; (void)a
 static int k_step_general(const sr_model *m, int i, int method) { (void)m; return sr_step(&general_model, method, X[i], U[i], 0.01, OUT[i]); }
 static int k_accel_jacobian(const sr_model *m, int i, int arg) { (void)arg; return sr_accel_jacobian(m, X[i], U[i], JOUT[i], JOUT[i] + SR_NV * SR_NE); }
 static int k_step_jacobian_lie_euler(const sr_model *m, int i, int arg) { (void)arg; return sr_step_jacobian_lie_euler(m, X[i], U[i], 0.01, JOUT[i], JOUT[i] + SR_NE * SR_NE); }
+static int k_step_jacobian_rkmk4(const sr_model *m, int i, int arg) { (void)arg; return sr_step_jacobian_rkmk4(m, X[i], U[i], 0.01, JOUT[i], JOUT[i] + SR_NE * SR_NE); }
+static int k_step_jacobian_cf4(const sr_model *m, int i, int arg) { (void)arg; return sr_step_jacobian_cf4(m, X[i], U[i], 0.01, JOUT[i], JOUT[i] + SR_NE * SR_NE); }
 
 #ifdef WITH_KANE
 static double KANE[NMAX][12], KANE_P[12]; /* the Kane model: its coordinates, the paper's twelve parameters */
@@ -167,6 +169,8 @@ int main(int argc, char **argv)
             {k_step_general, SR_RKMK4, SR_NX, 1, "step_rkmk4_general_robot", 0},
             {k_accel_jacobian, 0, SR_NV * (SR_NE + SR_NU), 1, "accel_jacobian", 0},
             {k_step_jacobian_lie_euler, 0, NOUT, 1, "step_jacobian_lie_euler", 0},
+            {k_step_jacobian_rkmk4, 0, NOUT, 4, "step_jacobian_rkmk4", 0},
+            {k_step_jacobian_cf4, 0, NOUT, 4, "step_jacobian_cf4", 0},
 #ifdef WITH_CASADI
             {k_casadi, 0, SR_NV, 10, "casadi_generated_reference_accel", 0},
 #endif

@@ -415,6 +415,10 @@ int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 #define sr_accel_jacobian_batch sr_accel_jacobian_batch_f
 #define sr_step_jacobian_lie_euler sr_step_jacobian_lie_euler_f
 #define sr_step_jacobian_lie_euler_batch sr_step_jacobian_lie_euler_batch_f
+#define sr_step_jacobian_rkmk4 sr_step_jacobian_rkmk4_f
+#define sr_step_jacobian_cf4 sr_step_jacobian_cf4_f
+#define sr_step_jacobian sr_step_jacobian_f
+#define sr_step_jacobian_batch sr_step_jacobian_batch_f
 #endif
 
 /* Jacobians of the accelerations in the error coordinates:
@@ -446,6 +450,22 @@ int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], co
  * one dt; stops at the first failing row, its index in *failed_row (-1 when all succeed). */
 int sr_step_jacobian_lie_euler_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real dt,
                                      sr_real *F, sr_real *G, long *failed_row);
+
+/* The same for one RKMK4 and one CF4 step (c/sr_step_jacobians.c): the exact derivatives of the
+ * steps of c/sr_steppers.c, stage by stage (four sr_accel_jacobian calls, dexp^-1 differentiated
+ * for RKMK4); checks, status codes and outputs as sr_step_jacobian_lie_euler. */
+int sr_step_jacobian_rkmk4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+                           sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU]);
+int sr_step_jacobian_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+                         sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU]);
+
+/* The step Jacobian of any method (SR_LIE_EULER, SR_RKMK4, SR_CF4; no SR_PROJECT): SR_ERR_ARG for
+ * another; and over n rows (x n x SR_NX, u n x SR_NU or NULL, F n x SR_NE^2, G n x SR_NE*SR_NU),
+ * stopping at the first failing row (its index in *failed_row, -1 when all succeed). */
+int sr_step_jacobian(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+                     sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU]);
+int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u, sr_real dt,
+                           sr_real *F, sr_real *G, long *failed_row);
 
 #ifdef __cplusplus
 }

@@ -205,6 +205,29 @@ static inline int deliver(int status, const sr_real *tmp, int n, sr_real *out)
     return SR_OK;
 }
 
+/* The right Jacobian of SO(3), Exp(phi + e) = Exp(phi) Exp(Jr(phi) e) + O(|e|^2):
+ * Jr = I - a [[phi]] + b [[phi]]^2, a = (1 - cos t)/t^2, b = (t - sin t)/t^3 (series below t = 1/4). */
+static inline void so3_right_jacobian(const sr_real phi[3], sr_real Jr[9])
+{
+    const sr_real t2 = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2];
+    sr_real a, b, W[9], W2[9];
+    int i;
+    if (t2 < SR_SERIES_T2) {
+        a = cosc_series(t2);
+        b = (SR_C(1.0) / 6) * (1 - t2 * (SR_C(1.0) / 20) * (1 - t2 * (SR_C(1.0) / 42) * (1 - t2 * (SR_C(1.0) / 72) *
+            (1 - t2 * (SR_C(1.0) / 110) * (1 - t2 * (SR_C(1.0) / 156))))));
+    } else {
+        const sr_real t = SR_SQRT(t2), s_half = SR_SIN(SR_C(0.5) * t);
+        a = SR_C(2.0) * s_half * s_half / t2;
+        b = (t - SR_SIN(t)) / (t2 * t);
+    }
+    W[0] = 0;       W[1] = -phi[2]; W[2] = phi[1];
+    W[3] = phi[2];  W[4] = 0;       W[5] = -phi[0];
+    W[6] = -phi[1]; W[7] = phi[0];  W[8] = 0;
+    matmul3(W, W, W2);
+    for (i = 0; i < 9; ++i) Jr[i] = (i % 4 == 0 ? 1 : 0) - a * W[i] + b * W2[i];
+}
+
 /* ---- sr_kernels.c: the model's kernels, of the paper's geometry or general (sr_model) ------ */
 #ifdef SR_USE_FLOAT
 #define sr_internal_accel sr_internal_accel_f
@@ -243,6 +266,7 @@ int sr_internal_cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real
 #define sr_internal_rkmk4_core sr_internal_rkmk4_core_f
 #define sr_internal_dexpinv sr_internal_dexpinv_f
 #define sr_internal_project sr_internal_project_f
+#define sr_internal_act sr_internal_act_f
 #endif
 
 /* A Lie-algebra element ("tangent coordinates") of the state's group, 13 numbers:
@@ -269,6 +293,10 @@ int sr_internal_vector_field(const sr_model *model, const sr_real x[SR_NX], cons
 int sr_internal_rkmk4_core(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
                            sr_real K[4][SR_NT], sr_real theta[SR_NT], sr_real *comp, sr_real out[SR_NX],
                            long *evaluations);
+
+/* out = x . exp(th): R_S Exp(th_S), the one-axis rotations by their angles, q + th_q, nu + th_nu
+ * (out must not alias x). */
+void sr_internal_act(const sr_real x[SR_NX], const sr_real th[SR_NT], sr_real out[SR_NX]);
 
 /* k = dexp^{-1}_{-th}(f) (k may alias f). */
 void sr_internal_dexpinv(const sr_real th[SR_NT], const sr_real f[SR_NT], sr_real k[SR_NT]);

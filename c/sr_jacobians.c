@@ -79,29 +79,6 @@ int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, con
     return SR_OK;
 }
 
-/* The right Jacobian of SO(3), Exp(phi + e) = Exp(phi) Exp(Jr(phi) e) + O(|e|^2):
- * Jr = I - a [[phi]] + b [[phi]]^2, a = (1 - cos t)/t^2, b = (t - sin t)/t^3 (series below t = 1/4). */
-static void so3_right_jacobian(const sr_real phi[3], sr_real Jr[9])
-{
-    const sr_real t2 = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2];
-    sr_real a, b, W[9], W2[9];
-    int i;
-    if (t2 < SR_SERIES_T2) {
-        a = cosc_series(t2);
-        b = (SR_C(1.0) / 6) * (1 - t2 * (SR_C(1.0) / 20) * (1 - t2 * (SR_C(1.0) / 42) * (1 - t2 * (SR_C(1.0) / 72) *
-            (1 - t2 * (SR_C(1.0) / 110) * (1 - t2 * (SR_C(1.0) / 156))))));
-    } else {
-        const sr_real t = SR_SQRT(t2), s_half = SR_SIN(SR_C(0.5) * t);
-        a = SR_C(2.0) * s_half * s_half / t2;
-        b = (t - SR_SIN(t)) / (t2 * t);
-    }
-    W[0] = 0;       W[1] = -phi[2]; W[2] = phi[1];
-    W[3] = phi[2];  W[4] = 0;       W[5] = -phi[0];
-    W[6] = -phi[1]; W[7] = phi[0];  W[8] = 0;
-    matmul3(W, W, W2);
-    for (i = 0; i < 9; ++i) Jr[i] = (i % 4 == 0 ? 1 : 0) - a * W[i] + b * W2[i];
-}
-
 int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                                sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
 {

@@ -145,6 +145,11 @@ static void act(const sr_real x[SR_NX], const sr_real th[SR_NT], sr_real out[SR_
     apply(x, delta, NULL, out);
 }
 
+void sr_internal_act(const sr_real x[SR_NX], const sr_real th[SR_NT], sr_real out[SR_NX])
+{
+    act(x, th, out);
+}
+
 /* k = dexp^{-1}_{-th}(f): the so(3) block gets the closed form above (series below
  * |th| = 0.1 rad, where the omitted t^8/47900160 term is below 1e-16 relative); the abelian
  * blocks are copied.  k may alias f. */

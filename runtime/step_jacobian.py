@@ -91,28 +91,28 @@ class StepJacobianMethods:
     def step_jacobian(self, x, u=None, dt=0.01, method="lie-euler"):
         """(F, G), (12, 12) and (12, 2): step(x ⊕ d, u + w) ⊖ step(x, u) = F d + G w + O(2), the
         exact derivative of one step of `method` as implemented.  Batches: x (B, 35), u (B, 2)
-        or None give (B, 12, 12), (B, 12, 2).  Lie–Euler is C (sr_step_jacobian_lie_euler);
-        RKMK4 and CF4 are CasADi's AD of the exported steps (needs the dev or casadi extra)."""
+        or None give (B, 12, 12), (B, 12, 2).  All three in C (sr_step_jacobian, batches by
+        sr_step_jacobian_batch; c/sr_jacobians.c, c/sr_step_jacobians.c); `casadi_step_jacobian`
+        is CasADi's AD of the exported steps, the independent check."""
         if method not in STEPS:
             raise ValueError(f"method: unknown integrator {method!r}; choose one of {sorted(STEPS)}")
         x, u = self._state_and_input(x, u)
         dt = self._dt(dt)
-        if method == "lie-euler":
-            return self._lie_euler_step_jacobian(x, u, dt)
-        return self.casadi_step_jacobian(x, u, dt, method)
+        return self._c_step_jacobian(x, u, dt, method)
 
-    def _lie_euler_step_jacobian(self, x, u, dt):
+    def _c_step_jacobian(self, x, u, dt, method):
         from bindings._sr import ffi, lib
 
         def ptr(arr):
             return ffi.cast("double *", ffi.from_buffer(arr))
+        code = {"lie-euler": lib.SR_LIE_EULER, "rkmk4": lib.SR_RKMK4, "cf4": lib.SR_CF4}[method]
         lead = x.shape[:-1]
         F, G = np.empty(lead + (NE, NE)), np.empty(lead + (NE, NU))
         if x.ndim == 1:
-            self._check("x", lib.sr_step_jacobian_lie_euler(self._model, ptr(x), ptr(u), dt, ptr(F), ptr(G)))
+            self._check("x", lib.sr_step_jacobian(self._model, code, ptr(x), ptr(u), dt, ptr(F), ptr(G)))
             return F, G
         failed = ffi.new("long *")
-        status = lib.sr_step_jacobian_lie_euler_batch(self._model, x.shape[0], ptr(x), ptr(u), dt, ptr(F), ptr(G), failed)
+        status = lib.sr_step_jacobian_batch(self._model, code, x.shape[0], ptr(x), ptr(u), dt, ptr(F), ptr(G), failed)
         self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
         return F, G
 

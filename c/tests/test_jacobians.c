@@ -63,21 +63,24 @@ static void test_accel_jacobian_bad_input_leaves_outputs_untouched(void)
     CHECK_STATUS(sr_accel_jacobian_batch(&m, -1, x, NULL, Ja, Jb, &failed), SR_ERR_ARG);
 }
 
-static void test_lie_euler_step_jacobian_columns_are_central_differences_through_retract_and_local(void)
+/* The columns of F and G of one step of `method` against central differences of the C step through
+ * sr_retract and sr_local (robot: the paper's, or the general one of sr_test.c). */
+static void check_step_jacobian_against_differences(int method, int general, unsigned long long seed)
 {
     const double h = TEST_EPS < 1e-10 ? 1e-4 : 3e-2, tol = TEST_EPS < 1e-10 ? 1e-6 : 3e-2;
     const sr_real dt = SR_C(0.05);
     sr_real p[SR_NPARAM], x[SR_NX], y[SR_NX], y0[SR_NX], ys[SR_NX], u[SR_NU] = {SR_C(0.05), SR_C(-0.02)}, up[SR_NU];
     sr_real d[SR_NE], F[SR_NE * SR_NE], G[SR_NE * SR_NU], ep[SR_NE], em[SR_NE];
-    test_rng rng = {31};
+    test_rng rng;
     sr_model m;
     double scale = 0;
     int k, i, s;
-    paper_simulation_params(p);
+    rng.s = seed;
+    if (general) general_robot_params(p); else paper_simulation_params(p);
     CHECK_STATUS(sr_model_init(&m, p), SR_OK);
     random_state(&rng, p[SR_P_r], 2.0, x);
-    CHECK_STATUS(sr_step_jacobian_lie_euler(&m, x, u, dt, F, G), SR_OK);
-    CHECK_STATUS(sr_step_lie_euler(&m, x, u, dt, y0), SR_OK);
+    CHECK_STATUS(sr_step_jacobian(&m, method, x, u, dt, F, G), SR_OK);
+    CHECK_STATUS(sr_step(&m, method, x, u, dt, y0), SR_OK);
     for (i = 0; i < SR_NE * SR_NE; ++i) scale = fabs((double)F[i]) > scale ? fabs((double)F[i]) : scale;
     for (k = 0; k < SR_NE + SR_NU; ++k) {
         for (s = -1; s <= 1; s += 2) {
@@ -85,13 +88,54 @@ static void test_lie_euler_step_jacobian_columns_are_central_differences_through
             memcpy(up, u, sizeof up);
             if (k < SR_NE) d[k] = (sr_real)(s * h); else up[k - SR_NE] += (sr_real)(s * h);
             CHECK_STATUS(sr_retract(&m, x, d, y), SR_OK);
-            CHECK_STATUS(sr_step_lie_euler(&m, y, up, dt, ys), SR_OK);
+            CHECK_STATUS(sr_step(&m, method, y, up, dt, ys), SR_OK);
             CHECK_STATUS(sr_local(&m, y0, ys, s > 0 ? ep : em), SR_OK);
         }
         for (i = 0; i < SR_NE; ++i)
             CHECK_NEAR(k < SR_NE ? F[SR_NE * i + k] : G[SR_NU * i + k - SR_NE],
                        ((double)ep[i] - (double)em[i]) / (2 * h), tol * scale);
     }
+}
+
+static void test_lie_euler_step_jacobian_columns_are_central_differences_through_retract_and_local(void)
+{
+    check_step_jacobian_against_differences(SR_LIE_EULER, 0, 31);
+}
+
+static void test_rkmk4_and_cf4_step_jacobians_are_central_differences_through_retract_and_local(void)
+{
+    check_step_jacobian_against_differences(SR_RKMK4, 0, 33);
+    check_step_jacobian_against_differences(SR_CF4, 0, 35);
+}
+
+static void test_step_jacobians_of_a_general_robot_are_central_differences(void)
+{
+    check_step_jacobian_against_differences(SR_LIE_EULER, 1, 43);
+    check_step_jacobian_against_differences(SR_RKMK4, 1, 45);
+    check_step_jacobian_against_differences(SR_CF4, 1, 47);
+}
+
+static void test_step_jacobian_refuses_an_unknown_method_and_batches_name_the_failing_row(void)
+{
+    sr_real p[SR_NPARAM], x[3][SR_NX], F[3][SR_NE * SR_NE], G[3][SR_NE * SR_NU], Fs[SR_NE * SR_NE], Gs[SR_NE * SR_NU];
+    test_rng rng = {53};
+    sr_model m;
+    long failed = 7;
+    int i;
+    paper_simulation_params(p);
+    CHECK_STATUS(sr_model_init(&m, p), SR_OK);
+    for (i = 0; i < 3; ++i) random_state(&rng, p[SR_P_r], 1.0, x[i]);
+    CHECK_STATUS(sr_step_jacobian(&m, SR_RKMK4 | SR_PROJECT, x[0], NULL, SR_C(0.01), Fs, Gs), SR_ERR_ARG);
+    CHECK_STATUS(sr_step_jacobian_batch(&m, 7, 3, x[0], NULL, SR_C(0.01), F[0], G[0], &failed), SR_ERR_ARG);
+    CHECK_STATUS(sr_step_jacobian_batch(&m, SR_CF4, 3, x[0], NULL, SR_C(0.01), F[0], G[0], &failed), SR_OK);
+    CHECK(failed == -1);
+    for (i = 0; i < 3; ++i) {
+        CHECK_STATUS(sr_step_jacobian_cf4(&m, x[i], NULL, SR_C(0.01), Fs, Gs), SR_OK);
+        CHECK(memcmp(Fs, F[i], sizeof Fs) == 0 && memcmp(Gs, G[i], sizeof Gs) == 0);
+    }
+    x[2][SR_X_w_S] = (sr_real)NAN;
+    CHECK_STATUS(sr_step_jacobian_batch(&m, SR_RKMK4, 3, x[0], NULL, SR_C(0.01), F[0], G[0], &failed), SR_ERR_NONFINITE);
+    CHECK(failed == 2);
 }
 
 static void test_lie_euler_step_jacobian_bad_input_gives_status_and_leaves_outputs_untouched(void)
@@ -137,6 +181,9 @@ void suite_jacobians(void)
     RUN_TEST(test_accel_jacobian_columns_are_central_differences_along_retract);
     RUN_TEST(test_accel_jacobian_bad_input_leaves_outputs_untouched);
     RUN_TEST(test_lie_euler_step_jacobian_columns_are_central_differences_through_retract_and_local);
+    RUN_TEST(test_rkmk4_and_cf4_step_jacobians_are_central_differences_through_retract_and_local);
+    RUN_TEST(test_step_jacobians_of_a_general_robot_are_central_differences);
+    RUN_TEST(test_step_jacobian_refuses_an_unknown_method_and_batches_name_the_failing_row);
     RUN_TEST(test_lie_euler_step_jacobian_bad_input_gives_status_and_leaves_outputs_untouched);
     RUN_TEST(test_lie_euler_step_jacobian_batch_equals_single_calls_and_names_the_failing_row);
 }

@@ -136,14 +136,16 @@ def check_harness(result, model, X, U, step_dt=0.01):
             check("C loop Kane Jacobian by CasADi AD (speed and torque columns) vs CasADi AD of the reference",
                   "kane_casadi_c_accel_jacobian",
                   lambda i: np.concatenate([Ja[i][:, 7:12].ravel(), Jb[i].ravel()]), 1e-9)
-    if "step_jacobian_lie_euler" in result:
-        from ..step_jacobian import jacobian_function
-        n = len(X)
-        F, G = jacobian_function("lie-euler").map(n)(np.asarray(X).T, np.asarray(U).T, step_dt, model.params.as_array())
-        F = np.asarray(F).reshape(NE, n, NE).transpose(1, 0, 2)
-        G = np.asarray(G).reshape(NE, n, NU).transpose(1, 0, 2)
-        check("C Lie-Euler step_jacobian vs CasADi AD of the exported SX step", "step_jacobian_lie_euler",
-              lambda i: np.concatenate([F[i].ravel(), G[i].ravel()]), 1e-10)
+    for method in ("lie-euler", "rkmk4", "cf4"):
+        key = "step_jacobian_" + method.replace("-", "_")
+        if key in result:
+            from ..step_jacobian import jacobian_function
+            n = len(X)
+            F, G = jacobian_function(method).map(n)(np.asarray(X).T, np.asarray(U).T, step_dt, model.params.as_array())
+            F = np.asarray(F).reshape(NE, n, NE).transpose(1, 0, 2)
+            G = np.asarray(G).reshape(NE, n, NU).transpose(1, 0, 2)
+            check(f"C {method} step_jacobian vs CasADi AD of the exported SX step", key,
+                  lambda i, F=F, G=G: np.concatenate([F[i].ravel(), G[i].ravel()]), 1e-10)
     if "accel_general_robot" in result:
         general = ReferenceModel(general_robot(model.params).as_dict())
         general_accel = general.accel_batch(X, U)

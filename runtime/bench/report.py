@@ -50,6 +50,10 @@ def targets(res):
         if "step_jacobian_lie_euler" in c:
             out.append(("Lie-Euler step_jacobian <= 2x accel_jacobian (C loop)",
                         c["step_jacobian_lie_euler"]["ns"] <= 2 * c["accel_jacobian"]["ns"]))
+        for key in ("step_jacobian_rkmk4", "step_jacobian_cf4"):
+            if key in c:
+                out.append((f"{key[14:].upper()} step_jacobian <= 6x accel_jacobian (C loop)",
+                            c[key]["ns"] <= 6 * c["accel_jacobian"]["ns"]))
         if "kane_casadi_c_accel_jacobian" in c:
             out.append(("accel_jacobian >= 10x faster than CasADi AD C of the Kane Jacobian",
                         10 * c["accel_jacobian"]["ns"] <= c["kane_casadi_c_accel_jacobian"]["ns"]))
@@ -77,9 +81,11 @@ def sections(res):
     if "accel_jacobian" in c:
         rows.append(("our accel_jacobian (Ja 5x12 and Jb 5x2)", f"{c['accel_jacobian']['ns']:,.1f} ns",
                      f"{c['accel_jacobian']['ns'] / ours:.1f}x"))
-    if "step_jacobian_lie_euler" in c:
-        rows.append(("our Lie-Euler step_jacobian (F 12x12 and G 12x2)", f"{c['step_jacobian_lie_euler']['ns']:,.1f} ns",
-                     f"{c['step_jacobian_lie_euler']['ns'] / ours:.1f}x"))
+    for key, label in (("step_jacobian_lie_euler", "Lie-Euler"), ("step_jacobian_rkmk4", "RKMK4"),
+                       ("step_jacobian_cf4", "CF4")):
+        if key in c:
+            rows.append((f"our {label} step_jacobian (F 12x12 and G 12x2)", f"{c[key]['ns']:,.1f} ns",
+                         f"{c[key]['ns'] / ours:.1f}x"))
     if "accel_general_robot" in c:
         rows.append(("our accel of a general robot (issue 18: general kernels)", f"{c['accel_general_robot']['ns']:,.1f} ns",
                      f"{c['accel_general_robot']['ns'] / ours:.1f}x"))

@@ -111,8 +111,8 @@ def step_jacobian_checks(n_states=20, seed=7, jacobian=None, params=None, dt=0.0
     """Rows of `make verify` for step_jacobian (issue 19), per method:
 
     * against Richardson central differences of the C step through retract/local (≤ 1e-8
-      relative; the Jacobian under test is CasADi's AD of the exported SX step, so the two sides
-      share only the model);
+      relative; the Jacobian under test is the C kernel of every method, the differences are
+      those of the C step itself through retract/local);
     * its derivative in dt at 0 against `linearize` (C accel_jacobian plus the kinematics):
       (F(h) − I)/h → A and G(h)/h → B as h → 0, Richardson-extrapolated from h = 1e-5 and 5e-6
       (≤ 1e-6 relative: truncation O(h²|A|²), rounding 1e-16/h).

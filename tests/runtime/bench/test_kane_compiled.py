@@ -78,12 +78,13 @@ def test_compiled_kane_from_python_is_checked_against_our_accel_and_timed(model)
 
 
 @pytest.mark.parametrize("key, entry", [("accel_jacobian", 2), ("kane_casadi_c_accel_jacobian", 8 * 5 + 2),
-                                        ("step_jacobian_lie_euler", 12 * 5 + 2)])
+                                        ("step_jacobian_lie_euler", 12 * 5 + 2), ("step_jacobian_rkmk4", 12 * 5 + 2),
+                                        ("step_jacobian_cf4", 12 * 5 + 2), ("accel_general_robot", 3)])
 def test_the_bench_refuses_a_jacobian_off_by_1e_6(c_loop, model, key, entry):
     """Our accel_jacobian and the Kane Jacobian by CasADi AD are checked against CasADi AD of the reference
     before their times count (the Kane one in its speed and torque columns, entry 42 = column 8, row 2)."""
     result, X, U = c_loop
     bad = copy.deepcopy(result)
     bad[key]["check"][3][entry] *= 1 + 1e-6
-    with pytest.raises(WrongNumbers, match="Jacobian|jacobian"):
+    with pytest.raises(WrongNumbers, match="Jacobian|jacobian|general robot"):
         harness.check_harness(bad, model, X, U)

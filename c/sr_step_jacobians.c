@@ -1,0 +1,292 @@
+/*
+ * sr_step_jacobians.c -- the Jacobians F, G of one RKMK4 or CF4 step in the error coordinates
+ * (issue 19): step(x (+) d, u + w) (-) step(x, u) = F d + G w + O(2), the exact derivatives of
+ * the maps of c/sr_steppers.c as they are implemented (stage by stage, dexp^-1 differentiated).
+ *
+ * Every quantity of a step carries its derivative with respect to (d, w): a matrix of
+ * NC = SR_NE + SR_NU columns.  The rules, for the action y = x . exp(th) of c/sr_steppers.c:
+ *   y (-) y0 = A(th) (x (-) x0) + B(th) dth,   A = diag(Exp(th_S)^T, 1, 1, I_2, I_5),
+ *                                              B = diag(Jr(th_S), 1, 1, [I_2 0], I_5)
+ * (the right Jacobian Jr of SO(3); q_z does not move); for the vector field f of
+ * sr_internal_vector_field at a stage state y with error e: df = J_f(y) e + [0 | J_u] w, from
+ * sr_accel_jacobian (the accelerations) and the rolling kinematics (q' = r (R_S w) x e_z, as in
+ * sr_step_jacobian_lie_euler); and for k = dexp^-1(th, f) = f + th x f / 2 + c(|th|^2) th x (th x f)
+ * on the SO(3) block: dk = (I + [th]/2 + c [th]^2) df + (-[f]/2 + c ((th.f) I + th f^T - 2 f th^T)
+ * + 2 c'(|th|^2) (th x (th x f)) th^T) dth.
+ */
+#include "sr_internal.h"
+
+#include <string.h>
+
+#define NC (SR_NE + SR_NU)
+
+typedef sr_real tangent[SR_NT][NC];   /* d(13-vector)/d(d, w) */
+typedef sr_real error[SR_NE][NC];     /* d(state error)/d(d, w) */
+
+/* c(s) of dexp^-1 (s = |th|^2) and its derivative dc/ds: the closed form of sr_internal_dexpinv,
+ * with the same series below s = 1e-2. */
+static void dexpinv_coefficient(sr_real s, sr_real *c, sr_real *dc)
+{
+    if (s < SR_C(1e-2)) {
+        *c = SR_C(1.0) / 12 + s * (SR_C(1.0) / 720 + s * (SR_C(1.0) / 30240 + s * (SR_C(1.0) / 1209600)));
+        *dc = SR_C(1.0) / 720 + s * (SR_C(2.0) / 30240 + s * (SR_C(3.0) / 1209600));
+    } else {
+        const sr_real half = SR_C(0.5) * SR_SQRT(s), sn = SR_SIN(half), cs = SR_COS(half);
+        const sr_real phi = 1 - half * cs / sn;                 /* c = phi / s */
+        const sr_real dphi_dhalf = -cs / sn + half / (sn * sn);  /* d(1 - h cot h)/dh */
+        *c = phi / s;
+        *dc = dphi_dhalf / (SR_C(8.0) * half) / s - phi / (s * s);   /* h = sqrt(s)/2: dh/ds = 1/(8h) */
+    }
+}
+
+/* dy = A(th) dx + B(th) dth (dx may be NULL: a state that does not depend on (d, w) other than
+ * through x itself, i.e. dx = [I | 0]). */
+static void act_jacobian(const sr_real th[SR_NT], const error *dx, const tangent dth, error dy)
+{
+    sr_real D[9], Jr[9];
+    error out;
+    int i, j, c;
+    so3_exp_minus_identity(th + SR_T_S, D);
+    so3_right_jacobian(th + SR_T_S, Jr);
+    for (c = 0; c < NC; ++c) {
+        sr_real in[SR_NE];
+        for (i = 0; i < SR_NE; ++i) in[i] = dx ? (*dx)[i][c] : (sr_real)(i == c);
+        for (i = 0; i < 3; ++i) {   /* Exp(th)^T = I + D^T, then + Jr dth_S */
+            sr_real s = in[SR_E_xi_S + i];
+            for (j = 0; j < 3; ++j) s += D[3 * j + i] * in[SR_E_xi_S + j] + Jr[3 * i + j] * dth[SR_T_S + j][c];
+            out[SR_E_xi_S + i][c] = s;
+        }
+        out[SR_E_th_Y][c] = in[SR_E_th_Y] + dth[SR_T_Y][c];
+        out[SR_E_th_P][c] = in[SR_E_th_P] + dth[SR_T_P][c];
+        for (i = 0; i < 2; ++i) out[SR_E_q + i][c] = in[SR_E_q + i] + dth[SR_T_Q + i][c];
+        for (i = 0; i < SR_NV; ++i) out[SR_E_nu + i][c] = in[SR_E_nu + i] + dth[SR_T_V + i][c];
+    }
+    memcpy(dy, out, sizeof out);
+}
+
+/* f = f(y) and df = J_f(y) dy + [0 | J_u] (see the top of the file). */
+static int field_jacobian(const sr_model *model, const sr_real y[SR_NX], const sr_real u[SR_NU], error dy,
+                          sr_real f[SR_NT], tangent df)
+{
+    const sr_real *R = y + SR_X_R_S, *w = y + SR_X_w_S, r = model->p[SR_P_r];
+    sr_real Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], p[2][3];
+    int i, j, k, c, status = sr_internal_vector_field(model, y, u, f, NULL);
+    if (status == SR_OK) status = sr_accel_jacobian(model, y, u, Ja, Jb);
+    if (status != SR_OK) return status;
+    for (j = 0; j < 3; ++j) {
+        p[0][j] = r * R[3 + j];     /* q_x' = r (R_S w)_y */
+        p[1][j] = -r * R[j];        /* q_y' = -r (R_S w)_x */
+    }
+    for (c = 0; c < NC; ++c) {
+        for (i = 0; i < 3; ++i) df[SR_T_S + i][c] = dy[SR_E_nu + i][c];
+        df[SR_T_Y][c] = dy[SR_E_nu + 3][c];
+        df[SR_T_P][c] = dy[SR_E_nu + 4][c];
+        for (i = 0; i < 2; ++i) {   /* d(q') = p . (dw - w x dxi) = p . dw + (w x p) . dxi */
+            const sr_real *q = p[i];
+            const sr_real wxp[3] = {w[1] * q[2] - w[2] * q[1], w[2] * q[0] - w[0] * q[2], w[0] * q[1] - w[1] * q[0]};
+            sr_real s = 0;
+            for (j = 0; j < 3; ++j) s += q[j] * dy[SR_E_nu + j][c] + wxp[j] * dy[SR_E_xi_S + j][c];
+            df[SR_T_Q + i][c] = s;
+        }
+        df[SR_T_Q + 2][c] = 0;
+        for (i = 0; i < SR_NV; ++i) {
+            sr_real s = c >= SR_NE ? Jb[SR_NU * i + (c - SR_NE)] : 0;
+            for (k = 0; k < SR_NE; ++k) s += Ja[SR_NE * i + k] * dy[k][c];
+            df[SR_T_V + i][c] = s;
+        }
+    }
+    return SR_OK;
+}
+
+/* k = dexp^-1(th, f) and dk (f and df are overwritten: k may alias f). */
+static void dexpinv_jacobian(const sr_real th[SR_NT], const tangent dth, sr_real f[SR_NT], tangent df)
+{
+    const sr_real *t = th + SR_T_S, *v = f + SR_T_S;
+    const sr_real s = t[0] * t[0] + t[1] * t[1] + t[2] * t[2], tv = t[0] * v[0] + t[1] * v[1] + t[2] * v[2];
+    sr_real c, dc, T[9], T2[9], P[9], Q[9], b[3];
+    int i, j, col;
+    dexpinv_coefficient(s, &c, &dc);
+    T[0] = 0;     T[1] = -t[2]; T[2] = t[1];
+    T[3] = t[2];  T[4] = 0;     T[5] = -t[0];
+    T[6] = -t[1]; T[7] = t[0];  T[8] = 0;
+    matmul3(T, T, T2);
+    for (i = 0; i < 3; ++i) b[i] = T2[3 * i + 0] * v[0] + T2[3 * i + 1] * v[1] + T2[3 * i + 2] * v[2];
+    for (i = 0; i < 9; ++i) P[i] = (i % 4 == 0 ? 1 : 0) + SR_C(0.5) * T[i] + c * T2[i];   /* dk/dv */
+    /* dk/dt = -[v]/2 + c ((t.v) I + t v^T - 2 v t^T) + 2 c' b t^T  (b = t x (t x v)) */
+    Q[0] = 0;                 Q[1] = SR_C(0.5) * v[2];  Q[2] = -SR_C(0.5) * v[1];
+    Q[3] = -SR_C(0.5) * v[2]; Q[4] = 0;                 Q[5] = SR_C(0.5) * v[0];
+    Q[6] = SR_C(0.5) * v[1];  Q[7] = -SR_C(0.5) * v[0]; Q[8] = 0;
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j)
+            Q[3 * i + j] += c * ((i == j ? tv : 0) + t[i] * v[j] - 2 * v[i] * t[j]) + 2 * dc * b[i] * t[j];
+    for (col = 0; col < NC; ++col) {
+        sr_real out[3];
+        for (i = 0; i < 3; ++i) {
+            out[i] = 0;
+            for (j = 0; j < 3; ++j) out[i] += P[3 * i + j] * df[SR_T_S + j][col] + Q[3 * i + j] * dth[SR_T_S + j][col];
+        }
+        for (i = 0; i < 3; ++i) df[SR_T_S + i][col] = out[i];
+    }
+    sr_internal_dexpinv(th, f, f);
+}
+
+/* th = sum_k coef[k] K[k] and its derivative. */
+static void combine_jacobian(int n, const sr_real *coef, const sr_real (*K)[SR_NT], tangent *dK,
+                             sr_real th[SR_NT], tangent dth)
+{
+    int i, c, k;
+    for (i = 0; i < SR_NT; ++i) {
+        th[i] = 0;
+        for (k = 0; k < n; ++k) th[i] += coef[k] * K[k][i];
+        for (c = 0; c < NC; ++c) {
+            sr_real s = 0;
+            for (k = 0; k < n; ++k) s += coef[k] * dK[k][i][c];
+            dth[i][c] = s;
+        }
+    }
+}
+
+/* The error of x itself: [I | 0]. */
+static void identity(error e)
+{
+    int i, c;
+    for (i = 0; i < SR_NE; ++i)
+        for (c = 0; c < NC; ++c) e[i][c] = (sr_real)(i == c);
+}
+
+static void deliver_jacobians(error dy, sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
+{
+    int i, c;
+    for (i = 0; i < SR_NE; ++i)
+        for (c = 0; c < NC; ++c) {
+            if (c < SR_NE) F[SR_NE * i + c] = dy[i][c];
+            else G[SR_NU * i + (c - SR_NE)] = dy[i][c];
+        }
+}
+
+static int check_step_arguments(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+                                sr_real *F, sr_real *G)
+{
+    int status;
+    if (!F || !G) return SR_ERR_NULL;
+    status = sr_check_state(model, x);
+    if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
+    if (status != SR_OK) return status;
+    return (dt > 0) && isfinite(dt) ? SR_OK : SR_ERR_ARG;
+}
+
+int sr_step_jacobian_rkmk4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+                           sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
+{
+    static const sr_real zero_u[SR_NU] = {0, 0};
+    static const sr_real a_diag[3] = {SR_C(0.5), SR_C(0.5), SR_C(1.0)};
+    const sr_real b[4] = {dt / 6, dt / 3, dt / 3, dt / 6};
+    sr_real K[4][SR_NT], th[SR_NT], y[SR_NX], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
+    tangent dK[4], dth;
+    error dy;
+    int i, c, s, status = check_step_arguments(model, x, u, dt, F, G);
+    if (status != SR_OK) return status;
+    if (!u) u = zero_u;
+    identity(dy);
+    status = field_jacobian(model, x, u, dy, K[0], dK[0]);
+    for (s = 1; s < 4 && status == SR_OK; ++s) {
+        for (i = 0; i < SR_NT; ++i) {
+            th[i] = a_diag[s - 1] * dt * K[s - 1][i];
+            for (c = 0; c < NC; ++c) dth[i][c] = a_diag[s - 1] * dt * dK[s - 1][i][c];
+        }
+        sr_internal_act(x, th, y);
+        act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dy);
+        status = field_jacobian(model, y, u, dy, K[s], dK[s]);
+        if (status == SR_OK) dexpinv_jacobian(th, (const sr_real(*)[NC])dth, K[s], dK[s]);
+    }
+    if (status != SR_OK) return status;
+    combine_jacobian(4, b, (const sr_real(*)[SR_NT])K, dK, th, dth);
+    act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dy);
+    deliver_jacobians(dy, f, g);
+    if (!all_finite(f, SR_NE * SR_NE) || !all_finite(g, SR_NE * SR_NU)) return SR_ERR_NONFINITE;
+    memcpy(F, f, sizeof f);
+    memcpy(G, g, sizeof g);
+    return SR_OK;
+}
+
+int sr_step_jacobian_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+                         sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
+{
+    static const sr_real zero_u[SR_NU] = {0, 0};
+    const sr_real beta1[4] = {dt / 4, dt / 6, dt / 6, -dt / 12};
+    const sr_real beta2[4] = {-dt / 12, dt / 6, dt / 6, dt / 4};
+    const sr_real half[2] = {SR_C(0.5) * dt, 0}, one[2] = {dt, -SR_C(0.5) * dt};
+    sr_real Fk[4][SR_NT], th[SR_NT], th2[SR_NT], Y2[SR_NX], Y[SR_NX], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
+    tangent dF[4], dth, dth2;
+    error dx, dY2, dY;
+    int status = check_step_arguments(model, x, u, dt, F, G);
+    if (status != SR_OK) return status;
+    if (!u) u = zero_u;
+    identity(dx);
+    status = field_jacobian(model, x, u, dx, Fk[0], dF[0]);                        /* F1 = f(x) */
+    if (status == SR_OK) {                                                         /* Y2 = x . exp(h/2 F1) */
+        combine_jacobian(1, half, (const sr_real(*)[SR_NT])Fk, dF, th, dth);
+        sr_internal_act(x, th, Y2);
+        act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dY2);
+        status = field_jacobian(model, Y2, u, dY2, Fk[1], dF[1]);                  /* F2 = f(Y2) */
+    }
+    if (status == SR_OK) {                                                         /* Y3 = x . exp(h/2 F2) */
+        combine_jacobian(1, half, (const sr_real(*)[SR_NT])Fk + 1, dF + 1, th, dth);
+        sr_internal_act(x, th, Y);
+        act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dY);
+        status = field_jacobian(model, Y, u, dY, Fk[2], dF[2]);                    /* F3 = f(Y3) */
+    }
+    if (status == SR_OK) {                                                         /* Y4 = Y2 . exp(h (F3 - F1/2)) */
+        const sr_real (*pair)[SR_NT] = (const sr_real(*)[SR_NT])Fk;
+        tangent dpair[2];
+        sr_real two[2][SR_NT];
+        memcpy(two[0], pair[2], sizeof two[0]);
+        memcpy(two[1], pair[0], sizeof two[1]);
+        memcpy(dpair[0], dF[2], sizeof dpair[0]);
+        memcpy(dpair[1], dF[0], sizeof dpair[1]);
+        combine_jacobian(2, one, (const sr_real(*)[SR_NT])two, dpair, th, dth);
+        sr_internal_act(Y2, th, Y);
+        act_jacobian(th, (const error *)&dY2, (const sr_real(*)[NC])dth, dY);
+        status = field_jacobian(model, Y, u, dY, Fk[3], dF[3]);                    /* F4 = f(Y4) */
+    }
+    if (status != SR_OK) return status;
+    /* x_new = x . exp(th) . exp(th2) */
+    combine_jacobian(4, beta1, (const sr_real(*)[SR_NT])Fk, dF, th, dth);
+    combine_jacobian(4, beta2, (const sr_real(*)[SR_NT])Fk, dF, th2, dth2);
+    act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dY);
+    act_jacobian(th2, (const error *)&dY, (const sr_real(*)[NC])dth2, dY);
+    deliver_jacobians(dY, f, g);
+    if (!all_finite(f, SR_NE * SR_NE) || !all_finite(g, SR_NE * SR_NU)) return SR_ERR_NONFINITE;
+    memcpy(F, f, sizeof f);
+    memcpy(G, g, sizeof g);
+    return SR_OK;
+}
+
+int sr_step_jacobian(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+                     sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
+{
+    switch (method) {
+    case SR_LIE_EULER: return sr_step_jacobian_lie_euler(model, x, u, dt, F, G);
+    case SR_RKMK4: return sr_step_jacobian_rkmk4(model, x, u, dt, F, G);
+    case SR_CF4: return sr_step_jacobian_cf4(model, x, u, dt, F, G);
+    default: return SR_ERR_ARG;
+    }
+}
+
+int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u, sr_real dt,
+                           sr_real *F, sr_real *G, long *failed_row)
+{
+    long i;
+    if (failed_row) *failed_row = -1;
+    if (!model || (n > 0 && (!x || !F || !G))) return SR_ERR_NULL;
+    if (n < 0 || (method != SR_LIE_EULER && method != SR_RKMK4 && method != SR_CF4)) return SR_ERR_ARG;
+    for (i = 0; i < n; ++i) {
+        const int status = sr_step_jacobian(model, method, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt,
+                                            F + i * SR_NE * SR_NE, G + i * SR_NE * SR_NU);
+        if (status != SR_OK) {
+            if (failed_row) *failed_row = i;
+            return status;
+        }
+    }
+    return SR_OK;
+}
