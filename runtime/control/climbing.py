@@ -13,7 +13,7 @@ yoke and the pendulum (m_P g l/2 for the paper's robot); a larger torque flips t
 Both follow from the physics alone, not from the kernels; `simulate_climb` runs the kernels, and
 tests/runtime/control/test_climbing.py holds one against the other on both sides of the limit.
 
-    python -m runtime.control.climbing      # prints the limit and both sides for the shipped ramps
+    python -m runtime.control.climbing      # prints the limit, writes docs/figures/climbing-limit.png
 """
 import math
 import sys
@@ -59,6 +59,14 @@ def simulate_climb(params, u_Y, duration=60.0, window=5.0):
 
 
 def main(argv=()):
+    """Prints the limit and both sides for the paper's robot; writes the figure (argv[0], default
+    docs/figures/climbing-limit.png): simulated against predicted speed over slopes for the paper's
+    robot and the battery robot of runtime/scenarios/robots/battery-geared.toml."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ..scenarios.scenario import load_scenario
     base = Params.paper_simulation()
     u_Y = 0.5
     limit = climbing_limit(base, u_Y)
@@ -68,6 +76,22 @@ def main(argv=()):
         p = base.replace(slope=slope)
         print(f"  slope {slope:.5f} rad: predicted {steady_climb_speed(p, u_Y, slope):+.4f} m/s, "
               f"simulated {simulate_climb(p, u_Y):+.4f} m/s")
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    robots = {"the paper's robot": base, "battery-geared robot": load_scenario("battery-geared").params}
+    for label, robot in robots.items():
+        lim = climbing_limit(robot, u_Y)
+        slopes = np.linspace(0.0, 1.6 * lim, 9)
+        line, = ax.plot(np.degrees(slopes), [steady_climb_speed(robot, u_Y, s) for s in slopes], "-",
+                        label=f"{label}: power balance (limit {math.degrees(lim):.2f}°)")
+        ax.plot(np.degrees(slopes), [simulate_climb(robot.replace(slope=s), u_Y) for s in slopes], "o",
+                color=line.get_color(), label=f"{label}: simulated (kernels, RKMK4)")
+    ax.axhline(0.0, color="0.6", lw=0.8)
+    ax.set_xlabel("slope [deg]"), ax.set_ylabel("steady speed up the slope [m/s]")
+    ax.set_title(f"climbing under a held yoke torque of {u_Y} N m"), ax.legend(fontsize=7)
+    fig.tight_layout()
+    out = argv[0] if argv else "docs/figures/climbing-limit.png"
+    fig.savefig(out, dpi=100)
+    print(f"wrote {out}")
     return 0
 
 
