@@ -139,3 +139,64 @@ def step_jacobian_checks(n_states=20, seed=7, jacobian=None, params=None, dt=0.0
                      *worst_fd, 1e-8))
         rows.append((f"step_jacobian {method}: d/dt at 0 vs linearize ({n_states} states)", *worst_lin, 1e-6))
     return rows
+
+
+#: (h, h/2) per method for the variational check, and the order of the step Jacobian's local
+#: error: Lie–Euler is first order (local error O(h²)), RKMK4 and CF4 fourth (O(h⁵)).
+VARIATIONAL_STEPS = {"lie-euler": ((0.02, 0.01), 2), "rkmk4": ((0.05, 0.025), 5), "cf4": ((0.05, 0.025), 5)}
+
+
+def variational_jacobian(model, x, u, h):
+    """(Φ, Ψ) of the exact flow over time h from x with u held: the variational equations
+    Φ' = A(x(t)) Φ, Ψ' = A(x(t)) Ψ + B(x(t)), Φ(0) = I, Ψ(0) = 0, with (A, B) = linearize (the
+    continuous error dynamics in the same coordinates), integrated with x by solve_ivp (DOP853,
+    rtol = atol = 1e-13)."""
+    from scipy.integrate import solve_ivp
+
+    from ..validation import project_state
+    from .verify import state_derivative
+
+    n = NE * (NE + NU)
+
+    def rhs(_, y):
+        xs = project_state(y[:STATE_DIM], model.params.r)
+        A, B = model.linearize(xs, u)
+        P = y[STATE_DIM:].reshape(NE, NE + NU)
+        dP = A @ P
+        dP[:, NE:] += B
+        return np.concatenate([state_derivative(model, xs, u), dP.ravel()])
+
+    y0 = np.concatenate([x, np.hstack([np.eye(NE), np.zeros((NE, NU))]).ravel()])
+    sol = solve_ivp(rhs, (0.0, h), y0, method="DOP853", rtol=1e-13, atol=1e-13)
+    P = sol.y[STATE_DIM:, -1].reshape(NE, NE + NU)
+    assert P.size == n
+    return P[:, :NE], P[:, NE:]
+
+
+def variational_checks(n_states=3, seed=9, jacobian=None, params=None):
+    """Rows of `make verify`: step_jacobian against the variational equations along the same step.
+    The discrete map's Jacobian differs from the flow's by the method's local error, so the row
+    measures the order of that difference from steps h and h/2 (Lie–Euler 2, RKMK4 and CF4 5) and
+    passes when the measured order is at least the expected one minus 0.5 (worst over n_states).
+    Returns (name, worst difference at h/2, worst |measured − expected| shortfall, tolerance) rows."""
+    params = Params.paper_simulation() if params is None else params
+    model = Model(params)
+    jacobian = jacobian or (lambda m, x, u, dt_, method: m.step_jacobian(x, u, dt_, method))
+    rng = np.random.default_rng(seed)
+    X = np.array([random_state(rng, params, max_speed=2.0) for _ in range(n_states)])
+    U = random_inputs(rng, n_states, max_torque=0.3)
+    rows = []
+    for method, ((h1, h2), order) in VARIATIONAL_STEPS.items():
+        worst_order, worst_error = np.inf, 0.0
+        for x, u in zip(X, U):
+            errors = []
+            for h in (h1, h2):
+                F, G = jacobian(model, x, u, h, method)
+                Phi, Psi = variational_jacobian(model, x, u, h)
+                errors.append(float(np.abs(np.hstack([F, G]) - np.hstack([Phi, Psi])).max()))
+            measured = np.log2(errors[0] / errors[1])
+            worst_order, worst_error = min(worst_order, measured), max(worst_error, errors[1])
+        shortfall = max(0.0, order - worst_order)
+        rows.append((f"step_jacobian {method} vs the variational equations: local order {worst_order:.2f} "
+                     f"(expected {order}; {n_states} states, h = {h1:g}, {h2:g} s)", worst_error, shortfall, 0.5))
+    return rows

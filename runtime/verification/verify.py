@@ -321,7 +321,7 @@ def planar_symmetry(steps=2000):
 
 
 def jacobian_rows(n_states=1000, seed=5):
-    from .jacobians import accel_jacobian_checks, step_jacobian_checks
+    from .jacobians import accel_jacobian_checks, step_jacobian_checks, variational_checks
     general = random_general_params(np.random.default_rng(seed + 2))
     general_rows = [(f"{name} on a general robot", *rest)
                     for name, *rest in accel_jacobian_checks(max(n_states // 5, 20), seed + 3, params=general,
@@ -329,7 +329,11 @@ def jacobian_rows(n_states=1000, seed=5):
     return ([CheckResult(*row, catches="a Jacobian entry off by 1e-6")
              for row in accel_jacobian_checks(n_states, seed) + general_rows]
             + [CheckResult(*row, catches="an entry of F or G off by 1e-6 of the largest")
-               for row in step_jacobian_checks(min(n_states, 20), seed + 1)])
+               for row in step_jacobian_checks(min(n_states, 20), seed + 1)]
+            + [CheckResult(*row, detail="worst rel = how far the measured order falls short of the expected",
+                           catches="a step Jacobian of the wrong order (another method's, a missing stage); "
+                                   "for RKMK4 and CF4 an entry off by 1e-3")
+               for row in variational_checks(seed=seed + 4)])
 
 
 def linearization_rows():

@@ -69,3 +69,30 @@ def test_accel_jacobian_rows_fail_for_a_perturbed_jacobian_of_a_general_robot():
         return Ja, Jb
     rows = accel_jacobian_checks(n_states=20, n_difference=3, params=general_robot(), jacobian=perturbed)
     assert rows_pass(rows) == [False, False]
+
+
+def test_step_jacobians_differ_from_the_variational_equations_by_their_methods_local_error():
+    from runtime.verification.jacobians import variational_checks
+    assert rows_pass(variational_checks(n_states=2)) == [True, True, True]
+
+
+def test_the_variational_rows_fail_for_another_methods_jacobian():
+    """Lie-Euler's Jacobian handed in for RKMK4 and CF4: the difference is O(h^2), not O(h^5)."""
+    from runtime.verification.jacobians import variational_checks
+
+    def lie_euler_for_all(model, x, u, dt, method):
+        return model.step_jacobian(x, u, dt, "lie-euler")
+    assert rows_pass(variational_checks(n_states=1, jacobian=lie_euler_for_all)) == [True, False, False]
+
+
+def test_the_fourth_order_variational_rows_fail_for_a_jacobian_entry_off_by_1e_3():
+    """(Lie-Euler's own O(h^2) difference, 3e-2 at h = 0.01 s, hides such an entry: its Richardson
+    rows are the tight ones.)"""
+    from runtime.verification.jacobians import variational_checks
+
+    def perturbed(model, x, u, dt, method):
+        F, G = model.step_jacobian(x, u, dt, method)
+        F = F.copy()
+        F[3, 7] += 1e-3 * np.abs(F).max()
+        return F, G
+    assert rows_pass(variational_checks(n_states=1, jacobian=perturbed)) == [True, False, False]
