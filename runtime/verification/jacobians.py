@@ -154,7 +154,7 @@ def variational_jacobian(model, x, u, h):
     from scipy.integrate import solve_ivp
 
     from ..validation import project_state
-    from .verify import state_derivative
+    from .flow import state_derivative
 
     n = NE * (NE + NU)
 

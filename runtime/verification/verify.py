@@ -31,9 +31,10 @@ import numpy as np
 
 from ..model import Model
 from ..params import Params
-from ..so3 import exp, hat, rot_x, rot_y, rot_z, vee
-from ..state import IDX_NU, IDX_Q, IDX_QZ, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NX, initial_state, rotations
+from ..so3 import exp, rot_x, rot_y, rot_z
+from ..state import IDX_NU, IDX_Q, IDX_QZ, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, initial_state, rotations
 from ..validation import project_state
+from .flow import state_derivative
 from .sampling import random_general_params, random_inputs, random_params, random_state
 
 
@@ -52,24 +53,6 @@ class CheckResult:
         if self.at_least:
             return bool(self.abs_error >= self.tolerance)
         return bool(self.rel_error <= self.tolerance)
-
-
-def state_derivative(model, x, u=None):
-    """ẋ for the whole 35-vector: Ṙ_S = R_S⟦ω_S⟧, Ṙ_Y = R_Y ω_Y Σ_Y, Ṙ_P = R_P ω_P Σ_P, q̇ = r R_S(ω_S × γ), ν̇.
-
-    The dynamics live on SO(3)³; a Runge–Kutta integrator in ℝ³⁵ evaluates stages slightly
-    off it, so the vector field is extended by projection (`project_state`).
-    """
-    xp = project_state(x, model.params.r)
-    R_S, R_Y, R_P = rotations(xp)
-    w = xp[IDX_WS]
-    d = np.empty(NX)
-    d[IDX_RS] = (R_S @ hat(w)).ravel()
-    d[IDX_RY] = (R_Y @ hat([xp[IDX_WY], 0, 0])).ravel()
-    d[IDX_RP] = (R_P @ hat([0, xp[IDX_WP], 0])).ravel()
-    d[IDX_Q] = model.params.r * R_S @ np.cross(w, R_S[2])
-    d[IDX_NU] = model.accel(xp, u)
-    return d
 
 
 def integrate(model, x0, t_end, u=None, rtol=1e-12, atol=1e-12, dense=False):
