@@ -235,6 +235,16 @@ theta_P = 0.5
     (VALID + "[[torque]]\nfrom_time = 0.1\nto_time = 0.2\nu_P = 1.0\n", "torque[1].from_time", "past the end"),
     (VALID.replace('preset = "paper"', 'preset = "paper"\nr = 1e-200\nb = 1e-200\nh = 1e-200\nl = 1e-200'),
      "params", "Params.j_S: must be > 0"),
+    # issue 18: the general robot's values
+    (VALID.replace('preset = "paper"', 'preset = "paper"\nJ_P = [[0.1, 0, 0], [0, 0.1, 0], [0, 0, 0.3]]'),
+     "Params.J_P", "not a physical inertia tensor"),
+    (VALID.replace('preset = "paper"', 'preset = "paper"\nJ_Y = [[0.2, 0.18, 0], [0.18, 0.2, 0], [0, 0, 0.3]]'),
+     "Params.J_Y", "not a physical inertia tensor"),
+    (VALID.replace('preset = "paper"', 'preset = "paper"\nc_Y = [0.0, 0.0, 0.31]'), "Params.c_Y", "inside the shell"),
+    (VALID.replace('preset = "paper"', 'preset = "paper"\nslope = 1.6'), "Params.slope", "pi/2"),
+    (VALID.replace('preset = "paper"', 'preset = "paper"\nc_P = [0.0, -0.1]'), "Params.c_P", "shape (3,)"),
+    (VALID.replace('preset = "paper"', 'preset = "paper"\nslope = 0.1\nb = 0.3'), "Params.b", "paper's robot"),
+    (VALID.replace('preset = "paper"', 'robot = "no-such-robot.toml"'), "robot", "cannot read"),
 ])
 def test_invalid_files_name_the_file_the_key_and_the_problem(tmp_path, text, key, what):
     path = tmp_path / "bad.toml"
