@@ -40,27 +40,36 @@ static void dexpinv_coefficient(sr_real s, sr_real *c, sr_real *dc)
 }
 
 /* dy = A(th) dx + B(th) dth (dx may be NULL: a state that does not depend on (d, w) other than
- * through x itself, i.e. dx = [I | 0]). */
+ * through x itself, i.e. dx = [I | 0]).  Row by row, each row a contiguous axpy over the NC
+ * columns (what the compiler vectorises). */
 static void act_jacobian(const sr_real th[SR_NT], const error *dx, const tangent dth, error dy)
 {
     sr_real D[9], Jr[9];
-    error out;
+    error in, out;
     int i, j, c;
     so3_exp_minus_identity(th + SR_T_S, D);
     so3_right_jacobian(th + SR_T_S, Jr);
-    for (c = 0; c < NC; ++c) {
-        sr_real in[SR_NE];
-        for (i = 0; i < SR_NE; ++i) in[i] = dx ? (*dx)[i][c] : (sr_real)(i == c);
-        for (i = 0; i < 3; ++i) {   /* Exp(th)^T = I + D^T, then + Jr dth_S */
-            sr_real s = in[SR_E_xi_S + i];
-            for (j = 0; j < 3; ++j) s += D[3 * j + i] * in[SR_E_xi_S + j] + Jr[3 * i + j] * dth[SR_T_S + j][c];
-            out[SR_E_xi_S + i][c] = s;
+    if (dx) memcpy(in, *dx, sizeof in);
+    else
+        for (i = 0; i < SR_NE; ++i)
+            for (c = 0; c < NC; ++c) in[i][c] = (sr_real)(i == c);
+    for (i = 0; i < 3; ++i) {   /* Exp(th)^T = I + D^T, then + Jr dth_S */
+        sr_real *o = out[SR_E_xi_S + i];
+        for (c = 0; c < NC; ++c) o[c] = in[SR_E_xi_S + i][c];
+        for (j = 0; j < 3; ++j) {
+            const sr_real dji = D[3 * j + i], jrij = Jr[3 * i + j];
+            const sr_real *a = in[SR_E_xi_S + j], *b = dth[SR_T_S + j];
+            for (c = 0; c < NC; ++c) o[c] += dji * a[c] + jrij * b[c];
         }
-        out[SR_E_th_Y][c] = in[SR_E_th_Y] + dth[SR_T_Y][c];
-        out[SR_E_th_P][c] = in[SR_E_th_P] + dth[SR_T_P][c];
-        for (i = 0; i < 2; ++i) out[SR_E_q + i][c] = in[SR_E_q + i] + dth[SR_T_Q + i][c];
-        for (i = 0; i < SR_NV; ++i) out[SR_E_nu + i][c] = in[SR_E_nu + i] + dth[SR_T_V + i][c];
     }
+    for (c = 0; c < NC; ++c) {
+        out[SR_E_th_Y][c] = in[SR_E_th_Y][c] + dth[SR_T_Y][c];
+        out[SR_E_th_P][c] = in[SR_E_th_P][c] + dth[SR_T_P][c];
+    }
+    for (i = 0; i < 2; ++i)
+        for (c = 0; c < NC; ++c) out[SR_E_q + i][c] = in[SR_E_q + i][c] + dth[SR_T_Q + i][c];
+    for (i = 0; i < SR_NV; ++i)
+        for (c = 0; c < NC; ++c) out[SR_E_nu + i][c] = in[SR_E_nu + i][c] + dth[SR_T_V + i][c];
     memcpy(dy, out, sizeof out);
 }
 
@@ -77,22 +86,26 @@ static int field_jacobian(const sr_model *model, const sr_real y[SR_NX], const s
         p[0][j] = r * R[3 + j];     /* q_x' = r (R_S w)_y */
         p[1][j] = -r * R[j];        /* q_y' = -r (R_S w)_x */
     }
-    for (c = 0; c < NC; ++c) {
-        for (i = 0; i < 3; ++i) df[SR_T_S + i][c] = dy[SR_E_nu + i][c];
-        df[SR_T_Y][c] = dy[SR_E_nu + 3][c];
-        df[SR_T_P][c] = dy[SR_E_nu + 4][c];
-        for (i = 0; i < 2; ++i) {   /* d(q') = p . (dw - w x dxi) = p . dw + (w x p) . dxi */
-            const sr_real *q = p[i];
-            const sr_real wxp[3] = {w[1] * q[2] - w[2] * q[1], w[2] * q[0] - w[0] * q[2], w[0] * q[1] - w[1] * q[0]};
-            sr_real s = 0;
-            for (j = 0; j < 3; ++j) s += q[j] * dy[SR_E_nu + j][c] + wxp[j] * dy[SR_E_xi_S + j][c];
-            df[SR_T_Q + i][c] = s;
+    for (i = 0; i < 3; ++i) memcpy(df[SR_T_S + i], dy[SR_E_nu + i], sizeof df[0]);
+    memcpy(df[SR_T_Y], dy[SR_E_nu + 3], sizeof df[0]);
+    memcpy(df[SR_T_P], dy[SR_E_nu + 4], sizeof df[0]);
+    for (i = 0; i < 2; ++i) {   /* d(q') = p . (dw - w x dxi) = p . dw + (w x p) . dxi */
+        const sr_real *q = p[i];
+        const sr_real wxp[3] = {w[1] * q[2] - w[2] * q[1], w[2] * q[0] - w[0] * q[2], w[0] * q[1] - w[1] * q[0]};
+        sr_real *o = df[SR_T_Q + i];
+        for (c = 0; c < NC; ++c) o[c] = 0;
+        for (j = 0; j < 3; ++j) {
+            const sr_real *a = dy[SR_E_nu + j], *b = dy[SR_E_xi_S + j];
+            for (c = 0; c < NC; ++c) o[c] += q[j] * a[c] + wxp[j] * b[c];
         }
-        df[SR_T_Q + 2][c] = 0;
-        for (i = 0; i < SR_NV; ++i) {
-            sr_real s = c >= SR_NE ? Jb[SR_NU * i + (c - SR_NE)] : 0;
-            for (k = 0; k < SR_NE; ++k) s += Ja[SR_NE * i + k] * dy[k][c];
-            df[SR_T_V + i][c] = s;
+    }
+    for (c = 0; c < NC; ++c) df[SR_T_Q + 2][c] = 0;
+    for (i = 0; i < SR_NV; ++i) {
+        sr_real *o = df[SR_T_V + i];
+        for (c = 0; c < NC; ++c) o[c] = c >= SR_NE ? Jb[SR_NU * i + (c - SR_NE)] : 0;
+        for (k = 0; k < SR_NE; ++k) {
+            const sr_real jik = Ja[SR_NE * i + k], *a = dy[k];
+            for (c = 0; c < NC; ++c) o[c] += jik * a[c];
         }
     }
     return SR_OK;
@@ -119,13 +132,16 @@ static void dexpinv_jacobian(const sr_real th[SR_NT], const tangent dth, sr_real
     for (i = 0; i < 3; ++i)
         for (j = 0; j < 3; ++j)
             Q[3 * i + j] += c * ((i == j ? tv : 0) + t[i] * v[j] - 2 * v[i] * t[j]) + 2 * dc * b[i] * t[j];
-    for (col = 0; col < NC; ++col) {
-        sr_real out[3];
+    {
+        sr_real out[3][NC];
         for (i = 0; i < 3; ++i) {
-            out[i] = 0;
-            for (j = 0; j < 3; ++j) out[i] += P[3 * i + j] * df[SR_T_S + j][col] + Q[3 * i + j] * dth[SR_T_S + j][col];
+            for (col = 0; col < NC; ++col) out[i][col] = 0;
+            for (j = 0; j < 3; ++j) {
+                const sr_real pij = P[3 * i + j], qij = Q[3 * i + j], *a = df[SR_T_S + j], *b = dth[SR_T_S + j];
+                for (col = 0; col < NC; ++col) out[i][col] += pij * a[col] + qij * b[col];
+            }
         }
-        for (i = 0; i < 3; ++i) df[SR_T_S + i][col] = out[i];
+        memcpy(df[SR_T_S], out, sizeof out);
     }
     sr_internal_dexpinv(th, f, f);
 }
@@ -138,10 +154,10 @@ static void combine_jacobian(int n, const sr_real *coef, const sr_real (*K)[SR_N
     for (i = 0; i < SR_NT; ++i) {
         th[i] = 0;
         for (k = 0; k < n; ++k) th[i] += coef[k] * K[k][i];
-        for (c = 0; c < NC; ++c) {
-            sr_real s = 0;
-            for (k = 0; k < n; ++k) s += coef[k] * dK[k][i][c];
-            dth[i][c] = s;
+        for (c = 0; c < NC; ++c) dth[i][c] = 0;
+        for (k = 0; k < n; ++k) {
+            const sr_real ck = coef[k], *a = dK[k][i];
+            for (c = 0; c < NC; ++c) dth[i][c] += ck * a[c];
         }
     }
 }
