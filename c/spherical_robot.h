@@ -467,6 +467,106 @@ int sr_step_jacobian(const sr_model *model, int method, const sr_real x[SR_NX], 
 int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u, sr_real dt,
                            sr_real *F, sr_real *G, long *failed_row);
 
+/* ---- The firmware controller: LQR gain-scheduled on speed and curvature (c/sr_control.c) ----
+ *
+ * Issue 20.  The controller acts through the two motor torques only.  It measures the state
+ * against a reference that rolls at speed v_ref along the heading psi_ref (the heading to hold,
+ * or a path's tangent at the point nearest to the robot, with the path's curvature kappa and the
+ * signed cross-track error e_y, left positive), in the error coordinates z[SR_LQR_NZ]:
+ *   z[0..2]  E = Log(Q_ref^T Q): the yoke's attitude in the world, Q = R_S R_Y, against
+ *            Q_ref = rot_z(psi_ref - pi/2) (the yoke upright, rolling along psi_ref)       [rad]
+ *   z[3]     the pendulum's angle theta_P                                                 [rad]
+ *   z[4..6]  R_Y^T w_S - (-v_ref / r, 0, 0): the shell's rate in the yoke's frame       [rad/s]
+ *   z[7]     w_Y - v_ref / r;   z[8]  w_P                                               [rad/s]
+ *   z[9]     e_y (path references; 0 otherwise)                                           [m]
+ *   z[10]    the integral of e_y;  z[11]  the integral of z[4] - z*[4]          [m s], [rad]
+ * In these coordinates steady rolling on a path of constant curvature is an equilibrium (the
+ * shell is a uniform sphere: its phase about the yoke's hinge does not enter the dynamics), so
+ * the law is time-invariant: u = u* - K (z - z*), with the operating point (z*, u*) and the gain
+ * K interpolated bilinearly in (v_ref, kappa) over a grid designed offline
+ * (runtime/control/lqr_design.py: Newton on the reduced dynamics, their linearisation, a
+ * discrete Riccati equation at the controller's period; docs/control.md).  K_path is used for
+ * path references, K_heading (whose e_y columns are zero) for speed and heading references.
+ * The torques are clipped to +-u_max; the integrators advance by one period only when neither
+ * torque was clipped (conditional anti-windup).  The curvature of the operating point follows
+ * the reference's at most kappa_rate per second (a figure eight's switch of turn direction). */
+#define SR_LQR_NZ 12
+#ifndef SR_LQR_MAX_SPEEDS
+#define SR_LQR_MAX_SPEEDS 6
+#endif
+#ifndef SR_LQR_MAX_CURVATURES
+#define SR_LQR_MAX_CURVATURES 5
+#endif
+
+#ifdef SR_USE_FLOAT
+#define sr_lqr sr_lqr_f
+#define sr_lqr_target sr_lqr_target_f
+#define sr_lqr_memory sr_lqr_memory_f
+#define sr_lqr_check sr_lqr_check_f
+#define sr_lqr_reset sr_lqr_reset_f
+#define sr_lqr_error sr_lqr_error_f
+#define sr_lqr_control sr_lqr_control_f
+#endif
+
+/* A gain schedule (read-only during control; fill it from the design, e.g. the header that
+ * `python -m runtime.control.lqr --emit-c` writes).  Point (i, j) of the grid, speed i and
+ * curvature j, is entry i * n_curvatures + j of z_star, u_star, K_path and K_heading
+ * (K row-major 2 x SR_LQR_NZ). */
+typedef struct sr_lqr {
+    int n_speeds;                                   /* 1 .. SR_LQR_MAX_SPEEDS */
+    int n_curvatures;                               /* 1 .. SR_LQR_MAX_CURVATURES */
+    sr_real speeds[SR_LQR_MAX_SPEEDS];              /* strictly increasing [m/s] */
+    sr_real curvatures[SR_LQR_MAX_CURVATURES];      /* strictly increasing [1/m] */
+    sr_real z_star[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_LQR_NZ];
+    sr_real u_star[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_NU];
+    sr_real K_path[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_NU * SR_LQR_NZ];
+    sr_real K_heading[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_NU * SR_LQR_NZ];
+    sr_real period;                                 /* the controller's sampling period [s], > 0 */
+    sr_real u_max;                                  /* torque limit on both motors [N m], > 0 */
+    sr_real kappa_rate;                             /* [1/(m s)], >= 0 */
+} sr_lqr;
+
+/* What to track at this sample (from the reference). */
+typedef struct sr_lqr_target {
+    sr_real speed;        /* v_ref [m/s] */
+    sr_real heading;      /* psi_ref [rad]: the heading to hold or the path's tangent */
+    sr_real curvature;    /* kappa [1/m], left positive (path references) */
+    sr_real cross_track;  /* e_y [m], positive when the robot is left of the path */
+    int path;             /* nonzero: a path reference (curvature and cross_track are read) */
+} sr_lqr_target;
+
+/* The controller's memory between samples (sr_lqr_reset before the first). */
+typedef struct sr_lqr_memory {
+    sr_real integrals[2];  /* z[10], z[11] */
+    sr_real kappa;         /* the operating point's curvature [1/m] */
+    int started;           /* 0 until the first sample */
+    int saturated;         /* out: the last sample clipped a torque */
+} sr_lqr_memory;
+
+/* Checks a schedule: sizes in range, grids strictly increasing, every entry finite, period and
+ * u_max > 0, kappa_rate >= 0.  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
+int sr_lqr_check(const sr_lqr *lqr);
+
+/* Zeroes the memory.  Returns SR_OK or SR_ERR_NULL. */
+int sr_lqr_reset(sr_lqr_memory *memory);
+
+/* The error coordinates z of x against the target (integrals: z[10], z[11]; NULL: zeros).
+ * Checks x in full (sr_check_state) and the target for finiteness.  Returns SR_OK,
+ * SR_ERR_NULL, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION or SR_ERR_CONSTRAINT; z is written only
+ * on SR_OK. */
+int sr_lqr_error(const sr_model *model, const sr_real x[SR_NX], const sr_lqr_target *target,
+                 const sr_real integrals[2], sr_real z[SR_LQR_NZ]);
+
+/* One sample of the controller: the torques u (clipped to +-u_max) for the next period, and
+ * (if u_raw is not NULL) the torques before clipping; advances the memory.  Checks x and the
+ * target as sr_lqr_error does, the schedule's sizes, period and u_max (SR_ERR_ARG), and that
+ * the torques are finite (SR_ERR_NONFINITE: a non-finite entry of the schedule that was used);
+ * run sr_lqr_check once on a schedule before using it.  u, u_raw and the memory are written
+ * only on SR_OK. */
+int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_NX],
+                   const sr_lqr_target *target, sr_lqr_memory *memory, sr_real u[SR_NU],
+                   sr_real u_raw[SR_NU]);
+
 #ifdef __cplusplus
 }
 #endif

@@ -192,6 +192,39 @@ static inline void rotate_about_axis(const sr_real *R, int k, sr_real angle, sr_
     matmul3(R, E, out);
 }
 
+/* w = Log(R), |w| <= pi, for a rotation R (row-major), accurate for every angle: the axis comes
+ * from the skew part while the angle is at most pi/2 and from the symmetric part beyond, where
+ * sin(theta) loses the accuracy that (R + R^T)/2 - cos(theta) I = (1 - cos theta) n n^T keeps. */
+static inline void so3_log(const sr_real R[9], sr_real w[3])
+{
+    const sr_real s[3] = {SR_C(0.5) * (R[7] - R[5]), SR_C(0.5) * (R[2] - R[6]), SR_C(0.5) * (R[3] - R[1])};
+    const sr_real sin_t = SR_SQRT(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    sr_real cos_t = SR_C(0.5) * (R[0] + R[4] + R[8] - 1);
+    sr_real theta, scale;
+    int i;
+    cos_t = cos_t > 1 ? 1 : (cos_t < -1 ? -1 : cos_t);
+    theta = SR_ATAN2(sin_t, cos_t);
+    if (cos_t >= 0) {
+        /* theta / sin(theta); its series below 1e-4 rad (the next term, 7 t^4/360, is < 2e-18). */
+        scale = theta < SR_C(1e-4) ? 1 + theta * theta / 6 : theta / sin_t;
+        for (i = 0; i < 3; ++i) w[i] = scale * s[i];
+    } else {
+        /* The column of S = (R + R^T)/2 - cos(theta) I with the largest diagonal entry: that
+         * entry is (1 - cos theta) n_k^2 >= 1/3, so its direction is n to rounding. */
+        sr_real n[3], norm;
+        int k = 0;
+        for (i = 1; i < 3; ++i)
+            if (R[4 * i] > R[4 * k]) k = i;
+        for (i = 0; i < 3; ++i) n[i] = SR_C(0.5) * (R[3 * i + k] + R[3 * k + i]);
+        n[k] -= cos_t;
+        /* The sign of the axis from the skew part sin(theta) n (immaterial at theta = pi). */
+        if (n[0] * s[0] + n[1] * s[1] + n[2] * s[2] < 0)
+            for (i = 0; i < 3; ++i) n[i] = -n[i];
+        norm = SR_SQRT(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (i = 0; i < 3; ++i) w[i] = theta * n[i] / norm;
+    }
+}
+
 /* Copy n results from tmp to out when the computation succeeded and they are all finite:
  * outputs are either fully written and finite or untouched.  (The generated kernels do the
  * same themselves: they write only on SR_GEN_OK, and return SR_GEN_NONFINITE, equal to

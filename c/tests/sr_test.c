@@ -48,6 +48,7 @@ int main(void)
     suite_group();
     suite_general();
     suite_jacobians();
+    suite_control();
     return sr_test_summary();
 }
 

@@ -70,6 +70,7 @@ void suite_batch(void);
 void suite_group(void);
 void suite_general(void);
 void suite_jacobians(void);
+void suite_control(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 

@@ -1,4 +1,4 @@
-"""`make control`: every available controller on every shipped task; one table (Markdown and CSV),
+"""`make control`: every controller of every shipped task (a task file lists its controllers); one table (Markdown and CSV),
 a folder per run with summary.json (metrics under `tracking`) and figures.
 
     python -m runtime control [--out out/control] [--tasks circle,line] [--duration S]
@@ -58,8 +58,11 @@ def main(argv=()):
         parser.error(f"--duration: must be > 0 s, got {args.duration:g}")
     out = pathlib.Path(args.out)
     rows = []
-    for name in tqdm(args.tasks.split(","), unit="task"):
+    runs = []
+    for name in args.tasks.split(","):
         task = load_task(name)
+        runs += [(name, task.with_controller(kind)) for kind in task.controller_kinds]
+    for name, task in tqdm(runs, unit="run"):
         if args.duration is not None:
             steps = max(1, round(min(args.duration, task.duration) / task.scenario.dt))
             task = dataclasses.replace(task, scenario=dataclasses.replace(task.scenario, steps=steps))

@@ -21,13 +21,15 @@ from ..scenarios.scenario import parse_scenario
 from .closed_loop import Noise
 from .controller import DEFAULT_U_MAX
 from .geometry import heading
+from .lqr import GAIN_NAMES as LQR_GAIN_NAMES
+from .lqr import Lqr, LqrGains
 from .pid import GAIN_NAMES, Pid, PidGains
 from .reference import KINDS, SpeedHeading, circle_path, figure8_path, line_path, waypoints_path
 from ..state import IDX_Q
 
-#: Controller kinds of issue #20; only these are built so far (NMPC and LQR wait for #19).
+#: Controller kinds of issue #20; NMPC is not built yet.
 CONTROLLER_KINDS = ("pid", "nmpc", "lqr")
-AVAILABLE_CONTROLLERS = {"pid": (Pid, PidGains, GAIN_NAMES)}
+AVAILABLE_CONTROLLERS = {"pid": (Pid, PidGains, GAIN_NAMES), "lqr": (Lqr, LqrGains, LQR_GAIN_NAMES)}
 _SCENARIO_KEYS = {"description", "dt", "duration", "steps", "method", "params", "initial"}
 _REFERENCE_KEYS = {"kind", "speed", "heading", "offset", "radius", "size", "points"}
 _NEEDS = {"speed": ("speed",), "heading": ("speed", "heading"), "line": ("speed", "offset"),
@@ -37,21 +39,44 @@ _NOISE_KEYS = {"noise_position_m": "position_m", "noise_attitude_rad": "attitude
 
 
 @dataclasses.dataclass(frozen=True)
+class ControllerSpec:
+    """One `[controller]` table (or one entry of `[[controller]]`): its kind, rate, limit and tuning."""
+    kind: str
+    rate: float
+    u_max: float
+    gains: object
+
+
+@dataclasses.dataclass(frozen=True)
 class Task:
     name: str
     source: str
     scenario: object            # runtime.scenarios.scenario.Scenario: the controller's model and x0
     reference_spec: dict
-    controller_kind: str
-    rate: float
-    u_max: float
-    gains: object
+    controllers: tuple          # ControllerSpec, one per kind; the first is the task's default
     plant_params: object        # runtime.Params of the simulated robot
     noise: Noise
 
     @property
     def duration(self):
         return self.scenario.duration
+
+    # The first controller's settings (a task run with one controller: `with_controller`).
+    controller_kind = property(lambda self: self.controllers[0].kind)
+    rate = property(lambda self: self.controllers[0].rate)
+    u_max = property(lambda self: self.controllers[0].u_max)
+    gains = property(lambda self: self.controllers[0].gains)
+
+    @property
+    def controller_kinds(self):
+        return tuple(c.kind for c in self.controllers)
+
+    def with_controller(self, kind):
+        """The task with only its controller of this kind."""
+        for spec in self.controllers:
+            if spec.kind == kind:
+                return dataclasses.replace(self, controllers=(spec,))
+        raise ValueError(f"{self.source}: no controller of kind {kind!r} (it has {', '.join(self.controller_kinds)})")
 
     def controller(self):
         cls = AVAILABLE_CONTROLLERS[self.controller_kind][0]
@@ -108,14 +133,21 @@ def parse_task(data, source="<task>", name="task"):
                          f"{', '.join(sorted(_SCENARIO_KEYS | {'reference', 'controller', 'plant'}))}")
     scenario = parse_scenario({k: v for k, v in data.items() if k in _SCENARIO_KEYS}, source, name)
     reference = _parse_reference(data.get("reference"), source)
-    kind, rate, u_max, gains = _parse_controller(data.get("controller"), source)
-    per = rate * scenario.dt
-    if abs(1 / per - round(1 / per)) > 1e-9 * (1 / per):
-        raise ValueError(f"{source}: controller.rate: the period 1/{rate:g} s is not a whole number of "
-                         f"steps dt = {scenario.dt:g} s")
+    tables = data.get("controller")
+    tables = tables if isinstance(tables, list) and tables else [tables]
+    controllers = []
+    for i, table in enumerate(tables):
+        spec = ControllerSpec(*_parse_controller(table, source, "controller" if len(tables) == 1 else f"controller[{i}]"))
+        if spec.kind in (c.kind for c in controllers):
+            raise ValueError(f"{source}: controller[{i}].kind: {spec.kind!r} appears twice")
+        per = spec.rate * scenario.dt
+        if abs(1 / per - round(1 / per)) > 1e-9 * (1 / per):
+            raise ValueError(f"{source}: controller.rate: the period 1/{spec.rate:g} s is not a whole number of "
+                             f"steps dt = {scenario.dt:g} s")
+        controllers.append(spec)
     plant, noise = _parse_plant(data.get("plant", {}), scenario.params, source)
-    return Task(name=name, source=source, scenario=scenario, reference_spec=reference, controller_kind=kind,
-                rate=rate, u_max=u_max, gains=gains, plant_params=plant, noise=noise)
+    return Task(name=name, source=source, scenario=scenario, reference_spec=reference,
+                controllers=tuple(controllers), plant_params=plant, noise=noise)
 
 
 def _table(value, where, allowed):
@@ -169,24 +201,29 @@ def _parse_reference(table, source):
     return spec
 
 
-def _parse_controller(table, source):
-    where = f"{source}: controller"
+def _parse_controller(table, source, name="controller"):
+    where = f"{source}: {name}"
     if table is None:
-        raise ValueError(f"{where}: missing (required): give kind = \"pid\"")
+        raise ValueError(f"{where}: missing (required): give kind = \"pid\" or \"lqr\"")
     if not isinstance(table, dict):
         raise ValueError(f"{where}: expected a table, got {type(table).__name__} {table!r}")
     kind = table.get("kind")
     if kind not in CONTROLLER_KINDS:
         raise ValueError(f"{where}.kind: expected one of {', '.join(CONTROLLER_KINDS)}, got {kind!r}")
     if kind not in AVAILABLE_CONTROLLERS:
-        raise ValueError(f"{where}.kind: {kind!r} is not yet available (it waits for the Jacobians and the "
-                         f"CasADi model of issue #19); available: {', '.join(AVAILABLE_CONTROLLERS)}")
+        raise ValueError(f"{where}.kind: {kind!r} is not yet available (issue #20); "
+                         f"available: {', '.join(AVAILABLE_CONTROLLERS)}")
     _, gains_cls, gain_names = AVAILABLE_CONTROLLERS[kind]
     _table(table, where, {"kind", "rate", "u_max", *gain_names})
     rate = _real(table.get("rate", 50.0), f"{where}.rate", positive=True)
     u_max = _real(table.get("u_max", DEFAULT_U_MAX), f"{where}.u_max", positive=True)
-    gains = gains_cls(**{k: _real(v, f"{where}.{k}", nonnegative=True)
-                         for k, v in table.items() if k in gain_names})
+    try:
+        gains = gains_cls(**{k: _real(v, f"{where}.{k}", nonnegative=True)
+                             for k, v in table.items() if k in gain_names})
+    except ValueError as exc:
+        if str(exc).startswith(source):
+            raise
+        raise ValueError(f"{where}.{exc}") from None
     return kind, rate, u_max, gains
 
 

@@ -16,7 +16,7 @@ def with_(section, **values):
 def test_the_six_tasks_of_issue_20_ship():
     assert set(shipped_tasks()) >= {"speed-step", "heading-step", "line", "circle", "figure8", "square"}
     for name in shipped_tasks():
-        assert load_task(name).controller_kind == "pid"
+        assert load_task(name).controller_kinds == ("pid", "lqr")
 
 
 @pytest.mark.parametrize("section, values, named", [
@@ -27,7 +27,9 @@ def test_the_six_tasks_of_issue_20_ship():
     ("reference", {"kind": "waypoints", "points": [[1.0]]}, "reference.points"),
     ("reference", {"colour": 1}, "reference: unknown key"),
     ("controller", {"kind": "nmpc"}, "controller.kind: 'nmpc' is not yet available"),
-    ("controller", {"kind": "lqr"}, "controller.kind: 'lqr' is not yet available"),
+    ("controller", {"kind": "lqr", "n_speeds": 0.5}, "controller.n_speeds"),
+    ("controller", {"kind": "lqr", "tilt_rad": 0.0}, "controller.tilt_rad"),
+    ("controller", {"kind": "lqr", "k_v": 1.0}, "controller: unknown key"),
     ("controller", {"rate": -5.0}, "controller.rate"),
     ("controller", {"rate": 30.0}, "controller.rate"),
     ("controller", {"u_max": 0.0}, "controller.u_max"),
@@ -53,3 +55,14 @@ def test_plant_overrides_change_only_the_plant():
     task = parse_task(with_("plant", m_P=1.1, k_S=0.2))
     assert task.plant_params.m_P == 1.1 and task.scenario.params.m_P == 1.0
     assert task.plant_params.k_S == 0.2
+
+
+def test_a_task_lists_several_controllers_each_kind_once():
+    data = with_("reference")
+    data["controller"] = [{"kind": "pid"}, {"kind": "lqr", "rate": 100.0}]
+    task = parse_task(data)
+    assert task.controller_kinds == ("pid", "lqr")
+    assert task.with_controller("lqr").rate == 100.0 and task.with_controller("lqr").controller_kinds == ("lqr",)
+    data["controller"] = [{"kind": "pid"}, {"kind": "pid"}]
+    with pytest.raises(ValueError, match=r"controller\[1\]\.kind: 'pid' appears twice"):
+        parse_task(data, source="t.toml")

@@ -1,0 +1,195 @@
+"""The LQR controller: gain-scheduled on the reference's speed and curvature (runtime/control/lqr_design.py).
+
+At every sample: the error coordinates z of the measured state against the reference (speed v_ref,
+heading ψ_ref, curvature κ, cross-track error e_y), the operating point (z*, u*) and gain K
+interpolated bilinearly in (v_ref, κ) over the design grid, u = u* − K (z − z*), then the
+integrators (∫e_y, ∫ of the rolling-rate error) advance by one period unless a torque was clipped
+(conditional anti-windup).
+"""
+import dataclasses
+
+import numpy as np
+
+from bindings._sr import ffi, lib
+
+from ..model import Model
+from .controller import DEFAULT_U_MAX, Controller
+from . import lqr_design as design
+
+
+@dataclasses.dataclass(frozen=True)
+class LqrGains:
+    """Tuning of `Lqr` (the `[controller]` keys of a task file): Bryson's-rule error sizes, the
+    design grid, and how fast the operating point follows the path's curvature.
+
+    Bryson's rule: Q = diag(1/e_i²), R = I/u_max²: e_i is the error in coordinate i that is worth
+    the full torque.  Tuned on the shipped tasks (docs/control.md, "LQR")."""
+    tilt_rad: float = 1.0             # E_x: the yoke's tilt about its hinge (the pendulum's lever), left loose
+    attitude_rad: float = 0.1         # E_y, E_z: the yoke's lean and heading
+    pendulum_rad: float = 0.3         # θ_P
+    rolling_rate_rad_s: float = 0.2   # Ω_x, the shell's rolling rate: the speed (v = r |Ω_x|)
+    rate_rad_s: float = 0.5           # Ω_y, Ω_z
+    joint_rate_rad_s: float = 2.0     # ω_Y, ω_P
+    cross_track_m: float = 0.15       # e_y
+    cross_track_integral_m_s: float = 20.0   # ∫e_y dt (large: a slow integrator, no overshoot on a line)
+    speed_integral_rad: float = 0.5   # ∫(Ω_x − Ω_x*) dt
+    v_min: float = 0.1                # the design grid's speeds [m/s]: v_min .. v_max in n_speeds
+    v_max: float = 0.5
+    n_speeds: float = 5
+    kappa_max: float = 0.5            # ... and curvatures −κ_max .. κ_max [1/m] in n_curvatures
+    n_curvatures: float = 5
+    kappa_rate: float = 0.3           # how fast the operating point follows the path's curvature [1/(m s)]
+
+    def __post_init__(self):
+        for name in ("tilt_rad", "attitude_rad", "pendulum_rad", "rolling_rate_rad_s", "rate_rad_s",
+                     "joint_rate_rad_s", "cross_track_m", "cross_track_integral_m_s", "speed_integral_rad"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name}: an error size must be > 0, got {getattr(self, name)!r}")
+        for name in ("n_speeds", "n_curvatures"):
+            n = getattr(self, name)
+            if n != int(n) or n < 1:
+                raise ValueError(f"{name}: expected a whole number >= 1, got {n!r}")
+        if self.n_speeds > 1 and not self.v_max > self.v_min:
+            raise ValueError(f"v_max: must exceed v_min = {self.v_min!r} when n_speeds > 1, got {self.v_max!r}")
+        if self.n_curvatures > 1 and not self.kappa_max > 0:
+            raise ValueError(f"kappa_max: must be > 0 when n_curvatures > 1, got {self.kappa_max!r}")
+
+    def weights(self, u_max):
+        return design.Weights(attitude_rad=(self.tilt_rad, self.attitude_rad, self.attitude_rad), pendulum_rad=self.pendulum_rad,
+                              rate_rad_s=(self.rolling_rate_rad_s, self.rate_rad_s, self.rate_rad_s),
+                              yoke_rate_rad_s=self.joint_rate_rad_s, pendulum_rate_rad_s=self.joint_rate_rad_s, cross_track_m=self.cross_track_m,
+                              cross_track_integral_m_s=self.cross_track_integral_m_s,
+                              speed_integral_rad=self.speed_integral_rad, torque_n_m=u_max)
+
+
+GAIN_NAMES = tuple(f.name for f in dataclasses.fields(LqrGains))
+
+
+@dataclasses.dataclass(frozen=True)
+class Schedule:
+    """Operating points on a grid: z_star (nv, nk, NZ), u_star (nv, nk, 2), K_path / K_heading (nv, nk, 2, NZ)."""
+    speeds: np.ndarray
+    curvatures: np.ndarray
+    z_star: np.ndarray
+    u_star: np.ndarray
+    K_path: np.ndarray
+    K_heading: np.ndarray
+
+    def at(self, v, kappa):
+        """(z*, u*, K_path, K_heading) bilinearly interpolated, clamped to the grid."""
+        def bracket(grid, value):
+            if len(grid) == 1:
+                return 0, 0, 0.0
+            i = int(np.clip(np.searchsorted(grid, value) - 1, 0, len(grid) - 2))
+            w = float(np.clip((value - grid[i]) / (grid[i + 1] - grid[i]), 0.0, 1.0))
+            return i, i + 1, w
+        i0, i1, wv = bracket(self.speeds, v)
+        j0, j1, wk = bracket(self.curvatures, kappa)
+
+        def mix(a):
+            return ((1 - wv) * ((1 - wk) * a[i0, j0] + wk * a[i0, j1])
+                    + wv * ((1 - wk) * a[i1, j0] + wk * a[i1, j1]))
+        return mix(self.z_star), mix(self.u_star), mix(self.K_path), mix(self.K_heading)
+
+
+def design_schedule(params, rate, u_max, gains=LqrGains()):
+    """The schedule over the grid of `gains` (cached: tasks and tests design the same one often)."""
+    key = (params.as_array().tobytes(), float(rate), float(u_max), gains)
+    if key not in _SCHEDULES:
+        _SCHEDULES[key] = _design(params, rate, u_max, gains)
+    return _SCHEDULES[key]
+
+
+_SCHEDULES = {}
+
+
+def _design(params, rate, u_max, gains):
+    model = Model(params)
+    speeds = np.linspace(gains.v_min, gains.v_max, int(gains.n_speeds))
+    curvatures = np.linspace(-gains.kappa_max, gains.kappa_max, int(gains.n_curvatures))
+    nv, nk = len(speeds), len(curvatures)
+    z_star, u_star = np.zeros((nv, nk, design.NZ)), np.zeros((nv, nk, 2))
+    K_path, K_heading = np.zeros((nv, nk, 2, design.NZ)), np.zeros((nv, nk, 2, design.NZ))
+    weights = gains.weights(u_max)
+    # Each curvature's operating point starts from its neighbour's, outward from the straightest.
+    order = np.argsort(np.abs(curvatures), kind="stable")
+    for i, v in enumerate(speeds):
+        solved = {}
+        for j in order:
+            near = min(solved, key=lambda k: abs(curvatures[k] - curvatures[j]), default=None)
+            try:
+                solved[j] = design.operating_point(model, v, curvatures[j],
+                                                   start=None if near is None else solved[near])
+            except ValueError:      # too far from the neighbour for Newton alone: continuation from level
+                solved[j] = design.operating_point(model, v, curvatures[j])
+            z_star[i, j], u_star[i, j] = solved[j]
+            A, B = design.linearization(model, z_star[i, j], u_star[i, j], v, curvatures[j])
+            K_path[i, j] = design.gains(A, B, 1.0 / rate, weights, path=True)
+            K_heading[i, j] = design.gains(A, B, 1.0 / rate, weights, path=False)
+    return Schedule(speeds, curvatures, z_star, u_star, K_path, K_heading)
+
+
+def to_c(schedule, period, u_max, kappa_rate):
+    """The schedule as the C struct `sr_lqr` (cffi), checked by `sr_lqr_check`."""
+    nv, nk = len(schedule.speeds), len(schedule.curvatures)
+    if nv > lib.SR_LQR_MAX_SPEEDS or nk > lib.SR_LQR_MAX_CURVATURES:
+        raise ValueError(f"controller: the design grid has {nv} speeds and {nk} curvatures; the C controller "
+                         f"holds at most {lib.SR_LQR_MAX_SPEEDS} and {lib.SR_LQR_MAX_CURVATURES}")
+    c = ffi.new("sr_lqr *")
+    c.n_speeds, c.n_curvatures = nv, nk
+    c.speeds[0:nv] = schedule.speeds.tolist()
+    c.curvatures[0:nk] = schedule.curvatures.tolist()
+    for i in range(nv):
+        for j in range(nk):
+            n = i * nk + j
+            c.z_star[n][0:design.NZ] = schedule.z_star[i, j].tolist()
+            c.u_star[n][0:2] = schedule.u_star[i, j].tolist()
+            c.K_path[n][0:2 * design.NZ] = schedule.K_path[i, j].ravel().tolist()
+            c.K_heading[n][0:2 * design.NZ] = schedule.K_heading[i, j].ravel().tolist()
+    c.period, c.u_max, c.kappa_rate = period, u_max, kappa_rate
+    status = lib.sr_lqr_check(c)
+    if status != lib.SR_OK:
+        raise ValueError(f"controller: the LQR schedule is not valid for the C controller "
+                         f"({ffi.string(lib.sr_status_string(status)).decode()})")
+    return c
+
+
+def c_target(target):
+    t = ffi.new("sr_lqr_target *")
+    t.speed, t.heading = target.speed, target.heading
+    t.path = target.cross_track is not None
+    if t.path:
+        t.curvature, t.cross_track = target.curvature, target.cross_track
+    return t
+
+
+class Lqr(Controller):
+    """The C controller `sr_lqr_control` (c/sr_control.c) on a schedule designed here."""
+    kind = "lqr"
+
+    def __init__(self, params, rate=50.0, u_max=DEFAULT_U_MAX, gains=LqrGains(), schedule=None):
+        super().__init__(params, rate, u_max)
+        self.gains = gains
+        self.schedule = schedule if schedule is not None else design_schedule(params, rate, u_max, gains)
+        self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate)
+        self._model = Model(params)
+        self._memory = ffi.new("sr_lqr_memory *")
+        self._u, self._raw = np.zeros(2), np.zeros(2)
+
+    def reset(self, x0):
+        super().reset(x0)
+        lib.sr_lqr_reset(self._memory)
+
+    @property
+    def integrals(self):
+        return np.array(list(self._memory.integrals))
+
+    def compute(self, t, x, target):
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        status = lib.sr_lqr_control(self._c, self._model._model, ffi.cast("double *", ffi.from_buffer(x)),
+                                    c_target(target), self._memory, ffi.cast("double *", ffi.from_buffer(self._u)),
+                                    ffi.cast("double *", ffi.from_buffer(self._raw)))
+        if status != lib.SR_OK:
+            raise ValueError(f"controller lqr: {ffi.string(lib.sr_status_string(status)).decode()} "
+                             f"at t = {t:g} s")
+        return self._raw.copy()

@@ -1,0 +1,160 @@
+"""The C controller `sr_lqr_control` (c/sr_control.c) against the law written out here in NumPy:
+error coordinates, interpolation of the schedule, clipping, anti-windup, the curvature's rate limit."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from bindings._sr import ffi, lib
+from runtime import so3
+from runtime.control import lqr
+from runtime.control import lqr_design as design
+from runtime.control.reference import Target
+from runtime.model import Model
+from runtime.params import Params
+from runtime.state import initial_state
+
+PARAMS = Params.paper_simulation()
+RATE, U_MAX = 50.0, 0.5
+MODEL_C = Model(PARAMS)._model
+
+
+def schedule():
+    return lqr.design_schedule(PARAMS, RATE, U_MAX)
+
+
+def random_state(rng):
+    return initial_state(theta_Y=rng.uniform(-np.pi, np.pi), theta_P=rng.uniform(-1, 1),
+                         R_S=so3.random_rotation(rng), q=(*rng.normal(0, 2, 2), PARAMS.r),
+                         w_S=rng.normal(0, 1, 3), w_Y=rng.normal(0, 1), w_P=rng.normal(0, 1), r=PARAMS.r)
+
+
+def random_target(rng, path):
+    return Target(speed=rng.uniform(0.0, 0.6), heading=rng.uniform(-np.pi, np.pi),
+                  curvature=rng.uniform(-0.7, 0.7) if path else 0.0,
+                  cross_track=rng.normal(0, 0.3) if path else None)
+
+
+def c_error(x, target, integrals=(0.0, 0.0)):
+    z = np.empty(design.NZ)
+    status = lib.sr_lqr_error(MODEL_C,
+                              ffi.cast("double *", ffi.from_buffer(x)), lqr.c_target(target),
+                              ffi.new("double[2]", list(integrals)), ffi.cast("double *", ffi.from_buffer(z)))
+    assert status == lib.SR_OK
+    return z
+
+
+
+
+def python_law(sched, x, target, integrals, kappa_before, period=1 / RATE, u_max=U_MAX, kappa_rate=0.3):
+    """u_raw, u, the integrals and the operating point's curvature after one sample."""
+    path = target.cross_track is not None
+    kappa = target.curvature if path else 0.0
+    if kappa_before is not None:
+        step = kappa_rate * period
+        kappa = kappa_before + np.clip(kappa - kappa_before, -step, step)
+    z_star, u_star, K_path, K_heading = sched.at(target.speed, kappa)
+    z = design.error_coordinates(x, PARAMS.r, target.speed, target.heading,
+                                 target.cross_track if path else 0.0, integrals)
+    dz = z - z_star
+    raw = u_star - (K_path if path else K_heading) @ dz
+    u = np.clip(raw, -u_max, u_max)
+    if np.all(u == raw):
+        integrals = integrals + period * np.array([dz[design.Z_EY] if path else 0.0, dz[4]])
+    return raw, u, integrals, kappa
+
+
+@pytest.mark.parametrize("path", [False, True])
+def test_c_error_coordinates_equal_the_numpy_ones(path):
+    rng = np.random.default_rng(1)
+    for _ in range(200):
+        x, target = random_state(rng), random_target(rng, path)
+        integrals = rng.normal(size=2)
+        expected = design.error_coordinates(x, PARAMS.r, target.speed, target.heading,
+                                            target.cross_track if path else 0.0, integrals)
+        # 1e-10: within 1e-4 rad of π, runtime.so3.log takes the axis from the skew part, which
+        # loses digits there (1.4e-12 at 3.14147 rad among these states); the C log does not.
+        assert np.allclose(c_error(x, target, integrals), expected, rtol=0, atol=1e-10)
+
+
+def test_the_error_coordinates_vanish_at_the_reference():
+    v, psi = 0.3, 0.7
+    Q = design.reference_attitude(psi)
+    x = initial_state(R_S=Q, w_S=(-v / PARAMS.r, 0, 0), w_Y=v / PARAMS.r, r=PARAMS.r)
+    assert np.abs(c_error(x, Target(v, psi))).max() < 1e-15
+
+
+@pytest.mark.parametrize("path", [False, True])
+def test_c_law_equals_the_numpy_law_over_a_run_of_samples(path):
+    rng = np.random.default_rng(2)
+    sched = schedule()
+    controller = lqr.Lqr(PARAMS, RATE, U_MAX, schedule=sched)
+    for trial in range(20):
+        controller.reset(None)
+        integrals, kappa = np.zeros(2), None
+        for _ in range(10):
+            x, target = random_state(rng), random_target(rng, path)
+            raw = controller.compute(0.0, x, target)
+            u = np.array(list(controller._u))
+            raw_np, u_np, integrals, kappa = python_law(sched, x, target, integrals, kappa)
+            assert np.allclose(raw, raw_np, rtol=1e-12, atol=1e-12)
+            assert np.allclose(u, u_np, rtol=1e-12, atol=1e-12)
+            assert np.array_equal(np.abs(u) == U_MAX, np.abs(u_np) == U_MAX)
+            assert np.allclose(controller.integrals, integrals, rtol=1e-12, atol=1e-14)
+            assert np.isclose(controller._memory.kappa, kappa, rtol=0, atol=1e-15)
+
+
+def test_the_law_comparison_fails_for_a_gain_perturbed_by_one_part_in_a_million():
+    sched = schedule()
+    K = sched.K_heading.copy()
+    row, col = np.unravel_index(np.argmax(np.abs(K[2, 2])), K[2, 2].shape)   # v = 0.3 m/s, κ = 0
+    K[2, 2, row, col] *= 1 + 1e-6
+    perturbed = dataclasses.replace(sched, K_heading=K)
+    controller = lqr.Lqr(PARAMS, RATE, U_MAX, schedule=perturbed)
+    controller.reset(None)
+    x = initial_state(theta_P=0.1, R_S=so3.rot_z(-np.pi / 2) @ so3.exp([0.2, 0.1, 0.3]), w_S=(-1.0, 0.1, 0.2),
+                      w_Y=1.1, w_P=0.3, r=PARAMS.r)
+    target = Target(0.3, 0.0)
+    raw = controller.compute(0.0, x, target)
+    raw_np, *_ = python_law(sched, x, target, np.zeros(2), None)
+    assert not np.allclose(raw, raw_np, rtol=1e-12, atol=1e-12)
+
+
+def test_integrators_hold_while_a_torque_is_clipped():
+    controller = lqr.Lqr(PARAMS, RATE, U_MAX, schedule=schedule())
+    controller.reset(None)
+    x = initial_state(r=PARAMS.r)                     # at rest, asked to roll at 0.5 m/s: clipped
+    raw = controller.compute(0.0, x, Target(0.5, 0.0, 0.0, 0.2))
+    assert np.abs(raw).max() > U_MAX and controller._memory.saturated == 1
+    assert np.array_equal(controller.integrals, [0.0, 0.0])
+
+
+def test_the_operating_points_curvature_follows_a_jump_at_the_bounded_rate():
+    controller = lqr.Lqr(PARAMS, RATE, U_MAX, schedule=schedule())
+    controller.reset(None)
+    x = initial_state(R_S=so3.rot_z(-np.pi / 2), w_S=(-1.0, 0.0, 0.0), w_Y=1.0, r=PARAMS.r)
+    controller.compute(0.0, x, Target(0.3, 0.0, 0.5, 0.0))
+    assert controller._memory.kappa == 0.5                        # the first sample takes it as it is
+    for k in range(1, 4):
+        controller.compute(0.0, x, Target(0.3, 0.0, -0.5, 0.0))
+        assert np.isclose(controller._memory.kappa, 0.5 - k * 0.3 / RATE, rtol=0, atol=1e-15)
+
+
+def test_a_schedule_with_a_nan_is_refused_by_name():
+    bad = dataclasses.replace(schedule(), u_star=np.full_like(schedule().u_star, np.nan))
+    with pytest.raises(ValueError, match="controller: the LQR schedule is not valid"):
+        lqr.Lqr(PARAMS, RATE, U_MAX, schedule=bad)
+
+
+def test_a_design_grid_larger_than_the_c_struct_is_refused_by_name():
+    with pytest.raises(ValueError, match="the C controller holds at most"):
+        lqr.Lqr(PARAMS, RATE, U_MAX, gains=lqr.LqrGains(n_speeds=lib.SR_LQR_MAX_SPEEDS + 1))
+
+
+def test_a_state_that_is_no_state_is_refused_by_name():
+    controller = lqr.Lqr(PARAMS, RATE, U_MAX, schedule=schedule())
+    controller.reset(None)
+    x = initial_state(r=PARAMS.r)
+    x[0] = 2.0                                        # R_S no rotation
+    with pytest.raises(ValueError, match="controller lqr: .*rotation"):
+        controller.compute(0.0, x, Target(0.3, 0.0))
