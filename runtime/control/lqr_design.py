@@ -45,8 +45,13 @@ from ..state import IDX_RP, IDX_RS, IDX_WP, IDX_WS, IDX_WY, initial_state, rotat
 
 NZ = 12
 Z_E, Z_TH_P, Z_OM, Z_WY, Z_WP, Z_EY, Z_IY, Z_IV = slice(0, 3), 3, slice(4, 7), 7, 8, 9, 10, 11
-#: The physical part of z (its first NZ_BODY entries): what the field of the robot moves.
-NZ_BODY = 10
+Z_OM_X = Z_OM.start               # the shell's rolling rate: the speed
+#: The robot's own coordinates, z[:NZ_ROBOT] (attitude, pendulum, rates); then the path's and the integrators.
+NZ_ROBOT = Z_EY
+#: The unknowns of an operating point: z[:NZ_ROBOT], then the two torques.
+W_Z, W_U = slice(0, NZ_ROBOT), slice(NZ_ROBOT, NZ_ROBOT + 2)
+#: Below this (relative to the largest gain, for K), an operating point's or a gain's entry is rounding noise.
+SYMMETRY_ZERO = 1e-13
 #: Yoke attitude that rolls along +x (heading 0): R_S = rot_z(−π/2), θ_Y = 0 (docs/control.md).
 Q_HEADING_0 = so3.rot_z(-math.pi / 2)
 
@@ -69,7 +74,7 @@ def error_coordinates(x, r, v_ref, psi_ref, cross_track=0.0, integrals=(0.0, 0.0
     z[Z_E] = so3.log(reference_attitude(psi_ref).T @ Q)
     z[Z_TH_P] = _pendulum_angle(x)
     z[Z_OM] = R_Y.T @ x[IDX_WS]
-    z[4] += v_ref / r
+    z[Z_OM_X] += v_ref / r
     z[Z_WY] = x[IDX_WY] - v_ref / r
     z[Z_WP] = x[IDX_WP]
     z[Z_EY] = cross_track
@@ -118,7 +123,7 @@ def field(model, z, u, v, kappa, z_star_om_x=0.0):
     out[Z_WY], out[Z_WP] = a[3], a[4]
     out[Z_EY] = q_dot[1]
     out[Z_IY] = z[Z_EY]
-    out[Z_IV] = z[4] - z_star_om_x
+    out[Z_IV] = z[Z_OM_X] - z_star_om_x
     return out
 
 
@@ -133,25 +138,29 @@ def operating_point(model, v, kappa=0.0, start=None, tol=1e-12, iterations=40):
 
     def residual(w, kappa):
         z = np.zeros(NZ)
-        z[:NZ_BODY - 1] = w[:9]
-        f = field(model, z, w[9:11], v, kappa)
+        z[:NZ_ROBOT] = w[W_Z]
+        f = field(model, z, w[W_U], v, kappa)
         x = lift(z, v, r)
         q_dot_x = r * np.cross(x[IDX_RS].reshape(3, 3) @ x[IDX_WS], [0.0, 0.0, 1.0])[0]
-        return np.concatenate([f[:NZ_BODY], [q_dot_x - v]])
+        return np.concatenate([f[:NZ_ROBOT], [f[Z_EY], q_dot_x - v]])
 
     if start is not None:
-        w = np.concatenate([start[0][:9], start[1]])
+        w = np.concatenate([start[0][:NZ_ROBOT], start[1]])
         kappas = [kappa]
     else:
-        w = np.zeros(11)
-        w[9] = v * (p.k_S + p.k_Y) / r
+        w = np.zeros(NZ_ROBOT + 2)
+        w[W_U.start] = v * (p.k_S + p.k_Y) / r
         steps = max(1, int(math.ceil(abs(kappa) * r / 0.01)))
         kappas = np.linspace(0.0, kappa, steps + 1)
     for kappa_k in kappas:
         w = _newton(lambda w: residual(w, kappa_k), w, tol, iterations, v, kappa_k)
+    # Entries that vanish by symmetry (straight rolling has no lean, no sideways rate, no
+    # pendulum torque) come out of Newton as rounding noise, down to 1e-55: below the 1e-12 the
+    # solve converges to, they are zeros (and a float firmware cannot even hold them).
+    w = np.where(np.abs(w) < SYMMETRY_ZERO, 0.0, w)
     z = np.zeros(NZ)
-    z[:9] = w[:9]
-    return z, w[9:11].copy()
+    z[:NZ_ROBOT] = w[W_Z]
+    return z, w[W_U].copy()
 
 
 def _newton(residual, w, tol, iterations, v, kappa):
@@ -173,7 +182,7 @@ def _newton(residual, w, tol, iterations, v, kappa):
 
 def linearization(model, z_star, u_star, v, kappa=0.0, h=1e-6):
     """(A, B), NZ×NZ and NZ×2: central differences of `field` at the operating point."""
-    f = lambda z, u: field(model, z, u, v, kappa, z_star[4])   # noqa: E731
+    f = lambda z, u: field(model, z, u, v, kappa, z_star[Z_OM_X])   # noqa: E731
     A, B = np.empty((NZ, NZ)), np.empty((NZ, 2))
     for j in range(NZ):
         dz = np.zeros(NZ)
@@ -226,5 +235,5 @@ def gains(A, B, period, weights=Weights(), path=True):
     P = solve_discrete_are(Ad, Bd, Qw, Rw)
     K_keep = np.linalg.solve(Rw + Bd.T @ P @ Bd, Bd.T @ P @ Ad)
     K = np.zeros((2, NZ))
-    K[:, keep] = K_keep
+    K[:, keep] = np.where(np.abs(K_keep) < SYMMETRY_ZERO * np.abs(K_keep).max(), 0.0, K_keep)
     return K

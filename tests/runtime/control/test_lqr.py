@@ -60,7 +60,7 @@ def python_law(sched, x, target, integrals, kappa_before, period=1 / RATE, u_max
     raw = u_star - (K_path if path else K_heading) @ dz
     u = np.clip(raw, -u_max, u_max)
     if np.all(u == raw):
-        integrals = integrals + period * np.array([dz[design.Z_EY] if path else 0.0, dz[4]])
+        integrals = integrals + period * np.array([dz[design.Z_EY] if path else 0.0, dz[design.Z_OM_X]])
     return raw, u, integrals, kappa
 
 

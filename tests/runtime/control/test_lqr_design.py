@@ -16,7 +16,7 @@ MODEL = Model(Params.paper_simulation())
 def reduced_exponents(field=design.field, v=0.5):
     z, u = design.operating_point(MODEL, v)
     A, _ = design.linearization(MODEL, z, u, v)
-    ev = np.linalg.eigvals(A[:design.NZ_BODY - 1, :design.NZ_BODY - 1])
+    ev = np.linalg.eigvals(A[:design.NZ_ROBOT, :design.NZ_ROBOT])
     return np.sort(ev[np.abs(ev) > 1e-7].real)
 
 

@@ -1,0 +1,80 @@
+"""The closed-loop firmware example (c/examples/firmware_lqr.c) equals the Python closed loop of the
+same task bit for bit (double build, host), and its checked-in header is the current design."""
+import re
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import ROOT
+from runtime.control.closed_loop import simulate_closed_loop
+from runtime.control.firmware import header, write_header
+from runtime.control.firmware import firmware_task
+
+C_DIR = ROOT / "c"
+MAKE = shutil.which("make")
+pytestmark = pytest.mark.skipif(not (MAKE and shutil.which("cc")), reason="needs make and a C compiler")
+
+
+def build_and_run(header_dir, build_dir):
+    exe = build_dir / "firmware_lqr"
+    subprocess.run([MAKE, "-s", "-C", str(C_DIR), f"BUILD={build_dir}",
+                    f"CFLAGS=-O2 -DLQR_TASK_FROM_INCLUDE_PATH -I{header_dir}", str(exe)],
+                   check=True, capture_output=True, text=True)
+    out = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout
+    return np.loadtxt(out.splitlines()[1:], delimiter=",")
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """(firmware rows, Python closed-loop result, header text, build dir, controller) of the default task."""
+    tmp = tmp_path_factory.mktemp("firmware")
+    task, controller = write_header(tmp / "lqr_task.h")
+    rows = build_and_run(tmp, tmp / "build")
+    result = simulate_closed_loop(task.plant_params, controller, task.reference(), task.scenario.x0,
+                                  task.duration, task.scenario.dt, task.scenario.method)
+    return rows, result, (tmp / "lqr_task.h").read_text(), tmp, controller
+
+
+def test_the_firmware_closed_loop_equals_the_python_closed_loop_bit_for_bit(runs):
+    rows, result, *_ = runs
+    assert rows.shape == (len(result.time), 38)
+    assert np.array_equal(rows[:, 0], result.time)
+    assert np.array_equal(rows[:, 1:36], result.trajectory)
+    assert np.array_equal(rows[:, 36:38], result.torques)
+
+
+def test_the_firmware_run_turns_the_robot_to_the_new_heading(runs):
+    from runtime.control.geometry import heading
+    rows, *_ = runs
+    assert abs(heading(rows[-1, 1:36]) - np.pi / 2) < np.radians(3)
+
+
+def test_the_bit_for_bit_check_fails_for_one_gain_changed_in_its_last_digits(runs):
+    rows, _, text, tmp, controller = runs
+    # The largest gain of the operating point the task uses (0.3 m/s, straight), 1e-12 relative.
+    schedule = controller.schedule
+    i, j = np.argmin(np.abs(schedule.speeds - 0.3)), np.argmin(np.abs(schedule.curvatures))
+    gain = float(np.abs(schedule.K_heading[i, j]).max())
+    literal = next(f"SR_C({v!r})" for v in (gain, -gain) if f"SR_C({v!r})" in text[text.index("/* K_heading */"):])
+    at = text.index(literal, text.index("/* K_heading */"))
+    changed = text[:at] + f"SR_C({float(literal[5:-1]) * (1 + 1e-12)!r})" + text[at + len(literal):]
+    other = tmp / "perturbed"
+    other.mkdir()
+    (other / "lqr_task.h").write_text(changed)
+    perturbed = build_and_run(other, tmp / "build-perturbed")
+    assert not np.array_equal(perturbed[:, 1:36], rows[:, 1:36])
+
+
+def test_the_checked_in_header_is_the_current_design():
+    # Not byte for byte: the Riccati solution's last bits depend on the machine's LAPACK.
+    task = firmware_task()
+    fresh = header(task, task.controller())
+    shipped = (C_DIR / "examples" / "lqr_task.h").read_text()
+    number = re.compile(r"SR_C\(([-0-9.e]+)\)")
+    a = np.array([float(v) for v in number.findall(shipped)])
+    b = np.array([float(v) for v in number.findall(fresh)])
+    assert a.shape == b.shape
+    assert np.allclose(a, b, rtol=1e-8, atol=1e-10)
+    assert number.sub("", shipped) == number.sub("", fresh)
