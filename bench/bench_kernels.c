@@ -1,7 +1,8 @@
 /* bench_kernels.c -- times the kernels in a C loop (no Python in the timed region).
  *
  * usage: bench_kernels INPUT.bin REPEATS
- * INPUT.bin: int32 n, then params[12], states[n][35], inputs[n][2] (float64); with -DWITH_KANE
+ * INPUT.bin: int32 n, then params[SR_NPARAM], states[n][35], inputs[n][2], a general robot's
+ * params[SR_NPARAM] (float64), the LQR's schedule (the bytes of an sr_lqr); with -DWITH_KANE
  * also kane[n][12], each state in the Kane model's coordinates (runtime/bench/kane_compiled.py).
  * Prints one JSON object: ns per call of each kernel (best of 11 rounds, each kernel timed
  * once per round over REPEATS sweeps of the n states, after a 0.3 s warm-up) and the outputs for every one of the n states,
@@ -54,6 +55,16 @@ static int k_step_general(const sr_model *m, int i, int method) { (void)m; retur
 static int k_accel_jacobian(const sr_model *m, int i, int arg) { (void)arg; return sr_accel_jacobian(m, X[i], U[i], JOUT[i], JOUT[i] + SR_NV * SR_NE); }
 static int k_step_jacobian_lie_euler(const sr_model *m, int i, int arg) { (void)arg; return sr_step_jacobian_lie_euler(m, X[i], U[i], 0.01, JOUT[i], JOUT[i] + SR_NE * SR_NE); }
 static int k_step_jacobian_rkmk4(const sr_model *m, int i, int arg) { (void)arg; return sr_step_jacobian_rkmk4(m, X[i], U[i], 0.01, JOUT[i], JOUT[i] + SR_NE * SR_NE); }
+/* The LQR controller: one sample from a fresh memory, a path target (runtime/bench/harness.py
+ * LQR_TARGET holds the same numbers for the check). */
+static sr_lqr LQR;
+static const sr_lqr_target LQR_TARGET = {SR_C(0.3), SR_C(0.5), SR_C(0.2), SR_C(0.05), 1};
+static int k_lqr_control(const sr_model *m, int i, int arg)
+{
+    sr_lqr_memory memory = {{0, 0}, 0, 0, 0};
+    (void)arg;
+    return sr_lqr_control(&LQR, m, X[i], &LQR_TARGET, &memory, OUT[i], NULL);
+}
 static int k_step_jacobian_cf4(const sr_model *m, int i, int arg) { (void)arg; return sr_step_jacobian_cf4(m, X[i], U[i], 0.01, JOUT[i], JOUT[i] + SR_NE * SR_NE); }
 
 #ifdef WITH_KANE
@@ -138,14 +149,16 @@ int main(int argc, char **argv)
     if (fread(p, sizeof(sr_real), SR_NPARAM, f) != SR_NPARAM
         || fread(X, sizeof(sr_real) * SR_NX, (size_t)n, f) != (size_t)n
         || fread(U, sizeof(sr_real) * SR_NU, (size_t)n, f) != (size_t)n
-        || fread(gp, sizeof(sr_real), SR_NPARAM, f) != SR_NPARAM) { fprintf(stderr, "short input\n"); return 2; }
+        || fread(gp, sizeof(sr_real), SR_NPARAM, f) != SR_NPARAM
+        || fread(&LQR, sizeof LQR, 1, f) != 1) { fprintf(stderr, "short input\n"); return 2; }
 #ifdef WITH_KANE
     if (fread(KANE, sizeof(double) * 12, (size_t)n, f) != (size_t)n
         || fread(KANE_P, sizeof(double), 12, f) != 12) { fprintf(stderr, "short input\n"); return 2; }
 #endif
     fclose(f);
     repeats = atoi(argv[2]);
-    if (sr_model_init(&model, p) != SR_OK || sr_model_init(&general_model, gp) != SR_OK || !general_model.general) {
+    if (sr_model_init(&model, p) != SR_OK || sr_model_init(&general_model, gp) != SR_OK || !general_model.general
+        || sr_lqr_check(&LQR) != SR_OK) {
         fprintf(stderr, "bad params\n");
         return 2;
     }
@@ -171,6 +184,7 @@ int main(int argc, char **argv)
             {k_step_jacobian_lie_euler, 0, NOUT, 1, "step_jacobian_lie_euler", 0},
             {k_step_jacobian_rkmk4, 0, NOUT, 4, "step_jacobian_rkmk4", 0},
             {k_step_jacobian_cf4, 0, NOUT, 4, "step_jacobian_cf4", 0},
+            {k_lqr_control, 0, SR_NU, 1, "lqr_control", 0},
 #ifdef WITH_CASADI
             {k_casadi, 0, SR_NV, 10, "casadi_generated_reference_accel", 0},
 #endif

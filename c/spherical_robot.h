@@ -488,7 +488,8 @@ int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_r
  * discrete Riccati equation at the controller's period; docs/control.md).  K_path is used for
  * path references, K_heading (whose e_y columns are zero) for speed and heading references.
  * The torques are clipped to +-u_max; the integrators advance by one period only when neither
- * torque was clipped (conditional anti-windup).  The curvature of the operating point follows
+ * torque was clipped (conditional anti-windup), and the cross-track integral only while
+ * |e_y| <= integral_zone (a large initial offset, such as a line's, winds nothing up).  The curvature of the operating point follows
  * the reference's at most kappa_rate per second (a figure eight's switch of turn direction). */
 #define SR_LQR_NZ 12
 #ifndef SR_LQR_MAX_SPEEDS
@@ -524,6 +525,7 @@ typedef struct sr_lqr {
     sr_real period;                                 /* the controller's sampling period [s], > 0 */
     sr_real u_max;                                  /* torque limit on both motors [N m], > 0 */
     sr_real kappa_rate;                             /* [1/(m s)], >= 0 */
+    sr_real integral_zone;                          /* [m], > 0 */
 } sr_lqr;
 
 /* What to track at this sample (from the reference). */
@@ -543,8 +545,8 @@ typedef struct sr_lqr_memory {
     int saturated;         /* out: the last sample clipped a torque */
 } sr_lqr_memory;
 
-/* Checks a schedule: sizes in range, grids strictly increasing, every entry finite, period and
- * u_max > 0, kappa_rate >= 0.  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
+/* Checks a schedule: sizes in range, grids strictly increasing, every entry finite, period,
+ * u_max and integral_zone > 0, kappa_rate >= 0.  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
 int sr_lqr_check(const sr_lqr *lqr);
 
 /* Zeroes the memory.  Returns SR_OK or SR_ERR_NULL. */

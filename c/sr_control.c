@@ -11,14 +11,15 @@ static int valid_sizes(const sr_lqr *lqr)
 {
     return lqr->n_speeds >= 1 && lqr->n_speeds <= SR_LQR_MAX_SPEEDS && lqr->n_curvatures >= 1
         && lqr->n_curvatures <= SR_LQR_MAX_CURVATURES && lqr->period > 0 && lqr->u_max > 0
-        && lqr->kappa_rate >= 0;
+        && lqr->kappa_rate >= 0 && lqr->integral_zone > 0;
 }
 
 int sr_lqr_check(const sr_lqr *lqr)
 {
     int i, n;
     if (!lqr) return SR_ERR_NULL;
-    if (!all_finite(&lqr->period, 1) || !all_finite(&lqr->u_max, 1) || !all_finite(&lqr->kappa_rate, 1))
+    if (!all_finite(&lqr->period, 1) || !all_finite(&lqr->u_max, 1) || !all_finite(&lqr->kappa_rate, 1)
+        || !all_finite(&lqr->integral_zone, 1))
         return SR_ERR_NONFINITE;
     if (!valid_sizes(lqr)) return SR_ERR_ARG;
     n = lqr->n_speeds * lqr->n_curvatures;
@@ -153,7 +154,7 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
     if (!all_finite(raw, SR_NU)) return SR_ERR_NONFINITE;
 
     if (!clipped) {
-        memory->integrals[0] += lqr->period * (target->path ? dz[9] : 0);
+        if (target->path && SR_FABS(dz[9]) <= lqr->integral_zone) memory->integrals[0] += lqr->period * dz[9];
         memory->integrals[1] += lqr->period * dz[4];
     }
     memory->kappa = kappa;

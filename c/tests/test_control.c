@@ -31,6 +31,7 @@ static void empty_schedule(sr_lqr *lqr, int n_speeds)
     lqr->period = SR_C(0.02);
     lqr->u_max = SR_C(0.5);
     lqr->kappa_rate = SR_C(0.3);
+    lqr->integral_zone = SR_C(0.2);
 }
 
 static void test_error_coordinates_vanish_at_the_reference_and_read_each_deviation(void)
@@ -127,7 +128,7 @@ static void test_between_two_speeds_the_law_interpolates_linearly_and_clamps_out
     CHECK_NEAR(u[0], SR_C(0.3), 0);
 }
 
-static void test_clipped_torques_hold_the_integrators(void)
+static void test_clipped_torques_and_large_offsets_hold_the_integrators(void)
 {
     sr_model m;
     sr_lqr lqr;
@@ -147,6 +148,13 @@ static void test_clipped_torques_hold_the_integrators(void)
     CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &t, &mem, u, raw), SR_OK);
     CHECK(mem.saturated == 0);
     CHECK_NEAR(mem.integrals[0], 0.02 * 0.1, 8 * TEST_EPS);
+    /* Outside the integral zone (|e_y| = 0.3 > 0.2 m) the cross-track integral holds. */
+    {
+        const sr_lqr_target far = {SR_C(0.2), 0, 0, SR_C(0.3), 1};
+        const sr_real before = mem.integrals[0];
+        CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &far, &mem, u, raw), SR_OK);
+        CHECK(mem.saturated == 0 && mem.integrals[0] == before);
+    }
 }
 
 static void test_the_operating_curvature_follows_a_jump_at_its_rate(void)
@@ -219,7 +227,7 @@ void suite_control(void)
     RUN_TEST(test_error_coordinates_vanish_at_the_reference_and_read_each_deviation);
     RUN_TEST(test_the_law_at_a_grid_point_is_u_star_minus_K_dz);
     RUN_TEST(test_between_two_speeds_the_law_interpolates_linearly_and_clamps_outside);
-    RUN_TEST(test_clipped_torques_hold_the_integrators);
+    RUN_TEST(test_clipped_torques_and_large_offsets_hold_the_integrators);
     RUN_TEST(test_the_operating_curvature_follows_a_jump_at_its_rate);
     RUN_TEST(test_bad_input_gives_status_and_leaves_outputs_untouched);
 }

@@ -65,6 +65,20 @@ def general_robot(params):
     return load_scenario("battery-geared").params.replace(r=params.r, slope=0.05)
 
 
+#: The LQR's schedule and the target of its timed sample (bench/bench_kernels.c: LQR_TARGET).
+LQR_RATE, LQR_U_MAX = 50.0, 0.5
+
+
+def lqr_controller(params):
+    from ..control.lqr import Lqr
+    return Lqr(params, LQR_RATE, LQR_U_MAX)
+
+
+def lqr_target():
+    from ..control.reference import Target
+    return Target(speed=0.3, heading=0.5, curvature=0.2, cross_track=0.05)
+
+
 def run_harness(exe, params, X, U, repeats, kane_inputs=None):
     data = build_dir_input = exe.parent / "input.bin"
     with open(build_dir_input, "wb") as f:
@@ -73,6 +87,8 @@ def run_harness(exe, params, X, U, repeats, kane_inputs=None):
         f.write(np.ascontiguousarray(X).tobytes())
         f.write(np.ascontiguousarray(U).tobytes())
         f.write(np.ascontiguousarray(general_robot(params).as_array()).tobytes())
+        from bindings._sr import ffi
+        f.write(bytes(ffi.buffer(lqr_controller(params)._c)))
         if kane_inputs is not None:     # the Kane model's coordinates, then its (the paper's) parameters
             f.write(np.ascontiguousarray(kane_inputs, dtype=np.float64).tobytes())
             f.write(np.ascontiguousarray(params.paper_params.as_array(), dtype=np.float64).tobytes())
@@ -152,6 +168,13 @@ def check_harness(result, model, X, U, step_dt=0.01):
         check("C accel of a general robot vs reference", "accel_general_robot", lambda i: general_accel[i], 1e-10)
         check("C RKMK4 step of a general robot vs NumPy tableau on the reference", "step_rkmk4_general_robot",
               lambda i: STEPPERS["rkmk4"](general.accel, general.params["r"], X[i], U[i], step_dt), 1e-10)
+    if "lqr_control" in result:
+        from ..verification.lqr_law import numpy_law
+        controller, target = lqr_controller(model.params), lqr_target()
+        g = controller.gains
+        check("C lqr_control vs the NumPy law (runtime.verification.lqr_law)", "lqr_control",
+              lambda i: numpy_law(controller.schedule, model.params.r, X[i], target, np.zeros(2), None,
+                                  controller.period, controller.u_max, g.kappa_rate, g.integral_zone_m)[1], 1e-10)
     if "casadi_generated_reference_accel" in result:
         check("CasADi-generated reference vs reference", "casadi_generated_reference_accel", lambda i: accel[i], 1e-10)
     for value in result.values():

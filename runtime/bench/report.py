@@ -57,6 +57,8 @@ def targets(res):
         if "kane_casadi_c_accel_jacobian" in c:
             out.append(("accel_jacobian >= 10x faster than CasADi AD C of the Kane Jacobian",
                         10 * c["accel_jacobian"]["ns"] <= c["kane_casadi_c_accel_jacobian"]["ns"]))
+    if "lqr_control" in c:
+        out.append(("the C controller (LQR, one sample) <= 1 us (C loop)", c["lqr_control"]["ns"] <= 1000))
     if "accel_general_robot" in c:
         out.append(("accel of a general robot <= 1.3x the paper-geometry kernel (C loop; paper robots are "
                     "given that kernel automatically)", c["accel_general_robot"]["ns"] <= 1.3 * ours))
@@ -86,6 +88,9 @@ def sections(res):
         if key in c:
             rows.append((f"our {label} step_jacobian (F 12x12 and G 12x2)", f"{c[key]['ns']:,.1f} ns",
                          f"{c[key]['ns'] / ours:.1f}x"))
+    if "lqr_control" in c:
+        rows.append(("our LQR controller, one sample (sr_lqr_control, state checked)", f"{c['lqr_control']['ns']:,.1f} ns",
+                     f"{c['lqr_control']['ns'] / ours:.1f}x"))
     if "accel_general_robot" in c:
         rows.append(("our accel of a general robot (issue 18: general kernels)", f"{c['accel_general_robot']['ns']:,.1f} ns",
                      f"{c['accel_general_robot']['ns'] / ours:.1f}x"))

@@ -39,10 +39,12 @@ class LqrGains:
     kappa_max: float = 0.5            # ... and curvatures −κ_max .. κ_max [1/m] in n_curvatures
     n_curvatures: float = 5
     kappa_rate: float = 0.3           # how fast the operating point follows the path's curvature [1/(m s)]
+    integral_zone_m: float = 0.1      # ∫e_y advances only while |e_y| ≤ this [m]
 
     def __post_init__(self):
         for name in ("tilt_rad", "attitude_rad", "pendulum_rad", "rolling_rate_rad_s", "rate_rad_s",
-                     "joint_rate_rad_s", "cross_track_m", "cross_track_integral_m_s", "speed_integral_rad"):
+                     "joint_rate_rad_s", "cross_track_m", "cross_track_integral_m_s", "speed_integral_rad",
+                     "integral_zone_m"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name}: an error size must be > 0, got {getattr(self, name)!r}")
         for name in ("n_speeds", "n_curvatures"):
@@ -129,7 +131,7 @@ def _design(params, rate, u_max, gains):
     return Schedule(speeds, curvatures, z_star, u_star, K_path, K_heading)
 
 
-def to_c(schedule, period, u_max, kappa_rate):
+def to_c(schedule, period, u_max, kappa_rate, integral_zone):
     """The schedule as the C struct `sr_lqr` (cffi), checked by `sr_lqr_check`."""
     nv, nk = len(schedule.speeds), len(schedule.curvatures)
     if nv > lib.SR_LQR_MAX_SPEEDS or nk > lib.SR_LQR_MAX_CURVATURES:
@@ -146,7 +148,7 @@ def to_c(schedule, period, u_max, kappa_rate):
             c.u_star[n][0:2] = schedule.u_star[i, j].tolist()
             c.K_path[n][0:2 * design.NZ] = schedule.K_path[i, j].ravel().tolist()
             c.K_heading[n][0:2 * design.NZ] = schedule.K_heading[i, j].ravel().tolist()
-    c.period, c.u_max, c.kappa_rate = period, u_max, kappa_rate
+    c.period, c.u_max, c.kappa_rate, c.integral_zone = period, u_max, kappa_rate, integral_zone
     status = lib.sr_lqr_check(c)
     if status != lib.SR_OK:
         raise ValueError(f"controller: the LQR schedule is not valid for the C controller "
@@ -171,7 +173,7 @@ class Lqr(Controller):
         super().__init__(params, rate, u_max)
         self.gains = gains
         self.schedule = schedule if schedule is not None else design_schedule(params, rate, u_max, gains)
-        self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate)
+        self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate, gains.integral_zone_m)
         self._model = Model(params)
         self._memory = ffi.new("sr_lqr_memory *")
         self._u, self._raw = np.zeros(2), np.zeros(2)

@@ -13,6 +13,7 @@ from runtime.control.reference import Target
 from runtime.model import Model
 from runtime.params import Params
 from runtime.state import initial_state
+from runtime.verification.lqr_law import numpy_law
 
 PARAMS = Params.paper_simulation()
 RATE, U_MAX = 50.0, 0.5
@@ -46,22 +47,10 @@ def c_error(x, target, integrals=(0.0, 0.0)):
 
 
 
-def python_law(sched, x, target, integrals, kappa_before, period=1 / RATE, u_max=U_MAX, kappa_rate=0.3):
-    """u_raw, u, the integrals and the operating point's curvature after one sample."""
-    path = target.cross_track is not None
-    kappa = target.curvature if path else 0.0
-    if kappa_before is not None:
-        step = kappa_rate * period
-        kappa = kappa_before + np.clip(kappa - kappa_before, -step, step)
-    z_star, u_star, K_path, K_heading = sched.at(target.speed, kappa)
-    z = design.error_coordinates(x, PARAMS.r, target.speed, target.heading,
-                                 target.cross_track if path else 0.0, integrals)
-    dz = z - z_star
-    raw = u_star - (K_path if path else K_heading) @ dz
-    u = np.clip(raw, -u_max, u_max)
-    if np.all(u == raw):
-        integrals = integrals + period * np.array([dz[design.Z_EY] if path else 0.0, dz[design.Z_OM_X]])
-    return raw, u, integrals, kappa
+def python_law(sched, x, target, integrals, kappa_before):
+    gains = lqr.LqrGains()
+    return numpy_law(sched, PARAMS.r, x, target, integrals, kappa_before, 1 / RATE, U_MAX, gains.kappa_rate,
+                     gains.integral_zone_m)
 
 
 @pytest.mark.parametrize("path", [False, True])
