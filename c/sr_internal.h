@@ -23,8 +23,8 @@
 
 #ifdef SR_USE_FLOAT
 #define SR_SQRT sqrtf
-#define SR_SIN sinf
-#define SR_COS cosf
+#define SR_SIN SR_GEN_SIN      /* c/sr_trig.c, or libm's with -DSR_LIBM_TRIG (sr_real.h) */
+#define SR_COS SR_GEN_COS
 #define SR_FABS fabsf
 #define SR_POW powf
 #define SR_ATAN2 atan2f
@@ -38,6 +38,11 @@
 #define SR_ATAN2 atan2
 #define SR_EPSILON DBL_EPSILON
 #endif
+
+/* c/sr_trig.c's float sine and cosine: accurate to 2^-23 up to SR_TRIG_EXACT_RANGE, their
+ * reduction's rounding growing as |x| 2^-24 beyond, NaN past SR_TRIG_MAX_ARG. */
+#define SR_TRIG_EXACT_RANGE 8192.0f
+#define SR_TRIG_MAX_ARG 16777216.0f
 
 /* The generated kernels' status codes are the library's: their results pass through. */
 #if SR_GEN_OK != SR_OK || SR_GEN_NONFINITE != SR_ERR_NONFINITE || SR_GEN_SINGULAR != SR_ERR_SINGULAR

@@ -11,7 +11,10 @@
  *                     -Wall -Wextra -Wpedantic -Werror (no double promotion).
  *   SR_GEN_SIN, SR_GEN_COS
  *                     the sine and cosine of sr_real (sr_gen_general_constants
- *                     takes those of the slope, once per model).
+ *                     takes those of the slope, once per model): libm's in
+ *                     double, the library's own in float (c/sr_trig.c: no
+ *                     4 KB libm reduction in a firmware; -DSR_LIBM_TRIG for
+ *                     libm's sinf and cosf).
  *   SR_GEN_PIVOT_TOL  relative pivot tolerance of the joint-first solve in
  *                     sr_gen_accel: each pivot of M (M_33, M_44, the leading
  *                     minors of the Schur complement) must exceed it times
@@ -32,8 +35,16 @@
 typedef float sr_real;
 #define SR_C(v) ((sr_real)(v##f))
 #define SR_GEN_PIVOT_TOL SR_C(1e-6)
+#ifdef SR_LIBM_TRIG
 #define SR_GEN_SIN sinf
 #define SR_GEN_COS cosf
+#else
+#define SR_GEN_SIN sr_internal_sinf
+#define SR_GEN_COS sr_internal_cosf
+/* c/sr_trig.c (internal to the library). */
+float sr_internal_sinf(float x);
+float sr_internal_cosf(float x);
+#endif
 #else
 typedef double sr_real;
 #define SR_C(v) ((sr_real)(v))

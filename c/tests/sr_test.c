@@ -49,6 +49,7 @@ int main(void)
     suite_general();
     suite_jacobians();
     suite_control();
+    suite_trig();
     return sr_test_summary();
 }
 

@@ -71,6 +71,7 @@ void suite_group(void);
 void suite_general(void);
 void suite_jacobians(void);
 void suite_control(void);
+void suite_trig(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 
