@@ -82,6 +82,9 @@ def simulate_closed_loop(plant_params, controller, reference, x0, duration, dt, 
         x = traj[k * per]
         y = _measure(x, plant_params.r, noise, rng)
         target = reference.target(k * controller.period, y[IDX_Q], float(heading(y)))
+        if getattr(reference, "is_path", False) and hasattr(controller, "preview_distances"):
+            target = dataclasses.replace(target, curvature_ahead=reference.curvature_ahead(
+                controller.preview_distances(target)))
         u = controller.update(k * controller.period, y, target)
         torques[k * per:(k + 1) * per] = u
         traj[k * per:(k + 1) * per + 1] = plant.simulate(x, dt, per, np.tile(u, (per, 1)), method=method)

@@ -39,6 +39,8 @@ class LqrGains:
     kappa_max: float = 0.5            # ... and curvatures −κ_max .. κ_max [1/m] in n_curvatures
     n_curvatures: float = 5
     kappa_rate: float = 0.3           # how fast the operating point follows the path's curvature [1/(m s)]
+    preview_m: float = 0.3            # the path's curvature is averaged over preview_m ± smoothing_m [m]
+    smoothing_m: float = 0.5          # ... along the path from the nearest point (0: the curvature there)
     integral_zone_m: float = 0.1      # ∫e_y advances only while |e_y| ≤ this [m]
 
     def __post_init__(self):
@@ -182,12 +184,30 @@ class Lqr(Controller):
         super().reset(x0)
         lib.sr_lqr_reset(self._memory)
 
+    def preview_distances(self, target):
+        """Where the path's curvature is read (runtime/control/closed_loop.py fills
+        target.curvature_ahead): 41 points over preview_m ± smoothing_m."""
+        g = self.gains
+        return g.preview_m + np.linspace(-g.smoothing_m, g.smoothing_m, 41)
+
+    def operating_curvature(self, target):
+        """The curvature the operating point is scheduled on: the path's, averaged over the preview
+        window when the reference gave it (a figure eight's switch of turn direction then starts
+        before the crossing, as the pendulum needs seconds to swing from one lean to the other)."""
+        if target.cross_track is None:
+            return 0.0
+        if target.curvature_ahead is not None and len(target.curvature_ahead):
+            return float(np.mean(target.curvature_ahead))
+        return float(target.curvature)
+
     @property
     def integrals(self):
         return np.array(list(self._memory.integrals))
 
     def compute(self, t, x, target):
         x = np.ascontiguousarray(x, dtype=np.float64)
+        if target.cross_track is not None:
+            target = dataclasses.replace(target, curvature=self.operating_curvature(target))
         status = lib.sr_lqr_control(self._c, self._model._model, ffi.cast("double *", ffi.from_buffer(x)),
                                     c_target(target), self._memory, ffi.cast("double *", ffi.from_buffer(self._u)),
                                     ffi.cast("double *", ffi.from_buffer(self._raw)))

@@ -27,6 +27,7 @@ class Target:
     heading: float                    # rad: the heading to hold, or the path's tangent heading
     curvature: float = 0.0            # 1/m, left positive (path tasks)
     cross_track: float | None = None  # m, positive when the robot is left of the path (path tasks)
+    curvature_ahead: tuple | None = None  # 1/m at the distances a controller asked for (its preview)
 
 
 class SpeedHeading:
@@ -78,6 +79,10 @@ class Path:
         i, e = self.nearest(position)
         self._hint = i
         return Target(self.speed, float(self.tangent[i]), float(self.curvature[i]), e)
+
+    def curvature_ahead(self, distances):
+        """The path's curvature at `distances` [m] from the last nearest point (held beyond the ends)."""
+        return tuple(np.interp(self.s[self._hint] + np.asarray(distances, dtype=float), self.s, self.curvature))
 
     def cross_track(self, positions):
         """Signed cross-track error (n,) of a sequence of positions (n, ≥2), matched in order."""

@@ -147,3 +147,36 @@ def test_a_state_that_is_no_state_is_refused_by_name():
     x[0] = 2.0                                        # R_S no rotation
     with pytest.raises(ValueError, match="controller lqr: .*rotation"):
         controller.compute(0.0, x, Target(0.3, 0.0))
+
+
+def test_the_operating_curvature_is_the_paths_curvature_averaged_over_the_preview_window():
+    controller = lqr.Lqr(PARAMS, RATE, U_MAX, schedule=schedule())
+    distances = controller.preview_distances(Target(0.3, 0.0))
+    g = controller.gains
+    assert np.isclose(distances.min(), g.preview_m - g.smoothing_m) and np.isclose(distances.max(), g.preview_m + g.smoothing_m)
+    ahead = tuple(np.where(distances < 0.25, 0.5, -0.5))         # a switch of turn direction 0.25 m ahead
+    target = Target(0.3, 0.0, 0.5, 0.0, curvature_ahead=ahead)
+    assert controller.operating_curvature(target) == pytest.approx(np.mean(ahead))
+    assert controller.operating_curvature(Target(0.3, 0.0, 0.5, 0.0)) == 0.5       # no preview given
+    assert controller.operating_curvature(Target(0.3, 0.0)) == 0.0                 # no path
+
+
+def _figure8_crossing_error(gains):
+    from runtime.control.closed_loop import simulate_closed_loop
+    from runtime.control.task import load_task
+    from runtime.state import IDX_Q
+    task = load_task("figure8").with_controller("lqr")
+    reference = task.reference()
+    controller = lqr.Lqr(task.scenario.params, task.rate, task.u_max, gains)
+    result = simulate_closed_loop(task.plant_params, controller, reference, task.scenario.x0, 60.0,
+                                  task.scenario.dt, task.scenario.method)
+    e = reference.cross_track(result.trajectory[::10, IDX_Q][:, :2])
+    return np.abs(e[result.time[::10] >= 40.0]).max()      # the lobes switch at about 42 s
+
+
+def test_with_the_curvature_preview_the_lqr_follows_the_figure_eight_through_its_crossing():
+    assert _figure8_crossing_error(lqr.LqrGains()) < 0.2
+
+
+def test_the_crossing_check_fails_without_the_preview():
+    assert _figure8_crossing_error(lqr.LqrGains(preview_m=0.0, smoothing_m=0.0)) > 0.2
