@@ -2,7 +2,7 @@
 
 A controller is sampled every 1/rate s on the (possibly noisy) measured state; its torques are
 held until the next sample (zero-order hold, runtime/control/closed_loop.py).  `Controller.update`
-clips the design's torques to |u| ≤ u_max, counts the samples where it had to, and times the
+clips the design's torques to |u| ≤ u_max, counts the samples where a torque is at its limit, and times the
 design's own computation (`solve_s`), so that every controller is measured the same way.
 """
 import time
@@ -11,6 +11,9 @@ import numpy as np
 
 #: Default torque limit [N m]: the low end of the paper's 0.5–2 N m (issue #20).
 DEFAULT_U_MAX = 0.5
+#: A torque within this fraction of u_max counts as saturated: clipped (PID, LQR) or held at its
+#: bound by the optimiser (NMPC, whose QP returns the bound to rounding).
+SATURATION_TOL = 1e-9
 
 
 class Controller:
@@ -49,7 +52,7 @@ class Controller:
                              f"expected two finite numbers")
         u = np.clip(raw, -self.u_max, self.u_max)
         self.samples += 1
-        if np.any(u != raw):
+        if np.any(np.abs(u) >= self.u_max * (1 - SATURATION_TOL)):
             self.saturated += 1
         self.after_limits(raw, u)
         return u

@@ -23,13 +23,16 @@ from .controller import DEFAULT_U_MAX
 from .geometry import heading
 from .lqr import GAIN_NAMES as LQR_GAIN_NAMES
 from .lqr import Lqr, LqrGains
+from .nmpc import GAIN_NAMES as NMPC_GAIN_NAMES
+from .nmpc import Nmpc, NmpcGains
 from .pid import GAIN_NAMES, Pid, PidGains
 from .reference import KINDS, SpeedHeading, circle_path, figure8_path, line_path, waypoints_path
 from ..state import IDX_Q
 
-#: Controller kinds of issue #20; NMPC is not built yet.
-CONTROLLER_KINDS = ("pid", "nmpc", "lqr")
-AVAILABLE_CONTROLLERS = {"pid": (Pid, PidGains, GAIN_NAMES), "lqr": (Lqr, LqrGains, LQR_GAIN_NAMES)}
+#: Controller kinds of issue #20: (class, its settings, the settings' names).
+AVAILABLE_CONTROLLERS = {"pid": (Pid, PidGains, GAIN_NAMES), "lqr": (Lqr, LqrGains, LQR_GAIN_NAMES),
+                         "nmpc": (Nmpc, NmpcGains, NMPC_GAIN_NAMES)}
+CONTROLLER_KINDS = tuple(AVAILABLE_CONTROLLERS)
 _SCENARIO_KEYS = {"description", "dt", "duration", "steps", "method", "params", "initial"}
 _REFERENCE_KEYS = {"kind", "speed", "heading", "offset", "radius", "size", "points"}
 _NEEDS = {"speed": ("speed",), "heading": ("speed", "heading"), "line": ("speed", "offset"),
@@ -204,15 +207,12 @@ def _parse_reference(table, source):
 def _parse_controller(table, source, name="controller"):
     where = f"{source}: {name}"
     if table is None:
-        raise ValueError(f"{where}: missing (required): give kind = \"pid\" or \"lqr\"")
+        raise ValueError(f"{where}: missing (required): give kind = \"pid\", \"lqr\" or \"nmpc\"")
     if not isinstance(table, dict):
         raise ValueError(f"{where}: expected a table, got {type(table).__name__} {table!r}")
     kind = table.get("kind")
     if kind not in CONTROLLER_KINDS:
         raise ValueError(f"{where}.kind: expected one of {', '.join(CONTROLLER_KINDS)}, got {kind!r}")
-    if kind not in AVAILABLE_CONTROLLERS:
-        raise ValueError(f"{where}.kind: {kind!r} is not yet available (issue #20); "
-                         f"available: {', '.join(AVAILABLE_CONTROLLERS)}")
     _, gains_cls, gain_names = AVAILABLE_CONTROLLERS[kind]
     _table(table, where, {"kind", "rate", "u_max", *gain_names})
     rate = _real(table.get("rate", 50.0), f"{where}.rate", positive=True)

@@ -1,4 +1,4 @@
-"""Every shipped task with every controller (PID, LQR) on a short horizon: the error shrinks, torques
+"""Every shipped task with every controller (PID, LQR, NMPC) on a short horizon: the error shrinks, torques
 stay within limits."""
 import dataclasses
 
@@ -12,7 +12,7 @@ from runtime.control.task import load_task
 from runtime.state import IDX_Q
 
 
-CONTROLLERS = ["pid", "lqr"]
+CONTROLLERS = ["pid", "lqr", "nmpc"]
 
 
 def short(name, duration, kind="pid", **changes):

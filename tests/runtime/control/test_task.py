@@ -16,7 +16,8 @@ def with_(section, **values):
 def test_the_six_tasks_of_issue_20_ship():
     assert set(shipped_tasks()) >= {"speed-step", "heading-step", "line", "circle", "figure8", "square"}
     for name in shipped_tasks():
-        assert load_task(name).controller_kinds == ("pid", "lqr")
+        assert load_task(name).controller_kinds == ("pid", "lqr", "nmpc")
+        assert load_task(name).with_controller("nmpc").rate == 20.0
 
 
 @pytest.mark.parametrize("section, values, named", [
@@ -26,7 +27,7 @@ def test_the_six_tasks_of_issue_20_ship():
     ("reference", {"speed": "fast"}, "reference.speed"),
     ("reference", {"kind": "waypoints", "points": [[1.0]]}, "reference.points"),
     ("reference", {"colour": 1}, "reference: unknown key"),
-    ("controller", {"kind": "nmpc"}, "controller.kind: 'nmpc' is not yet available"),
+    ("controller", {"kind": "nmpc", "horizon": 0}, "controller.horizon: expected a whole number"),
     ("controller", {"kind": "lqr", "n_speeds": 0.5}, "controller.n_speeds"),
     ("controller", {"kind": "lqr", "tilt_rad": 0.0}, "controller.tilt_rad"),
     ("controller", {"kind": "lqr", "k_v": 1.0}, "controller: unknown key"),

@@ -1,0 +1,325 @@
+"""NMPC on the full non-linear model, built on the model as CasADi (issue #20).
+
+The model.  The reduced error coordinates of runtime/control/lqr_design.py (the yoke's attitude
+error E = Log(Q_refᵀ Q) on SO(3), the pendulum, the rates in the yoke's frame, the cross-track
+error) carry the whole dynamics of the rolling robot along a path: no term is dropped, only the
+symmetry (where the robot is, the shell's phase about the hinge) is quotiented out.  Their field
+is written here in CasADi around the exported `sr_accel` of generated/casadi/ (the same M and f as
+the C kernels): `reduced_field` equals `lqr_design.field` on the C kernel to round-off (test).
+One step of the prediction model is the classical RK4 of that field over one controller period.
+
+The solver: real-time iterations (Diehl, Bock & Schlöder 2005; what acados and ACADO ship for
+fast NMPC).  Multiple shooting over N periods: at every sample the nodes (z̄_k, ū_k) of the
+previous solution, shifted by one period, are linearised (the RK4 step and its exact Jacobians
+by CasADi's AD, one call of the mapped Function for all N nodes, compiled to C once and cached),
+the gaps d_k = Φ(z̄_k, ū_k) − z̄_{k+1} kept, the initial value embedded (δz_0 = z_0 − z̄_0), and one
+Gauss–Newton QP in the torques is solved with the torque limits as bounds (condensed: 2N unknowns,
+qpOASES from the CasADi wheel).  The cost is quadratic in z and u (the LQR's Bryson weights, the
+LQR's Riccati cost-to-go at the end), so Gauss–Newton's Hessian is the exact one.
+Why not a converged NLP solve per sample: fatrop on the same OCP through Opti took 281 ms per
+sample (p50, AMD EPYC), far above the 50 ms period; one RTI iteration takes ~1–2 ms and,
+warm-started every period, tracks the converged solution (docs/control.md).
+"""
+import dataclasses
+import hashlib
+import os
+import pathlib
+import shutil
+import subprocess
+import tempfile
+
+import numpy as np
+
+from ..casadi_model import load, parameter_vector
+from .controller import DEFAULT_U_MAX, Controller
+from . import lqr_design as design
+from .lqr import LqrGains, design_schedule
+
+#: The NMPC's state: the robot's error coordinates and the cross-track error, no integrators.
+NZ_N = design.Z_EY + 1
+Z_E = design.Z_E
+
+
+def _casadi():
+    import casadi
+    return casadi
+
+
+def _so3_exp_casadi(ca, e):
+    """Exp(e) and J_r⁻¹(e) in CasADi, with series below |e| = 1e-4 (no 0/0 in value or derivative)."""
+    t2 = ca.dot(e, e)
+    small = t2 < 1e-8
+    safe = ca.if_else(small, 1.0, t2)
+    t = ca.sqrt(safe)
+    a = ca.if_else(small, 1 - t2 / 6, ca.sin(t) / t)
+    b = ca.if_else(small, 0.5 - t2 / 24, (1 - ca.cos(t)) / safe)
+    c = ca.if_else(small, 1.0 / 12 + t2 / 720, 1 / safe - (1 + ca.cos(t)) / (2 * t * ca.sin(t)))
+    W = ca.skew(e)
+    W2 = ca.mtimes(W, W)
+    return ca.SX.eye(3) + a * W + b * W2, ca.SX.eye(3) + 0.5 * W + c * W2
+
+
+def reduced_field():
+    """casadi.Function (z[NZ_N], u[2], v, kappa, p) -> ż[NZ_N]: `lqr_design.field` (without the
+    integrators) on the exported `sr_accel`; p the parameters in SR_P_* order."""
+    ca = _casadi()
+    accel = load("sr_accel")
+    z, u = ca.SX.sym("z", NZ_N), ca.SX.sym("u", 2)
+    v, kappa = ca.SX.sym("v"), ca.SX.sym("kappa")
+    p = ca.SX.sym("p", accel.size1_in(2))
+    r = p[_r_index()]
+    exp_E, jr_inv = _so3_exp_casadi(ca, z[Z_E])
+    Q = ca.mtimes(ca.DM(design.reference_attitude(0.0)), exp_E)       # the lift: R_S = Q, θ_Y = 0
+    th = z[design.Z_TH_P]
+    R_P = ca.vertcat(ca.horzcat(ca.cos(th), 0, ca.sin(th)), ca.horzcat(0, 1, 0),
+                     ca.horzcat(-ca.sin(th), 0, ca.cos(th)))
+    w_S = z[design.Z_OM] + ca.vertcat(-v / r, 0, 0)
+    w_Y, w_P = z[design.Z_WY] + v / r, z[design.Z_WP]
+    row_major = lambda M: ca.reshape(M.T, 9, 1)                       # noqa: E731  (SR_X_R_*: rows)
+    x = ca.vertcat(row_major(Q), row_major(ca.SX.eye(3)), row_major(R_P), 0, z[design.Z_EY], r, w_S, w_Y, w_P)
+    a = accel(x, u, p)
+    e_z = ca.DM([0.0, 0.0, 1.0])
+    q_dot = r * ca.cross(ca.mtimes(Q, w_S), e_z)
+    s_dot = q_dot[0] / (1 - kappa * z[design.Z_EY])
+    w_Q = w_S + ca.vertcat(w_Y, 0, 0)
+    z_dot = ca.vertcat(ca.mtimes(jr_inv, w_Q - kappa * s_dot * ca.mtimes(Q.T, e_z)),
+                       w_P,
+                       a[0:3] - ca.cross(ca.vertcat(w_Y, 0, 0), w_S),
+                       a[3], a[4], q_dot[1])
+    return ca.Function("reduced_field", [z, u, v, kappa, p], [z_dot], ["z", "u", "v", "kappa", "p"], ["z_dot"])
+
+
+def _r_index():
+    from bindings._sr import lib
+    return lib.SR_P_r
+
+
+def node_function(period):
+    """casadi.Function (z, u, v, kappa, p) -> (z⁺, A, B): one RK4 step of `reduced_field` over
+    `period` and its Jacobians ∂z⁺/∂z (NZ_N×NZ_N) and ∂z⁺/∂u (NZ_N×2), by AD."""
+    ca = _casadi()
+    f = reduced_field()
+    z, u = ca.SX.sym("z", NZ_N), ca.SX.sym("u", 2)
+    v, kappa, p = ca.SX.sym("v"), ca.SX.sym("kappa"), ca.SX.sym("p", f.size1_in(4))
+    h = float(period)
+    k1 = f(z, u, v, kappa, p)
+    k2 = f(z + h / 2 * k1, u, v, kappa, p)
+    k3 = f(z + h / 2 * k2, u, v, kappa, p)
+    k4 = f(z + h * k3, u, v, kappa, p)
+    z_next = z + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return ca.Function("nmpc_node", [z, u, v, kappa, p], [z_next, ca.jacobian(z_next, z), ca.jacobian(z_next, u)],
+                       ["z", "u", "v", "kappa", "p"], ["z_next", "A", "B"])
+
+
+def cache_dir():
+    """Where compiled prediction models are kept: $SR_CACHE_DIR, else ~/.cache/spherical_robot."""
+    return pathlib.Path(os.environ.get("SR_CACHE_DIR") or pathlib.Path.home() / ".cache" / "spherical_robot")
+
+
+def compiled(function):
+    """`function` compiled to C by CasADi's code generator and the system's cc (-O1), as a
+    casadi.Function; cached under `cache_dir()` by the hash of the generated source, so the ~10 s
+    compile is paid once per model version.  Without a C compiler: `function` itself (CasADi's
+    virtual machine, ~15× slower)."""
+    ca = _casadi()
+    compiler = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+    if compiler is None:
+        return function
+    with tempfile.TemporaryDirectory() as tmp:
+        generator = ca.CodeGenerator(f"{function.name()}.c", {"with_header": False})
+        generator.add(function)
+        generator.generate(tmp + "/")
+        source = pathlib.Path(tmp, f"{function.name()}.c").read_bytes()
+        key = hashlib.sha256(source).hexdigest()[:16]
+        library = cache_dir() / f"{function.name()}-{key}.so"
+        if not library.exists():
+            library.parent.mkdir(parents=True, exist_ok=True)
+            partial = library.with_suffix(f".{os.getpid()}.tmp")
+            subprocess.run([compiler, "-shared", "-fPIC", "-O1", "-o", str(partial), str(pathlib.Path(tmp, f"{function.name()}.c"))],
+                           check=True, capture_output=True)
+            os.replace(partial, library)     # atomic: a concurrent build never sees half a library
+    return ca.external(function.name(), str(library))
+
+
+@dataclasses.dataclass(frozen=True)
+class NmpcGains(LqrGains):
+    """Tuning of `Nmpc` (`[controller]` keys): the LQR's error sizes and design grid (the
+    operating points are the horizon's reference), and the horizon."""
+    horizon: float = 30               # N nodes
+    node_periods: float = 2           # controller periods per node: the horizon is N × node_periods / rate
+    iterations: float = 1             # real-time iterations per sample
+
+    def __post_init__(self):
+        super().__post_init__()
+        for name in ("horizon", "node_periods", "iterations"):
+            n = getattr(self, name)
+            if n != int(n) or n < 1:
+                raise ValueError(f"{name}: expected a whole number >= 1, got {n!r}")
+
+
+GAIN_NAMES = tuple(f.name for f in dataclasses.fields(NmpcGains))
+
+_NODES = {}
+#: Gauss–Newton iterations of the first sample, from the operating points as the guess.
+COLD_START_ITERATIONS = 20
+#: A jump of the reference's heading between samples (a waypoint's corner) larger than this
+#: starts the iterations afresh: the last solution's coordinates are relative to the old heading.
+HEADING_JUMP_RAD = 0.3
+
+
+class _Diverged(Exception):
+    """The prediction or the QP gave no finite answer."""
+
+
+def _wrap(angle):
+    return (angle + np.pi) % (2 * np.pi) - np.pi
+
+
+class Nmpc(Controller):
+    """Real-time-iteration NMPC (see the module's docstring); `rate` 20 Hz by default."""
+    kind = "nmpc"
+
+    def __init__(self, params, rate=20.0, u_max=DEFAULT_U_MAX, gains=NmpcGains()):
+        super().__init__(params, rate, u_max)
+        ca = _casadi()
+        self.gains, self.n = gains, int(gains.horizon)
+        self.node_periods = int(gains.node_periods)
+        self.node_period = self.period * self.node_periods
+        self.schedule = design_schedule(params, rate, u_max, gains)
+        key = (self.node_period, self.n)
+        if key not in _NODES:
+            _NODES[key] = compiled(node_function(self.node_period).map(self.n))
+        self._nodes = _NODES[key]
+        self._p = parameter_vector(params)
+        q = gains.weights(u_max).q_diagonal()[:NZ_N]
+        self._q_path, self._q_heading = q, np.where(np.arange(NZ_N) == design.Z_EY, 0.0, q)
+        self._r = 1.0 / u_max ** 2
+        self._P_path, self._P_heading = self._terminal_costs()
+        n2 = 2 * self.n
+        self._qp = ca.conic("nmpc_qp", "daqp", {"h": ca.Sparsity.dense(n2, n2), "a": ca.Sparsity(0, n2)},
+                            {"error_on_fail": False})
+        self.reset(None)
+
+    def _terminal_costs(self):
+        """The discrete Riccati cost-to-go of the prediction model at every operating point of the
+        schedule, with the cross-track error (paths) and without it (speed and heading)."""
+        from scipy.linalg import solve_discrete_are
+        s = self.schedule
+        shape = s.z_star.shape[:2] + (NZ_N, NZ_N)
+        P_path, P_heading = np.zeros(shape), np.zeros(shape)
+        body = np.arange(design.Z_EY)
+        R = self._r * np.eye(2)
+        node = node_function(self.node_period)
+        for i, j in np.ndindex(shape[:2]):
+            _, A, B = (out.full() for out in node(s.z_star[i, j][:NZ_N], s.u_star[i, j], s.speeds[i],
+                                                   s.curvatures[j], self._p))
+            P_path[i, j] = solve_discrete_are(A, B, np.diag(self._q_path), R)
+            P_heading[i, j][np.ix_(body, body)] = solve_discrete_are(A[np.ix_(body, body)], B[body],
+                                                                     np.diag(self._q_heading[body]), R)
+        return P_path, P_heading
+
+    def reset(self, x0):
+        super().reset(x0)
+        self._guess, self._heading = None, 0.0
+        self.restarts = 0
+
+    def preview_distances(self, target):
+        """The horizon's nodes along the path at the reference speed: v T k, k = 0 .. N [m]."""
+        return target.speed * self.node_period * np.arange(self.n + 1)
+
+    def _references(self, v, kappas):
+        """z* (N+1, NZ_N) and u* (N, 2) at speed v and the nodes' curvatures: `Schedule.at`,
+        vectorised over the nodes (the same bilinear interpolation, clamped to the grid)."""
+        s = self.schedule
+        weights = []
+        for grid, values in ((s.speeds, np.array([v])), (s.curvatures, np.asarray(kappas))):
+            if len(grid) == 1:
+                weights.append((np.zeros(len(values), int), np.zeros(len(values), int), np.zeros(len(values))))
+                continue
+            lo = np.clip(np.searchsorted(grid, values) - 1, 0, len(grid) - 2)
+            w = np.clip((values - grid[lo]) / (grid[lo + 1] - grid[lo]), 0.0, 1.0)
+            weights.append((lo, np.minimum(lo + 1, len(grid) - 1), w))
+        (i0, i1, wv), (j0, j1, wk) = weights
+        wv, wk = wv[0], wk[:, None]
+
+        def mix(a):
+            return ((1 - wv) * ((1 - wk) * a[i0[0], j0] + wk * a[i0[0], j1])
+                    + wv * ((1 - wk) * a[i1[0], j0] + wk * a[i1[0], j1]))
+        return mix(s.z_star)[:, :NZ_N], mix(s.u_star)[:-1]
+
+    def compute(self, t, x, target):
+        n, path = self.n, target.cross_track is not None
+        v = float(target.speed)
+        if path and target.curvature_ahead is not None and len(target.curvature_ahead) == n + 1:
+            kappas = np.asarray(target.curvature_ahead, dtype=float)
+        else:
+            kappas = np.full(n + 1, float(target.curvature) if path else 0.0)
+        z0 = design.error_coordinates(x, self.params.r, v, target.heading,
+                                      target.cross_track if path else 0.0)[:NZ_N]
+        zs, us = self._references(v, kappas)
+        if self._guess is not None and abs(_wrap(target.heading - self._heading)) > HEADING_JUMP_RAD:
+            self._guess = None                  # a corner: the last solution is in another frame
+        self._heading = target.heading
+        if self._guess is None:
+            Z, U = zs.copy(), us.copy()
+        else:                                   # the last solution, one node on when a node has passed
+            Z, U = self._guess
+            if self.samples % self.node_periods == 0:
+                Z = np.vstack([Z[1:], Z[-1:]])
+                U = np.vstack([U[1:], U[-1:]])
+        s = self.schedule
+        i = int(np.argmin(np.abs(s.speeds - v)))
+        j = int(np.argmin(np.abs(s.curvatures - kappas[-1])))
+        P = (self._P_path if path else self._P_heading)[i, j]
+        q = self._q_path if path else self._q_heading
+        try:
+            Z, U = self._iterate(z0, Z, U, zs, us, v, kappas, q, P, cold=self._guess is None)
+        except _Diverged:                        # a warm start gone bad: once more from the reference
+            self.restarts += 1
+            try:
+                Z, U = self._iterate(z0, zs.copy(), us.copy(), zs, us, v, kappas, q, P, cold=True)
+            except _Diverged:                    # no prediction at all: hold the reference's torques
+                self._guess = None
+                return us[0]
+        self._guess = (Z, U)
+        return U[0]
+
+    def _iterate(self, z0, Z, U, zs, us, v, kappas, q, P, cold):
+        # Cold start: iterate to convergence once (RTI's usual initialisation), then one per sample.
+        for _ in range(COLD_START_ITERATIONS if cold else int(self.gains.iterations)):
+            Z, U = self._iteration(z0, Z, U, zs, us, v, kappas, q, P)
+        return Z, U
+
+    def _iteration(self, z0, Z, U, zs, us, v, kappas, q, P):
+        """One Gauss–Newton QP around the nodes (Z (N+1, NZ_N), U (N, 2)); the new nodes.
+        Raises _Diverged when the prediction overflows or the QP fails."""
+        n, nz = self.n, NZ_N
+        z_next, A, B = (out.full() for out in self._nodes(Z[:n].T, U.T, v, kappas[:n].reshape(1, n), self._p))
+        if not (np.all(np.isfinite(z_next)) and np.all(np.isfinite(A)) and np.all(np.isfinite(B))):
+            raise _Diverged
+        z_next = z_next.T
+        A = A.reshape(nz, n, nz).transpose(1, 0, 2)      # A[k]: nz×nz
+        B = B.reshape(nz, n, 2).transpose(1, 0, 2)       # B[k]: nz×2
+        gaps = z_next - Z[1:]
+        # δz_{k+1} = A_k δz_k + B_k δu_k + d_k: δz_k = c_k + G_k δU (condensing).
+        G = np.zeros((n + 1, nz, 2 * n))
+        c = np.zeros((n + 1, nz))
+        c[0] = z0 - Z[0]
+        with np.errstate(over="ignore", invalid="ignore"):     # an unstable guess: checked below
+            for k in range(n):
+                G[k + 1] = A[k] @ G[k]
+                G[k + 1][:, 2 * k:2 * k + 2] += B[k]
+                c[k + 1] = A[k] @ c[k] + gaps[k]
+            W = np.broadcast_to(q, (n + 1, nz))
+            e = Z + c - zs                          # the predicted error at δU = 0
+            Gs = G[1:n].reshape(-1, 2 * n)
+            H = Gs.T @ (W[1:n].reshape(-1, 1) * Gs) + G[n].T @ P @ G[n] + self._r * np.eye(2 * n)
+            g = Gs.T @ (W[1:n].reshape(-1) * e[1:n].reshape(-1)) + G[n].T @ P @ e[n] + self._r * (U - us).reshape(-1)
+        if not (np.all(np.isfinite(H)) and np.all(np.isfinite(g))):
+            raise _Diverged
+        sol = self._qp(h=H, g=g, lbx=(-self.u_max - U).reshape(-1), ubx=(self.u_max - U).reshape(-1))
+        dU = sol["x"].full().reshape(-1)
+        if not (self._qp.stats()["success"] and np.all(np.isfinite(dU))):
+            raise _Diverged
+        Z_new = Z + c + (G @ dU)
+        return Z_new, U + dU.reshape(n, 2)
