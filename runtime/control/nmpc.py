@@ -35,8 +35,9 @@ from .controller import DEFAULT_U_MAX, Controller
 from . import lqr_design as design
 from .lqr import LqrGains, design_schedule
 
-#: The NMPC's state: the robot's error coordinates and the cross-track error, no integrators.
-NZ_N = design.Z_EY + 1
+#: The NMPC's state: the robot's error coordinates, the cross-track error and its integral
+#: (offset-free tracking of a robot heavier than the model); the speed's integrator is left out.
+NZ_N = design.Z_IY + 1
 Z_E = design.Z_E
 
 
@@ -85,7 +86,7 @@ def reduced_field():
     z_dot = ca.vertcat(ca.mtimes(jr_inv, w_Q - kappa * s_dot * ca.mtimes(Q.T, e_z)),
                        w_P,
                        a[0:3] - ca.cross(ca.vertcat(w_Y, 0, 0), w_S),
-                       a[3], a[4], q_dot[1])
+                       a[3], a[4], q_dot[1], z[design.Z_EY])
     return ca.Function("reduced_field", [z, u, v, kappa, p], [z_dot], ["z", "u", "v", "kappa", "p"], ["z_dot"])
 
 
@@ -101,14 +102,17 @@ def node_function(period):
     f = reduced_field()
     z, u = ca.SX.sym("z", NZ_N), ca.SX.sym("u", 2)
     v, kappa, p = ca.SX.sym("v"), ca.SX.sym("kappa"), ca.SX.sym("p", f.size1_in(4))
-    h = float(period)
+    z_next = _rk4(f, z, u, v, kappa, p, float(period))
+    return ca.Function("nmpc_node", [z, u, v, kappa, p], [z_next, ca.jacobian(z_next, z), ca.jacobian(z_next, u)],
+                       ["z", "u", "v", "kappa", "p"], ["z_next", "A", "B"])
+
+
+def _rk4(f, z, u, v, kappa, p, h):
     k1 = f(z, u, v, kappa, p)
     k2 = f(z + h / 2 * k1, u, v, kappa, p)
     k3 = f(z + h / 2 * k2, u, v, kappa, p)
     k4 = f(z + h * k3, u, v, kappa, p)
-    z_next = z + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-    return ca.Function("nmpc_node", [z, u, v, kappa, p], [z_next, ca.jacobian(z_next, z), ca.jacobian(z_next, u)],
-                       ["z", "u", "v", "kappa", "p"], ["z_next", "A", "B"])
+    return z + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
 def cache_dir():
@@ -145,6 +149,9 @@ def compiled(function):
 class NmpcGains(LqrGains):
     """Tuning of `Nmpc` (`[controller]` keys): the LQR's error sizes and design grid (the
     operating points are the horizon's reference), and the horizon."""
+    torque_step_n_m: float = 0.1      # a change of torque from one node to the next worth the full cost
+    cross_track_integral_m_s: float = 2.0    # ∫e_y: faster than the LQR's (the horizon sees its overshoot)
+    integral_zone_m: float = 0.02     # ... and advancing only this near the path (no windup while converging)
     horizon: float = 30               # N nodes
     node_periods: float = 2           # controller periods per node: the horizon is N × node_periods / rate
     iterations: float = 1             # real-time iterations per sample
@@ -161,7 +168,7 @@ GAIN_NAMES = tuple(f.name for f in dataclasses.fields(NmpcGains))
 
 _NODES = {}
 #: Gauss–Newton iterations of the first sample, from the operating points as the guess.
-COLD_START_ITERATIONS = 20
+COLD_START_ITERATIONS = 8
 #: A jump of the reference's heading between samples (a waypoint's corner) larger than this
 #: starts the iterations afresh: the last solution's coordinates are relative to the old heading.
 HEADING_JUMP_RAD = 0.3
@@ -190,10 +197,16 @@ class Nmpc(Controller):
         if key not in _NODES:
             _NODES[key] = compiled(node_function(self.node_period).map(self.n))
         self._nodes = _NODES[key]
+
         self._p = parameter_vector(params)
         q = gains.weights(u_max).q_diagonal()[:NZ_N]
-        self._q_path, self._q_heading = q, np.where(np.arange(NZ_N) == design.Z_EY, 0.0, q)
+        self._q_path = q
+        self._q_heading = np.where(np.isin(np.arange(NZ_N), (design.Z_EY, design.Z_IY)), 0.0, q)
         self._r = 1.0 / u_max ** 2
+        # ‖D U − (u_last, 0, …)‖²: the torques' changes from the last applied one and node to node.
+        n2 = 2 * self.n
+        self._D = np.eye(n2) - np.eye(n2, k=-2)
+        self._r_step = 1.0 / gains.torque_step_n_m ** 2
         self._P_path, self._P_heading = self._terminal_costs()
         n2 = 2 * self.n
         self._qp = ca.conic("nmpc_qp", "daqp", {"h": ca.Sparsity.dense(n2, n2), "a": ca.Sparsity(0, n2)},
@@ -220,7 +233,8 @@ class Nmpc(Controller):
 
     def reset(self, x0):
         super().reset(x0)
-        self._guess, self._heading = None, 0.0
+        self._guess, self._heading, self._u_last = None, 0.0, None
+        self.integral = 0.0                     # ∫e_y dt [m s], the controller's own state
         self.restarts = 0
 
     def preview_distances(self, target):
@@ -254,10 +268,11 @@ class Nmpc(Controller):
             kappas = np.asarray(target.curvature_ahead, dtype=float)
         else:
             kappas = np.full(n + 1, float(target.curvature) if path else 0.0)
-        z0 = design.error_coordinates(x, self.params.r, v, target.heading,
-                                      target.cross_track if path else 0.0)[:NZ_N]
+        z0 = design.error_coordinates(x, self.params.r, v, target.heading, target.cross_track if path else 0.0,
+                                      (self.integral if path else 0.0, 0.0))[:NZ_N]
         zs, us = self._references(v, kappas)
-        if self._guess is not None and abs(_wrap(target.heading - self._heading)) > HEADING_JUMP_RAD:
+        jumped = abs(_wrap(target.heading - self._heading)) > HEADING_JUMP_RAD
+        if self._guess is not None and jumped:
             self._guess = None                  # a corner: the last solution is in another frame
         self._heading = target.heading
         if self._guess is None:
@@ -281,7 +296,11 @@ class Nmpc(Controller):
             except _Diverged:                    # no prediction at all: hold the reference's torques
                 self._guess = None
                 return us[0]
-        self._guess = (Z, U)
+        self._guess, self._u_last = (Z, U), U[0].copy()
+        # The integral advances while the robot is near the path and the torques are free
+        # (conditional anti-windup, as the LQR's).
+        if path and abs(target.cross_track) <= self.gains.integral_zone_m and np.all(np.abs(U[0]) < self.u_max * 0.999):
+            self.integral += self.period * target.cross_track
         return U[0]
 
     def _iterate(self, z0, Z, U, zs, us, v, kappas, q, P, cold):
@@ -315,6 +334,11 @@ class Nmpc(Controller):
             Gs = G[1:n].reshape(-1, 2 * n)
             H = Gs.T @ (W[1:n].reshape(-1, 1) * Gs) + G[n].T @ P @ G[n] + self._r * np.eye(2 * n)
             g = Gs.T @ (W[1:n].reshape(-1) * e[1:n].reshape(-1)) + G[n].T @ P @ e[n] + self._r * (U - us).reshape(-1)
+        if self._u_last is not None:
+            step = self._D @ U.reshape(-1)
+            step[:2] -= self._u_last
+            H += self._r_step * (self._D.T @ self._D)
+            g += self._r_step * (self._D.T @ step)
         if not (np.all(np.isfinite(H)) and np.all(np.isfinite(g))):
             raise _Diverged
         sol = self._qp(h=H, g=g, lbx=(-self.u_max - U).reshape(-1), ubx=(self.u_max - U).reshape(-1))

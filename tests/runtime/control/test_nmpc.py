@@ -96,6 +96,7 @@ def first_torque_against_lqr(R_scale=1.0):
     P = solve_discrete_are(A, B, np.diag(controller._q_path), R)
     K = np.linalg.solve(R + B.T @ P @ B, B.T @ P @ A)
     dz = 1e-4 * np.random.default_rng(6).normal(size=nmpc.NZ_N)
+    dz[design.Z_IY] = 0.0                         # the controller's own integral starts at 0
     z = z_star.copy()
     z[:nmpc.NZ_N] += dz
     x = design.lift(z, v, PARAMS.r)
@@ -138,3 +139,25 @@ def test_a_diverged_prediction_falls_back_to_the_reference_torques(monkeypatch):
     u = controller.compute(0.0, x, Target(speed=0.3, heading=0.0, curvature=0.0, cross_track=0.0))
     _, u_star = controller._references(0.3, np.zeros(controller.n + 1))
     assert np.array_equal(u, u_star[0]) and controller.restarts == 1
+
+
+def circle_offset_against_a_heavier_plant(integral_m_s):
+    """Mean cross-track error over the last 10 s of the circle, plant 10 % heavier, no noise."""
+    from runtime.control.benchmark import run_task
+    from runtime.control.closed_loop import Noise
+    from runtime.control.task import load_task
+    from runtime.state import IDX_Q
+    task = load_task("circle-mismatch").with_controller("nmpc")
+    spec = task.controllers[0]
+    spec = dataclasses.replace(spec, gains=dataclasses.replace(spec.gains, cross_track_integral_m_s=integral_m_s))
+    result, reference, _ = run_task(dataclasses.replace(task, controllers=(spec,), noise=Noise()))
+    late = result.time >= result.time[-1] - 10.0
+    return float(np.mean(reference.cross_track(result.trajectory[late][::20, IDX_Q][:, :2])))
+
+
+def test_the_cross_track_integral_removes_the_offset_of_a_mismatched_plant():
+    assert abs(circle_offset_against_a_heavier_plant(nmpc.NmpcGains().cross_track_integral_m_s)) < 0.002
+
+
+def test_the_offset_check_fails_without_the_integral():
+    assert abs(circle_offset_against_a_heavier_plant(1e6)) > 0.01
