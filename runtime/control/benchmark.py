@@ -38,7 +38,8 @@ def run_task(task, progress=False):
     """(ClosedLoopResult, reference, tracking metrics) of one task."""
     reference = task.reference()
     result = simulate_closed_loop(task.plant_params, task.controller(), reference, task.scenario.x0,
-                                  task.duration, task.scenario.dt, task.scenario.method, task.noise, progress)
+                                  task.duration, task.scenario.dt, task.scenario.method, task.noise, progress,
+                                  task.make_estimator())
     every = max(1, round(1 / (task.rate * task.scenario.dt)))
     return result, reference, tracking_metrics(result, reference, task.reference_spec["kind"],
                                                task.plant_params.r, sample_every=every)

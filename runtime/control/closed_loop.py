@@ -1,9 +1,10 @@
 """Closed-loop simulation: the plant on the C steppers, the controller sampled with a zero-order hold.
 
 Every controller period the controller reads the measured state (the plant's state, plus sensor
-noise if asked), its torques are held constant, and the plant advances by `Model.simulate` (the
-guarded C loop) for the period's steps.  The plant may have other parameters than the
-controller's model (`[plant]` in a task file).
+noise if asked) or, with an estimator (`[estimator]` in a task file), the estimator's state
+after that measurement; its torques are held constant, and the plant advances by
+`Model.simulate` (the guarded C loop) for the period's steps.  The plant may have other
+parameters than the controller's model (`[plant]` in a task file).
 """
 import dataclasses
 import time
@@ -40,6 +41,7 @@ class ClosedLoopResult:
     saturated_fraction: float
     solve_s: np.ndarray         # (k,) [s] the controller's computation time per sample
     wall_time_s: float
+    estimates: np.ndarray | None = None   # (k, 35): what the controller was given, when an estimator ran
 
 
 def _measure(x, r, noise, rng):
@@ -57,10 +59,12 @@ def _measure(x, r, noise, rng):
 
 
 def simulate_closed_loop(plant_params, controller, reference, x0, duration, dt, method="rkmk4",
-                         noise=Noise(), progress=False):
+                         noise=Noise(), progress=False, estimator=None):
     """Run `controller` on `reference` from x0 for `duration` s; the plant steps by `dt`.
 
-    The controller period must be a whole number of plant steps.
+    The controller period must be a whole number of plant steps.  `estimator` (e.g.
+    runtime.control.estimator.Ekf): `reset(y)` and `update(y, u, period)` -> the state the
+    controller and the reference are given instead of the measurement y.
     """
     per = round(controller.period / dt)
     if per < 1 or abs(per * dt - controller.period) > 1e-9 * controller.period:
@@ -77,10 +81,14 @@ def simulate_closed_loop(plant_params, controller, reference, x0, duration, dt, 
     controller.reset(_measure(x0, plant_params.r, noise, rng))
     if hasattr(reference, "reset"):
         reference.reset()
+    estimates = np.empty((samples, x0.size)) if estimator is not None else None
     started = time.perf_counter()
     for k in tqdm(range(samples), disable=not progress or None, unit="sample", leave=False):
         x = traj[k * per]
         y = _measure(x, plant_params.r, noise, rng)
+        if estimator is not None:
+            y = estimator.reset(y) if k == 0 else estimator.update(y, u, controller.period)
+            estimates[k] = y
         target = reference.target(k * controller.period, y[IDX_Q], float(heading(y)))
         if getattr(reference, "is_path", False) and hasattr(controller, "preview_distances"):
             target = dataclasses.replace(target, curvature_ahead=reference.curvature_ahead(
@@ -92,4 +100,5 @@ def simulate_closed_loop(plant_params, controller, reference, x0, duration, dt, 
     return ClosedLoopResult(time=np.arange(len(traj)) * dt, trajectory=traj, torques=torques,
                             control_time=np.arange(samples) * controller.period,
                             saturated_fraction=controller.saturated_fraction,
-                            solve_s=np.asarray(controller.solve_s), wall_time_s=time.perf_counter() - started)
+                            solve_s=np.asarray(controller.solve_s), wall_time_s=time.perf_counter() - started,
+                            estimates=estimates)

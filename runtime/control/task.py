@@ -25,6 +25,8 @@ from .lqr import GAIN_NAMES as LQR_GAIN_NAMES
 from .lqr import Lqr, LqrGains
 from .nmpc import GAIN_NAMES as NMPC_GAIN_NAMES
 from .nmpc import Nmpc, NmpcGains
+from .estimator import SETTING_NAMES as ESTIMATOR_SETTINGS
+from .estimator import Ekf, EkfSettings
 from .pid import GAIN_NAMES, Pid, PidGains
 from .reference import KINDS, SpeedHeading, circle_path, figure8_path, line_path, waypoints_path
 from ..state import IDX_Q
@@ -59,6 +61,7 @@ class Task:
     controllers: tuple          # ControllerSpec, one per kind; the first is the task's default
     plant_params: object        # runtime.Params of the simulated robot
     noise: Noise
+    estimator: object = None    # EkfSettings, or None: the controller reads the measurement itself
 
     @property
     def duration(self):
@@ -84,6 +87,10 @@ class Task:
     def controller(self):
         cls = AVAILABLE_CONTROLLERS[self.controller_kind][0]
         return cls(self.scenario.params, rate=self.rate, u_max=self.u_max, gains=self.gains)
+
+    def make_estimator(self):
+        """The `[estimator]` on the controller's model (never the plant's), or None."""
+        return None if self.estimator is None else Ekf(self.scenario.params, self.estimator)
 
     def reference(self):
         """The reference, built from the start pose (paths start at the robot, tangent to its heading)."""
@@ -130,10 +137,11 @@ def load_task(name_or_path):
 def parse_task(data, source="<task>", name="task"):
     if not isinstance(data, dict):
         raise ValueError(f"{source}: expected a table")
-    unknown = sorted(set(data) - _SCENARIO_KEYS - {"reference", "controller", "plant"})
+    sections = {"reference", "controller", "plant", "estimator"}
+    unknown = sorted(set(data) - _SCENARIO_KEYS - sections)
     if unknown:
         raise ValueError(f"{source}: unknown key(s) {', '.join(map(repr, unknown))}; allowed: "
-                         f"{', '.join(sorted(_SCENARIO_KEYS | {'reference', 'controller', 'plant'}))}")
+                         f"{', '.join(sorted(_SCENARIO_KEYS | sections))}")
     scenario = parse_scenario({k: v for k, v in data.items() if k in _SCENARIO_KEYS}, source, name)
     reference = _parse_reference(data.get("reference"), source)
     tables = data.get("controller")
@@ -149,8 +157,17 @@ def parse_task(data, source="<task>", name="task"):
                              f"steps dt = {scenario.dt:g} s")
         controllers.append(spec)
     plant, noise = _parse_plant(data.get("plant", {}), scenario.params, source)
+    estimator = _parse_estimator(data["estimator"], source) if "estimator" in data else None
     return Task(name=name, source=source, scenario=scenario, reference_spec=reference,
-                controllers=tuple(controllers), plant_params=plant, noise=noise)
+                controllers=tuple(controllers), plant_params=plant, noise=noise, estimator=estimator)
+
+
+def _parse_estimator(table, source):
+    where = f"{source}: estimator"
+    _table(table, where, {"kind", *ESTIMATOR_SETTINGS})
+    if table.get("kind") != "ekf":
+        raise ValueError(f"{where}.kind: expected \"ekf\", got {table.get('kind')!r}")
+    return EkfSettings(**{k: _real(v, f"{where}.{k}", positive=True) for k, v in table.items() if k != "kind"})
 
 
 def _table(value, where, allowed):

@@ -1,0 +1,80 @@
+"""An extended Kalman filter on the group: the controller's view of a robot measured with noise.
+
+The state is a point x of SO(3) × SO(2) × SO(2) × ℝ² × ℝ⁵ and the filter's uncertainty lives in
+its tangent space, in the right-trivialised error coordinates δ ∈ ℝ¹² of issue #19 (x ⊕ δ,
+y ⊖ x: runtime/group.py), as in the invariant / error-state filters of the estimation literature
+(and manif's and SymForce's examples).  One sample of period T, torques u held:
+
+    predict   x⁻ = step(x̂, u, T)                 one RKMK4 step (c/sr_steppers.c)
+              P⁻ = F P Fᵀ + G_w Σ_w G_wᵀ T        F = ∂step/∂δ, the exact step Jacobian (issue #19)
+    correct   e  = y ⊖ x⁻                          the measurement's error coordinates
+              K  = P⁻ (P⁻ + R)⁻¹,  x̂ = x⁻ ⊕ K e,  P = (I − K) P⁻
+
+The measurement is the whole state with noise (what the closed loop's sensors give: position,
+the shell's attitude, the joint encoders, the rates), so its Jacobian is the identity in these
+coordinates.  The process noise Σ_w is a white acceleration on the five rates (model mismatch:
+a heavier robot, other dampings); G_w puts it on ν.  The model is the controller's (its nominal
+parameters), never the plant's.
+"""
+import dataclasses
+
+import numpy as np
+
+from ..model import Model
+from ..state import IDX_E_NU, IDX_E_Q, IDX_E_TH_P, IDX_E_TH_Y, IDX_E_XI_S, NE
+
+
+@dataclasses.dataclass(frozen=True)
+class EkfSettings:
+    """`[estimator]` keys: the sensors' standard deviations the filter assumes, and the process noise."""
+    position_m: float = 0.005           # q_x, q_y
+    attitude_rad: float = 0.005         # R_S, each axis
+    joint_rad: float = 1e-4             # the encoders of θ_Y, θ_P
+    rate_rad_s: float = 0.02            # ω_S, ω_Y, ω_P
+    accel_rad_s2: float = 0.05          # process noise: white angular acceleration on the rates [rad/s²/√Hz]
+
+    def __post_init__(self):
+        for field in dataclasses.fields(self):
+            value = getattr(self, field.name)
+            if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
+                raise ValueError(f"{field.name}: a standard deviation must be a finite number > 0, got {value!r}")
+
+
+SETTING_NAMES = tuple(f.name for f in dataclasses.fields(EkfSettings))
+
+
+class Ekf:
+    """`reset(y)` with the first measurement, then `update(y, u, period)` once per sample -> x̂."""
+    kind = "ekf"
+
+    def __init__(self, params, settings=EkfSettings(), method="rkmk4"):
+        self.model, self.settings, self.method = Model(params), settings, method
+        s = settings
+        r = np.zeros(NE)
+        r[IDX_E_XI_S] = s.attitude_rad ** 2
+        r[IDX_E_TH_Y] = r[IDX_E_TH_P] = s.joint_rad ** 2
+        r[IDX_E_Q] = s.position_m ** 2
+        r[IDX_E_NU] = s.rate_rad_s ** 2
+        self.R = np.diag(r)
+        self.x, self.P = None, None
+
+    def reset(self, y):
+        """Start from the first measurement, as uncertain as the sensors."""
+        self.x, self.P = np.array(y, dtype=np.float64), self.R.copy()
+        return self.x
+
+    def update(self, y, u, period):
+        """x̂ after the sample: the prediction over `period` with torques u, corrected by y."""
+        if self.x is None:
+            raise ValueError("estimator: update before reset")
+        x_pred = self.model.step(self.x, u, period, self.method)
+        F, _ = self.model.step_jacobian(self.x, u, period, self.method)
+        Q = np.zeros((NE, NE))
+        Q[IDX_E_NU, IDX_E_NU] = self.settings.accel_rad_s2 ** 2 * period * np.eye(IDX_E_NU.stop - IDX_E_NU.start)
+        P = F @ self.P @ F.T + Q
+        e = self.model.local(x_pred, y)
+        K = np.linalg.solve((P + self.R).T, P.T).T          # P (P + R)⁻¹, P and R symmetric
+        self.x = self.model.retract(x_pred, K @ e)
+        I_K = np.eye(NE) - K
+        self.P = I_K @ P @ I_K.T + K @ self.R @ K.T          # Joseph form: stays symmetric positive
+        return self.x
