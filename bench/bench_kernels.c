@@ -31,7 +31,7 @@
 #define NOUT (SR_NE * (SR_NE + SR_NU)) /* the Jacobians' outputs: a step Jacobian's F and G */
 /* The Jacobians write to JOUT, everything else to OUT: one buffer as wide as a step Jacobian
  * would spread the other kernels' outputs over five times the memory and slow them. */
-static sr_real X[NMAX][SR_NX], U[NMAX][SR_NU], OUT[NMAX][SR_NX], JOUT[NMAX][NOUT];
+static sr_real X[NMAX][SR_NX], U[NMAX][SR_NU], OUT[NMAX][SR_NX], JOUT[NMAX][NOUT], BATCH_OUT[NMAX][SR_NV];
 static double sink;
 
 static double now_ns(void)
@@ -50,6 +50,12 @@ static int k_accel(const sr_model *m, int i, int arg) { (void)arg; return sr_acc
 static int k_gen_accel(const sr_model *m, int i, int arg) { (void)arg; return sr_gen_accel(m->c, X[i], U[i], OUT[i]); }
 static int k_inertia(const sr_model *m, int i, int arg) { (void)arg; return sr_inertia(m, X[i], OUT[i]); }
 static int k_step(const sr_model *m, int i, int method) { return sr_step(m, method, X[i], U[i], 0.01, OUT[i]); }
+/* The batch form Python's Model.accel calls: sr_check_state and sr_accel on every row, vectorised. */
+static int k_checked_accel_batch(const sr_model *m, int n, int arg)
+{
+    (void)arg;
+    return sr_checked_accel_batch(m, n, X[0], U[0], BATCH_OUT[0], NULL);
+}
 static int k_accel_general(const sr_model *m, int i, int arg) { (void)m; (void)arg; return sr_accel(&general_model, X[i], U[i], OUT[i]); }
 static int k_step_general(const sr_model *m, int i, int method) { (void)m; return sr_step(&general_model, method, X[i], U[i], 0.01, OUT[i]); }
 static int k_accel_jacobian(const sr_model *m, int i, int arg) { (void)arg; return sr_accel_jacobian(m, X[i], U[i], JOUT[i], JOUT[i] + SR_NV * SR_NE); }
@@ -93,6 +99,7 @@ typedef struct {
     int arg, nout, repeat_divisor;
     const char *name;
     double best;
+    int batch; /* fn does all n states in one call (fn(model, n, arg)), its outputs in BATCH_OUT */
 } bench_case;
 
 /* One timed sweep: `repeats` passes over the n states, ns per call. */
@@ -100,7 +107,11 @@ static double sweep(const bench_case *c, int n, int repeats)
 {
     double t0 = now_ns();
     int r, i, reps = repeats / c->repeat_divisor > 0 ? repeats / c->repeat_divisor : 1;
-    for (r = 0; r < reps; ++r)
+    for (r = 0; r < reps && c->batch; ++r) {
+        if (c->fn(&model, n, c->arg) != 0) { fprintf(stderr, "%s failed\n", c->name); exit(2); }
+        sink += BATCH_OUT[n - 1][0];
+    }
+    for (r = 0; r < reps && !c->batch; ++r)
         for (i = 0; i < n; ++i) {
             if (c->fn(&model, i, c->arg) != 0) { fprintf(stderr, "%s failed at state %d\n", c->name, i); exit(2); }
             sink += c->nout > SR_NX ? JOUT[i][0] : OUT[i][0];
@@ -112,10 +123,13 @@ static void print_case(const bench_case *c, int n)
 {
     int i, k;
     printf("  \"%s\": {\"ns\": %.3f, \"check\": [", c->name, c->best);
+    if (c->batch) c->fn(&model, n, c->arg);
     for (i = 0; i < n; ++i) {
-        c->fn(&model, i, c->arg);
+        if (!c->batch) c->fn(&model, i, c->arg);
         printf("%s[", i ? ", " : "");
-        for (k = 0; k < c->nout; ++k) printf("%s%.17g", k ? ", " : "", (double)(c->nout > SR_NX ? JOUT[i][k] : OUT[i][k]));
+        for (k = 0; k < c->nout; ++k)
+            printf("%s%.17g", k ? ", " : "",
+                   (double)(c->batch ? BATCH_OUT[i][k] : c->nout > SR_NX ? JOUT[i][k] : OUT[i][k]));
         printf("]");
     }
     printf("]},\n");
@@ -178,6 +192,7 @@ int main(int argc, char **argv)
             {k_step, SR_LIE_EULER, SR_NX, 1, "step_lie_euler", 0},
             {k_step, SR_RKMK4, SR_NX, 1, "step_rkmk4", 0},
             {k_step, SR_CF4, SR_NX, 1, "step_cf4", 0},
+            {k_checked_accel_batch, 0, SR_NV, 1, "checked_accel_batch", 0, 1},
             {k_accel_general, 0, SR_NV, 1, "accel_general_robot", 0},
             {k_step_general, SR_RKMK4, SR_NX, 1, "step_rkmk4_general_robot", 0},
             {k_accel_jacobian, 0, SR_NV * (SR_NE + SR_NU), 1, "accel_jacobian", 0},

@@ -68,6 +68,7 @@ extern "C" {
 #define sr_check_state_batch sr_check_state_batch_f
 #define sr_accel sr_accel_f
 #define sr_accel_batch sr_accel_batch_f
+#define sr_checked_accel_batch sr_checked_accel_batch_f
 #define sr_inertia sr_inertia_f
 #define sr_rhs sr_rhs_f
 #define sr_energy sr_energy_f
@@ -219,9 +220,17 @@ int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_N
 
 /* sr_accel over n states: x is n x SR_NX, u is n x SR_NU (or NULL), a is n x SR_NV,
  * all row-major.  Stops at the first failing row, whose index goes to *failed_row
- * (if not NULL; -1 when all rows succeed). */
+ * (if not NULL; -1 when all rows succeed); only the rows before it are written.
+ * Each row's result and status are sr_accel's, bit for bit: the rows go through a vectorised
+ * form of the checks and the kernel 64 at a time (sr_gen_accel_lanes; GCC vectorises it at -O3,
+ * docs/sweeps.md "The batch accel"), and any row that form does not clear through sr_accel itself. */
 int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
                    sr_real *a, long *failed_row);
+
+/* sr_check_state, then sr_accel, on each of n states, as sr_accel_batch (what the Python
+ * Model.accel does for a batch): the full state check at little cost over sr_accel_batch. */
+int sr_checked_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
+                           sr_real *a, long *failed_row);
 
 /* Generalized inertia M (row-major 5x5): kinetic energy = 1/2 nu^T M nu [kg m^2]. */
 int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * SR_NV]);

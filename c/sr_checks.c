@@ -59,3 +59,48 @@ int sr_check_state_batch(const sr_model *model, long n, const sr_real *x, long *
     }
     return SR_OK;
 }
+
+/* ---- the lanes form, for the batch calls --------------------------------------------------- */
+
+/* The tests of sr_check_state and of the kernels' cheap checks (checks() in sr_internal.h), one
+ * lane per state of a block, without branches, so that the loop vectorises as sr_gen_accel_lanes
+ * does.  ok[i] = 1 where the lane is clean, else 0: the scalar functions then decide, and name
+ * what is wrong.  The form is stricter than the scalar tests, never looser: the defects of the
+ * unit lengths, orthogonality and determinants are summed (their sum within SR_ROTATION_TOL
+ * implies each one is), the entries that must be exact 0 or 1 likewise (a sum of absolute values
+ * is 0 only if each term is), and a NaN or infinity makes a sum fail.  Finiteness: q_x, q_y here;
+ * every other entry of x and u enters these sums or the kernel's outputs, whose sum the lanes
+ * kernel tests (tests/c: a NaN or infinity in any entry of any row is reported). */
+void sr_internal_check_lanes(const sr_model *model, long n, const sr_real *restrict x, long x_stride,
+                             sr_real *restrict ok)
+{
+    const sr_real r = model->p[SR_P_r];
+    long i;
+    for (i = 0; i < n; ++i) {
+        const sr_real *S = x + x_stride * i + SR_X_R_S, *Y = x + x_stride * i + SR_X_R_Y;
+        const sr_real *P = x + x_stride * i + SR_X_R_P, *q = x + x_stride * i + SR_X_q;
+        /* R_S: orthonormal columns (the upper triangle of R^T R), determinant 1, unit third row. */
+        const sr_real rotation
+            = SR_FABS(S[0] * S[0] + S[3] * S[3] + S[6] * S[6] - 1) + SR_FABS(S[0] * S[1] + S[3] * S[4] + S[6] * S[7])
+            + SR_FABS(S[0] * S[2] + S[3] * S[5] + S[6] * S[8]) + SR_FABS(S[1] * S[1] + S[4] * S[4] + S[7] * S[7] - 1)
+            + SR_FABS(S[1] * S[2] + S[4] * S[5] + S[7] * S[8]) + SR_FABS(S[2] * S[2] + S[5] * S[5] + S[8] * S[8] - 1)
+            + SR_FABS(S[0] * (S[4] * S[8] - S[5] * S[7]) - S[1] * (S[3] * S[8] - S[5] * S[6])
+                      + S[2] * (S[3] * S[7] - S[4] * S[6]) - 1)
+            + SR_FABS(S[6] * S[6] + S[7] * S[7] + S[8] * S[8] - 1)
+            /* R_Y about x, R_P about y: the (cos, sin) blocks rotations. */
+            + SR_FABS(Y[4] * Y[4] + Y[7] * Y[7] - 1) + SR_FABS(Y[5] * Y[5] + Y[8] * Y[8] - 1)
+            + SR_FABS(Y[4] * Y[5] + Y[7] * Y[8]) + SR_FABS(Y[4] * Y[8] - Y[5] * Y[7] - 1)
+            + SR_FABS(P[0] * P[0] + P[6] * P[6] - 1) + SR_FABS(P[2] * P[2] + P[8] * P[8] - 1)
+            + SR_FABS(P[0] * P[2] + P[6] * P[8]) + SR_FABS(P[0] * P[8] - P[2] * P[6] - 1)
+            + SR_FABS(P[0] * P[0] + P[2] * P[2] - 1);
+        /* ... and their axis rows and columns exact. */
+        const sr_real exact = SR_FABS(Y[0] - 1) + SR_FABS(Y[1]) + SR_FABS(Y[2]) + SR_FABS(Y[3]) + SR_FABS(Y[6])
+                            + SR_FABS(P[4] - 1) + SR_FABS(P[1]) + SR_FABS(P[3]) + SR_FABS(P[5]) + SR_FABS(P[7]);
+        /* The contact q_z = r; q_x, q_y finite. */
+        const sr_real contact = SR_FABS(q[2] - r);
+        sr_real good = rotation <= SR_ROTATION_TOL ? 1 : 0;   /* selects, not &&: no branches */
+        good = exact == 0 ? good : 0;
+        good = contact <= SR_ROTATION_TOL * r ? good : 0;
+        ok[i] = SR_GEN_LANE_FINITE(q[0] + q[1]) ? good : 0;
+    }
+}

@@ -300,6 +300,7 @@ int sr_internal_cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real
 #ifdef SR_USE_FLOAT /* float symbols carry _f, as in spherical_robot.h */
 #define sr_internal_valid_method sr_internal_valid_method_f
 #define sr_internal_advance sr_internal_advance_f
+#define sr_internal_check_lanes sr_internal_check_lanes_f
 #define sr_internal_vector_field sr_internal_vector_field_f
 #define sr_internal_rkmk4_core sr_internal_rkmk4_core_f
 #define sr_internal_dexpinv sr_internal_dexpinv_f
@@ -310,6 +311,10 @@ int sr_internal_cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real
 /* A Lie-algebra element ("tangent coordinates") of the state's group, 13 numbers:
  * [th_S (3) | th_Y | th_P | th_q (3) | th_nu (5)] (see the top of sr_steppers.c). */
 enum { SR_T_S = 0, SR_T_Y = 3, SR_T_P = 4, SR_T_Q = 5, SR_T_V = 8, SR_NT = 13 };
+
+/* The lanes form of the state checks but finiteness (c/sr_checks.c): ok[i] = 1 or 0. */
+void sr_internal_check_lanes(const sr_model *model, long n, const sr_real *restrict x, long x_stride,
+                             sr_real *restrict ok);
 
 /* Nonzero if method is SR_LIE_EULER, SR_RKMK4 or SR_CF4, optionally | SR_PROJECT. */
 int sr_internal_valid_method(int method);

@@ -105,21 +105,58 @@ int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_N
     return sr_internal_accel(model, x, u ? u : sr_zero_u, a);
 }
 
-int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
-                   sr_real *a, long *failed_row)
+/* sr_accel (and, if `full`, sr_check_state first) on n rows, a block at a time: the vectorised
+ * lanes form of the checks and the kernel over the block, into a local block, then row by row:
+ * a clean lane's result is copied out, any other row goes through the scalar functions (which
+ * return the same status codes and write the same bits as they would alone).  So the rows after
+ * a failing one are not written, as with a loop of sr_accel.  The general robot goes row by row. */
+static int accel_rows(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real *a,
+                      long *failed_row, int full)
 {
-    long i;
+    enum { BLOCK = 64 };
+    sr_real ok_state[BLOCK], ok_accel[BLOCK], block[BLOCK * SR_NV];
+    long start, i;
+    int k;
     if (failed_row) *failed_row = -1;
     if (!model || !x || !a) return SR_ERR_NULL;
     if (n < 0) return SR_ERR_ARG;
-    for (i = 0; i < n; ++i) {
-        int status = sr_accel(model, x + i * SR_NX, u ? u + i * SR_NU : NULL, a + i * SR_NV);
-        if (status != SR_OK) {
-            if (failed_row) *failed_row = i;
-            return status;
+    for (start = 0; start < n; start += BLOCK) {
+        const long m = n - start < BLOCK ? n - start : BLOCK;
+        const sr_real *xb = x + start * SR_NX, *ub = u ? u + start * SR_NU : NULL;
+        sr_real *ab = a + start * SR_NV;
+        if (model->general) {
+            for (i = 0; i < m; ++i) ok_state[i] = ok_accel[i] = 0;
+        } else {
+            sr_internal_check_lanes(model, m, xb, SR_NX, ok_state);
+            sr_gen_accel_lanes(model->c, m, xb, SR_NX, ub ? ub : sr_zero_u, ub ? SR_NU : 0, block, SR_NV, ok_accel);
+        }
+        for (i = 0; i < m; ++i) {
+            int status;
+            if (ok_state[i] != 0 && ok_accel[i] != 0) {
+                for (k = 0; k < SR_NV; ++k) ab[i * SR_NV + k] = block[i * SR_NV + k];
+                continue;
+            }
+            status = full ? sr_check_state(model, xb + i * SR_NX) : SR_OK;
+            if (status == SR_OK) status = sr_accel(model, xb + i * SR_NX, ub ? ub + i * SR_NU : NULL, ab + i * SR_NV);
+            if (status != SR_OK) {
+                if (failed_row) *failed_row = start + i;
+                return status;
+            }
         }
     }
     return SR_OK;
+}
+
+int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
+                   sr_real *a, long *failed_row)
+{
+    return accel_rows(model, n, x, u, a, failed_row, 0);
+}
+
+int sr_checked_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
+                           sr_real *a, long *failed_row)
+{
+    return accel_rows(model, n, x, u, a, failed_row, 1);
 }
 
 int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * SR_NV])

@@ -21,6 +21,11 @@
  *                     M's diagonal entry, as in an LDL^T, or the kernel
  *                     returns SR_GEN_SINGULAR (1e-13 for double, 1e-6 for
  *                     float).
+ *   SR_GEN_LANE_FINITE(v)
+ *                     1 if v is finite, else 0, without a branch or a call
+ *                     (v - v is 0 for a finite v, NaN otherwise), so that the
+ *                     lanes kernels (sr_gen_*_lanes) stay vectorisable; exact
+ *                     without -ffast-math, which the library is never built with.
  *   SR_GEN_OK, SR_GEN_NONFINITE, SR_GEN_SINGULAR
  *                     the kernels' status codes; c/sr_internal.h asserts
  *                     that they equal SR_OK, SR_ERR_NONFINITE and
@@ -52,6 +57,8 @@ typedef double sr_real;
 #define SR_GEN_SIN sin
 #define SR_GEN_COS cos
 #endif
+
+#define SR_GEN_LANE_FINITE(v) ((v) - (v) == 0)
 
 #define SR_GEN_OK 0
 #define SR_GEN_NONFINITE 2

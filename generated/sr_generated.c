@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 1a5996603be42750], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 73dbb556dee0c068], SymPy 1.14.0. */
 #include "sr_generated.h"
 
 #include <math.h>
@@ -514,7 +514,8 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     const sr_real M_1_1 = -t27;
     const sr_real M_2_2 = (k_7 - t26) + t23;
     /* M positive definite: the joint block, then the leading minors of S; C = adj S (symmetric). */
-    if (!(M_3_3 > 0 && M_4_4 > 0)) return SR_GEN_SINGULAR;
+    if (!(M_3_3 > 0)) return SR_GEN_SINGULAR;
+    if (!(M_4_4 > 0)) return SR_GEN_SINGULAR;
     const sr_real C_0_0 = (S_1_1*S_2_2) - (S_1_2*S_1_2);
     const sr_real C_0_1 = (S_1_2*S_0_2) - (S_0_1*S_2_2);
     const sr_real C_0_2 = (S_0_1*S_1_2) - (S_1_1*S_0_2);
@@ -3588,4 +3589,151 @@ int sr_gen_general_accel_jacobian_terms(const sr_real cg[SR_GEN_GENERAL_NCONST],
     dM[73] = out_163;
     dM[74] = out_164;
     return SR_GEN_OK;
+}
+
+/* sr_gen_accel on n states, for the batch calls: one loop without branches that the compiler vectorises across states (the same expressions, so each lane's result is the scalar kernel's, bit for bit); every output is written, and ok[i] is cleared where the scalar kernel would fail (or its outputs' sum overflows: decide such a state by the scalar kernel). GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic). */
+void sr_gen_accel_lanes(const sr_real c[SR_GEN_NCONST], long n, const sr_real *restrict x, long x_stride, const sr_real *restrict u, long u_stride, sr_real *restrict a, long a_stride, sr_real *restrict ok)
+{
+    const sr_real j_xx = c[6];
+    const sr_real j_yy = c[7];
+    const sr_real j_P = c[8];
+    const sr_real k_S = c[9];
+    const sr_real k_Y = c[10];
+    const sr_real k_P = c[11];
+    const sr_real k_0 = c[12];
+    const sr_real k_1 = c[13];
+    const sr_real k_2 = c[14];
+    const sr_real k_3 = c[15];
+    const sr_real k_4 = c[16];
+    const sr_real k_6 = c[18];
+    const sr_real k_7 = c[19];
+    const sr_real k_8 = c[20];
+    const sr_real k_9 = c[21];
+    const sr_real k_18 = c[30];
+    const sr_real k_19 = c[31];
+    const sr_real k_20 = c[32];
+    long i;
+    for (i = 0; i < n; ++i) {
+        const sr_real gamma_x = x[x_stride*i + 6];
+        const sr_real gamma_y = x[x_stride*i + 7];
+        const sr_real gamma_z = x[x_stride*i + 8];
+        const sr_real RY_11 = x[x_stride*i + 13];
+        const sr_real RY_21 = x[x_stride*i + 16];
+        const sr_real RP_00 = x[x_stride*i + 18];
+        const sr_real RP_02 = x[x_stride*i + 20];
+        const sr_real w_Sx = x[x_stride*i + 30];
+        const sr_real w_Sy = x[x_stride*i + 31];
+        const sr_real w_Sz = x[x_stride*i + 32];
+        const sr_real w_Y = x[x_stride*i + 33];
+        const sr_real w_P = x[x_stride*i + 34];
+        const sr_real u_Y = u[u_stride*i + 0];
+        const sr_real u_P = u[u_stride*i + 1];
+        sr_real good = 1;
+        const sr_real t0 = (RY_11*w_Sy) + (RY_21*w_Sz);
+        const sr_real t1 = (RY_11*w_Sz) - (RY_21*w_Sy);
+        const sr_real t2 = w_Y*t1;
+        const sr_real t3 = w_Y*t0;
+        const sr_real w_y_x = w_Sx + w_Y;
+        const sr_real a_w = (RP_02*w_y_x) + (RP_00*t1);
+        const sr_real t4 = j_P*a_w;
+        const sr_real t5 = (RY_11*gamma_y) + (RY_21*gamma_z);
+        const sr_real t6 = k_9*t5;
+        const sr_real t7 = (RY_11*gamma_z) - (RY_21*gamma_y);
+        const sr_real t8 = RP_02*(j_P*RP_02);
+        const sr_real t9 = t8 - k_4;
+        const sr_real t10 = -t9;
+        const sr_real t11 = SR_C(1.0)/t10;
+        const sr_real t12 = RP_00*t7;
+        const sr_real t13 = k_3*t12;
+        const sr_real t14 = -(t9 + t13);
+        const sr_real t15 = k_20*t5;
+        const sr_real t16 = RP_02*k_3;
+        const sr_real t17 = (j_P - (gamma_x*t16)) - t13;
+        const sr_real t18 = RP_00*((RP_02*j_P) - (gamma_x*k_3));
+        const sr_real t19 = -t18;
+        const sr_real t20 = k_1*t12;
+        const sr_real t21 = t5*(k_0*t5);
+        const sr_real t22 = t7*(k_0*t7);
+        const sr_real t23 = t8 - t22;
+        const sr_real t24 = gamma_x*k_0;
+        const sr_real t25 = (RP_00*k_3)*t5;
+        const sr_real t26 = k_1*(RP_02*gamma_x);
+        const sr_real t27 = t21 + ((t26 - k_6) + t20);
+        const sr_real t28 = t22 - t8;
+        const sr_real tau_Y_x = t1*(j_xx*t0);
+        const sr_real alpha_P_x = -(w_P*t1);
+        const sr_real alpha_P_z = (w_P*(w_Sx + w_Y)) - t3;
+        const sr_real a_alpha = (RP_02*alpha_P_x) + (RP_00*alpha_P_z);
+        const sr_real w_p_y = w_P + t0;
+        const sr_real w_x_a_x = RP_00*w_p_y;
+        const sr_real tau_P_x = ((RP_00*t6) - (w_x_a_x*t4)) + (j_P*(alpha_P_x - (RP_02*a_alpha)));
+        const sr_real T_x = tau_Y_x + tau_P_x;
+        const sr_real t29 = (u_Y - (w_Y*k_Y)) - T_x;
+        const sr_real alpha_P_y = t2;
+        const sr_real w_x_a_y = (RP_02*t1) - (RP_00*w_y_x);
+        const sr_real tau_P_y = ((j_P*alpha_P_y) - (k_9*((RP_00*gamma_x) - (RP_02*t7)))) - (w_x_a_y*t4);
+        const sr_real t30 = (u_P - (w_P*k_P)) - tau_P_y;
+        const sr_real tau_Y_y = j_yy*(t2 - (w_y_x*t1));
+        const sr_real tau_Y_z = -((t0*(k_19*w_y_x)) + (k_8*t3));
+        const sr_real w_x_a_z = -(RP_02*w_p_y);
+        const sr_real tau_P_z = (j_P*(alpha_P_z - (RP_00*a_alpha))) - ((RP_02*t6) + (w_x_a_z*t4));
+        const sr_real b_x = ((RP_00*alpha_P_y) + (w_p_y*w_x_a_z)) - (t1*w_x_a_y);
+        const sr_real b_y = ((t1*w_x_a_x) - (RP_00*alpha_P_x)) + ((RP_02*alpha_P_z) - (w_y_x*w_x_a_z));
+        const sr_real b_z = ((w_y_x*w_x_a_y) - (RP_02*alpha_P_y)) - (w_p_y*w_x_a_x);
+        const sr_real T_y = tau_Y_y + tau_P_y;
+        const sr_real T_z = tau_Y_z + tau_P_z;
+        const sr_real beta_0_3 = t14*t11;
+        const sr_real beta_0_4 = RP_02*t15;
+        const sr_real beta_1_4 = k_18*t17;
+        const sr_real beta_2_3 = t19*t11;
+        const sr_real beta_2_4 = RP_00*t15;
+        const sr_real S_0_0 = (((k_2 + t21) - ((t16*t5)*beta_0_4)) - (t20 + t23)) - (t14*beta_0_3);
+        const sr_real S_0_1 = (t5*((RP_02*k_3) - t24)) - (beta_0_4*t17);
+        const sr_real S_0_2 = (((t7*((RP_02*k_3) - t24)) - t18) - (t25*beta_0_4)) - (t19*beta_0_3);
+        const sr_real S_1_1 = -(t27 + (t17*beta_1_4));
+        const sr_real S_1_2 = (t5*((RP_00*k_3) - (k_0*t7))) - (t25*beta_1_4);
+        const sr_real S_2_2 = (((k_7 - t26) - t28) - (t25*beta_2_4)) - (t19*beta_2_3);
+        const sr_real g_0 = (((k_3*((t5*b_z) - (t7*b_y))) - ((w_Sx*k_S) + (beta_0_4*t30))) - T_x) - (beta_0_3*t29);
+        const sr_real g_1 = (k_3*((t7*b_x) - (gamma_x*b_z))) - ((beta_1_4*t30) + ((k_S*t0) + T_y));
+        const sr_real g_2 = (((k_3*((gamma_x*b_y) - (t5*b_x))) - ((k_S*t1) + (beta_2_4*t30))) - T_z) - (beta_2_3*t29);
+        const sr_real fD_3 = t11*t29;
+        const sr_real fD_4 = k_18*t30;
+        const sr_real M_3_3 = t10;
+        const sr_real M_4_4 = j_P;
+        const sr_real M_0_0 = (k_2 + t21) + (t28 - t20);
+        const sr_real M_1_1 = -t27;
+        const sr_real M_2_2 = (k_7 - t26) + t23;
+        /* M positive definite: the joint block, then the leading minors of S; C = adj S (symmetric). */
+        good = (M_3_3 > 0) ? good : 0;
+        good = (M_4_4 > 0) ? good : 0;
+        const sr_real C_0_0 = (S_1_1*S_2_2) - (S_1_2*S_1_2);
+        const sr_real C_0_1 = (S_1_2*S_0_2) - (S_0_1*S_2_2);
+        const sr_real C_0_2 = (S_0_1*S_1_2) - (S_1_1*S_0_2);
+        const sr_real C_1_1 = (S_0_0*S_2_2) - (S_0_2*S_0_2);
+        const sr_real C_1_2 = (S_0_1*S_0_2) - (S_1_2*S_0_0);
+        const sr_real C_2_2 = (S_1_1*S_0_0) - (S_0_1*S_0_1);
+        const sr_real det_S = (S_0_2*C_0_2) + ((S_0_0*C_0_0) + (S_0_1*C_0_1));
+        good = (S_0_0 > SR_GEN_PIVOT_TOL*M_0_0) ? good : 0;
+        good = (C_2_2 > SR_GEN_PIVOT_TOL*M_1_1*S_0_0) ? good : 0;
+        good = (det_S > SR_GEN_PIVOT_TOL*M_2_2*C_2_2) ? good : 0;
+        const sr_real inv_det_S = SR_C(1.0)/det_S;
+        const sr_real a_0 = ((C_0_2*g_2) + ((g_1*C_0_1) + (C_0_0*g_0)))*inv_det_S;
+        const sr_real a_1 = ((C_1_2*g_2) + ((g_1*C_1_1) + (C_0_1*g_0)))*inv_det_S;
+        const sr_real a_2 = ((C_2_2*g_2) + ((g_1*C_1_2) + (C_0_2*g_0)))*inv_det_S;
+        const sr_real a_3 = (fD_3 - (beta_0_3*a_0)) - (beta_2_3*a_2);
+        const sr_real a_4 = (fD_4 - (beta_0_4*a_0)) - ((beta_1_4*a_1) + (beta_2_4*a_2));
+        const sr_real out_0 = a_0;
+        const sr_real out_1 = (RY_11*a_1) - (RY_21*a_2);
+        const sr_real out_2 = (RY_11*a_2) + (RY_21*a_1);
+        const sr_real out_3 = a_3;
+        const sr_real out_4 = a_4;
+        const sr_real out_sum = (out_2 + out_3) + (out_4 + (out_0 + out_1));
+        good = (SR_GEN_LANE_FINITE(out_sum)) ? good : 0;
+        a[a_stride*i + 0] = out_0;
+        a[a_stride*i + 1] = out_1;
+        a[a_stride*i + 2] = out_2;
+        a[a_stride*i + 3] = out_3;
+        a[a_stride*i + 4] = out_4;
+        ok[i] = good;
+    }
 }

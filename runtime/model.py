@@ -137,15 +137,25 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods):
 
     def _accel(self, x, u):
         """`accel` for every input: converted and checked in Python's terms, then C."""
-        x, u = self._state_and_input(x, u)
+        x = real_array(x, "x", (NX,))
         if x.ndim == 1:
+            x, u = self._state_and_input(x, u, batch=False)
             out = np.empty(NV)
             self._check("x", lib.sr_accel(self._model, _ptr(x), _ptr(u), _ptr(out)))
             return out
+        # A batch: C checks every state in full and solves, both vectorised (sr_checked_accel_batch);
+        # the state it stops at is checked again here, for the message that names what is wrong.
+        u = None if u is None else self._input(u, x)
         out = np.empty((x.shape[0], NV))
         failed = ffi.new("long *")
-        status = lib.sr_accel_batch(self._model, x.shape[0], _ptr(x), _ptr(u), _ptr(out), failed)
-        self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
+        status = lib.sr_checked_accel_batch(self._model, x.shape[0], _ptr(x), ffi.NULL if u is None else _ptr(u),
+                                            _ptr(out), failed)
+        if status != lib.SR_OK:
+            row = failed[0]
+            field = f"x[{row}]" if row >= 0 else "x"
+            if row >= 0:
+                check_states(self._model, x[row], self.params.r, field)
+            self._check(field, status)
         return out
 
     def _single(self, fn, x, n, field="x"):

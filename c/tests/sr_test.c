@@ -50,6 +50,7 @@ int main(void)
     suite_jacobians();
     suite_control();
     suite_trig();
+    suite_accel_batch();
     return sr_test_summary();
 }
 

@@ -72,6 +72,7 @@ void suite_general(void);
 void suite_jacobians(void);
 void suite_control(void);
 void suite_trig(void);
+void suite_accel_batch(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 

@@ -32,32 +32,53 @@ def emit_assignments(scheduler, assignments, declare):
     return lines
 
 
-def emit_inputs(kernel, used, layouts):
+def input_entries(kernel, used, layouts):
+    """(symbol, array, index) of every input symbol the kernel reads, in argument order."""
     table = input_symbols(kernel.inputs, layouts)
     missing = [s for s in used if s not in table]
     if missing:
         raise ValueError(f"kernel {kernel.name} uses symbols outside its inputs: {missing}")
-    lines = []
-    for sym in sorted(used, key=lambda s: (kernel.inputs.index(table[s][0]), table[s][1])):
-        array, index = table[sym]
-        lines.append(f"    const sr_real {sym.name} = {array}[{index}];")
-    return lines
+    return [(sym, *table[sym]) for sym in sorted(used, key=lambda s: (kernel.inputs.index(table[s][0]), table[s][1]))]
 
 
-def emit_results(scheduler, results, finite_or_untouched):
+#: The arrays that hold one state's data; a lanes kernel reads them per lane, the others once.
+#: The strides are arguments: GCC 12 vectorises the loop with them, not with constant strides of 35.
+PER_LANE = {"x": "x_stride*i", "u": "u_stride*i"}
+
+
+def scalar_guard(condition, status):
+    """A test that must hold, in a scalar kernel: return `status` if it does not."""
+    return f"    if (!({condition})) return {status};"
+
+
+def lane_guard(condition, status):
+    """The same test in a lanes kernel: no branch, the lane's flag cleared.  The flag is an sr_real
+    and the test a select, so that the loop vectorises with the baseline x86-64 instructions (SSE2
+    has no select of 64-bit integers by a comparison of doubles)."""
+    return f"    good = ({condition}) ? good : 0;"
+
+
+def emit_results(scheduler, results, finite_or_untouched, guard=scalar_guard):
     """Assign the outputs; with `finite_or_untouched`, only after checking that all are finite.
 
     One test of their sum clears the common case (a NaN or an infinity makes
     it non-finite); a sum that is not finite is decided value by value, so
     finite values whose sum overflows still pass.  The caller's arrays are
-    written last, so they may alias the inputs.
+    written last, so they may alias the inputs.  In a lanes kernel
+    (`lane_guard`) the outputs are always written and a non-finite sum
+    clears the lane's flag: the caller decides such a lane by the scalar kernel.
     """
     if not finite_or_untouched:
         return [f"    {target} = {scheduler.assign(target, value)};" for target, value in results]
     names = [f"out_{i}" for i in range(len(results))]
     lines = [f"    const sr_real {n} = {scheduler.assign(n, value)};" for n, (_, value) in zip(names, results)]
     each = " && ".join(f"isfinite({n})" for n in names)
-    if len(names) == 1:
+    if guard is lane_guard:
+        total = names[0] if len(names) == 1 else "out_sum"
+        if len(names) > 1:
+            lines.append(f"    const sr_real out_sum = {scheduler.assign('out_sum', sp.Add(*sp.symbols(names, real=True)))};")
+        lines.append(guard(f"SR_GEN_LANE_FINITE({total})", "SR_GEN_NONFINITE"))
+    elif len(names) == 1:
         lines.append(f"    if (!{each}) return SR_GEN_NONFINITE;")
     else:
         lines.append(f"    const sr_real out_sum = {scheduler.assign('out_sum', sp.Add(*sp.symbols(names, real=True)))};")
@@ -76,17 +97,26 @@ def signature(kernel):
     return f"int {PREFIX}{kernel.name}({', '.join(args)})"
 
 
-def emit_kernel(kernel, layouts):
-    """C text of one kernel and its flop count."""
+def lanes_signature(kernel):
+    """sr_gen_<name>_lanes: the kernel on n states; the rows of x, u and the outputs stride
+    entries apart (u_stride 0 repeats one row), a flag per state (1 or 0)."""
+    if not kernel.solve or kernel.inputs != ("c", "x", "u"):
+        raise ValueError(f"kernel {kernel.name}: lanes are emitted for the solve of (c, x, u) only")
+    return (f"void {PREFIX}{kernel.name}_lanes({INPUT_DOCS['c'][0]}, long n, const sr_real *restrict x, long x_stride, "
+            "const sr_real *restrict u, long u_stride, sr_real *restrict a, long a_stride, sr_real *restrict ok)")
+
+
+def kernel_body(kernel, guard, row=""):
+    """(symbols read, body lines after the reads) of a kernel, its tests written by `guard`, its
+    outputs at `out[row + k]`."""
     scheduler = Scheduler(Printer())
     defined = [symbol for symbol, _ in kernel.definitions]
     exprs = [value for _, value in kernel.definitions] + [e for o in kernel.outputs for e in o.exprs]
     temporaries, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("t"), order="canonical")
     definitions, reduced = list(zip(defined, reduced[:len(defined)])), reduced[len(defined):]
     used = set().union(*(e.free_symbols for e in exprs)) - set(defined) if exprs else set()
-    body = emit_inputs(kernel, used, layouts)
     nodes = temporaries + definitions
-    body += emit_assignments(scheduler, dependency_order(nodes, [s for s, _ in nodes] + reduced), declare=True)
+    body = emit_assignments(scheduler, dependency_order(nodes, [s for s, _ in nodes] + reduced), declare=True)
     k, results = 0, []
     for out in kernel.outputs:
         values = reduced[k:k + len(out.exprs)]
@@ -96,12 +126,39 @@ def emit_kernel(kernel, layouts):
         else:
             results += [(f"{out.name}[{i}]", v) for i, v in enumerate(values)]
     if kernel.solve:
-        lines, results = emit_shell_solve(scheduler, "a", S.R_Y, {s.name for s in defined})
+        lines, results = emit_shell_solve(scheduler, "a", S.R_Y, {s.name for s in defined}, guard)
         body += lines
-    body += emit_results(scheduler, results, kernel.finite_or_untouched)
-    body.append("    return SR_GEN_OK;")
+    results = [(target.replace("[", f"[{row}", 1), value) for target, value in results]
+    return used, body + emit_results(scheduler, results, kernel.finite_or_untouched, guard)
+
+
+def emit_kernel(kernel, layouts):
+    """C text of one kernel and its flop count."""
+    used, body = kernel_body(kernel, scalar_guard)
+    reads = [f"    const sr_real {sym.name} = {array}[{index}];" for sym, array, index in input_entries(kernel, used, layouts)]
+    body = reads + body + ["    return SR_GEN_OK;"]
     doc = f"/* {kernel.doc} */"
     return "\n".join([doc, signature(kernel), "{", *body, "}", ""]), count_flops(body)
+
+
+def lanes_doc(kernel):
+    return (f"/* sr_gen_{kernel.name} on n states, for the batch calls: one loop without branches that the"
+            " compiler vectorises across states (the same expressions, so each lane's result is the scalar"
+            " kernel's, bit for bit); every output is written, and ok[i] is cleared where the scalar kernel"
+            " would fail (or its outputs' sum overflows: decide such a state by the scalar kernel)."
+            " GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic). */")
+
+
+def emit_lanes(kernel, layouts):
+    """C text of sr_gen_<name>_lanes (see `lanes_doc`)."""
+    used, body = kernel_body(kernel, lane_guard, row="a_stride*i + ")
+    entries = input_entries(kernel, used, layouts)
+    once = [f"    const sr_real {sym.name} = {array}[{index}];" for sym, array, index in entries if array not in PER_LANE]
+    each = [f"    const sr_real {sym.name} = {array}[{PER_LANE[array]} + {index}];"
+            for sym, array, index in entries if array in PER_LANE]
+    loop = each + ["    sr_real good = 1;"] + body + ["    ok[i] = good;"]
+    return "\n".join([lanes_doc(kernel), lanes_signature(kernel), "{", *once, "    long i;",
+                      "    for (i = 0; i < n; ++i) {", *("    " + line for line in loop), "    }", "}", ""])
 
 
 def provenance():
@@ -138,8 +195,10 @@ def layout_macros():
 def header_text(ks, flops, n_constants, n_general_constants):
     guard = "SR_GENERATED_H"
     protos = "\n".join(f"/* {k.doc} */\n{signature(k)};" for k in ks)
+    protos += "".join(f"\n{lanes_doc(k)}\n{lanes_signature(k)};" for k in ks if k.lanes)
     flop_macros = "\n".join(f"#define SR_GEN_{k.name.upper()}_FLOPS {flops[k.name]}" for k in ks)
     float_names = "\n".join(f"#define {PREFIX}{k.name} {PREFIX}{k.name}_f" for k in ks)
+    float_names += "".join(f"\n#define {PREFIX}{k.name}_lanes {PREFIX}{k.name}_lanes_f" for k in ks if k.lanes)
     return f"""{banner()}/*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -196,6 +255,7 @@ def write(out_dir):
     layouts = array_layouts(constants, general_constants)
     emitted = [emit_kernel(k, layouts) for k in ks]
     flops = {k.name: n for k, (_, n) in zip(ks, emitted)}
+    emitted += [(emit_lanes(k, layouts), None) for k in ks if k.lanes]
     files = {HEADER_NAME: header_text(ks, flops, len(constants), len(general_constants)),
              SOURCE_NAME: source_text(emitted)}
     files.update(casadi_files())

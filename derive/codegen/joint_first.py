@@ -41,7 +41,7 @@ def joint_first_system(M, f):
     )
 
 
-def emit_shell_solve(scheduler, out_name, rotation, defined):
+def emit_shell_solve(scheduler, out_name, rotation, defined, guard):
     """C for the rest of `joint_first_system`: S ω̇' = g by the adjugate of S, then the joints.
 
     M is positive definite iff M_33, M_44 and the leading minors of S are
@@ -51,6 +51,7 @@ def emit_shell_solve(scheduler, out_name, rotation, defined):
     shell accelerations come out in the frame of the system (the yoke frame,
     see `derive.yoke_frame`) and are written as `rotation` times them.
     Couplings β_ik not among the `defined` names are identically zero and left out.
+    `guard(condition, status)` is the C line of a test that must hold (`emit.Guards`).
     """
     def sym(name):
         return sp.Symbol(name, real=True)
@@ -65,13 +66,13 @@ def emit_shell_solve(scheduler, out_name, rotation, defined):
         return f"    const sr_real {name} = {scheduler.assign(name, value)};"
 
     lines = ["    /* M positive definite: the joint block, then the leading minors of S; C = adj S (symmetric). */",
-             "    if (!(M_3_3 > 0 && M_4_4 > 0)) return SR_GEN_SINGULAR;"]
+             guard("M_3_3 > 0", "SR_GEN_SINGULAR"), guard("M_4_4 > 0", "SR_GEN_SINGULAR")]
     lines += [let(f"C_{i}_{j}", C_[i, j]) for i in range(3) for j in range(i, 3)]
     lines += [
         let("det_S", (S_.row(0) * C.col(0))[0]),
-        "    if (!(S_0_0 > SR_GEN_PIVOT_TOL*M_0_0)) return SR_GEN_SINGULAR;",
-        "    if (!(C_2_2 > SR_GEN_PIVOT_TOL*M_1_1*S_0_0)) return SR_GEN_SINGULAR;",
-        "    if (!(det_S > SR_GEN_PIVOT_TOL*M_2_2*C_2_2)) return SR_GEN_SINGULAR;",
+        guard("S_0_0 > SR_GEN_PIVOT_TOL*M_0_0", "SR_GEN_SINGULAR"),
+        guard("C_2_2 > SR_GEN_PIVOT_TOL*M_1_1*S_0_0", "SR_GEN_SINGULAR"),
+        guard("det_S > SR_GEN_PIVOT_TOL*M_2_2*C_2_2", "SR_GEN_SINGULAR"),
         let("inv_det_S", 1 / sym("det_S")),
     ]
     lines += [let(f"a_{i}", (C.row(i) * g)[0] * sym("inv_det_S")) for i in range(3)]

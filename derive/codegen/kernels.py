@@ -95,7 +95,7 @@ def kernels():
         Kernel("equilibrium_residual", "f at ν = 0, u = 0 (eq. 106); zero iff R_S R_Y R_P e_z = ±e_z (eq. 108).",
                ("c", "x"), (Output("res", tuple(D.equilibrium_residual()), "residual"),)),
         Kernel("accel", "ν̇ = (ω̇_S, ω̇_Y, ω̇_P) solving M ν̇ = f, joints first; SR_GEN_SINGULAR if M is not positive definite.",
-               ("c", "x", "u"), accel_outputs, solve=True, definitions=accel_definitions),
+               ("c", "x", "u"), accel_outputs, solve=True, definitions=accel_definitions, lanes=True),
         accel_jacobian_terms(),
         Kernel("paper_params", "The paper's robot (Section 2.3) as a general one: p[SR_P_*] from the"
                " paper's twelve parameters (derive.parameters.from_paper).",

@@ -41,7 +41,7 @@ def build_harness(build, native, with_casadi, kane=None):
     """The C loop's executable; `kane` = (sources, macros) of runtime/bench/kane_compiled.write_kane_c."""
     cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
     sources = [str(p) for d in ("generated", "c") for p in sorted((ROOT / d).glob("*.c"))]
-    flags = ["-std=c99", "-O2", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c'}", f"-I{build}"]
+    flags = ["-std=c99", "-O3", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c'}", f"-I{build}"]
     if native:
         flags.append("-march=native")
     if with_casadi:
@@ -129,6 +129,8 @@ def check_harness(result, model, X, U, step_dt=0.01):
     accel = ref.accel_batch(X, U)
     check("C accel vs reference", "accel", lambda i: accel[i], 1e-10)
     check("C raw accel vs reference", "accel_unchecked", lambda i: accel[i], 1e-10)
+    if "checked_accel_batch" in result:
+        check("C checked accel batch vs reference", "checked_accel_batch", lambda i: accel[i], 1e-10)
     check("C inertia vs reference", "inertia", lambda i: ref.inertia(X[i]), 1e-10)
     for key, method in [("step_lie_euler", "lie-euler"), ("step_rkmk4", "rkmk4"), ("step_cf4", "cf4")]:
         if key in result:

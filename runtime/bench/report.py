@@ -64,6 +64,9 @@ def targets(res):
                     "given that kernel automatically)", c["accel_general_robot"]["ns"] <= 1.3 * ours))
     if "t_shape_rkmk4_ms" in py:
         out.append(("t-shape rkmk4 end to end <= 4 ms", py["t_shape_rkmk4_ms"] <= 4))
+    if "python_batch_accel_ns_per_state" in py:
+        out.append((f"Model.accel batch of {py['batch_size']:,} <= 1/3 of one checked accel (C loop), per state",
+                    3 * py["python_batch_accel_ns_per_state"] <= ours))
     return out
 
 
@@ -96,8 +99,15 @@ def sections(res):
                      f"{c['accel_general_robot']['ns'] / ours:.1f}x"))
         rows.append(("our rkmk4 step of a general robot", f"{c['step_rkmk4_general_robot']['ns']:,.1f} ns",
                      f"{c['step_rkmk4_general_robot']['ns'] / c['step_rkmk4']['ns']:.1f}x our rkmk4 step"))
+    if "checked_accel_batch" in c:
+        rows.append(("our checked accel batch (sr_checked_accel_batch, full state check), per state",
+                     f"{c['checked_accel_batch']['ns']:,.1f} ns", f"{c['checked_accel_batch']['ns'] / ours:.2f}x"))
     if res.get("c_loop_native"):
-        rows.append(("our accel, checked API, -march=native", f"{res['c_loop_native']['accel']['ns']:,.1f} ns", ""))
+        native = res["c_loop_native"]
+        rows.append(("our accel, checked API, -march=native", f"{native['accel']['ns']:,.1f} ns", ""))
+        if "checked_accel_batch" in native:
+            rows.append(("our checked accel batch, -march=native, per state", f"{native['checked_accel_batch']['ns']:,.1f} ns",
+                         f"{native['checked_accel_batch']['ns'] / ours:.2f}x"))
     for key, label in C_BASELINES:
         if key in c:
             rows.append((label, f"{c[key]['ns']:,.1f} ns", f"{c[key]['ns'] / ours:,.1f}x slower"))
@@ -119,7 +129,8 @@ def sections(res):
     out.append(("Python call against Python call (one call from Python, best of several rounds)", rows))
 
     batch = py["python_batch_accel_ns_per_state"]
-    rows = [("quantity", "time", "ratio"), (f"Model.accel batch of {py['batch_size']:,}", f"{batch:,.1f} ns", "1")]
+    rows = [("quantity", "time", "ratio"), (f"Model.accel batch of {py['batch_size']:,}", f"{batch:,.1f} ns",
+                                             f"{batch / ours:.2f}x one checked accel in C")]
     if "python_batch_accel_first_call_ns_per_state" in py:
         rows.append(("  the same, first call (output memory touched for the first time)",
                      f"{py['python_batch_accel_first_call_ns_per_state']:,.1f} ns", ""))

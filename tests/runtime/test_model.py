@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 
 from runtime import Model, Params, initial_state
+from runtime.errors import KernelError
 from runtime.verification.sampling import random_inputs, random_params, random_state, random_states
 from runtime.so3 import rot_x, rot_y, rot_z
 
@@ -22,6 +23,20 @@ def test_batch_accel_equals_row_by_row_accel(model, rng):
     assert batch.shape == (50, 5)
     rows = np.array([model.accel(x, u) for x, u in zip(X, U)])
     assert np.array_equal(batch, rows)
+
+
+def test_batch_accel_over_several_blocks_equals_row_by_row_accel(model, rng):
+    # C runs a batch 64 rows at a time through the vectorised kernel (sr_checked_accel_batch).
+    X, U = random_states(rng, 150), random_inputs(rng, 150)
+    assert np.array_equal(model.accel(X, U), np.array([model.accel(x, u) for x, u in zip(X, U)]))
+    assert np.array_equal(model.accel(X), np.array([model.accel(x) for x in X]))
+
+
+def test_batch_accel_checks_every_state_in_full(model, rng):
+    X = random_states(rng, 150)
+    X[130, 0] += 1e-3           # R_S no longer a rotation; |gamma| = 1 still (the kernel's cheap check)
+    with pytest.raises(KernelError, match=r"^x\[130\]: .*R_S"):
+        model.accel(X)
 
 
 def test_accel_without_input_equals_zero_torque(model, rng):
