@@ -68,7 +68,9 @@ def test_the_bit_for_bit_check_fails_for_one_gain_changed_in_its_last_digits(run
 
 
 def test_the_checked_in_header_is_the_current_design():
-    # Not byte for byte: the Riccati solution's last bits depend on the machine's LAPACK.
+    # Not byte for byte: the Riccati solution's last bits depend on the machine's LAPACK (an AMD
+    # EPYC with AVX-512 gave 2 of the 1634 numbers 1.1e-8 and 1.6e-8 relative from the checked-in
+    # ones, written on a Zen 3 VM; a change of the design moves them by far more).
     task = firmware_task()
     fresh = header(task, task.controller())
     shipped = (C_DIR / "examples" / "lqr_task.h").read_text()
@@ -76,5 +78,5 @@ def test_the_checked_in_header_is_the_current_design():
     a = np.array([float(v) for v in number.findall(shipped)])
     b = np.array([float(v) for v in number.findall(fresh)])
     assert a.shape == b.shape
-    assert np.allclose(a, b, rtol=1e-8, atol=1e-10)
+    assert np.allclose(a, b, rtol=1e-7, atol=1e-10)
     assert number.sub("", shipped) == number.sub("", fresh)
