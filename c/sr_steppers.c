@@ -75,11 +75,27 @@ int sr_internal_vector_field(const sr_model *model, const sr_real x[SR_NX], cons
  * R <- R + R D: the remaining rounding is that of one addition per entry, which does not
  * repeat from step to step. */
 
-/* The increment of a one-axis rotation R = Exp(theta [[e_k]]) (k = 0: R_Y about x, entries
- * c = R[4], s = R[7]; k = 1: R_P about y, c = R[0], s = R[2]) by angle: R (Exp - I) changes
- * only (c, s), by (c (cos - 1) - s sin, s (cos - 1) + c sin), and the exact zeros and ones get
- * a zero increment.  The state check has made sure R has this form. */
-static void axis_increment(const sr_real R[9], int k, sr_real angle, sr_real delta[9])
+/* out[i] = x[i] + d, Kahan-compensated when comp is not NULL: the low-order bits that one
+ * addition loses are carried to the next step instead of being rounded the same way at every
+ * step, which keeps |R^T R - I| at the rounding level even when a resting robot's increments
+ * stay constant and below one ulp of the entries near 1 (the stagnation that otherwise grows
+ * |R^T R - I| linearly). */
+static inline sr_real add(sr_real x, sr_real d, sr_real *comp)
+{
+    sr_real y, t;
+    if (!comp) return x + d;
+    y = d - *comp;
+    t = x + y;
+    *comp = (t - x) - y;
+    return t;
+}
+
+/* The one-axis rotation R = Exp(theta [[e_k]]) (k = 0: R_Y about x, entries c = R[4],
+ * s = R[7]; k = 1: R_P about y, c = R[0], s = R[2]) times Exp(angle [[e_k]]): R (Exp - I)
+ * changes only (c, s), by (c (cos - 1) - s sin, s (cos - 1) + c sin); the exact zeros and ones
+ * are copied (an increment of exactly 0, whose compensation stays 0).  The state check has made
+ * sure R has this form. */
+static void advance_axis(const sr_real R[9], int k, sr_real angle, sr_real *comp, sr_real out[9])
 {
     const int ic = k == 0 ? 4 : 0, is = k == 0 ? 7 : 2;      /* where c and s stand */
     const int ims = k == 0 ? 5 : 6, ic2 = 8;                   /* -s and the second c */
@@ -89,19 +105,23 @@ static void axis_increment(const sr_real R[9], int k, sr_real angle, sr_real del
     sin_and_cos_minus_one(angle, &sn, &cm1);
     dc = c * cm1 - s * sn;
     ds = s * cm1 + c * sn;
-    for (m = 0; m < 9; ++m) delta[m] = 0;
-    delta[ic] = dc;
-    delta[ic2] = dc;
-    delta[is] = ds;
-    delta[ims] = -ds;
+    for (m = 0; m < 9; ++m) out[m] = R[m];
+    out[ic] = add(R[ic], dc, comp ? comp + ic : NULL);
+    out[ic2] = add(R[ic2], dc, comp ? comp + ic2 : NULL);
+    out[is] = add(R[is], ds, comp ? comp + is : NULL);
+    out[ims] = add(R[ims], -ds, comp ? comp + ims : NULL);
 }
 
-/* delta = x . exp(th1) . exp(th2) - x, written as increments (th2 may be NULL: one exponential).
- * On SO(3): R (E1 E2 - I) = R (D1 + D2 + D1 D2) with D = E - I; the one-axis rotations and the
- * vector parts add their arguments. */
-static void increment(const sr_real x[SR_NX], const sr_real th1[SR_NT], const sr_real *th2, sr_real delta[SR_NX])
+/* out = x . exp(th1) . exp(th2), formed as x + increment (th2 may be NULL: one exponential);
+ * comp as in `add`.  On SO(3): R E1 E2 = R + R (D1 + D2 + D1 D2) with D = E - I, whose small
+ * entries carry full relative precision (forming E and then R E would round the diagonal of E
+ * to the grid of numbers near 1 in the same way at every step when the angular velocity
+ * changes slowly: |R^T R - I| would grow linearly, about 1e-11 after 10^6 steps).  The
+ * one-axis rotations and the vector parts add their arguments.  out may alias x. */
+static void advance(const sr_real x[SR_NX], const sr_real th1[SR_NT], const sr_real *th2, sr_real *comp,
+                    sr_real out[SR_NX])
 {
-    sr_real D[9];
+    sr_real D[9], dR[9];
     int i;
     so3_exp_minus_identity(th1 + SR_T_S, D);
     if (th2) {
@@ -110,39 +130,21 @@ static void increment(const sr_real x[SR_NX], const sr_real th1[SR_NT], const sr
         matmul3(D, D2, D12);
         for (i = 0; i < 9; ++i) D[i] = D[i] + D2[i] + D12[i];
     }
-    matmul3(x + SR_X_R_S, D, delta + SR_X_R_S);
-    axis_increment(x + SR_X_R_Y, 0, th1[SR_T_Y] + (th2 ? th2[SR_T_Y] : 0), delta + SR_X_R_Y);
-    axis_increment(x + SR_X_R_P, 1, th1[SR_T_P] + (th2 ? th2[SR_T_P] : 0), delta + SR_X_R_P);
-    for (i = 0; i < 3; ++i) delta[SR_X_q + i] = th1[SR_T_Q + i] + (th2 ? th2[SR_T_Q + i] : 0);
-    for (i = 0; i < SR_NV; ++i) delta[SR_X_w_S + i] = th1[SR_T_V + i] + (th2 ? th2[SR_T_V + i] : 0);
+    matmul3(x + SR_X_R_S, D, dR);
+    for (i = 0; i < 9; ++i) out[SR_X_R_S + i] = add(x[SR_X_R_S + i], dR[i], comp ? comp + SR_X_R_S + i : NULL);
+    advance_axis(x + SR_X_R_Y, 0, th1[SR_T_Y] + (th2 ? th2[SR_T_Y] : 0), comp ? comp + SR_X_R_Y : NULL, out + SR_X_R_Y);
+    advance_axis(x + SR_X_R_P, 1, th1[SR_T_P] + (th2 ? th2[SR_T_P] : 0), comp ? comp + SR_X_R_P : NULL, out + SR_X_R_P);
+    for (i = 0; i < 3; ++i)
+        out[SR_X_q + i] = add(x[SR_X_q + i], th1[SR_T_Q + i] + (th2 ? th2[SR_T_Q + i] : 0), comp ? comp + SR_X_q + i : NULL);
+    for (i = 0; i < SR_NV; ++i)
+        out[SR_X_w_S + i] = add(x[SR_X_w_S + i], th1[SR_T_V + i] + (th2 ? th2[SR_T_V + i] : 0),
+                                comp ? comp + SR_X_w_S + i : NULL);
 }
 
-/* out = x + delta.  With comp (a running compensation, zero at the start of a simulation)
- * the sum is Kahan-compensated: the low-order bits that one addition loses are carried to
- * the next step instead of being rounded the same way at every step, which keeps |R^T R - I|
- * at the rounding level even when a resting robot's increments stay constant and below one
- * ulp of the entries near 1 (the stagnation that otherwise grows |R^T R - I| linearly). */
-static void apply(const sr_real x[SR_NX], const sr_real delta[SR_NX], sr_real *comp, sr_real out[SR_NX])
-{
-    int i;
-    if (!comp) {
-        for (i = 0; i < SR_NX; ++i) out[i] = x[i] + delta[i];
-        return;
-    }
-    for (i = 0; i < SR_NX; ++i) {
-        const sr_real y = delta[i] - comp[i];
-        const sr_real t = x[i] + y;
-        comp[i] = (t - x[i]) - y;
-        out[i] = t;
-    }
-}
-
-/* out = x . exp(th) (see the top of the file); out must not alias x. */
+/* out = x . exp(th) (see the top of the file); out may alias x. */
 static void act(const sr_real x[SR_NX], const sr_real th[SR_NT], sr_real out[SR_NX])
 {
-    sr_real delta[SR_NX];
-    increment(x, th, NULL, delta);
-    apply(x, delta, NULL, out);
+    advance(x, th, NULL, NULL, out);
 }
 
 void sr_internal_act(const sr_real x[SR_NX], const sr_real th[SR_NT], sr_real out[SR_NX])
@@ -193,7 +195,7 @@ static void combine(int n, const sr_real *coef, const sr_real (*K)[SR_NT], sr_re
  *     Theta_4 = h K3,                  K4 = dexpinv(Theta_4, f(x . exp Theta_4)),
  *     Theta = h (K1 + 2 K2 + 2 K3 + K4)/6,   x_new = x . exp(Theta).
  * K[0] = f(x) must be filled by the caller (the adaptive driver reuses it); K[1..3] and theta
- * (the final Theta) are outputs.  out must not alias x. */
+ * (the final Theta) are outputs.  out and comp are written last, only on success; out may alias x. */
 int sr_internal_rkmk4_core(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
                            sr_real K[4][SR_NT], sr_real theta[SR_NT], sr_real *comp, sr_real out[SR_NX],
                            long *evaluations)
@@ -210,8 +212,7 @@ int sr_internal_rkmk4_core(const sr_model *model, const sr_real x[SR_NX], const 
         sr_internal_dexpinv(th, K[s], K[s]);
     }
     combine(4, b, (const sr_real(*)[SR_NT])K, theta);
-    increment(x, theta, NULL, y);
-    apply(x, y, comp, out);
+    advance(x, theta, NULL, comp, out);
     return SR_OK;
 }
 
@@ -219,7 +220,8 @@ int sr_internal_rkmk4_core(const sr_model *model, const sr_real x[SR_NX], const 
  *     F1 = f(x),  Y2 = x . exp(h/2 F1),  F2 = f(Y2),  Y3 = x . exp(h/2 F2),  F3 = f(Y3),
  *     Y4 = Y2 . exp(h (F3 - F1/2)),  F4 = f(Y4),
  *     x_new = x . exp(h/12 (3F1 + 2F2 + 2F3 - F4)) . exp(h/12 (-F1 + 2F2 + 2F3 + 3F4)).
- * No dexp^-1; on the abelian factors this is the classical RK4.  out must not alias x. */
+ * No dexp^-1; on the abelian factors this is the classical RK4.  out and comp are written last,
+ * only on success; out may alias x. */
 static int cf4_core(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
                     sr_real *comp, sr_real out[SR_NX], long *evaluations)
 {
@@ -243,36 +245,25 @@ static int cf4_core(const sr_model *model, const sr_real x[SR_NX], const sr_real
     if (status != SR_OK) return status;
     combine(4, beta1, (const sr_real(*)[SR_NT])F, th);
     combine(4, beta2, (const sr_real(*)[SR_NT])F, th2);
-    increment(x, th, th2, Y);  /* both exponentials as one increment of x */
-    apply(x, Y, comp, out);
+    advance(x, th, th2, comp, out);  /* both exponentials as one increment of x */
     return SR_OK;
 }
 
+/* The cores write out and comp only at their end, once every stage has succeeded, and their
+ * final update may alias x: no copies here. */
 static int rkmk4_step(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                       sr_real *comp, sr_real out[SR_NX])
 {
-    sr_real K[4][SR_NT], theta[SR_NT], y[SR_NX], c[SR_NX];
-    int i, status = sr_internal_vector_field(model, x, u, K[0], NULL);
+    sr_real K[4][SR_NT], theta[SR_NT];
+    const int status = sr_internal_vector_field(model, x, u, K[0], NULL);
     if (status != SR_OK) return status;
-    if (comp) for (i = 0; i < SR_NX; ++i) c[i] = comp[i];
-    status = sr_internal_rkmk4_core(model, x, u, dt, K, theta, comp ? c : NULL, y, NULL);
-    if (status != SR_OK) return status;
-    for (i = 0; i < SR_NX; ++i) out[i] = y[i];
-    if (comp) for (i = 0; i < SR_NX; ++i) comp[i] = c[i];
-    return SR_OK;
+    return sr_internal_rkmk4_core(model, x, u, dt, K, theta, comp, out, NULL);
 }
 
 static int cf4_step(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                     sr_real *comp, sr_real out[SR_NX])
 {
-    sr_real y[SR_NX], c[SR_NX];
-    int i, status;
-    if (comp) for (i = 0; i < SR_NX; ++i) c[i] = comp[i];
-    status = cf4_core(model, x, u, dt, comp ? c : NULL, y, NULL);
-    if (status != SR_OK) return status;
-    for (i = 0; i < SR_NX; ++i) out[i] = y[i];
-    if (comp) for (i = 0; i < SR_NX; ++i) comp[i] = c[i];
-    return SR_OK;
+    return cf4_core(model, x, u, dt, comp, out, NULL);
 }
 
 void sr_internal_project(sr_real x[SR_NX])
@@ -315,12 +306,11 @@ void sr_internal_project(sr_real x[SR_NX])
 static int lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                      sr_real dt, sr_real out[SR_NX])
 {
-    sr_real f[SR_NT], th[SR_NT], y[SR_NX];
+    sr_real f[SR_NT], th[SR_NT];
     int i, status = sr_internal_vector_field(model, x, u, f, NULL);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NT; ++i) th[i] = dt * f[i];
-    act(x, th, y);
-    for (i = 0; i < SR_NX; ++i) out[i] = y[i];
+    act(x, th, out);
     return SR_OK;
 }
 
