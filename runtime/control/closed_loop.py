@@ -64,12 +64,25 @@ def simulate_closed_loop(plant_params, controller, reference, x0, duration, dt, 
 
     The controller period must be a whole number of plant steps.  `estimator` (e.g.
     runtime.control.estimator.Ekf): `reset(y)` and `update(y, u, period)` -> the state the
-    controller and the reference are given instead of the measurement y.
+    controller and the reference are given instead of the measurement y.  An estimator with a
+    `rate` (> 0; a whole multiple of the controller's, its period a whole number of plant steps)
+    reads the sensors at that rate, between the controller's samples too, as a filter on a
+    faster sensor bus would; without one it runs once per controller sample.
     """
     per = round(controller.period / dt)
     if per < 1 or abs(per * dt - controller.period) > 1e-9 * controller.period:
         raise ValueError(f"controller.rate: the period 1/{controller.rate:g} s is not a whole number of "
                          f"plant steps dt = {dt:g} s")
+    sub = 1                     # estimator samples per controller sample
+    if estimator is not None and getattr(estimator, "rate", 0):
+        sub = round(controller.period * estimator.rate)
+        if sub < 1 or abs(sub - controller.period * estimator.rate) > 1e-9 * sub:
+            raise ValueError(f"estimator.rate: {estimator.rate:g} Hz is not a whole multiple of the controller's "
+                             f"{controller.rate:g} Hz")
+        if per % sub:
+            raise ValueError(f"estimator.rate: the period 1/{estimator.rate:g} s is not a whole number of plant "
+                             f"steps dt = {dt:g} s")
+    per_e, period_e = per // sub, controller.period / sub
     samples = round(duration / controller.period)
     if samples < 1:
         raise ValueError(f"duration: {duration:g} s is shorter than one controller period")
@@ -87,7 +100,7 @@ def simulate_closed_loop(plant_params, controller, reference, x0, duration, dt, 
         x = traj[k * per]
         y = _measure(x, plant_params.r, noise, rng)
         if estimator is not None:
-            y = estimator.reset(y) if k == 0 else estimator.update(y, u, controller.period)
+            y = estimator.reset(y) if k == 0 else estimator.update(y, u, period_e)
             estimates[k] = y
         target = reference.target(k * controller.period, y[IDX_Q], float(heading(y)))
         if getattr(reference, "is_path", False) and hasattr(controller, "preview_distances"):
@@ -95,7 +108,11 @@ def simulate_closed_loop(plant_params, controller, reference, x0, duration, dt, 
                 controller.preview_distances(target)))
         u = controller.update(k * controller.period, y, target)
         torques[k * per:(k + 1) * per] = u
-        traj[k * per:(k + 1) * per + 1] = plant.simulate(x, dt, per, np.tile(u, (per, 1)), method=method)
+        for j in range(sub):    # the estimator's samples between the controller's, u held
+            at = k * per + j * per_e
+            if j > 0:
+                estimator.update(_measure(traj[at], plant_params.r, noise, rng), u, period_e)
+            traj[at:at + per_e + 1] = plant.simulate(traj[at], dt, per_e, np.tile(u, (per_e, 1)), method=method)
     torques[-1] = torques[-2]
     return ClosedLoopResult(time=np.arange(len(traj)) * dt, trajectory=traj, torques=torques,
                             control_time=np.arange(samples) * controller.period,

@@ -32,11 +32,15 @@ class EkfSettings:
     joint_rad: float = 1e-4             # the encoders of θ_Y, θ_P
     rate_rad_s: float = 0.02            # ω_S, ω_Y, ω_P
     accel_rad_s2: float = 0.05          # process noise: white angular acceleration on the rates [rad/s²/√Hz]
+    rate: float = 0.0                   # the sensors' rate [Hz], a whole multiple of the controller's; 0: the controller's
 
     def __post_init__(self):
         for field in dataclasses.fields(self):
             value = getattr(self, field.name)
-            if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
+            if field.name == "rate":
+                if not (isinstance(value, (int, float)) and np.isfinite(value) and value >= 0):
+                    raise ValueError(f"rate: expected a finite number of Hz >= 0 (0: the controller's rate), got {value!r}")
+            elif not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
                 raise ValueError(f"{field.name}: a standard deviation must be a finite number > 0, got {value!r}")
 
 
@@ -49,6 +53,7 @@ class Ekf:
 
     def __init__(self, params, settings=EkfSettings(), method="rkmk4"):
         self.model, self.settings, self.method = Model(params), settings, method
+        self.rate = settings.rate         # the closed loop runs `update` at this rate (0: the controller's)
         s = settings
         r = np.zeros(NE)
         r[IDX_E_XI_S] = s.attitude_rad ** 2

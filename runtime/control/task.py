@@ -167,7 +167,8 @@ def _parse_estimator(table, source):
     _table(table, where, {"kind", *ESTIMATOR_SETTINGS})
     if table.get("kind") != "ekf":
         raise ValueError(f"{where}.kind: expected \"ekf\", got {table.get('kind')!r}")
-    return EkfSettings(**{k: _real(v, f"{where}.{k}", positive=True) for k, v in table.items() if k != "kind"})
+    return EkfSettings(**{k: _real(v, f"{where}.{k}", positive=k != "rate", nonnegative=k == "rate")
+                          for k, v in table.items() if k != "kind"})
 
 
 def _table(value, where, allowed):

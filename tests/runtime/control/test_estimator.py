@@ -59,10 +59,65 @@ def test_the_filtering_check_fails_for_a_prediction_that_does_not_move():
     assert not rms(estimates[:, IDX_Q][:, :2] - truth[:, IDX_Q][:, :2]) < 0.3 * SIGMA_POSITION
 
 
-@pytest.mark.parametrize("name", est.SETTING_NAMES)
+@pytest.mark.parametrize("name", [n for n in est.SETTING_NAMES if n != "rate"])
 def test_a_setting_that_is_not_positive_is_named(name):
     with pytest.raises(ValueError, match=name):
         est.EkfSettings(**{name: 0.0})
+
+
+def test_a_negative_rate_is_named_and_zero_means_the_controllers():
+    with pytest.raises(ValueError, match=r"^rate: "):
+        est.EkfSettings(rate=-1.0)
+    assert est.EkfSettings(rate=0.0).rate == 0.0
+
+
+class HeldController:
+    """Zero torques at 10 Hz, for the closed loop's bookkeeping."""
+    rate, period, saturated_fraction, solve_s = 10.0, 0.1, 0.0, ()
+
+    def reset(self, y):
+        pass
+
+    def update(self, t, y, target):
+        return np.zeros(2)
+
+
+class CountingEstimator:
+    """Records the period of every update; passes the measurement through."""
+    def __init__(self, rate):
+        self.rate, self.periods = rate, []
+
+    def reset(self, y):
+        return y
+
+    def update(self, y, u, period):
+        self.periods.append(period)
+        return y
+
+
+def closed_loop_with(estimator, seconds=1.0):
+    task = load_task("speed-step")
+    return simulate_closed_loop(task.plant_params, HeldController(), task.reference(), task.scenario.x0,
+                                seconds, 0.005, "lie-euler", estimator=estimator)
+
+
+def test_an_estimator_with_a_rate_reads_the_sensors_between_the_controllers_samples():
+    counting = CountingEstimator(rate=40.0)     # 4 per controller sample
+    closed_loop_with(counting)
+    assert counting.periods == [0.025] * (10 * 4 - 1)   # 10 samples, the first one a reset
+
+
+def test_an_estimator_without_a_rate_runs_once_per_controller_sample():
+    counting = CountingEstimator(rate=0.0)
+    closed_loop_with(counting)
+    assert counting.periods == [0.1] * 9
+
+
+@pytest.mark.parametrize("rate, why", [(25.0, "not a whole multiple"), (30.0, "not a whole number of plant steps")])
+def test_an_estimator_rate_the_loop_cannot_keep_is_named(rate, why):
+    # 25 Hz: 2.5 per controller sample; 30 Hz: 3 per sample, but 1/30 s is no whole number of 5 ms steps.
+    with pytest.raises(ValueError, match=rf"^estimator.rate: .*{why}"):
+        closed_loop_with(CountingEstimator(rate=rate))
 
 
 def test_a_task_file_names_a_bad_estimator():
@@ -73,5 +128,9 @@ def test_a_task_file_names_a_bad_estimator():
     data["estimator"] = {"kind": "ekf", "rate_rad_s": -1.0}
     with pytest.raises(ValueError, match=r"estimator.rate_rad_s: must be > 0"):
         parse_task(data, source="t.toml")
-    data["estimator"] = {"kind": "ekf", "rate_rad_s": 0.05}
+    data["estimator"] = {"kind": "ekf", "rate_rad_s": 0.05, "rate": 100}
     assert parse_task(data, source="t.toml").estimator.rate_rad_s == 0.05
+    assert parse_task(data, source="t.toml").estimator.rate == 100
+    data["estimator"] = {"kind": "ekf", "rate": -10}
+    with pytest.raises(ValueError, match=r"estimator.rate: must be >= 0"):
+        parse_task(data, source="t.toml")
