@@ -1,8 +1,9 @@
 /*
  * sr_jacobians.c -- derivatives of the dynamics in the error coordinates of c/sr_group.c
  * (issue 19).  The generated sr_gen_accel_jacobian_terms gives M, f, df/dd, df/du and dM/dd
- * (derive/derivatives.py); here one Cholesky factorisation of M serves the accelerations and
- * every column:  d(nu') = M^-1 (df - (dM) nu').
+ * (derive/derivatives.py); here one factorisation of M (joints first for the paper's geometry,
+ * Cholesky for a general robot) serves the accelerations and every column:
+ * d(nu') = M^-1 (df - (dM) nu').
  */
 #include "sr_internal.h"
 
@@ -28,29 +29,85 @@ static inline void solve(const sr_real L[SR_NV * SR_NV], const sr_real inv[SR_NV
     }
 }
 
+/* The paper's robot: M = [A B; B^T D], D = diag(M_33, M_44), since M_34 = 0 (the yoke and the
+ * pendulum rates do not couple; derive/codegen/joint_first.py proves it, and the generated terms
+ * kernel writes M_34 as a literal 0).  As in sr_gen_accel, the joints go first: with
+ * beta = B D^-1 and the Schur complement S = A - beta B^T (3 x 3), M v = r is
+ *     S v_S = r_S - beta r_J,   v_J = D^-1 r_J - beta^T v_S,
+ * S inverted by its adjugate.  The pivots are tested as in sr_gen_accel (M_33, M_44 > 0, the
+ * leading minors of S above SR_GEN_PIVOT_TOL times M's diagonal), else SR_ERR_SINGULAR. */
+typedef struct {
+    sr_real dinv[2], beta[3][2], Sinv[3][3];
+} joint_first;
+
+static int joint_first_factor(const sr_real Mu[15], joint_first *s)
+{
+    sr_real S[3][3], C[3][3], det;
+    int i, j, k;
+    if (!(Mu[SR_UPPER[3][3]] > 0 && Mu[SR_UPPER[4][4]] > 0)) return SR_ERR_SINGULAR;
+    for (k = 0; k < 2; ++k) s->dinv[k] = 1 / Mu[SR_UPPER[3 + k][3 + k]];
+    for (i = 0; i < 3; ++i)
+        for (k = 0; k < 2; ++k) s->beta[i][k] = Mu[SR_UPPER[i][3 + k]] * s->dinv[k];
+    for (i = 0; i < 3; ++i)
+        for (j = i; j < 3; ++j)
+            S[i][j] = S[j][i] = Mu[SR_UPPER[i][j]] - s->beta[i][0] * Mu[SR_UPPER[j][3]]
+                                                   - s->beta[i][1] * Mu[SR_UPPER[j][4]];
+    C[0][0] = S[1][1] * S[2][2] - S[1][2] * S[1][2];
+    C[0][1] = S[1][2] * S[0][2] - S[0][1] * S[2][2];
+    C[0][2] = S[0][1] * S[1][2] - S[1][1] * S[0][2];
+    C[1][1] = S[0][0] * S[2][2] - S[0][2] * S[0][2];
+    C[1][2] = S[0][1] * S[0][2] - S[1][2] * S[0][0];
+    C[2][2] = S[1][1] * S[0][0] - S[0][1] * S[0][1];
+    det = S[0][0] * C[0][0] + S[0][1] * C[0][1] + S[0][2] * C[0][2];
+    if (!(S[0][0] > SR_GEN_PIVOT_TOL * Mu[SR_UPPER[0][0]])) return SR_ERR_SINGULAR;
+    if (!(C[2][2] > SR_GEN_PIVOT_TOL * Mu[SR_UPPER[1][1]] * S[0][0])) return SR_ERR_SINGULAR;
+    if (!(det > SR_GEN_PIVOT_TOL * Mu[SR_UPPER[2][2]] * C[2][2])) return SR_ERR_SINGULAR;
+    for (i = 0; i < 3; ++i)
+        for (j = i; j < 3; ++j) s->Sinv[i][j] = s->Sinv[j][i] = C[i][j] / det;
+    return SR_OK;
+}
+
+/* B <- M^-1 B for the first n columns, M factored by joint_first_factor. */
+static inline void joint_first_solve(const joint_first *s, sr_real B[SR_NV][NCOL], int n)
+{
+    int i, c;
+    for (c = 0; c < n; ++c) {
+        sr_real g[3], v[3];
+        for (i = 0; i < 3; ++i) g[i] = B[i][c] - s->beta[i][0] * B[3][c] - s->beta[i][1] * B[4][c];
+        for (i = 0; i < 3; ++i) v[i] = s->Sinv[i][0] * g[0] + s->Sinv[i][1] * g[1] + s->Sinv[i][2] * g[2];
+        B[3][c] = s->dinv[0] * B[3][c] - (s->beta[0][0] * v[0] + s->beta[1][0] * v[1] + s->beta[2][0] * v[2]);
+        B[4][c] = s->dinv[1] * B[4][c] - (s->beta[0][1] * v[0] + s->beta[1][1] * v[1] + s->beta[2][1] * v[2]);
+        for (i = 0; i < 3; ++i) B[i][c] = v[i];
+    }
+}
+
 int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                       sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU])
 {
     static const sr_real zero_u[SR_NU] = {0, 0};
     sr_real Mu[15], f[SR_NV], df[SR_NV * SR_NE], dfdu[SR_NV * SR_NU], dM[5 * 15], L[SR_NV * SR_NV], inv[SR_NV];
     sr_real a[SR_NV][NCOL], B[SR_NV][NCOL], ja[SR_NV * SR_NE], jb[SR_NV * SR_NU];
+    joint_first jf;
     int status, i, j, k;
     if (!Ja || !Jb) return SR_ERR_NULL;
+    memset(&jf, 0, sizeof jf);    /* set on the paper's path only; GCC cannot see that */
     status = checks(model, x, u);
     if (status != SR_OK) return status;
     status = sr_internal_accel_jacobian_terms(model, x, u ? u : zero_u, Mu, f, df, dfdu, dM);
     if (status != SR_OK) return status;
-    status = sr_internal_cholesky(Mu, L, inv);
+    status = model->general ? sr_internal_cholesky(Mu, L, inv) : joint_first_factor(Mu, &jf);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NV; ++i) a[i][0] = f[i];
-    solve(L, inv, a, 1);                                  /* a = nu' */
+    if (model->general) solve(L, inv, a, 1);              /* a = nu' */
+    else joint_first_solve(&jf, a, 1);
     for (i = 0; i < SR_NV; ++i) {
         for (k = 0; k < SR_NE; ++k) B[i][k] = df[SR_NE * i + k];
         for (k = 0; k < SR_NU; ++k) B[i][SR_NE + k] = dfdu[SR_NU * i + k];
         for (k = 0; k < 5; ++k) /* the configuration directions d_xi_S, d_th_Y, d_th_P move M */
             for (j = 0; j < SR_NV; ++j) B[i][k] -= dM[15 * k + SR_UPPER[i][j]] * a[j][0];
     }
-    solve(L, inv, B, NCOL);
+    if (model->general) solve(L, inv, B, NCOL);
+    else joint_first_solve(&jf, B, NCOL);
     for (i = 0; i < SR_NV; ++i) {
         for (k = 0; k < SR_NE; ++k) ja[SR_NE * i + k] = B[i][k];
         for (k = 0; k < SR_NU; ++k) jb[SR_NU * i + k] = B[i][SR_NE + k];
