@@ -118,7 +118,8 @@ ffibuilder.set_source(
     # No FMA contraction: the firmware example (c/examples) must reproduce the Python runs bit for bit.
     # -O3: GCC vectorises the batch calls' lanes loops (sr_gen_accel_lanes) only with its full cost
     # model; without -ffast-math it changes no result (tests/bindings: batch == single, bit for bit).
-    extra_compile_args=["-std=c99", "-O3", "-ffp-contract=off", *NATIVE],
+    # -DSR_CLONES: the batch loops also for AVX2, picked at load time (c/sr_real.h, SR_LANES_CLONES).
+    extra_compile_args=["-std=c99", "-O3", "-ffp-contract=off", "-DSR_CLONES", *NATIVE],
 )
 
 if __name__ == "__main__":

@@ -71,8 +71,8 @@ int sr_check_state_batch(const sr_model *model, long n, const sr_real *x, long *
  * is 0 only if each term is), and a NaN or infinity makes a sum fail.  Finiteness: q_x, q_y here;
  * every other entry of x and u enters these sums or the kernel's outputs, whose sum the lanes
  * kernel tests (tests/c: a NaN or infinity in any entry of any row is reported). */
-void sr_internal_check_lanes(const sr_model *model, long n, const sr_real *restrict x, long x_stride,
-                             sr_real *restrict ok)
+SR_LANES_CLONES void sr_internal_check_lanes(const sr_model *model, long n, const sr_real *restrict x,
+                                             long x_stride, sr_real *restrict ok)
 {
     const sr_real r = model->p[SR_P_r];
     long i;

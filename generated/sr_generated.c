@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 73dbb556dee0c068], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources c8ad01e71a8162b4], SymPy 1.14.0. */
 #include "sr_generated.h"
 
 #include <math.h>
@@ -3591,8 +3591,8 @@ int sr_gen_general_accel_jacobian_terms(const sr_real cg[SR_GEN_GENERAL_NCONST],
     return SR_GEN_OK;
 }
 
-/* sr_gen_accel on n states, for the batch calls: one loop without branches that the compiler vectorises across states (the same expressions, so each lane's result is the scalar kernel's, bit for bit); every output is written, and ok[i] is cleared where the scalar kernel would fail (or its outputs' sum overflows: decide such a state by the scalar kernel). GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic). */
-void sr_gen_accel_lanes(const sr_real c[SR_GEN_NCONST], long n, const sr_real *restrict x, long x_stride, const sr_real *restrict u, long u_stride, sr_real *restrict a, long a_stride, sr_real *restrict ok)
+/* sr_gen_accel on n states, for the batch calls: one loop without branches that the compiler vectorises across states (the same expressions, so each lane's result is the scalar kernel's, bit for bit); every output is written, and ok[i] is cleared where the scalar kernel would fail (or its outputs' sum overflows: decide such a state by the scalar kernel). GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic), for AVX2 too (SR_LANES_CLONES). */
+SR_LANES_CLONES void sr_gen_accel_lanes(const sr_real c[SR_GEN_NCONST], long n, const sr_real *restrict x, long x_stride, const sr_real *restrict u, long u_stride, sr_real *restrict a, long a_stride, sr_real *restrict ok)
 {
     const sr_real j_xx = c[6];
     const sr_real j_yy = c[7];

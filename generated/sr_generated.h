@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 73dbb556dee0c068], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources c8ad01e71a8162b4], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -255,7 +255,7 @@ int sr_gen_general_energy(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real
 int sr_gen_general_equilibrium_residual(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], sr_real res[5]);
 /* M (upper triangle, row by row), f, ∂f/∂d (5 x SR_GEN_NE, row-major, error coordinates of SR_E_*), ∂f/∂u (5 x 2) and ∂M/∂d along δξ_S, δθ_Y, δθ_P (5 upper triangles) for the accel Jacobian ∂ν̇ = M⁻¹(∂f − (∂M) ν̇). */
 int sr_gen_general_accel_jacobian_terms(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real M[15], sr_real f[5], sr_real df[60], sr_real dfdu[10], sr_real dM[75]);
-/* sr_gen_accel on n states, for the batch calls: one loop without branches that the compiler vectorises across states (the same expressions, so each lane's result is the scalar kernel's, bit for bit); every output is written, and ok[i] is cleared where the scalar kernel would fail (or its outputs' sum overflows: decide such a state by the scalar kernel). GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic). */
+/* sr_gen_accel on n states, for the batch calls: one loop without branches that the compiler vectorises across states (the same expressions, so each lane's result is the scalar kernel's, bit for bit); every output is written, and ok[i] is cleared where the scalar kernel would fail (or its outputs' sum overflows: decide such a state by the scalar kernel). GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic), for AVX2 too (SR_LANES_CLONES). */
 void sr_gen_accel_lanes(const sr_real c[SR_GEN_NCONST], long n, const sr_real *restrict x, long x_stride, const sr_real *restrict u, long u_stride, sr_real *restrict a, long a_stride, sr_real *restrict ok);
 
 #endif /* SR_GENERATED_H */

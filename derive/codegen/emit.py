@@ -146,7 +146,7 @@ def lanes_doc(kernel):
             " compiler vectorises across states (the same expressions, so each lane's result is the scalar"
             " kernel's, bit for bit); every output is written, and ok[i] is cleared where the scalar kernel"
             " would fail (or its outputs' sum overflows: decide such a state by the scalar kernel)."
-            " GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic). */")
+            " GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic), for AVX2 too (SR_LANES_CLONES). */")
 
 
 def emit_lanes(kernel, layouts):
@@ -157,7 +157,7 @@ def emit_lanes(kernel, layouts):
     each = [f"    const sr_real {sym.name} = {array}[{PER_LANE[array]} + {index}];"
             for sym, array, index in entries if array in PER_LANE]
     loop = each + ["    sr_real good = 1;"] + body + ["    ok[i] = good;"]
-    return "\n".join([lanes_doc(kernel), lanes_signature(kernel), "{", *once, "    long i;",
+    return "\n".join([lanes_doc(kernel), "SR_LANES_CLONES " + lanes_signature(kernel), "{", *once, "    long i;",
                       "    for (i = 0; i < n; ++i) {", *("    " + line for line in loop), "    }", "}", ""])
 
 

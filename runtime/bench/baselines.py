@@ -159,6 +159,13 @@ def python_timings(model, X, U, batch_size, progress, with_kane=True, loop_steps
     out["python_batch_accel_first_call_ns_per_state"] = (time.perf_counter() - start) / batch_size * 1e9
     out["python_batch_accel_ns_per_state"] = best_seconds(lambda: model.accel(XB, UB), 3) / batch_size * 1e9
     out["batch_size"] = batch_size
+    # A batch that stays in the caches (10⁴ states, 2.8 MB): what the arithmetic costs without the
+    # memory traffic of 10⁶ states (docs/sweeps.md).
+    small, calls = min(10_000, batch_size), 20
+    XS, US = XB[:small].copy(), UB[:small].copy()
+    out["python_batch_accel_in_cache_ns_per_state"] = best_seconds(
+        lambda: [model.accel(XS, US) for _ in range(calls)], 5) / (calls * small) * 1e9
+    out["batch_size_in_cache"] = small
     check_close("batch accel", AB[:len(X)], np.array([model.accel(x, u) for x, u in zip(X, U)]), 0)
 
     u_prog = t_shape_program()

@@ -41,7 +41,7 @@ def build_harness(build, native, with_casadi, kane=None):
     """The C loop's executable; `kane` = (sources, macros) of runtime/bench/kane_compiled.write_kane_c."""
     cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
     sources = [str(p) for d in ("generated", "c") for p in sorted((ROOT / d).glob("*.c"))]
-    flags = ["-std=c99", "-O3", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c'}", f"-I{build}"]
+    flags = ["-std=c99", "-O3", "-DSR_CLONES", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c'}", f"-I{build}"]
     if native:
         flags.append("-march=native")
     if with_casadi:

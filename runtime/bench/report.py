@@ -134,6 +134,10 @@ def sections(res):
     if "python_batch_accel_first_call_ns_per_state" in py:
         rows.append(("  the same, first call (output memory touched for the first time)",
                      f"{py['python_batch_accel_first_call_ns_per_state']:,.1f} ns", ""))
+    if "python_batch_accel_in_cache_ns_per_state" in py:
+        small = py["python_batch_accel_in_cache_ns_per_state"]
+        rows.append((f"Model.accel batch of {py['batch_size_in_cache']:,} (in the caches)", f"{small:,.1f} ns",
+                     f"{small / ours:.2f}x one checked accel in C"))
     for name, ns in py.get("alternative_batch_ns_per_state", {}).items():
         rows.append((f"batch accel, {name}", f"{ns:,.1f} ns", f"{ns / batch:,.0f}x slower"))
     for key, value in py.items():
