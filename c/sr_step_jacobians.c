@@ -4,7 +4,7 @@
  * the maps of c/sr_steppers.c as they are implemented (stage by stage, dexp^-1 differentiated).
  *
  * Every quantity of a step carries its derivative with respect to (d, w): a matrix of
- * NC = SR_NE + SR_NU columns.  The rules, for the action y = x . exp(th) of c/sr_steppers.c:
+ * NC columns (see below).  The rules, for the action y = x . exp(th) of c/sr_steppers.c:
  *   y (-) y0 = A(th) (x (-) x0) + B(th) dth,   A = diag(Exp(th_S)^T, 1, 1, I_2, I_5),
  *                                              B = diag(Jr(th_S), 1, 1, [I_2 0], I_5)
  * (the right Jacobian Jr of SO(3); q_z does not move); for the vector field f of
@@ -18,10 +18,18 @@
 
 #include <string.h>
 
-#define NC (SR_NE + SR_NU)
+/* The columns carried: every direction of (d, w) but the two of dq.  Nothing in a step depends
+ * on where the robot stands (q enters neither the accelerations nor q' itself), so every
+ * derivative along dq is exactly 0 but that of q (+) itself, the identity; deliver_jacobians
+ * writes those columns.  Carrying 12 columns instead of 14, and skipping the dq rows in the
+ * products with the accelerations' Jacobian (whose dq columns are exact zeros), gives the same
+ * numbers with a sixth less work.  Column a of the carried ones is column full_column(a) of
+ * [F | G]. */
+#define NC (SR_NE + SR_NU - 2)
+#define full_column(a) ((a) < SR_E_q ? (a) : (a) + 2)
 
-typedef sr_real tangent[SR_NT][NC];   /* d(13-vector)/d(d, w) */
-typedef sr_real error[SR_NE][NC];     /* d(state error)/d(d, w) */
+typedef sr_real tangent[SR_NT][NC];   /* d(13-vector)/d(d, w), carried columns */
+typedef sr_real error[SR_NE][NC];     /* d(state error)/d(d, w), carried columns */
 
 /* c(s) of dexp^-1 (s = |th|^2) and its derivative dc/ds: the closed form of sr_internal_dexpinv,
  * with the same series below s = 1e-2. */
@@ -40,36 +48,41 @@ static void dexpinv_coefficient(sr_real s, sr_real *c, sr_real *dc)
 }
 
 /* dy = A(th) dx + B(th) dth (dx may be NULL: a state that does not depend on (d, w) other than
- * through x itself, i.e. dx = [I | 0]).  Row by row, each row a contiguous axpy over the NC
- * columns (what the compiler vectorises). */
+ * through x itself, i.e. dx = [I | 0], whose products are written out).  Row by row, each row a
+ * contiguous axpy over the NC columns (what the compiler vectorises). */
 static void act_jacobian(const sr_real th[SR_NT], const error *dx, const tangent dth, error dy)
 {
     sr_real D[9], Jr[9];
-    error in, out;
+    error out;
     int i, j, c;
     so3_exp_minus_identity(th + SR_T_S, D);
     so3_right_jacobian(th + SR_T_S, Jr);
-    if (dx) memcpy(in, *dx, sizeof in);
-    else
-        for (i = 0; i < SR_NE; ++i)
-            for (c = 0; c < NC; ++c) in[i][c] = (sr_real)(i == c);
     for (i = 0; i < 3; ++i) {   /* Exp(th)^T = I + D^T, then + Jr dth_S */
         sr_real *o = out[SR_E_xi_S + i];
-        for (c = 0; c < NC; ++c) o[c] = in[SR_E_xi_S + i][c];
+        if (dx) {
+            for (c = 0; c < NC; ++c) o[c] = (*dx)[SR_E_xi_S + i][c];
+            for (j = 0; j < 3; ++j) {
+                const sr_real dji = D[3 * j + i], *a = (*dx)[SR_E_xi_S + j];
+                for (c = 0; c < NC; ++c) o[c] += dji * a[c];
+            }
+        } else {
+            for (c = 0; c < NC; ++c) o[c] = c < 3 ? (c == i) + D[3 * c + i] : 0;
+        }
         for (j = 0; j < 3; ++j) {
-            const sr_real dji = D[3 * j + i], jrij = Jr[3 * i + j];
-            const sr_real *a = in[SR_E_xi_S + j], *b = dth[SR_T_S + j];
-            for (c = 0; c < NC; ++c) o[c] += dji * a[c] + jrij * b[c];
+            const sr_real jrij = Jr[3 * i + j], *b = dth[SR_T_S + j];
+            for (c = 0; c < NC; ++c) o[c] += jrij * b[c];
         }
     }
-    for (c = 0; c < NC; ++c) {
-        out[SR_E_th_Y][c] = in[SR_E_th_Y][c] + dth[SR_T_Y][c];
-        out[SR_E_th_P][c] = in[SR_E_th_P][c] + dth[SR_T_P][c];
+    for (c = 0; c < NC; ++c) {   /* the identity's rows, where dx is NULL: carried column a is full_column(a) */
+        out[SR_E_th_Y][c] = (dx ? (*dx)[SR_E_th_Y][c] : (sr_real)(c == SR_E_th_Y)) + dth[SR_T_Y][c];
+        out[SR_E_th_P][c] = (dx ? (*dx)[SR_E_th_P][c] : (sr_real)(c == SR_E_th_P)) + dth[SR_T_P][c];
     }
-    for (i = 0; i < 2; ++i)
-        for (c = 0; c < NC; ++c) out[SR_E_q + i][c] = in[SR_E_q + i][c] + dth[SR_T_Q + i][c];
+    for (i = 0; i < 2; ++i)   /* the dq columns are not carried: the identity has no entries here */
+        for (c = 0; c < NC; ++c) out[SR_E_q + i][c] = (dx ? (*dx)[SR_E_q + i][c] : 0) + dth[SR_T_Q + i][c];
     for (i = 0; i < SR_NV; ++i)
-        for (c = 0; c < NC; ++c) out[SR_E_nu + i][c] = in[SR_E_nu + i][c] + dth[SR_T_V + i][c];
+        for (c = 0; c < NC; ++c)
+            out[SR_E_nu + i][c] = (dx ? (*dx)[SR_E_nu + i][c] : (sr_real)(full_column(c) == SR_E_nu + i))
+                                + dth[SR_T_V + i][c];
     memcpy(dy, out, sizeof out);
 }
 
@@ -89,24 +102,29 @@ static int field_jacobian(const sr_model *model, const sr_real y[SR_NX], const s
     for (i = 0; i < 3; ++i) memcpy(df[SR_T_S + i], dy[SR_E_nu + i], sizeof df[0]);
     memcpy(df[SR_T_Y], dy[SR_E_nu + 3], sizeof df[0]);
     memcpy(df[SR_T_P], dy[SR_E_nu + 4], sizeof df[0]);
+    /* The rows are summed in local arrays, which the compiler knows alias nothing: summed in
+     * place, in df, the loops stayed scalar (df and dy could overlap as far as it knows). */
     for (i = 0; i < 2; ++i) {   /* d(q') = p . (dw - w x dxi) = p . dw + (w x p) . dxi */
         const sr_real *q = p[i];
         const sr_real wxp[3] = {w[1] * q[2] - w[2] * q[1], w[2] * q[0] - w[0] * q[2], w[0] * q[1] - w[1] * q[0]};
-        sr_real *o = df[SR_T_Q + i];
+        sr_real o[NC];
         for (c = 0; c < NC; ++c) o[c] = 0;
         for (j = 0; j < 3; ++j) {
             const sr_real *a = dy[SR_E_nu + j], *b = dy[SR_E_xi_S + j];
             for (c = 0; c < NC; ++c) o[c] += q[j] * a[c] + wxp[j] * b[c];
         }
+        memcpy(df[SR_T_Q + i], o, sizeof o);
     }
     for (c = 0; c < NC; ++c) df[SR_T_Q + 2][c] = 0;
     for (i = 0; i < SR_NV; ++i) {
-        sr_real *o = df[SR_T_V + i];
-        for (c = 0; c < NC; ++c) o[c] = c >= SR_NE ? Jb[SR_NU * i + (c - SR_NE)] : 0;
+        sr_real o[NC];
+        for (c = 0; c < NC; ++c) o[c] = full_column(c) >= SR_NE ? Jb[SR_NU * i + (full_column(c) - SR_NE)] : 0;
         for (k = 0; k < SR_NE; ++k) {
             const sr_real jik = Ja[SR_NE * i + k], *a = dy[k];
+            if (k == SR_E_q || k == SR_E_q + 1) continue;   /* exact zeros of Ja: q moves no acceleration */
             for (c = 0; c < NC; ++c) o[c] += jik * a[c];
         }
+        memcpy(df[SR_T_V + i], o, sizeof o);
     }
     return SR_OK;
 }
@@ -152,13 +170,15 @@ static void combine_jacobian(int n, const sr_real *coef, const sr_real (*K)[SR_N
 {
     int i, c, k;
     for (i = 0; i < SR_NT; ++i) {
+        sr_real o[NC];   /* local, as in field_jacobian */
         th[i] = 0;
         for (k = 0; k < n; ++k) th[i] += coef[k] * K[k][i];
-        for (c = 0; c < NC; ++c) dth[i][c] = 0;
+        for (c = 0; c < NC; ++c) o[c] = 0;
         for (k = 0; k < n; ++k) {
             const sr_real ck = coef[k], *a = dK[k][i];
-            for (c = 0; c < NC; ++c) dth[i][c] += ck * a[c];
+            for (c = 0; c < NC; ++c) o[c] += ck * a[c];
         }
+        memcpy(dth[i], o, sizeof o);
     }
 }
 
@@ -167,17 +187,21 @@ static void identity(error e)
 {
     int i, c;
     for (i = 0; i < SR_NE; ++i)
-        for (c = 0; c < NC; ++c) e[i][c] = (sr_real)(i == c);
+        for (c = 0; c < NC; ++c) e[i][c] = (sr_real)(i == full_column(c));
 }
 
 static void deliver_jacobians(error dy, sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
 {
     int i, c;
-    for (i = 0; i < SR_NE; ++i)
+    for (i = 0; i < SR_NE; ++i) {
         for (c = 0; c < NC; ++c) {
-            if (c < SR_NE) F[SR_NE * i + c] = dy[i][c];
-            else G[SR_NU * i + (c - SR_NE)] = dy[i][c];
+            const int col = full_column(c);
+            if (col < SR_NE) F[SR_NE * i + col] = dy[i][c];
+            else G[SR_NU * i + (col - SR_NE)] = dy[i][c];
         }
+        F[SR_NE * i + SR_E_q] = (sr_real)(i == SR_E_q);   /* the dq columns: see NC */
+        F[SR_NE * i + SR_E_q + 1] = (sr_real)(i == SR_E_q + 1);
+    }
 }
 
 static int check_step_arguments(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
