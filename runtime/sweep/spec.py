@@ -273,9 +273,10 @@ def sample_inputs(spec, start, stop):
     for q in spec.quantities:
         group, key = q.name.split(".", 1)
         v = values[q.name]
-        if group == "params" and not paper:
-            col = getattr(lib, f"SR_P_{key}")
-            params[:, col] = v * params[:, col] if q.relative else v
+        if group == "params":
+            if not paper:           # (the paper's names were applied above)
+                col = getattr(lib, f"SR_P_{key}")
+                params[:, col] = v * params[:, col] if q.relative else v
         elif group == "initial":
             _set_initial(x0, key, v, q.relative)
         else:

@@ -76,3 +76,11 @@ def test_the_shipped_sweep_varies_every_mass_and_damping_by_ten_percent():
     assert spec.samples == 10_000 and spec.scenario.name == "t-shape"
     assert {q.name for q in spec.quantities} == {f"params.{n}" for n in ("m_S", "m_b", "m_h", "m_P", "k_S", "k_Y", "k_P")}
     assert all(q.kind == "uniform" and q.numbers == (0.9, 1.1) and q.relative for q in spec.quantities)
+
+
+def test_samples_that_vary_no_torque_share_the_scenario_s_torque_program():
+    """Parameters given by the paper's names must not be taken for torque factors: the shipped
+    sweep once built a (samples, steps, 2) copy of one program per task (40 MB for 250 samples)."""
+    spec = load_sweep("t-shape-uncertainty")
+    params, x0, u, values = sample_inputs(spec, 0, 3)
+    assert np.array_equal(u, spec.scenario.torque_at_step_starts())
