@@ -32,6 +32,7 @@
 /* The Jacobians write to JOUT, everything else to OUT: one buffer as wide as a step Jacobian
  * would spread the other kernels' outputs over five times the memory and slow them. */
 static sr_real X[NMAX][SR_NX], U[NMAX][SR_NU], OUT[NMAX][SR_NX], JOUT[NMAX][NOUT], BATCH_OUT[NMAX][SR_NV];
+static sr_real STEP_BATCH_OUT[NMAX][SR_NX];
 static double sink;
 
 static double now_ns(void)
@@ -55,6 +56,11 @@ static int k_checked_accel_batch(const sr_model *m, int n, int arg)
 {
     (void)arg;
     return sr_checked_accel_batch(m, n, X[0], U[0], BATCH_OUT[0], NULL);
+}
+/* The batch step Python's Model.step calls for (B, 35) states: Lie-Euler vectorised across them. */
+static int k_step_batch(const sr_model *m, int n, int method)
+{
+    return sr_step_batch(m, method, n, X[0], U[0], 0.01, STEP_BATCH_OUT[0], NULL);
 }
 static int k_accel_general(const sr_model *m, int i, int arg) { (void)m; (void)arg; return sr_accel(&general_model, X[i], U[i], OUT[i]); }
 static int k_step_general(const sr_model *m, int i, int method) { (void)m; return sr_step(&general_model, method, X[i], U[i], 0.01, OUT[i]); }
@@ -99,7 +105,8 @@ typedef struct {
     int arg, nout, repeat_divisor;
     const char *name;
     double best;
-    int batch; /* fn does all n states in one call (fn(model, n, arg)), its outputs in BATCH_OUT */
+    int batch; /* fn does all n states in one call (fn(model, n, arg)), its outputs in BATCH_OUT
+                * (1) or, for a step batch, STEP_BATCH_OUT (2) */
 } bench_case;
 
 /* One timed sweep: `repeats` passes over the n states, ns per call. */
@@ -109,7 +116,7 @@ static double sweep(const bench_case *c, int n, int repeats)
     int r, i, reps = repeats / c->repeat_divisor > 0 ? repeats / c->repeat_divisor : 1;
     for (r = 0; r < reps && c->batch; ++r) {
         if (c->fn(&model, n, c->arg) != 0) { fprintf(stderr, "%s failed\n", c->name); exit(2); }
-        sink += BATCH_OUT[n - 1][0];
+        sink += c->batch == 2 ? STEP_BATCH_OUT[n - 1][0] : BATCH_OUT[n - 1][0];
     }
     for (r = 0; r < reps && !c->batch; ++r)
         for (i = 0; i < n; ++i) {
@@ -129,7 +136,8 @@ static void print_case(const bench_case *c, int n)
         printf("%s[", i ? ", " : "");
         for (k = 0; k < c->nout; ++k)
             printf("%s%.17g", k ? ", " : "",
-                   (double)(c->batch ? BATCH_OUT[i][k] : c->nout > SR_NX ? JOUT[i][k] : OUT[i][k]));
+                   (double)(c->batch == 2 ? STEP_BATCH_OUT[i][k] : c->batch ? BATCH_OUT[i][k]
+                            : c->nout > SR_NX ? JOUT[i][k] : OUT[i][k]));
         printf("]");
     }
     printf("]},\n");
@@ -193,6 +201,7 @@ int main(int argc, char **argv)
             {k_step, SR_RKMK4, SR_NX, 1, "step_rkmk4", 0},
             {k_step, SR_CF4, SR_NX, 1, "step_cf4", 0},
             {k_checked_accel_batch, 0, SR_NV, 1, "checked_accel_batch", 0, 1},
+            {k_step_batch, SR_LIE_EULER, SR_NX, 1, "step_batch_lie_euler", 0, 2},
             {k_accel_general, 0, SR_NV, 1, "accel_general_robot", 0},
             {k_step_general, SR_RKMK4, SR_NX, 1, "step_rkmk4_general_robot", 0},
             {k_accel_jacobian, 0, SR_NV * (SR_NE + SR_NU), 1, "accel_jacobian", 0},

@@ -78,6 +78,7 @@ extern "C" {
 #define sr_step_lie_euler sr_step_lie_euler_f
 #define sr_step_rkmk4 sr_step_rkmk4_f
 #define sr_step_cf4 sr_step_cf4_f
+#define sr_step_batch sr_step_batch_f
 #define sr_simulate sr_simulate_f
 #define sr_simulate_guarded sr_simulate_guarded_f
 #define sr_simulate_adaptive sr_simulate_adaptive_f
@@ -269,6 +270,17 @@ int sr_step_rkmk4(const sr_model *model, const sr_real x[SR_NX], const sr_real u
                   sr_real x_next[SR_NX]);
 int sr_step_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                 sr_real x_next[SR_NX]);
+
+/* sr_step on n states of one robot (x n x SR_NX, u n x SR_NU or NULL, x_next n x SR_NX; x_next may
+ * equal x, and must not overlap it otherwise), for particle filters, sampling-based controllers
+ * and Monte Carlo over initial states (issue 21; c/sr_step_batch.c).  Every row gets exactly the
+ * bits and the status code sr_step gives it; the call stops at the first failing row (its index
+ * in *failed_row, -1 when all succeed) and writes no row after it.  For SR_LIE_EULER and a robot
+ * of the paper's geometry it is vectorised across the states (64 at a time, in loops without
+ * branches: build with -O3; rows with a step angle of 1/4 rad or more, or anything the lanes
+ * cannot clear, go through sr_step); other methods and general robots go row by row. */
+int sr_step_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u, sr_real dt,
+                  sr_real *x_next, long *failed_row);
 
 /* steps steps of size dt from x0: traj[(steps+1) x SR_NX] receives x0 and every state after;
  * u is steps x SR_NU (torque held over each step) or NULL.  x0 gets the full check

@@ -307,6 +307,7 @@ int sr_internal_cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real
 #define sr_internal_valid_method sr_internal_valid_method_f
 #define sr_internal_advance sr_internal_advance_f
 #define sr_internal_check_lanes sr_internal_check_lanes_f
+#define sr_internal_lie_euler_lanes sr_internal_lie_euler_lanes_f
 #define sr_internal_vector_field sr_internal_vector_field_f
 #define sr_internal_rkmk4_core sr_internal_rkmk4_core_f
 #define sr_internal_dexpinv sr_internal_dexpinv_f
@@ -321,6 +322,12 @@ enum { SR_T_S = 0, SR_T_Y = 3, SR_T_P = 4, SR_T_Q = 5, SR_T_V = 8, SR_NT = 13 };
 /* The lanes form of the state checks but finiteness (c/sr_checks.c): ok[i] = 1 or 0. */
 void sr_internal_check_lanes(const sr_model *model, long n, const sr_real *restrict x, long x_stride,
                              sr_real *restrict ok);
+
+/* The Lie-Euler step of n states whose accelerations a are given, one lane per state, for
+ * sr_step_batch (c/sr_step_batch.c): ok[i] = 1 where the lane's result is sr_step's, else 0. */
+void sr_internal_lie_euler_lanes(sr_real r, long n, const sr_real *restrict x, long x_stride,
+                                 const sr_real *restrict a, long a_stride, sr_real dt,
+                                 sr_real *restrict out, long out_stride, sr_real *restrict ok);
 
 /* Nonzero if method is SR_LIE_EULER, SR_RKMK4 or SR_CF4, optionally | SR_PROJECT. */
 int sr_internal_valid_method(int method);

@@ -185,7 +185,10 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods):
 
     # -- time stepping ----------------------------------------------------------
     def step(self, x, u=None, dt=0.01, method="lie-euler"):
-        """One step of `method` with torques u held constant; returns the new state (35,)."""
+        """One step of `method` with torques u held constant: the new state (35,) for x (35,), or
+        (B, 35) for a batch x (B, 35) of states of this robot, u (2,) / (B, 2) or None; each row
+        is the single step's, bit for bit (C: sr_step_batch, vectorised across the states for
+        Lie-Euler)."""
         code = METHODS.get(method) if method.__class__ is str else None
         if code is not None:               # the fast path, as in `accel` (C also checks dt and the method)
             out = self._fast.step(x, u, dt, code)
@@ -195,11 +198,29 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods):
 
     def _step(self, x, u, dt, method):
         """`step` for every input: converted and checked in Python's terms, then C."""
-        x, u = self._state_and_input(x, u, batch=False)
+        x = real_array(x, "x", (NX,))
+        if x.ndim == 1:
+            x, u = self._state_and_input(x, u, batch=False)
+            dt = self._dt(dt)
+            out = np.empty(NX)
+            self._check("x", lib.sr_step(self._model, _method(method), _ptr(x), _ptr(u), dt, _ptr(out)),
+                        ": the step's result overflowed (dt too large for this state?)")
+            return out
+        # A batch: C checks every state in full and steps (sr_step_batch); the state it stops at
+        # is checked again here, for the message that names what is wrong (as in `_accel`).
+        u = None if u is None else self._input(u, x)
         dt = self._dt(dt)
-        out = np.empty(NX)
-        self._check("x", lib.sr_step(self._model, _method(method), _ptr(x), _ptr(u), dt, _ptr(out)),
-                    ": the step's result overflowed (dt too large for this state?)")
+        code = _method(method)
+        out = np.empty((x.shape[0], NX))
+        failed = ffi.new("long *")
+        status = lib.sr_step_batch(self._model, code, x.shape[0], _ptr(x), ffi.NULL if u is None else _ptr(u), dt,
+                                   _ptr(out), failed)
+        if status != lib.SR_OK:
+            row = failed[0]
+            field = f"x[{row}]" if row >= 0 else "x"
+            if row >= 0:
+                check_states(self._model, x[row], self.params.r, field)
+            self._check(field, status, ": the step's result overflowed (dt too large for this state?)")
         return out
 
     def simulate(self, x0, dt, steps, u=None, method="lie-euler", energy_tol=ENERGY_TOL, progress=None):

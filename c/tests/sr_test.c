@@ -51,6 +51,7 @@ int main(void)
     suite_control();
     suite_trig();
     suite_accel_batch();
+    suite_step_batch();
     return sr_test_summary();
 }
 

@@ -73,6 +73,7 @@ void suite_jacobians(void);
 void suite_control(void);
 void suite_trig(void);
 void suite_accel_batch(void);
+void suite_step_batch(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 

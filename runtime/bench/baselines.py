@@ -167,6 +167,14 @@ def python_timings(model, X, U, batch_size, progress, with_kane=True, loop_steps
         lambda: [model.accel(XS, US) for _ in range(calls)], 5) / (calls * small) * 1e9
     out["batch_size_in_cache"] = small
     check_close("batch accel", AB[:len(X)], np.array([model.accel(x, u) for x, u in zip(X, U)]), 0)
+    # Model.step on the same 10⁴ states (sr_step_batch: Lie-Euler vectorised across them), against
+    # one Model.step call per state from a Python loop, the way a user would step them otherwise.
+    out["python_batch_step_lie_euler_ns_per_state"] = best_seconds(
+        lambda: [model.step(XS, US, 0.01) for _ in range(calls)], 5) / (calls * small) * 1e9
+    out["python_loop_step_lie_euler_ns_per_state"] = best_seconds(
+        lambda: [model.step(x, u, 0.01) for x, u in zip(XS, US)], 3) / small * 1e9
+    check_close("batch step", model.step(XS[:len(X)], US[:len(X)], 0.01),
+                np.array([model.step(x, u, 0.01) for x, u in zip(XS[:len(X)], US[:len(X)])]), 0)
 
     u_prog = t_shape_program()
     x0 = initial_state()

@@ -102,12 +102,20 @@ def sections(res):
     if "checked_accel_batch" in c:
         rows.append(("our checked accel batch (sr_checked_accel_batch, full state check), per state",
                      f"{c['checked_accel_batch']['ns']:,.1f} ns", f"{c['checked_accel_batch']['ns'] / ours:.2f}x"))
+    if "step_batch_lie_euler" in c:
+        rows.append(("our Lie-Euler step batch (sr_step_batch, vectorised), per state",
+                     f"{c['step_batch_lie_euler']['ns']:,.1f} ns",
+                     f"{c['step_batch_lie_euler']['ns'] / c['step_lie_euler']['ns']:.2f}x our lie euler step"))
     if res.get("c_loop_native"):
         native = res["c_loop_native"]
         rows.append(("our accel, checked API, -march=native", f"{native['accel']['ns']:,.1f} ns", ""))
         if "checked_accel_batch" in native:
             rows.append(("our checked accel batch, -march=native, per state", f"{native['checked_accel_batch']['ns']:,.1f} ns",
                          f"{native['checked_accel_batch']['ns'] / ours:.2f}x"))
+        if "step_batch_lie_euler" in native:
+            rows.append(("our Lie-Euler step batch, -march=native, per state",
+                         f"{native['step_batch_lie_euler']['ns']:,.1f} ns",
+                         f"{native['step_batch_lie_euler']['ns'] / c['step_lie_euler']['ns']:.2f}x our lie euler step"))
     for key, label in C_BASELINES:
         if key in c:
             rows.append((label, f"{c[key]['ns']:,.1f} ns", f"{c[key]['ns'] / ours:,.1f}x slower"))
@@ -138,6 +146,10 @@ def sections(res):
         small = py["python_batch_accel_in_cache_ns_per_state"]
         rows.append((f"Model.accel batch of {py['batch_size_in_cache']:,} (in the caches)", f"{small:,.1f} ns",
                      f"{small / ours:.2f}x one checked accel in C"))
+    if "python_batch_step_lie_euler_ns_per_state" in py:
+        step, loop = py["python_batch_step_lie_euler_ns_per_state"], py["python_loop_step_lie_euler_ns_per_state"]
+        rows.append((f"Model.step lie-euler batch of {py['batch_size_in_cache']:,} / the same in a loop of single calls",
+                     f"{step:,.1f} / {loop:,.1f} ns", f"{loop / step:.1f}x faster as a batch"))
     for name, ns in py.get("alternative_batch_ns_per_state", {}).items():
         rows.append((f"batch accel, {name}", f"{ns:,.1f} ns", f"{ns / batch:,.0f}x slower"))
     for key, value in py.items():

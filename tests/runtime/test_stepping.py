@@ -89,3 +89,47 @@ def test_rotations_stay_orthonormal_over_1e5_steps(model):
 def test_centre_stays_at_height_r(model):
     traj = model.simulate(initial_state(theta_Y=0.5, theta_P=-0.7, w_S=(1, 2, 3)), 0.01, 1000)
     assert np.all(traj[:, 29] == model.params.r)
+
+
+# -- batches: Model.step on (B, 35) (C: sr_step_batch, vectorised across the states for Lie-Euler) --
+
+def batch(rng, n, params=None, max_speed=10.0):
+    x = np.stack([random_state(rng, params, max_speed=max_speed) for _ in range(n)])
+    return x, random_inputs(rng, n)
+
+
+@pytest.mark.parametrize("method, dt", [("lie-euler", 0.01), ("lie-euler", 0.05), ("rkmk4", 0.01), ("cf4", 0.02)])
+def test_a_batch_step_equals_single_steps_bit_for_bit(model, rng, method, dt):
+    """dt = 0.05 s with speeds to 10 rad/s takes some rows past the lanes' series range."""
+    x, u = batch(rng, 150)
+    y = model.step(x, u, dt, method)
+    assert y.shape == (150, 35)
+    assert np.array_equal(y, np.stack([model.step(x[i], u[i], dt, method) for i in range(150)]))
+    assert np.array_equal(model.step(x, None, dt, method), np.stack([model.step(s, None, dt, method) for s in x]))
+
+
+def test_a_batch_step_of_a_general_robot_equals_single_steps(rng):
+    from runtime.verification.sampling import random_general_params
+    general = Model(random_general_params(rng))
+    x, u = batch(rng, 70, general.params)
+    assert np.array_equal(general.step(x, u), np.stack([general.step(x[i], u[i]) for i in range(70)]))
+
+
+def test_a_batch_step_names_the_row_and_entry_that_is_wrong(model, rng):
+    x, u = batch(rng, 100)
+    x[77, 12] = np.nan
+    with pytest.raises(ValueError, match=r"x\[77\]: x\[77\]\[12\] \(R_Y\[1,0\]\) is nan"):
+        model.step(x, u)
+    x[77, 12] = 0.0
+    x[80, 0] += 1e-3
+    with pytest.raises(ValueError, match=r"x\[80\]: R_S .* not orthonormal"):
+        model.step(x, u)
+
+
+def test_a_batch_step_checks_the_torques_shape_and_values(model, rng):
+    x, u = batch(rng, 5)
+    with pytest.raises(ValueError, match="u: shape"):
+        model.step(x, u[:4])
+    u[3, 1] = np.inf
+    with pytest.raises(ValueError, match=r"u\[3, 1\] is inf"):
+        model.step(x, u)
