@@ -57,7 +57,7 @@ static int k_checked_accel_batch(const sr_model *m, int n, int arg)
     (void)arg;
     return sr_checked_accel_batch(m, n, X[0], U[0], BATCH_OUT[0], NULL);
 }
-/* The batch step Python's Model.step calls for (B, 35) states: Lie-Euler vectorised across them. */
+/* The batch step Python's Model.step calls for (B, 35) states, vectorised across them. */
 static int k_step_batch(const sr_model *m, int n, int method)
 {
     return sr_step_batch(m, method, n, X[0], U[0], 0.01, STEP_BATCH_OUT[0], NULL);
@@ -202,6 +202,8 @@ int main(int argc, char **argv)
             {k_step, SR_CF4, SR_NX, 1, "step_cf4", 0},
             {k_checked_accel_batch, 0, SR_NV, 1, "checked_accel_batch", 0, 1},
             {k_step_batch, SR_LIE_EULER, SR_NX, 1, "step_batch_lie_euler", 0, 2},
+            {k_step_batch, SR_RKMK4, SR_NX, 1, "step_batch_rkmk4", 0, 2},
+            {k_step_batch, SR_CF4, SR_NX, 1, "step_batch_cf4", 0, 2},
             {k_accel_general, 0, SR_NV, 1, "accel_general_robot", 0},
             {k_step_general, SR_RKMK4, SR_NX, 1, "step_rkmk4_general_robot", 0},
             {k_accel_jacobian, 0, SR_NV * (SR_NE + SR_NU), 1, "accel_jacobian", 0},

@@ -275,10 +275,11 @@ int sr_step_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[S
  * equal x, and must not overlap it otherwise), for particle filters, sampling-based controllers
  * and Monte Carlo over initial states (issue 21; c/sr_step_batch.c).  Every row gets exactly the
  * bits and the status code sr_step gives it; the call stops at the first failing row (its index
- * in *failed_row, -1 when all succeed) and writes no row after it.  For SR_LIE_EULER and a robot
- * of the paper's geometry it is vectorised across the states (64 at a time, in loops without
- * branches: build with -O3; rows with a step angle of 1/4 rad or more, or anything the lanes
- * cannot clear, go through sr_step); other methods and general robots go row by row. */
+ * in *failed_row, -1 when all succeed) and writes no row after it.  For SR_LIE_EULER, SR_RKMK4 and
+ * SR_CF4 and a robot of the paper's geometry it is vectorised across the states (16 at a time, in
+ * loops without branches: build with -O3; a row with a step angle of 1/4 rad or more, or anything
+ * else the lanes do not clear, goes through sr_step); the projected methods and general robots go
+ * row by row.  Stack: about 18 KB in double (five blocks of stage data). */
 int sr_step_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u, sr_real dt,
                   sr_real *x_next, long *failed_row);
 

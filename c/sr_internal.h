@@ -308,6 +308,9 @@ int sr_internal_cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real
 #define sr_internal_advance sr_internal_advance_f
 #define sr_internal_check_lanes sr_internal_check_lanes_f
 #define sr_internal_lie_euler_lanes sr_internal_lie_euler_lanes_f
+#define sr_internal_act_lanes sr_internal_act_lanes_f
+#define sr_internal_act2_lanes sr_internal_act2_lanes_f
+#define sr_internal_field_lanes sr_internal_field_lanes_f
 #define sr_internal_vector_field sr_internal_vector_field_f
 #define sr_internal_rkmk4_core sr_internal_rkmk4_core_f
 #define sr_internal_dexpinv sr_internal_dexpinv_f
@@ -328,6 +331,18 @@ void sr_internal_check_lanes(const sr_model *model, long n, const sr_real *restr
 void sr_internal_lie_euler_lanes(sr_real r, long n, const sr_real *restrict x, long x_stride,
                                  const sr_real *restrict a, long a_stride, sr_real dt,
                                  sr_real *restrict out, long out_stride, sr_real *restrict ok);
+
+/* The pieces of the fourth-order steps in the same form (c/sr_step_batch.c): x . exp(th) and
+ * x . exp(th1) . exp(th2) (ok cleared past the series or for a non-finite result, else kept); the
+ * vector field from given accelerations, then dexp^-1 if th is not NULL (ok likewise). */
+void sr_internal_act_lanes(long n, const sr_real *restrict x, long x_stride, const sr_real *restrict th,
+                           long th_stride, sr_real *restrict out, long out_stride, sr_real *restrict ok);
+void sr_internal_act2_lanes(long n, const sr_real *restrict x, long x_stride, const sr_real *restrict th1,
+                            const sr_real *restrict th2, long th_stride, sr_real *restrict out, long out_stride,
+                            sr_real *restrict ok);
+void sr_internal_field_lanes(sr_real r, long n, const sr_real *restrict y, long y_stride, const sr_real *restrict a,
+                             long a_stride, const sr_real *restrict th, long th_stride, sr_real *restrict f,
+                             long f_stride, sr_real *restrict ok);
 
 /* Nonzero if method is SR_LIE_EULER, SR_RKMK4 or SR_CF4, optionally | SR_PROJECT. */
 int sr_internal_valid_method(int method);

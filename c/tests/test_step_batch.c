@@ -1,8 +1,9 @@
 /*
- * test_step_batch.c -- sr_step_batch (c/sr_step_batch.c): the Lie-Euler step vectorised across
- * the states, every row not cleared by the lanes through sr_step.  Each row's result is sr_step's
- * bit for bit, whichever path it took (the lanes, or sr_step for a step angle past the series'
- * range), and every bad entry of every row is reported with sr_step's status, at its row.
+ * test_step_batch.c -- sr_step_batch (c/sr_step_batch.c, c/sr_step_lanes.c): every method's step
+ * vectorised across the states, every row not cleared by the lanes through sr_step.  Each row's
+ * result is sr_step's bit for bit, whichever path it took (the lanes, or sr_step for a step angle
+ * past the series' range), and every bad entry of every row is reported with sr_step's status, at
+ * its row.
  */
 #include "sr_test.h"
 
@@ -44,17 +45,21 @@ static int equal_to_single_steps(const sr_model *m, int method, sr_real x[N][SR_
     return 1;
 }
 
-static void test_lie_euler_rows_equal_single_steps_bit_for_bit(void)
+static void test_rows_equal_single_steps_bit_for_bit_for_every_method(void)
 {
     static sr_real x[N][SR_NX], u[N][SR_NU], y[N][SR_NX];
+    const int methods[] = {SR_LIE_EULER, SR_RKMK4, SR_CF4};
     sr_model m;
     long row = 99;
+    int k;
     paper_simulation_model(&m);
     random_rows(x, u, m.p[SR_P_r], 5.0);
-    CHECK_STATUS(sr_step_batch(&m, SR_LIE_EULER, N, x[0], u[0], (sr_real)0.01, y[0], &row), SR_OK);
-    CHECK(row == -1 && equal_to_single_steps(&m, SR_LIE_EULER, x, u, 1, (sr_real)0.01, y));
-    CHECK_STATUS(sr_step_batch(&m, SR_LIE_EULER, N, x[0], NULL, (sr_real)0.01, y[0], &row), SR_OK);
-    CHECK(row == -1 && equal_to_single_steps(&m, SR_LIE_EULER, x, u, 0, (sr_real)0.01, y));
+    for (k = 0; k < 3; ++k) {
+        CHECK_STATUS(sr_step_batch(&m, methods[k], N, x[0], u[0], (sr_real)0.01, y[0], &row), SR_OK);
+        CHECK(row == -1 && equal_to_single_steps(&m, methods[k], x, u, 1, (sr_real)0.01, y));
+        CHECK_STATUS(sr_step_batch(&m, methods[k], N, x[0], NULL, (sr_real)0.01, y[0], &row), SR_OK);
+        CHECK(row == -1 && equal_to_single_steps(&m, methods[k], x, u, 0, (sr_real)0.01, y));
+    }
 }
 
 /* Steps of up to 0.5 rad (speeds to 5 rad/s, dt = 0.1 s): the rows past the series' 1/4 rad go
@@ -75,6 +80,11 @@ static void test_rows_past_the_series_range_equal_single_steps(void)
     CHECK(past > 0 && past < N);   /* both paths are taken */
     CHECK_STATUS(sr_step_batch(&m, SR_LIE_EULER, N, x[0], u[0], (sr_real)0.1, y[0], NULL), SR_OK);
     CHECK(equal_to_single_steps(&m, SR_LIE_EULER, x, u, 1, (sr_real)0.1, y));
+    /* the stages' dexp^-1 series ends at |th|^2 = 1e-2: dt = 0.04 s takes some rows past it */
+    CHECK_STATUS(sr_step_batch(&m, SR_RKMK4, N, x[0], u[0], (sr_real)0.04, y[0], NULL), SR_OK);
+    CHECK(equal_to_single_steps(&m, SR_RKMK4, x, u, 1, (sr_real)0.04, y));
+    CHECK_STATUS(sr_step_batch(&m, SR_CF4, N, x[0], u[0], (sr_real)0.1, y[0], NULL), SR_OK);
+    CHECK(equal_to_single_steps(&m, SR_CF4, x, u, 1, (sr_real)0.1, y));
 }
 
 /* The comparison above sees a one-ulp change of one entry of one row (it can fail). */
@@ -89,7 +99,7 @@ static void test_bit_for_bit_comparison_sees_one_ulp(void)
     CHECK(!equal_to_single_steps(&m, SR_LIE_EULER, x, u, 1, (sr_real)0.01, y));
 }
 
-static void test_other_methods_and_general_robots_equal_single_steps(void)
+static void test_projected_methods_and_general_robots_equal_single_steps(void)
 {
     static sr_real x[N][SR_NX], u[N][SR_NU], y[N][SR_NX];
     sr_real p[SR_NPARAM];
@@ -98,13 +108,13 @@ static void test_other_methods_and_general_robots_equal_single_steps(void)
     general_robot_params(p);
     CHECK_STATUS(sr_model_init(&g, p), SR_OK);
     random_rows(x, u, m.p[SR_P_r], 5.0);
-    CHECK_STATUS(sr_step_batch(&m, SR_RKMK4, N, x[0], u[0], (sr_real)0.01, y[0], NULL), SR_OK);
-    CHECK(equal_to_single_steps(&m, SR_RKMK4, x, u, 1, (sr_real)0.01, y));
     CHECK_STATUS(sr_step_batch(&m, SR_CF4 | SR_PROJECT, N, x[0], u[0], (sr_real)0.01, y[0], NULL), SR_OK);
     CHECK(equal_to_single_steps(&m, SR_CF4 | SR_PROJECT, x, u, 1, (sr_real)0.01, y));
     random_rows(x, u, g.p[SR_P_r], 5.0);
     CHECK_STATUS(sr_step_batch(&g, SR_LIE_EULER, N, x[0], u[0], (sr_real)0.01, y[0], NULL), SR_OK);
     CHECK(equal_to_single_steps(&g, SR_LIE_EULER, x, u, 1, (sr_real)0.01, y));
+    CHECK_STATUS(sr_step_batch(&g, SR_RKMK4, N, x[0], u[0], (sr_real)0.01, y[0], NULL), SR_OK);
+    CHECK(equal_to_single_steps(&g, SR_RKMK4, x, u, 1, (sr_real)0.01, y));
 }
 
 /* In place (x_next = x): every row is stepped from its own old state. */
@@ -114,8 +124,8 @@ static void test_in_place_equals_a_separate_output(void)
     sr_model m;
     paper_simulation_model(&m);
     random_rows(x, u, m.p[SR_P_r], 5.0);
-    CHECK_STATUS(sr_step_batch(&m, SR_LIE_EULER, N, x[0], u[0], (sr_real)0.1, y[0], NULL), SR_OK);
-    CHECK_STATUS(sr_step_batch(&m, SR_LIE_EULER, N, x[0], u[0], (sr_real)0.1, x[0], NULL), SR_OK);
+    CHECK_STATUS(sr_step_batch(&m, SR_RKMK4, N, x[0], u[0], (sr_real)0.1, y[0], NULL), SR_OK);
+    CHECK_STATUS(sr_step_batch(&m, SR_RKMK4, N, x[0], u[0], (sr_real)0.1, x[0], NULL), SR_OK);
     CHECK(memcmp(x, y, sizeof x) == 0);
 }
 
@@ -143,7 +153,9 @@ static void test_every_non_finite_entry_is_reported_at_its_row(void)
                 if (status == SR_OK
                     || sr_step_batch(&m, SR_LIE_EULER, N, x[0], u[0], (sr_real)0.01, y[0], &row) != status
                     || row != rows[r] || memcmp(y, want, sizeof(sr_real) * SR_NX * rows[r]) != 0
-                    || (rows[r] + 1 < N && y[rows[r] + 1][0] != 0)) {
+                    || (rows[r] + 1 < N && y[rows[r] + 1][0] != 0)
+                    || sr_step_batch(&m, SR_RKMK4, N, x[0], u[0], (sr_real)0.01, y[0], &row) != status
+                    || row != rows[r]) {
                     ++missed;
                     printf("    entry %d of row %d = %g not reported\n", k, rows[r], bad[b]);
                 }
@@ -192,10 +204,10 @@ static void test_bad_arguments_get_sr_step_s_status(void)
 
 void suite_step_batch(void)
 {
-    RUN_TEST(test_lie_euler_rows_equal_single_steps_bit_for_bit);
+    RUN_TEST(test_rows_equal_single_steps_bit_for_bit_for_every_method);
     RUN_TEST(test_rows_past_the_series_range_equal_single_steps);
     RUN_TEST(test_bit_for_bit_comparison_sees_one_ulp);
-    RUN_TEST(test_other_methods_and_general_robots_equal_single_steps);
+    RUN_TEST(test_projected_methods_and_general_robots_equal_single_steps);
     RUN_TEST(test_in_place_equals_a_separate_output);
     RUN_TEST(test_every_non_finite_entry_is_reported_at_its_row);
     RUN_TEST(test_states_the_full_check_refuses_are_reported_at_their_row);

@@ -133,7 +133,8 @@ def check_harness(result, model, X, U, step_dt=0.01):
         check("C checked accel batch vs reference", "checked_accel_batch", lambda i: accel[i], 1e-10)
     check("C inertia vs reference", "inertia", lambda i: ref.inertia(X[i]), 1e-10)
     for key, method in [("step_lie_euler", "lie-euler"), ("step_rkmk4", "rkmk4"), ("step_cf4", "cf4"),
-                        ("step_batch_lie_euler", "lie-euler")]:
+                        ("step_batch_lie_euler", "lie-euler"), ("step_batch_rkmk4", "rkmk4"),
+                        ("step_batch_cf4", "cf4")]:
         if key in result:
             step = STEPPERS[method]
             check(f"C {method} step vs NumPy tableau on the reference", key,

@@ -102,20 +102,22 @@ def sections(res):
     if "checked_accel_batch" in c:
         rows.append(("our checked accel batch (sr_checked_accel_batch, full state check), per state",
                      f"{c['checked_accel_batch']['ns']:,.1f} ns", f"{c['checked_accel_batch']['ns'] / ours:.2f}x"))
-    if "step_batch_lie_euler" in c:
-        rows.append(("our Lie-Euler step batch (sr_step_batch, vectorised), per state",
-                     f"{c['step_batch_lie_euler']['ns']:,.1f} ns",
-                     f"{c['step_batch_lie_euler']['ns'] / c['step_lie_euler']['ns']:.2f}x our lie euler step"))
+    for method in ("lie_euler", "rkmk4", "cf4"):
+        if f"step_batch_{method}" in c:
+            rows.append((f"our {method.replace('_', '-')} step batch (sr_step_batch, vectorised), per state",
+                         f"{c[f'step_batch_{method}']['ns']:,.1f} ns",
+                         f"{c[f'step_batch_{method}']['ns'] / c[f'step_{method}']['ns']:.2f}x our {method.replace('_', ' ')} step"))
     if res.get("c_loop_native"):
         native = res["c_loop_native"]
         rows.append(("our accel, checked API, -march=native", f"{native['accel']['ns']:,.1f} ns", ""))
         if "checked_accel_batch" in native:
             rows.append(("our checked accel batch, -march=native, per state", f"{native['checked_accel_batch']['ns']:,.1f} ns",
                          f"{native['checked_accel_batch']['ns'] / ours:.2f}x"))
-        if "step_batch_lie_euler" in native:
-            rows.append(("our Lie-Euler step batch, -march=native, per state",
-                         f"{native['step_batch_lie_euler']['ns']:,.1f} ns",
-                         f"{native['step_batch_lie_euler']['ns'] / c['step_lie_euler']['ns']:.2f}x our lie euler step"))
+        for method in ("lie_euler", "rkmk4", "cf4"):
+            if f"step_batch_{method}" in native:
+                rows.append((f"our {method.replace('_', '-')} step batch, -march=native, per state",
+                             f"{native[f'step_batch_{method}']['ns']:,.1f} ns",
+                             f"{native[f'step_batch_{method}']['ns'] / c[f'step_{method}']['ns']:.2f}x our {method.replace('_', ' ')} step"))
     for key, label in C_BASELINES:
         if key in c:
             rows.append((label, f"{c[key]['ns']:,.1f} ns", f"{c[key]['ns'] / ours:,.1f}x slower"))
