@@ -130,6 +130,32 @@ static inline sr_real cosc_series(sr_real t2)
          + t8 * (SR_C(1.0) / 3628800 - t2 * (SR_C(1.0) / 479001600));
 }
 
+/* c(t) = (1 - (t/2) cot(t/2)) / t^2 of dexp^-1 (sr_steppers.c) and its derivative dc/ds, s = t^2,
+ * by their Taylor series for s < SR_SERIES_T2 (|t| < 1/4 rad), in Estrin's form: through s^5, the
+ * first omitted term of c, s^6/74724249600, is below 1e-17 of c there; dc through s^5 and one term
+ * more (its first omitted, 7 c_7 s^6, below 1e-16 of dc).  Up to 2026-11-25 the series ended at
+ * s = 1e-2 (four terms) and sin, cos and a division served beyond: RKMK4 stages at 10-25 rad/s
+ * with dt = 0.01 s took that branch, which the vectorised batch step (sr_step_lanes.c) cannot. */
+#define SR_DEXPINV_C0 (SR_C(1.0) / 12)
+#define SR_DEXPINV_C1 (SR_C(1.0) / 720)
+#define SR_DEXPINV_C2 (SR_C(1.0) / 30240)
+#define SR_DEXPINV_C3 (SR_C(1.0) / 1209600)
+#define SR_DEXPINV_C4 (SR_C(1.0) / 47900160)
+#define SR_DEXPINV_C5 (SR_C(691.0) / SR_C(1307674368000.0))
+#define SR_DEXPINV_C6 (SR_C(1.0) / SR_C(74724249600.0))
+static inline sr_real dexpinv_series(sr_real s)
+{
+    const sr_real s2 = s * s, s4 = s2 * s2;
+    return (SR_DEXPINV_C0 + s * SR_DEXPINV_C1) + s2 * (SR_DEXPINV_C2 + s * SR_DEXPINV_C3)
+         + s4 * (SR_DEXPINV_C4 + s * SR_DEXPINV_C5);
+}
+static inline sr_real dexpinv_series_derivative(sr_real s)
+{
+    const sr_real s2 = s * s, s4 = s2 * s2;
+    return (SR_DEXPINV_C1 + s * (2 * SR_DEXPINV_C2)) + s2 * (3 * SR_DEXPINV_C3 + s * (4 * SR_DEXPINV_C4))
+         + s4 * (5 * SR_DEXPINV_C5 + s * (6 * SR_DEXPINV_C6));
+}
+
 /* Rodrigues' coefficients A = sin(t)/t and B = (1 - cos t)/t^2 from t^2 = |w|^2, so that
  * Exp([[w]]) = I + A [[w]] + B [[w]]^2 (sr_so3_exp; the Lie-group steppers use the same
  * coefficients to form Exp - I directly). */

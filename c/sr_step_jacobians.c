@@ -32,12 +32,12 @@ typedef sr_real tangent[SR_NT][NC];   /* d(13-vector)/d(d, w), carried columns *
 typedef sr_real error[SR_NE][NC];     /* d(state error)/d(d, w), carried columns */
 
 /* c(s) of dexp^-1 (s = |th|^2) and its derivative dc/ds: the closed form of sr_internal_dexpinv,
- * with the same series below s = 1e-2. */
+ * with the same series below s = SR_SERIES_T2 (sr_internal.h). */
 static void dexpinv_coefficient(sr_real s, sr_real *c, sr_real *dc)
 {
-    if (s < SR_C(1e-2)) {
-        *c = SR_C(1.0) / 12 + s * (SR_C(1.0) / 720 + s * (SR_C(1.0) / 30240 + s * (SR_C(1.0) / 1209600)));
-        *dc = SR_C(1.0) / 720 + s * (SR_C(2.0) / 30240 + s * (SR_C(3.0) / 1209600));
+    if (s < SR_SERIES_T2) {
+        *c = dexpinv_series(s);
+        *dc = dexpinv_series_derivative(s);
     } else {
         const sr_real half = SR_C(0.5) * SR_SQRT(s), sn = SR_SIN(half), cs = SR_COS(half);
         const sr_real phi = 1 - half * cs / sn;                 /* c = phi / s */

@@ -4,7 +4,7 @@
  * branches or inner loops, that the compiler vectorises across the states from plain C99 (at -O3;
  * SR_LANES_CLONES adds AVX2).  Each computes the same expressions in the same order as the scalar
  * code, so a lane's result is the scalar step's bit for bit wherever the scalar code takes the
- * series branches; ok[i] is cleared where it does not (an angle of 1/4 rad or more, |th_S|^2 >= 1e-2
+ * series branches; ok[i] is cleared where it does not (an angle of 1/4 rad or more, |th_S| >= 1/4 rad
  * for dexp^-1) or where a result's sum is not finite, and sr_step_batch hands that state to sr_step.
  *
  * Strides are arguments (GCC 12 vectorises strided loads with a variable stride, not with a
@@ -323,7 +323,7 @@ SR_LANES_CLONES void sr_internal_act2_lanes(long n, const sr_real *restrict x, l
 
 /* f = the vector field at the states y (sr_internal_vector_field) whose accelerations a are
  * given; then, if th is not NULL, k = dexp^-1_{-th}(f) in place (sr_internal_dexpinv, its series
- * branch: ok[i] cleared where |th_S|^2 >= 1e-2, kept otherwise). */
+ * branch: ok[i] cleared where |th_S| >= 1/4 rad, kept otherwise). */
 SR_LANES_CLONES void sr_internal_field_lanes(sr_real r, long n, const sr_real *restrict y, long y_stride,
                                              const sr_real *restrict a, long a_stride, const sr_real *restrict th,
                                              long th_stride, sr_real *restrict f, long f_stride, sr_real *restrict ok)
@@ -354,14 +354,14 @@ SR_LANES_CLONES void sr_internal_field_lanes(sr_real r, long n, const sr_real *r
     for (i = 0; i < n; ++i) {
         const sr_real t0 = T(SR_T_S), t1 = T(SR_T_S + 1), t2 = T(SR_T_S + 2);
         const sr_real s2 = t0 * t0 + t1 * t1 + t2 * t2;
-        const sr_real c = SR_C(1.0) / 12 + s2 * (SR_C(1.0) / 720 + s2 * (SR_C(1.0) / 30240 + s2 * (SR_C(1.0) / 1209600)));
+        const sr_real c = dexpinv_series(s2);
         const sr_real u0 = F(SR_T_S), u1 = F(SR_T_S + 1), u2 = F(SR_T_S + 2);
         const sr_real a0 = t1 * u2 - t2 * u1, a1 = t2 * u0 - t0 * u2, a2 = t0 * u1 - t1 * u0;
         const sr_real b0 = t1 * a2 - t2 * a1, b1 = t2 * a0 - t0 * a2, b2 = t0 * a1 - t1 * a0;
         F(SR_T_S + 0) = u0 + SR_C(0.5) * a0 + c * b0;
         F(SR_T_S + 1) = u1 + SR_C(0.5) * a1 + c * b1;
         F(SR_T_S + 2) = u2 + SR_C(0.5) * a2 + c * b2;
-        ok[i] = s2 < SR_C(1e-2) ? ok[i] : 0;
+        ok[i] = s2 < SR_SERIES_T2 ? ok[i] : 0;
     }
 #undef Y
 #undef A

@@ -33,6 +33,7 @@
  * Right trivialisation.  For R(t) = R0 Exp([[theta(t)]]) to solve R' = R [[w]] we need
  *     theta' = dexp^{-1}_{-theta}(w) = w + 1/2 theta x w + c(|theta|) theta x (theta x w),
  *     c(t) = (1 - (t/2) cot(t/2)) / t^2 = 1/12 + t^2/720 + t^4/30240 + t^6/1209600 + ...
+ * (dexpinv_series in sr_internal.h)
  * (the inverse of the right Jacobian of SO(3)).  The left-action formulas of the literature
  * (y' = A(y) y, y1 = exp(...) y0) become ours for Z = R^T; in particular, in a product of
  * exponentials the factor applied first stands next to R0.
@@ -152,17 +153,16 @@ void sr_internal_act(const sr_real x[SR_NX], const sr_real th[SR_NT], sr_real ou
     act(x, th, out);
 }
 
-/* k = dexp^{-1}_{-th}(f): the so(3) block gets the closed form above (series below
- * |th| = 0.1 rad, where the omitted t^8/47900160 term is below 1e-16 relative); the abelian
- * blocks are copied.  k may alias f. */
+/* k = dexp^{-1}_{-th}(f): the so(3) block gets the closed form above (its series below
+ * |th| = 1/4 rad, dexpinv_series of sr_internal.h); the abelian blocks are copied.  k may alias f. */
 void sr_internal_dexpinv(const sr_real th[SR_NT], const sr_real f[SR_NT], sr_real k[SR_NT])
 {
     const sr_real *t = th + SR_T_S, *w = f + SR_T_S;
     const sr_real t2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
     sr_real c, a[3], b[3];
     int i;
-    if (t2 < SR_C(1e-2)) {
-        c = SR_C(1.0) / 12 + t2 * (SR_C(1.0) / 720 + t2 * (SR_C(1.0) / 30240 + t2 * (SR_C(1.0) / 1209600)));
+    if (t2 < SR_SERIES_T2) {
+        c = dexpinv_series(t2);
     } else {
         const sr_real half = SR_C(0.5) * SR_SQRT(t2);
         c = (1 - half * SR_COS(half) / SR_SIN(half)) / t2;

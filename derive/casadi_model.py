@@ -26,7 +26,6 @@ from . import state as S
 
 # The series thresholds of c/sr_internal.h (SR_SERIES_T2) and of sr_internal_dexpinv.
 SERIES_T2 = 0.0625
-DEXPINV_SERIES_T2 = 1e-2
 
 
 def sympy_to_casadi(exprs, values):
@@ -166,11 +165,13 @@ def dexpinv(th, k):
     """dexp⁻¹_{-θ}(k) on the so(3) block: k + ½ θ×k + c(|θ|) θ×(θ×k); the other blocks copied."""
     t, w = th[0:3], k[0:3]
     t2 = ca.dot(t, t)
-    small = t2 < DEXPINV_SERIES_T2
+    small = t2 < SERIES_T2
     safe = ca.if_else(small, 1.0, t2)
     half = 0.5 * ca.sqrt(safe)
-    c = ca.if_else(small, 1.0 / 12 + t2 * (1.0 / 720 + t2 * (1.0 / 30240 + t2 * (1.0 / 1209600))),
-                   (1 - half * ca.cos(half) / ca.sin(half)) / safe)
+    t4 = t2 * t2
+    series = ((1.0 / 12 + t2 * (1.0 / 720)) + t4 * (1.0 / 30240 + t2 * (1.0 / 1209600))
+              + (t4 * t4) * (1.0 / 47900160 + t2 * (691.0 / 1307674368000.0)))   # dexpinv_series of c/sr_internal.h
+    c = ca.if_else(small, series, (1 - half * ca.cos(half) / ca.sin(half)) / safe)
     a = ca.cross(t, w)
     return ca.vertcat(w + 0.5 * a + c * ca.cross(t, a), k[3:])
 

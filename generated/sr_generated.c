@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources c8ad01e71a8162b4], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 063b1d7b1d9b316c], SymPy 1.14.0. */
 #include "sr_generated.h"
 
 #include <math.h>

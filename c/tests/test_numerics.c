@@ -5,6 +5,7 @@
  * determinism (aliasing, re-entrancy: no hidden state between calls).
  */
 #include "sr_test.h"
+#include "sr_internal.h" /* dexpinv_series: internal, tested directly */
 
 #include <math.h>
 #include <string.h>
@@ -89,6 +90,40 @@ static void test_so3_exp_small_angle_series_match_libm_to_a_few_ulp(void)
         }
     }
     CHECK(!worst_truncated_ok); /* the truncated series fails the bound the C passes */
+}
+
+/* c(s) = (1 - (t/2) cot(t/2)) / t^2 of dexp^-1 (s = t^2) from the Bernoulli numbers, an
+ * independent form of its series: c = sum_{n>=1} (-1)^(n+1) B_2n s^(n-1) / (2n)!, ten terms. */
+static double dexpinv_reference(double s, int derivative)
+{
+    static const double B[11] = {1, 1.0 / 6, -1.0 / 30, 1.0 / 42, -1.0 / 30, 5.0 / 66, -691.0 / 2730, 7.0 / 6,
+                                 -3617.0 / 510, 43867.0 / 798, -174611.0 / 330};   /* B_0, B_2, ..., B_20 */
+    double sum = 0, factorial = 2;   /* (2n)! */
+    int n;
+    for (n = 1; n <= 10; ++n) {
+        const double coefficient = (n % 2 ? 1 : -1) * B[n] / factorial;
+        if (derivative) sum += n >= 2 ? (n - 1) * coefficient * pow(s, n - 2) : 0;
+        else sum += coefficient * pow(s, n - 1);
+        factorial *= (2 * n + 1) * (2 * n + 2);
+    }
+    return sum;
+}
+
+/* The series of dexp^-1's coefficient and of its derivative (sr_internal.h; the fourth-order steps
+ * and their Jacobians use them below s = 1/16) equal the Bernoulli form to a few ulp.  The control:
+ * the four-term series used below s = 1e-2 before 2026-11-25 misses the bound near 1/16. */
+static void test_dexpinv_series_match_the_bernoulli_form_to_a_few_ulp(void)
+{
+    int n, truncated_ok = 1;
+    for (n = 0; n < 400; ++n) {
+        const sr_real s = (sr_real)(0.0625 * n / 400.0);
+        const double sd = (double)s, c = dexpinv_reference(sd, 0), dc = dexpinv_reference(sd, 1);
+        const double four_terms = 1.0 / 12 + sd * (1.0 / 720 + sd * (1.0 / 30240 + sd * (1.0 / 1209600)));
+        CHECK_NEAR(dexpinv_series(s), c, 2 * TEST_EPS * c);
+        CHECK_NEAR(dexpinv_series_derivative(s), dc, 4 * TEST_EPS * dc);
+        if (fabs(four_terms - c) > 2 * DBL_EPSILON * c) truncated_ok = 0;
+    }
+    CHECK(!truncated_ok);
 }
 
 static void test_so3_exp_of_zero_is_identity(void)
@@ -401,6 +436,7 @@ void suite_numerics(void)
 {
     RUN_TEST(test_so3_exp_matches_taylor_series);
     RUN_TEST(test_so3_exp_small_angle_series_match_libm_to_a_few_ulp);
+    RUN_TEST(test_dexpinv_series_match_the_bernoulli_form_to_a_few_ulp);
     RUN_TEST(test_so3_exp_of_zero_is_identity);
     RUN_TEST(test_so3_exp_inverse_is_exp_of_minus_w);
     RUN_TEST(test_accel_at_identity_equilibrium_is_zero);
