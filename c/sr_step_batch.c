@@ -28,19 +28,26 @@ static void fourth_order_block(const sr_model *model, int method, long m, const 
     long i, k;
     int s;
     sr_internal_check_lanes(model, m, xb, SR_NX, ok);
+    /* Every lanes function writes its own verdict, 1 or 0, into ok_stage; a lane stays clean only
+     * while every verdict is 1. */
 #define AND_STAGE() for (i = 0; i < m; ++i) ok[i] = ok_stage[i] != 0 ? ok[i] : 0
-    sr_gen_accel_lanes(model->c, m, xb, SR_NX, u, us, acc, SR_NV, ok_stage);
-    AND_STAGE();
-    sr_internal_field_lanes(r, m, xb, SR_NX, acc, SR_NV, NULL, 0, K[0], SR_NT, ok);
+#define ACCEL(y)                                                                        \
+    do {                                                                                \
+        sr_gen_accel_lanes(model->c, m, y, SR_NX, u, us, acc, SR_NV, ok_stage);         \
+        AND_STAGE();                                                                    \
+    } while (0)
+    ACCEL(xb);
+    sr_internal_field_lanes(r, m, xb, SR_NX, acc, SR_NV, NULL, 0, K[0], SR_NT, ok_stage);
     if (method == SR_RKMK4) {
         static const sr_real a_diag[3] = {SR_C(0.5), SR_C(0.5), SR_C(1.0)};
         const sr_real b[4] = {dt / 6, dt / 3, dt / 3, dt / 6};
         for (s = 1; s < 4; ++s) {
             for (k = 0; k < m * SR_NT; ++k) th[k] = a_diag[s - 1] * dt * K[s - 1][k];
-            sr_internal_act_lanes(m, xb, SR_NX, th, SR_NT, Y, SR_NX, ok);
-            sr_gen_accel_lanes(model->c, m, Y, SR_NX, u, us, acc, SR_NV, ok_stage);
+            sr_internal_act_lanes(m, xb, SR_NX, th, SR_NT, Y, SR_NX, ok_stage);
             AND_STAGE();
-            sr_internal_field_lanes(r, m, Y, SR_NX, acc, SR_NV, th, SR_NT, K[s], SR_NT, ok);
+            ACCEL(Y);
+            sr_internal_field_lanes(r, m, Y, SR_NX, acc, SR_NV, th, SR_NT, K[s], SR_NT, ok_stage);
+            AND_STAGE();
         }
         for (k = 0; k < m * SR_NT; ++k) {   /* combine: th = sum_j b_j K_j */
             sr_real sum = 0;
@@ -50,25 +57,26 @@ static void fourth_order_block(const sr_model *model, int method, long m, const 
             sum += b[3] * K[3][k];
             th[k] = sum;
         }
-        sr_internal_act_lanes(m, xb, SR_NX, th, SR_NT, out, SR_NX, ok);
+        sr_internal_act_lanes(m, xb, SR_NX, th, SR_NT, out, SR_NX, ok_stage);
+        AND_STAGE();
     } else {
         const sr_real beta1[4] = {dt / 4, dt / 6, dt / 6, -dt / 12};
         const sr_real beta2[4] = {-dt / 12, dt / 6, dt / 6, dt / 4};
         for (k = 0; k < m * SR_NT; ++k) th[k] = SR_C(0.5) * dt * K[0][k];
-        sr_internal_act_lanes(m, xb, SR_NX, th, SR_NT, Y2, SR_NX, ok);                 /* Y2 */
-        sr_gen_accel_lanes(model->c, m, Y2, SR_NX, u, us, acc, SR_NV, ok_stage);
+        sr_internal_act_lanes(m, xb, SR_NX, th, SR_NT, Y2, SR_NX, ok_stage);           /* Y2 */
         AND_STAGE();
-        sr_internal_field_lanes(r, m, Y2, SR_NX, acc, SR_NV, NULL, 0, K[1], SR_NT, ok);
+        ACCEL(Y2);
+        sr_internal_field_lanes(r, m, Y2, SR_NX, acc, SR_NV, NULL, 0, K[1], SR_NT, ok_stage);
         for (k = 0; k < m * SR_NT; ++k) th[k] = SR_C(0.5) * dt * K[1][k];
-        sr_internal_act_lanes(m, xb, SR_NX, th, SR_NT, Y, SR_NX, ok);                  /* Y3 */
-        sr_gen_accel_lanes(model->c, m, Y, SR_NX, u, us, acc, SR_NV, ok_stage);
+        sr_internal_act_lanes(m, xb, SR_NX, th, SR_NT, Y, SR_NX, ok_stage);            /* Y3 */
         AND_STAGE();
-        sr_internal_field_lanes(r, m, Y, SR_NX, acc, SR_NV, NULL, 0, K[2], SR_NT, ok);
+        ACCEL(Y);
+        sr_internal_field_lanes(r, m, Y, SR_NX, acc, SR_NV, NULL, 0, K[2], SR_NT, ok_stage);
         for (k = 0; k < m * SR_NT; ++k) th[k] = dt * (K[2][k] - SR_C(0.5) * K[0][k]);
-        sr_internal_act_lanes(m, Y2, SR_NX, th, SR_NT, Y, SR_NX, ok);                  /* Y4 */
-        sr_gen_accel_lanes(model->c, m, Y, SR_NX, u, us, acc, SR_NV, ok_stage);
+        sr_internal_act_lanes(m, Y2, SR_NX, th, SR_NT, Y, SR_NX, ok_stage);            /* Y4 */
         AND_STAGE();
-        sr_internal_field_lanes(r, m, Y, SR_NX, acc, SR_NV, NULL, 0, K[3], SR_NT, ok);
+        ACCEL(Y);
+        sr_internal_field_lanes(r, m, Y, SR_NX, acc, SR_NV, NULL, 0, K[3], SR_NT, ok_stage);
         for (k = 0; k < m * SR_NT; ++k) {   /* the two combinations of the last update */
             sr_real s1 = 0, s2 = 0;
             s1 += beta1[0] * K[0][k];
@@ -82,8 +90,10 @@ static void fourth_order_block(const sr_model *model, int method, long m, const 
             th[k] = s1;
             Y2[k] = s2;     /* Y2 is free by now: it holds th2 */
         }
-        sr_internal_act2_lanes(m, xb, SR_NX, th, Y2, SR_NT, out, SR_NX, ok);
+        sr_internal_act2_lanes(m, xb, SR_NX, th, Y2, SR_NT, out, SR_NX, ok_stage);
+        AND_STAGE();
     }
+#undef ACCEL
 #undef AND_STAGE
 }
 
