@@ -31,6 +31,15 @@ def measure_samples_per_task(spec, seconds=TASK_SECONDS):
     return max(1, min(spec.samples, round(seconds / per_sample)))
 
 
+#: What the embedded LocalCluster changes of Dask's defaults (see `dask_client`).
+EMBEDDED_CLUSTER_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "5s",
+    "distributed.worker.memory.monitor-interval": "1s",
+}
+
+
 @contextlib.contextmanager
 def dask_client(scheduler=None, workers=None):
     """A distributed.Client: on `scheduler` (an address), or on a new LocalCluster of `workers`
@@ -43,11 +52,15 @@ def dask_client(scheduler=None, workers=None):
     import dask
     n = workers or os.cpu_count() or 1
     logging.getLogger("distributed").setLevel(logging.WARNING)   # no INFO lines when the cluster closes
-    # The workers' statistical profiler (a stack sample every 10 ms, for the dashboard's Profile
-    # page) cost a tenth of a core beside the C loops: CPU overhead of 1 worker against the C batch
-    # +16.7 % with it, +5.7 % without (AMD EPYC, make sweep-bench).  The nannies get this config
+    # Dask's own periodic work, for the dashboard and for spotting a blocked event loop, competes
+    # with the C loops for the cores (AMD EPYC, 2 cores, make sweep-bench): the workers' statistical
+    # profiler (a stack sample every 10 ms; CPU overhead of 1 worker against the C batch +16.7 %
+    # with it, +5.7 % without) is off, and the event-loop tick (every 20 ms, in every process), the
+    # system monitor (500 ms) and the nannies' memory monitor (100 ms) run less often: with them
+    # at their defaults the tasks of 2 workers ran 7 % slower than those of 1 and the speedup was
+    # 1.75-1.86x over eight runs, with these 1.87-1.91x over three.  The nannies get this config
     # and hand it to their workers; a cluster of the user's (--scheduler) keeps its own.
-    with dask.config.set({"distributed.worker.profile.enabled": False}), \
+    with dask.config.set(EMBEDDED_CLUSTER_CONFIG), \
             LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",  # any free port
                          silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
         yield client
