@@ -15,7 +15,7 @@ from ..verification.sampling import random_inputs, random_states
 from .baselines import python_timings
 from .checks import WrongNumbers
 from .kane_compiled import kane_inputs as kane_coordinates, write_kane_c
-from .harness import ROOT, build_harness, casadi_reference_c, check_harness, run_harness
+from .harness import ROOT, build_harness, casadi_reference_c, check_harness, memory_floor, run_harness
 from .report import format_markdown, format_report, write_results
 from .timing import cpu_name, pin_to_one_core
 
@@ -81,6 +81,8 @@ def run(args, core, progress):
                 exe = build_harness(build, native=True, with_casadi=False)
                 result["c_loop_native"] = run_harness(exe, params, X, U, args.repeats)
                 check_harness(result["c_loop_native"], model, X, U)
+                progress(f"the memory floor of a batch of {args.batch:.0e} states")
+                result["memory_floor_ns_per_state"] = memory_floor(build, args.batch)
         result["python"] = python_timings(model, X, U, args.batch, progress, with_kane=not args.no_kane,
                                           loop_steps=args.loop_steps)
     except WrongNumbers as exc:

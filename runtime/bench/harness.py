@@ -57,6 +57,17 @@ def build_harness(build, native, with_casadi, kane=None):
     return exe
 
 
+def memory_floor(build, states, rounds=7):
+    """ns per state of bench/memory_floor.c on `states` states: the batch accel's memory traffic
+    alone (read x and u, write 5 numbers a state), compiled as fast as it goes."""
+    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+    exe = build / "memory_floor"
+    subprocess.run([cc, "-std=c99", "-O3", "-ffast-math", "-march=native", str(ROOT / "bench" / "memory_floor.c"),
+                    "-o", str(exe)], check=True)
+    out = subprocess.run([str(exe), str(states), str(rounds)], check=True, capture_output=True, text=True).stdout
+    return json.loads(out)["ns_per_state"]
+
+
 def general_robot(params):
     """The general robot the C loop times beside `params` (issue 18): the same radius, so the same
     states are valid, with an off-centre battery, full tensors, geared rotors and a slope (its
