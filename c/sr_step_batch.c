@@ -16,10 +16,11 @@
  * fourth-order methods keep five blocks of stage data: about 18 KB in double). */
 enum { BLOCK = 16 };
 
-/* One fourth-order step (RKMK4 or CF4, as in sr_steppers.c) of the m <= BLOCK states xb, into
- * out; ok[i] = 1 where lane i's result is sr_step's, else 0 (that row is then left to sr_step). */
-static void fourth_order_block(const sr_model *model, int method, long m, const sr_real *xb, const sr_real *ub,
-                               sr_real dt, sr_real *out, sr_real *ok)
+/* One step of `method` (SR_LIE_EULER, SR_RKMK4 or SR_CF4, as in sr_steppers.c) of the m <= BLOCK
+ * states xb, into out; ok[i] = 1 where lane i's result is sr_step's, else 0 (that row is then left
+ * to sr_step). */
+static void step_block(const sr_model *model, int method, long m, const sr_real *xb, const sr_real *ub,
+                       sr_real dt, sr_real *out, sr_real *ok)
 {
     sr_real K[4][BLOCK * SR_NT], th[BLOCK * SR_NT], Y2[BLOCK * SR_NX], Y[BLOCK * SR_NX], acc[BLOCK * SR_NV];
     sr_real ok_stage[BLOCK];
@@ -37,6 +38,11 @@ static void fourth_order_block(const sr_model *model, int method, long m, const 
         AND_STAGE();                                                                    \
     } while (0)
     ACCEL(xb);
+    if (method == SR_LIE_EULER) {
+        sr_internal_lie_euler_lanes(r, m, xb, SR_NX, acc, SR_NV, dt, out, SR_NX, ok_stage);
+        AND_STAGE();
+        return;
+    }
     sr_internal_field_lanes(r, m, xb, SR_NX, acc, SR_NV, NULL, 0, K[0], SR_NT, ok_stage);
     if (method == SR_RKMK4) {
         static const sr_real a_diag[3] = {SR_C(0.5), SR_C(0.5), SR_C(1.0)};
@@ -100,7 +106,7 @@ static void fourth_order_block(const sr_model *model, int method, long m, const 
 int sr_step_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u, sr_real dt,
                   sr_real *x_next, long *failed_row)
 {
-    sr_real ok[BLOCK], ok_accel[BLOCK], acc[BLOCK * SR_NV], block[BLOCK * SR_NX];
+    sr_real ok[BLOCK], block[BLOCK * SR_NX];
     long start, i;
     int k;
     const int lanes = model && !model->general && dt > 0 && isfinite(dt)
@@ -112,14 +118,8 @@ int sr_step_batch(const sr_model *model, int method, long n, const sr_real *x, c
         const long m = n - start < BLOCK ? n - start : BLOCK;
         const sr_real *xb = x + start * SR_NX, *ub = u ? u + start * SR_NU : NULL;
         sr_real *ob = x_next + start * SR_NX;
-        if (lanes && method == SR_LIE_EULER) {
-            sr_internal_check_lanes(model, m, xb, SR_NX, ok);
-            sr_gen_accel_lanes(model->c, m, xb, SR_NX, ub ? ub : sr_zero_u, ub ? SR_NU : 0, acc, SR_NV, ok_accel);
-            for (i = 0; i < m; ++i) ok[i] = ok_accel[i] != 0 ? ok[i] : 0;
-            sr_internal_lie_euler_lanes(model->p[SR_P_r], m, xb, SR_NX, acc, SR_NV, dt, block, SR_NX, ok_accel);
-            for (i = 0; i < m; ++i) ok[i] = ok_accel[i] != 0 ? ok[i] : 0;
-        } else if (lanes) {
-            fourth_order_block(model, method, m, xb, ub, dt, block, ok);
+        if (lanes) {
+            step_block(model, method, m, xb, ub, dt, block, ok);
         } else {
             for (i = 0; i < m; ++i) ok[i] = 0;
         }

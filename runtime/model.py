@@ -150,13 +150,17 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods):
         failed = ffi.new("long *")
         status = lib.sr_checked_accel_batch(self._model, x.shape[0], _ptr(x), ffi.NULL if u is None else _ptr(u),
                                             _ptr(out), failed)
+        self._check_batch(x, status, failed[0])
+        return out
+
+    def _check_batch(self, x, status, row, detail=""):
+        """A batch call's status: the state C stopped at (row) is checked again here, for the message
+        that names what is wrong; then the status itself."""
         if status != lib.SR_OK:
-            row = failed[0]
             field = f"x[{row}]" if row >= 0 else "x"
             if row >= 0:
                 check_states(self._model, x[row], self.params.r, field)
-            self._check(field, status)
-        return out
+            self._check(field, status, detail)
 
     def _single(self, fn, x, n, field="x"):
         x = self._valid_states(x, field, batch=False)
@@ -215,12 +219,7 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods):
         failed = ffi.new("long *")
         status = lib.sr_step_batch(self._model, code, x.shape[0], _ptr(x), ffi.NULL if u is None else _ptr(u), dt,
                                    _ptr(out), failed)
-        if status != lib.SR_OK:
-            row = failed[0]
-            field = f"x[{row}]" if row >= 0 else "x"
-            if row >= 0:
-                check_states(self._model, x[row], self.params.r, field)
-            self._check(field, status, ": the step's result overflowed (dt too large for this state?)")
+        self._check_batch(x, status, failed[0], ": the step's result overflowed (dt too large for this state?)")
         return out
 
     def simulate(self, x0, dt, steps, u=None, method="lie-euler", energy_tol=ENERGY_TOL, progress=None):

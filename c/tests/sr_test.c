@@ -137,6 +137,15 @@ void random_state(test_rng *rng, double r, double max_speed, sr_real x[SR_NX])
     for (i = SR_X_w_S; i < SR_NX; ++i) x[i] = (sr_real)rng_uniform(rng, -max_speed, max_speed);
 }
 
+sr_real next_up(sr_real v)
+{
+#ifdef SR_USE_FLOAT
+    return nextafterf(v, INFINITY);
+#else
+    return nextafter(v, INFINITY);
+#endif
+}
+
 double orthonormality_error(const sr_real R[9])
 {
     double worst = 0, det;

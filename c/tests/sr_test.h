@@ -101,6 +101,8 @@ void make_state(sr_real x[SR_NX], double theta_Y, double theta_P, double r);
 /* A random valid state: uniform-ish R_S, any yoke and pendulum angle, q_z = r,
  * speeds up to max_speed rad/s. */
 void random_state(test_rng *rng, double r, double max_speed, sr_real x[SR_NX]);
+/* The next representable sr_real above v (a one-ulp change, for checks that must see it). */
+sr_real next_up(sr_real v);
 /* Largest |A^T A - I| entry and |det A - 1| of a row-major 3x3 matrix. */
 double orthonormality_error(const sr_real R[9]);
 

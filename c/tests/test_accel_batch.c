@@ -12,16 +12,6 @@
 
 #define N 150 /* two full blocks of 64 and a short one */
 
-/* The next representable sr_real above v. */
-static sr_real next_up(sr_real v)
-{
-#ifdef SR_USE_FLOAT
-    return nextafterf(v, INFINITY);
-#else
-    return nextafter(v, INFINITY);
-#endif
-}
-
 static void random_rows(sr_real x[N][SR_NX], sr_real u[N][SR_NU], double r)
 {
     test_rng rng = {11};
