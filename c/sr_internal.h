@@ -305,7 +305,7 @@ static inline void so3_right_jacobian(const sr_real phi[3], sr_real Jr[9])
 #define sr_internal_rhs sr_internal_rhs_f
 #define sr_internal_energy sr_internal_energy_f
 #define sr_internal_equilibrium_residual sr_internal_equilibrium_residual_f
-#define sr_internal_accel_jacobian_terms sr_internal_accel_jacobian_terms_f
+#define sr_internal_general_accel_jacobian_terms sr_internal_general_accel_jacobian_terms_f
 #define sr_internal_cholesky sr_internal_cholesky_f
 #endif
 
@@ -315,9 +315,11 @@ int sr_internal_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M
 int sr_internal_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NV]);
 int sr_internal_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy);
 int sr_internal_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV]);
-int sr_internal_accel_jacobian_terms(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                                     sr_real Mu[15], sr_real f[SR_NV], sr_real df[SR_NV * SR_NE],
-                                     sr_real dfdu[SR_NV * SR_NU], sr_real dM[5 * 15]);
+/* The general robot's M, f, df/dd, df/du and dM/dd (shell frame) for sr_accel_jacobian; the
+ * paper's robot has its own kernel in the yoke frame (c/sr_jacobians.c). */
+int sr_internal_general_accel_jacobian_terms(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                             sr_real Mu[15], sr_real f[SR_NV], sr_real df[SR_NV * SR_NE],
+                                             sr_real dfdu[SR_NV * SR_NU], sr_real dM[5 * 15]);
 
 /* Index of M[i][j] (either order) in the row-by-row upper triangle Mu[15] of a 5x5 matrix. */
 static const unsigned char SR_UPPER[SR_NV][SR_NV] = {

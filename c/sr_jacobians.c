@@ -1,9 +1,9 @@
 /*
  * sr_jacobians.c -- derivatives of the dynamics in the error coordinates of c/sr_group.c
- * (issue 19).  The generated sr_gen_accel_jacobian_terms gives M, f, df/dd, df/du and dM/dd
- * (derive/derivatives.py); here one factorisation of M (joints first for the paper's geometry,
- * Cholesky for a general robot) serves the accelerations and every column:
- * d(nu') = M^-1 (df - (dM) nu').
+ * (issue 19).  The generated kernels give M, f, df, df/du and dM (derive/derivatives.py): for a
+ * general robot in the shell frame, for the paper's in the yoke frame (a third of the operations);
+ * one factorisation of M (joints first for the paper's geometry, Cholesky for a general robot)
+ * serves the accelerations and every column: d(nu') = M^-1 (df - (dM) nu').
  */
 #include "sr_internal.h"
 
@@ -81,37 +81,116 @@ static inline void joint_first_solve(const joint_first *s, sr_real B[SR_NV][NCOL
     }
 }
 
-int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                      sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU])
+/* The general robot, in the shell frame: M, f, df/dd, df/du, dM/dd from the generated kernel,
+ * M = L L^T; ja, jb its 5 x 12 and 5 x 2 Jacobians. */
+static int general_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                  sr_real ja[SR_NV * SR_NE], sr_real jb[SR_NV * SR_NU])
 {
-    static const sr_real zero_u[SR_NU] = {0, 0};
     sr_real Mu[15], f[SR_NV], df[SR_NV * SR_NE], dfdu[SR_NV * SR_NU], dM[5 * 15], L[SR_NV * SR_NV], inv[SR_NV];
-    sr_real a[SR_NV][NCOL], B[SR_NV][NCOL], ja[SR_NV * SR_NE], jb[SR_NV * SR_NU];
-    joint_first jf;
+    sr_real a[SR_NV][NCOL], B[SR_NV][NCOL];
     int status, i, j, k;
-    if (!Ja || !Jb) return SR_ERR_NULL;
-    memset(&jf, 0, sizeof jf);    /* set on the paper's path only; GCC cannot see that */
-    status = checks(model, x, u);
+    status = sr_internal_general_accel_jacobian_terms(model, x, u, Mu, f, df, dfdu, dM);
     if (status != SR_OK) return status;
-    status = sr_internal_accel_jacobian_terms(model, x, u ? u : zero_u, Mu, f, df, dfdu, dM);
-    if (status != SR_OK) return status;
-    status = model->general ? sr_internal_cholesky(Mu, L, inv) : joint_first_factor(Mu, &jf);
+    status = sr_internal_cholesky(Mu, L, inv);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NV; ++i) a[i][0] = f[i];
-    if (model->general) solve(L, inv, a, 1);              /* a = nu' */
-    else joint_first_solve(&jf, a, 1);
+    solve(L, inv, a, 1);                                    /* a = nu' */
     for (i = 0; i < SR_NV; ++i) {
         for (k = 0; k < SR_NE; ++k) B[i][k] = df[SR_NE * i + k];
         for (k = 0; k < SR_NU; ++k) B[i][SR_NE + k] = dfdu[SR_NU * i + k];
         for (k = 0; k < 5; ++k) /* the configuration directions d_xi_S, d_th_Y, d_th_P move M */
             for (j = 0; j < SR_NV; ++j) B[i][k] -= dM[15 * k + SR_UPPER[i][j]] * a[j][0];
     }
-    if (model->general) solve(L, inv, B, NCOL);
-    else joint_first_solve(&jf, B, NCOL);
+    solve(L, inv, B, NCOL);
     for (i = 0; i < SR_NV; ++i) {
         for (k = 0; k < SR_NE; ++k) ja[SR_NE * i + k] = B[i][k];
         for (k = 0; k < SR_NU; ++k) jb[SR_NU * i + k] = B[i][SR_NE + k];
     }
+    return SR_OK;
+}
+
+/* The paper's robot, in the yoke frame (derive/derivatives.py, "the paper's robot in the yoke
+ * frame"): nu' = T^T g, T = diag(R_Y^T, 1, 1), g = M'^-1 f'(gamma', R_P, nu').  The generated kernel
+ * gives M', f', df' along (d_xi', d_th_P, d_nu'), df'/du and dM' along (d_xi', d_th_P); with one
+ * joint-first factorisation of M', G = M'^-1 (df' - (dM') g), 11 columns (Y_* below).  The chain
+ * rule to the error coordinates, c and s the entries of R_Y:
+ *   d_xi_S:            d_xi' = R_Y^T d_xi_S                   -> T^T G_xi' R_Y^T
+ *   d_th_Y:            gamma' and w' turn by -d_th_Y about e_x,
+ *                      and nu'_S = R_Y g_S turns with R_Y      -> T^T (G_xi'x + G_w' (w' x e_x)) + (R_Y (e_x x g_S), 0, 0)
+ *   d_th_P, d_w_Y, d_w_P, u:                                   -> T^T G
+ *   d_w_S:             d_w' = R_Y^T d_w_S                      -> T^T G_w' R_Y^T
+ * where T^T on the left turns rows 1 and 2 (the shell's y and z) by R_Y. */
+enum { Y_XI = 0, Y_TH_P = 3, Y_W = 4, Y_U = 9, Y_NCOL = 11 };
+
+static int paper_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                sr_real ja[SR_NV * SR_NE], sr_real jb[SR_NV * SR_NU])
+{
+    const sr_real c = x[SR_X_R_Y + 4], s = x[SR_X_R_Y + 7];
+    const sr_real *w = x + SR_X_w_S;
+    sr_real Mu[15], f[SR_NV], df[SR_NV * 9], dfdu[SR_NV * SR_NU], dM[4 * 15];
+    sr_real g[SR_NV][NCOL], B[SR_NV][NCOL], Y[SR_NV][SR_NE + SR_NU];
+    sr_real wy, wz;
+    joint_first jf;
+    int status, i, j, k;
+    status = sr_gen_accel_jacobian_yoke_terms(model->c, x, u, Mu, f, df, dfdu, dM);
+    if (status != SR_OK) return status;
+    status = joint_first_factor(Mu, &jf);
+    if (status != SR_OK) return status;
+    for (i = 0; i < SR_NV; ++i) g[i][0] = f[i];
+    joint_first_solve(&jf, g, 1);                            /* g = M'^-1 f' */
+    for (i = 0; i < SR_NV; ++i) {
+        for (k = 0; k < 9; ++k) B[i][k] = df[9 * i + k];
+        for (k = 0; k < SR_NU; ++k) B[i][Y_U + k] = dfdu[SR_NU * i + k];
+        for (k = 0; k < 4; ++k) /* d_xi', d_th_P move M' */
+            for (j = 0; j < SR_NV; ++j) B[i][k] -= dM[15 * k + SR_UPPER[i][j]] * g[j][0];
+    }
+    joint_first_solve(&jf, B, Y_NCOL);
+    wy = c * w[1] + s * w[2];                                /* w' = R_Y^T w_S */
+    wz = c * w[2] - s * w[1];
+    for (i = 0; i < SR_NV; ++i) {                            /* the columns, rows still in the yoke frame */
+        const sr_real *b = B[i];
+        sr_real *y = Y[i];
+        y[SR_E_xi_S + 0] = b[Y_XI + 0];
+        y[SR_E_xi_S + 1] = c * b[Y_XI + 1] - s * b[Y_XI + 2];
+        y[SR_E_xi_S + 2] = s * b[Y_XI + 1] + c * b[Y_XI + 2];
+        y[SR_E_th_Y] = b[Y_XI + 0] + wz * b[Y_W + 1] - wy * b[Y_W + 2];
+        y[SR_E_th_P] = b[Y_TH_P];
+        y[SR_E_q + 0] = 0;                                   /* the dynamics does not depend on q */
+        y[SR_E_q + 1] = 0;
+        y[SR_E_nu + 0] = b[Y_W + 0];
+        y[SR_E_nu + 1] = c * b[Y_W + 1] - s * b[Y_W + 2];
+        y[SR_E_nu + 2] = s * b[Y_W + 1] + c * b[Y_W + 2];
+        y[SR_E_nu + 3] = b[Y_W + 3];
+        y[SR_E_nu + 4] = b[Y_W + 4];
+        y[SR_NE + 0] = b[Y_U + 0];
+        y[SR_NE + 1] = b[Y_U + 1];
+    }
+    Y[1][SR_E_th_Y] -= g[2][0];                              /* + e_x x g_S, turned by R_Y below */
+    Y[2][SR_E_th_Y] += g[1][0];
+    for (k = 0; k < SR_NE + SR_NU; ++k) {                    /* T^T: the shell rows turn by R_Y */
+        const sr_real y1 = Y[1][k], y2 = Y[2][k];
+        Y[1][k] = c * y1 - s * y2;
+        Y[2][k] = s * y1 + c * y2;
+    }
+    for (i = 0; i < SR_NV; ++i) {
+        for (k = 0; k < SR_NE; ++k) ja[SR_NE * i + k] = Y[i][k];
+        for (k = 0; k < SR_NU; ++k) jb[SR_NU * i + k] = Y[i][SR_NE + k];
+    }
+    return SR_OK;
+}
+
+int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                      sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU])
+{
+    static const sr_real zero_u[SR_NU] = {0, 0};
+    sr_real ja[SR_NV * SR_NE], jb[SR_NV * SR_NU];
+    int status;
+    if (!Ja || !Jb) return SR_ERR_NULL;
+    status = checks(model, x, u);
+    if (status != SR_OK) return status;
+    status = model->general ? general_accel_jacobian(model, x, u ? u : zero_u, ja, jb)
+                            : paper_accel_jacobian(model, x, u ? u : zero_u, ja, jb);
+    if (status != SR_OK) return status;
     if (!all_finite(ja, SR_NV * SR_NE) || !all_finite(jb, SR_NV * SR_NU)) return SR_ERR_NONFINITE;
     memcpy(Ja, ja, sizeof ja);
     memcpy(Jb, jb, sizeof jb);

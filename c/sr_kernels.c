@@ -86,12 +86,16 @@ int sr_internal_equilibrium_residual(const sr_model *model, const sr_real x[SR_N
                           : sr_gen_equilibrium_residual(model->c, x, res);
 }
 
-int sr_internal_accel_jacobian_terms(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                                     sr_real Mu[15], sr_real f[SR_NV], sr_real df[SR_NV * SR_NE],
-                                     sr_real dfdu[SR_NV * SR_NU], sr_real dM[5 * 15])
+int sr_internal_general_accel_jacobian_terms(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                             sr_real Mu[15], sr_real f[SR_NV], sr_real df[SR_NV * SR_NE],
+                                             sr_real dfdu[SR_NV * SR_NU], sr_real dM[5 * 15])
 {
-    return model->general ? GENERAL(sr_gen_general_accel_jacobian_terms(model->cg, x, u, Mu, f, df, dfdu, dM))
-                          : sr_gen_accel_jacobian_terms(model->c, x, u, Mu, f, df, dfdu, dM);
+#ifdef SR_PAPER_ONLY
+    (void)model; (void)x; (void)u; (void)Mu; (void)f; (void)df; (void)dfdu; (void)dM;
+    return SR_ERR_PARAM;
+#else
+    return sr_gen_general_accel_jacobian_terms(model->cg, x, u, Mu, f, df, dfdu, dM);
+#endif
 }
 
 /* ---- the checked API ------------------------------------------------------------------------ */

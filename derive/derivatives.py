@@ -19,6 +19,7 @@ import sympy as sp
 from . import dynamics as D
 from . import robot as R
 from . import state as S
+from . import yoke_frame as YF
 
 
 def configuration_directions():
@@ -79,3 +80,39 @@ def accel_jacobian(M=None, f=None):
     for k, dM in enumerate(inertia_derivatives()):
         dM_a[:, k] = dM * a
     return M.LUsolve(rhs_jacobian() - dM_a)
+
+
+# ---- The paper's robot in the yoke frame (derive.yoke_frame): what c/sr_jacobians.c evaluates ----
+# ν̇ = Tᵀ g with T = diag(R_Yᵀ, 1, 1) and g = M'⁻¹ f'(γ', R_P, ν'), γ' = R_Yᵀ γ, ν' = T ν, where M'
+# and f' are M and f at R_Y = I (a third of the operations of the shell-frame forms, and none of
+# their dependence on R_Y).  The shell frame's error coordinates move the yoke frame's variables as
+#     δξ_S:  γ' → Exp(−⟦δξ'⟧) γ' with δξ' = R_Yᵀ δξ_S,
+#     δθ_Y:  γ' and ω' turn by −δθ_Y about e_x (δξ' = δθ_Y e_x, δω' = ω' × e_x δθ_Y),
+#            and the output ν̇_S = R_Y g_S turns with R_Y (+ R_Y (e_x × g_S) δθ_Y),
+#     δθ_P:  R_P → R_P Exp(δθ_P Σ_P),     δν: δν' = T δν,
+# so the derivatives below are taken along δξ' (3), δθ_P and δν' (5) only: the chain rule through T
+# is a few rotations by R_Y, done in C.  Like M and f, M' and f' agree with the derivation on the
+# manifold (yoke_frame.check_equivalence), so their tangent derivatives agree too.
+
+def yoke_configuration_directions():
+    """The rates of γ' and R_P along δξ'_x, δξ'_y, δξ'_z and δθ_P (unit steps; γ' stands as γ)."""
+    none, still = sp.zeros(3, 3), sp.zeros(3, 1)
+    units = [S.hat([int(i == k) for i in range(3)]) for k in range(3)]
+    directions = [S.configuration_rates(none, none, -E * S.gamma) for E in units]
+    directions.append(S.configuration_rates(none, S.R_P * S.Sigma_P, still))
+    return directions
+
+
+@functools.lru_cache(maxsize=None)
+def yoke_rhs_jacobian():
+    """∂f'/∂(δξ', δθ_P, δν') (5×9) in the yoke frame."""
+    f = YF.rhs()
+    columns = [f.applyfunc(lambda e: S.directional_derivative(e, rates)) for rates in yoke_configuration_directions()]
+    return sp.Matrix.hstack(*columns, f.jacobian(S.nu))
+
+
+@functools.lru_cache(maxsize=None)
+def yoke_inertia_derivatives():
+    """∂M'/∂(δξ', δθ_P): four 5×5 matrices (M' depends on γ' and R_P only)."""
+    M = YF.inertia()
+    return tuple(M.applyfunc(lambda e: S.directional_derivative(e, rates)) for rates in yoke_configuration_directions())

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 063b1d7b1d9b316c], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 59b256b5b57c9148], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/spherical_robot.h.
@@ -14,7 +14,7 @@
 
 #define SR_GEN_NPARAM 32
 #define SR_GEN_NPAPER 12
-#define SR_GEN_NCONST 40
+#define SR_GEN_NCONST 37
 #define SR_GEN_NCONST_NAMED 12
 #define SR_GEN_GENERAL_NCONST 104
 #define SR_GEN_GENERAL_NCONST_NAMED 31
@@ -88,13 +88,13 @@
 #define SR_PAPER_g 11
 
 /* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
-#define SR_GEN_CONSTANTS_FLOPS 50
+#define SR_GEN_CONSTANTS_FLOPS 43
 #define SR_GEN_INERTIA_FLOPS 107
 #define SR_GEN_RHS_FLOPS 168
 #define SR_GEN_ENERGY_FLOPS 136
 #define SR_GEN_EQUILIBRIUM_RESIDUAL_FLOPS 23
 #define SR_GEN_ACCEL_FLOPS 261
-#define SR_GEN_ACCEL_JACOBIAN_TERMS_FLOPS 1779
+#define SR_GEN_ACCEL_JACOBIAN_YOKE_TERMS_FLOPS 632
 #define SR_GEN_PAPER_PARAMS_FLOPS 52
 #define SR_GEN_GENERAL_CONSTANTS_FLOPS 324
 #define SR_GEN_GENERAL_INERTIA_FLOPS 219
@@ -112,7 +112,7 @@
 #define sr_gen_energy sr_gen_energy_f
 #define sr_gen_equilibrium_residual sr_gen_equilibrium_residual_f
 #define sr_gen_accel sr_gen_accel_f
-#define sr_gen_accel_jacobian_terms sr_gen_accel_jacobian_terms_f
+#define sr_gen_accel_jacobian_yoke_terms sr_gen_accel_jacobian_yoke_terms_f
 #define sr_gen_paper_params sr_gen_paper_params_f
 #define sr_gen_general_constants sr_gen_general_constants_f
 #define sr_gen_general_inertia sr_gen_general_inertia_f
@@ -146,13 +146,10 @@
  *   c[30] k_18 = 1/j_P
  *   c[31] k_19 = j_xx - j_yy
  *   c[32] k_20 = l*m_P*r/(2*j_P)
- *   c[33] k_21 = 2*j_P - 2*j_xx
- *   c[34] k_22 = 2*j_P
- *   c[35] k_23 = j_P - j_yy
- *   c[36] k_24 = 2*j_xx
- *   c[37] k_25 = 4*j_P - 4*j_xx
- *   c[38] k_26 = 4*j_P
- *   c[39] k_27 = 2*m_R*r**2 */
+ *   c[33] k_21 = j_P + j_yy
+ *   c[34] k_22 = 2*j_xx
+ *   c[35] k_23 = 2*m_R*r**2
+ *   c[36] k_24 = 2*j_P */
 int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[SR_GEN_NCONST]);
 /* Generalized inertia M(γ, R_Y, R_P), row-major 5x5, kinetic energy ½νᵀMν. */
 int sr_gen_inertia(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr_real M[25]);
@@ -164,8 +161,8 @@ int sr_gen_energy(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr
 int sr_gen_equilibrium_residual(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr_real res[5]);
 /* ν̇ = (ω̇_S, ω̇_Y, ω̇_P) solving M ν̇ = f, joints first; SR_GEN_SINGULAR if M is not positive definite. */
 int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real a[SR_GEN_NV]);
-/* M (upper triangle, row by row), f, ∂f/∂d (5 x SR_GEN_NE, row-major, error coordinates of SR_E_*), ∂f/∂u (5 x 2) and ∂M/∂d along δξ_S, δθ_Y, δθ_P (5 upper triangles) for the accel Jacobian ∂ν̇ = M⁻¹(∂f − (∂M) ν̇). */
-int sr_gen_accel_jacobian_terms(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real M[15], sr_real f[5], sr_real df[60], sr_real dfdu[10], sr_real dM[75]);
+/* The yoke frame's M' (upper triangle, row by row), f', ∂f'/∂(δξ', δθ_P, δν') (5 x 9, row-major), ∂f'/∂u (5 x 2) and ∂M'/∂(δξ', δθ_P) (4 upper triangles), at γ' = R_Y^T γ, ν' = diag(R_Y^T, 1, 1) ν, for the paper robot's accel Jacobian (c/sr_jacobians.c: g = M'⁻¹ f', ∂g = M'⁻¹(∂f' − (∂M') g), and the chain rule to the error coordinates). */
+int sr_gen_accel_jacobian_yoke_terms(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real M[15], sr_real f[5], sr_real df[45], sr_real dfdu[10], sr_real dM[60]);
 /* The paper's robot (Section 2.3) as a general one: p[SR_P_*] from the paper's twelve parameters (derive.parameters.from_paper). */
 int sr_gen_paper_params(const sr_real pp[SR_GEN_NPAPER], sr_real p[SR_GEN_NPARAM]);
 /* Constants of the general kernels from the parameters, cg[0..] = (r, m_R, m_P, j_S, k_S, k_Y, k_P, h_Y_x, h_Y_y, h_Y_z, h_P_x, h_P_y, h_P_z, Jh_Y_xx, Jh_Y_yy, Jh_Y_zz, Jh_Y_xy, Jh_Y_xz, Jh_Y_yz, Jh_P_xx, Jh_P_yy, Jh_P_zz, Jh_P_xy, Jh_P_xz, Jh_P_yz, j_mY, n_Y, j_mP, n_P, g_x, g_z), then the parameter-only subexpressions of the kernels:

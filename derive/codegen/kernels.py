@@ -96,7 +96,7 @@ def kernels():
                ("c", "x"), (Output("res", tuple(D.equilibrium_residual()), "residual"),)),
         Kernel("accel", "ν̇ = (ω̇_S, ω̇_Y, ω̇_P) solving M ν̇ = f, joints first; SR_GEN_SINGULAR if M is not positive definite.",
                ("c", "x", "u"), accel_outputs, solve=True, definitions=accel_definitions, lanes=True),
-        accel_jacobian_terms(),
+        accel_jacobian_yoke_terms(),
         Kernel("paper_params", "The paper's robot (Section 2.3) as a general one: p[SR_P_*] from the"
                " paper's twelve parameters (derive.parameters.from_paper).",
                ("pp",), (Output("p", tuple(P.from_paper()), "parameters of the general robot"),)),
@@ -138,9 +138,30 @@ def general_kernels():
     )
 
 
-def accel_jacobian_terms(robot=R.PAPER, name="accel_jacobian_terms", inputs=("c", "x", "u")):
-    """What the solves of sr_accel_jacobian (c/sr_jacobians.c) need, in one kernel so that CSE
-    shares M, f and their derivatives (derive.derivatives): ∂ν̇ = M⁻¹(∂f − (∂M) ν̇)."""
+def accel_jacobian_yoke_terms():
+    """What the paper robot's sr_accel_jacobian (c/sr_jacobians.c) needs, in the yoke frame
+    (derive.derivatives, "the paper's robot in the yoke frame"), at the shell-frame state: one
+    kernel, so that CSE shares M', f' and their derivatives."""
+    sub = YF.from_shell_frame()
+    M, f = YF.inertia(), YF.rhs()
+    dM = J.yoke_inertia_derivatives()
+    return Kernel(
+        "accel_jacobian_yoke_terms",
+        "The yoke frame's M' (upper triangle, row by row), f', ∂f'/∂(δξ', δθ_P, δν') (5 x 9, row-major),"
+        " ∂f'/∂u (5 x 2) and ∂M'/∂(δξ', δθ_P) (4 upper triangles), at γ' = R_Y^T γ, ν' = diag(R_Y^T, 1, 1) ν,"
+        " for the paper robot's accel Jacobian (c/sr_jacobians.c: g = M'⁻¹ f', ∂g = M'⁻¹(∂f' − (∂M') g),"
+        " and the chain rule to the error coordinates).",
+        ("c", "x", "u"),
+        (Output("M", tuple(M[i, j].xreplace(sub) for i, j in UPPER), "M', upper triangle row by row"),
+         Output("f", tuple(e.xreplace(sub) for e in f), "f'"),
+         Output("df", tuple(e.xreplace(sub) for e in J.yoke_rhs_jacobian()), "df'/d(xi', th_P, nu'), row-major 5 x 9"),
+         Output("dfdu", tuple(f.jacobian(S.u)), "df'/du, row-major 5 x 2"),
+         Output("dM", tuple(m[i, j].xreplace(sub) for m in dM for i, j in UPPER), "dM'/d(xi', th_P)_k, k < 4, upper triangles")))
+
+
+def accel_jacobian_terms(robot, name, inputs):
+    """What the solves of the general robot's sr_accel_jacobian (c/sr_jacobians.c) need, in one
+    kernel so that CSE shares M, f and their derivatives (derive.derivatives): ∂ν̇ = M⁻¹(∂f − (∂M) ν̇)."""
     upper = UPPER
     M, f = D.inertia(robot), D.rhs(robot)
     dM = J.inertia_derivatives(robot)
