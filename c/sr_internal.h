@@ -340,6 +340,8 @@ int sr_internal_cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real
 #define sr_internal_act2_lanes sr_internal_act2_lanes_f
 #define sr_internal_field_lanes sr_internal_field_lanes_f
 #define sr_internal_vector_field sr_internal_vector_field_f
+#define sr_internal_kinematics sr_internal_kinematics_f
+#define sr_internal_accel_jacobian sr_internal_accel_jacobian_f
 #define sr_internal_rkmk4_core sr_internal_rkmk4_core_f
 #define sr_internal_dexpinv sr_internal_dexpinv_f
 #define sr_internal_project sr_internal_project_f
@@ -386,6 +388,16 @@ int sr_internal_advance(const sr_model *model, int method, const sr_real x[SR_NX
  * evaluations in *evaluations (if not NULL). */
 int sr_internal_vector_field(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                              sr_real f[SR_NT], long *evaluations);
+
+/* The first SR_T_V entries of the vector field: the velocities and the rolling q' (the rest,
+ * the accelerations, from the dynamics). */
+void sr_internal_kinematics(const sr_model *model, const sr_real x[SR_NX], sr_real f[SR_NT]);
+
+/* sr_accel_jacobian without the checks (x valid, u not NULL): Ja, Jb and the accelerations a
+ * (to rounding those of sr_accel) at once, for the step Jacobians; outputs not tested for
+ * finiteness.  c/sr_jacobians.c. */
+int sr_internal_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                               sr_real a[SR_NV], sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU]);
 
 /* The stages of RKMK4 from K[0] = f(x) (filled by the caller): K[1..3] and the final Theta;
  * out = x . exp(Theta) (out must not alias x). */

@@ -84,7 +84,7 @@ static inline void joint_first_solve(const joint_first *s, sr_real B[SR_NV][NCOL
 /* The general robot, in the shell frame: M, f, df/dd, df/du, dM/dd from the generated kernel,
  * M = L L^T; ja, jb its 5 x 12 and 5 x 2 Jacobians. */
 static int general_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                                  sr_real ja[SR_NV * SR_NE], sr_real jb[SR_NV * SR_NU])
+                                  sr_real acc[SR_NV], sr_real ja[SR_NV * SR_NE], sr_real jb[SR_NV * SR_NU])
 {
     sr_real Mu[15], f[SR_NV], df[SR_NV * SR_NE], dfdu[SR_NV * SR_NU], dM[5 * 15], L[SR_NV * SR_NV], inv[SR_NV];
     sr_real a[SR_NV][NCOL], B[SR_NV][NCOL];
@@ -95,6 +95,7 @@ static int general_accel_jacobian(const sr_model *model, const sr_real x[SR_NX],
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NV; ++i) a[i][0] = f[i];
     solve(L, inv, a, 1);                                    /* a = nu' */
+    for (i = 0; i < SR_NV; ++i) acc[i] = a[i][0];
     for (i = 0; i < SR_NV; ++i) {
         for (k = 0; k < SR_NE; ++k) B[i][k] = df[SR_NE * i + k];
         for (k = 0; k < SR_NU; ++k) B[i][SR_NE + k] = dfdu[SR_NU * i + k];
@@ -123,7 +124,7 @@ static int general_accel_jacobian(const sr_model *model, const sr_real x[SR_NX],
 enum { Y_XI = 0, Y_TH_P = 3, Y_W = 4, Y_U = 9, Y_NCOL = 11 };
 
 static int paper_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                                sr_real ja[SR_NV * SR_NE], sr_real jb[SR_NV * SR_NU])
+                                sr_real acc[SR_NV], sr_real ja[SR_NV * SR_NE], sr_real jb[SR_NV * SR_NU])
 {
     const sr_real c = x[SR_X_R_Y + 4], s = x[SR_X_R_Y + 7];
     const sr_real *w = x + SR_X_w_S;
@@ -138,6 +139,11 @@ static int paper_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], c
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NV; ++i) g[i][0] = f[i];
     joint_first_solve(&jf, g, 1);                            /* g = M'^-1 f' */
+    acc[0] = g[0][0];                                        /* nu' = T^T g */
+    acc[1] = c * g[1][0] - s * g[2][0];
+    acc[2] = s * g[1][0] + c * g[2][0];
+    acc[3] = g[3][0];
+    acc[4] = g[4][0];
     for (i = 0; i < SR_NV; ++i) {
         for (k = 0; k < 9; ++k) B[i][k] = df[9 * i + k];
         for (k = 0; k < SR_NU; ++k) B[i][Y_U + k] = dfdu[SR_NU * i + k];
@@ -179,17 +185,21 @@ static int paper_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], c
     return SR_OK;
 }
 
+int sr_internal_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                               sr_real a[SR_NV], sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU])
+{
+    return model->general ? general_accel_jacobian(model, x, u, a, Ja, Jb) : paper_accel_jacobian(model, x, u, a, Ja, Jb);
+}
+
 int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                       sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU])
 {
-    static const sr_real zero_u[SR_NU] = {0, 0};
-    sr_real ja[SR_NV * SR_NE], jb[SR_NV * SR_NU];
+    sr_real a[SR_NV], ja[SR_NV * SR_NE], jb[SR_NV * SR_NU];
     int status;
     if (!Ja || !Jb) return SR_ERR_NULL;
     status = checks(model, x, u);
     if (status != SR_OK) return status;
-    status = model->general ? general_accel_jacobian(model, x, u ? u : zero_u, ja, jb)
-                            : paper_accel_jacobian(model, x, u ? u : zero_u, ja, jb);
+    status = sr_internal_accel_jacobian(model, x, u ? u : sr_zero_u, a, ja, jb);
     if (status != SR_OK) return status;
     if (!all_finite(ja, SR_NV * SR_NE) || !all_finite(jb, SR_NV * SR_NU)) return SR_ERR_NONFINITE;
     memcpy(Ja, ja, sizeof ja);
@@ -219,7 +229,7 @@ int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], co
                                sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
 {
     const sr_real *w = x + SR_X_w_S, *R = x + SR_X_R_S;
-    sr_real Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], phi[3], D[9], Jr[9], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
+    sr_real a[SR_NV], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], phi[3], D[9], Jr[9], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
     sr_real v[2][3], r;
     int status, i, j;
     if (!F || !G) return SR_ERR_NULL;
@@ -227,7 +237,7 @@ int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], co
     if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
     if (status != SR_OK) return status;
     if (!(dt > 0) || !isfinite(dt)) return SR_ERR_ARG;
-    status = sr_accel_jacobian(model, x, u, Ja, Jb);
+    status = sr_internal_accel_jacobian(model, x, u ? u : sr_zero_u, a, Ja, Jb);   /* checked above */
     if (status != SR_OK) return status;
     r = model->p[SR_P_r];
     memset(f, 0, sizeof f);

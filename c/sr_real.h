@@ -38,6 +38,11 @@
  *                     with single calls).  Off by default: the clones need
  *                     libgcc's CPU detection (__cpu_model) and the loader's
  *                     ifunc, outside the self-contained C99 of the library.
+ *   SR_JACOBIAN_CLONES
+ *                     the same before the definition of a fourth-order step
+ *                     Jacobian (c/sr_step_jacobians.c), with GCC's flatten, so
+ *                     that the file's helpers (rows of 12 columns: three AVX2
+ *                     vectors) are inlined into, and compiled for, each clone.
  *   SR_GEN_OK, SR_GEN_NONFINITE, SR_GEN_SINGULAR
  *                     the kernels' status codes; c/sr_internal.h asserts
  *                     that they equal SR_OK, SR_ERR_NONFINITE and
@@ -76,8 +81,10 @@ typedef double sr_real;
 #if defined(SR_CLONES) && defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) \
     && defined(__linux__) && defined(__GLIBC__)
 #define SR_LANES_CLONES __attribute__((target_clones("avx2", "default")))
+#define SR_JACOBIAN_CLONES __attribute__((target_clones("avx2", "default"), flatten))
 #else
 #define SR_LANES_CLONES
+#define SR_JACOBIAN_CLONES
 #endif
 
 #define SR_GEN_OK 0

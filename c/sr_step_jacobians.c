@@ -92,8 +92,11 @@ static int field_jacobian(const sr_model *model, const sr_real y[SR_NX], const s
 {
     const sr_real *R = y + SR_X_R_S, *w = y + SR_X_w_S, r = model->p[SR_P_r];
     sr_real Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], p[2][3];
-    int i, j, k, c, status = sr_internal_vector_field(model, y, u, f, NULL);
-    if (status == SR_OK) status = sr_accel_jacobian(model, y, u, Ja, Jb);
+    int i, j, k, c, status;
+    sr_internal_kinematics(model, y, f);
+    status = sr_internal_accel_jacobian(model, y, u, f + SR_T_V, Ja, Jb);
+    /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
+    if (status == SR_ERR_SINGULAR && !all_finite(y, SR_NX)) status = SR_ERR_NONFINITE;
     if (status != SR_OK) return status;
     for (j = 0; j < 3; ++j) {
         p[0][j] = r * R[3 + j];     /* q_x' = r (R_S w)_y */
@@ -129,20 +132,21 @@ static int field_jacobian(const sr_model *model, const sr_real y[SR_NX], const s
     return SR_OK;
 }
 
-/* k = dexp^-1(th, f) and dk (f and df are overwritten: k may alias f). */
-static void dexpinv_jacobian(const sr_real th[SR_NT], const tangent dth, sr_real f[SR_NT], tangent df)
+/* The derivatives of k = dexp^-1(th, f) on the SO(3) block, k_S = v + t x v / 2 + c t x (t x v) with
+ * t = th_S, v = f_S: P = dk_S/dv, Q = dk_S/dt (see the top of the file). */
+static void dexpinv_derivatives(const sr_real th[SR_NT], const sr_real f[SR_NT], sr_real P[9], sr_real Q[9])
 {
     const sr_real *t = th + SR_T_S, *v = f + SR_T_S;
     const sr_real s = t[0] * t[0] + t[1] * t[1] + t[2] * t[2], tv = t[0] * v[0] + t[1] * v[1] + t[2] * v[2];
-    sr_real c, dc, T[9], T2[9], P[9], Q[9], b[3];
-    int i, j, col;
+    sr_real c, dc, T[9], T2[9], b[3];
+    int i, j;
     dexpinv_coefficient(s, &c, &dc);
     T[0] = 0;     T[1] = -t[2]; T[2] = t[1];
     T[3] = t[2];  T[4] = 0;     T[5] = -t[0];
     T[6] = -t[1]; T[7] = t[0];  T[8] = 0;
     matmul3(T, T, T2);
     for (i = 0; i < 3; ++i) b[i] = T2[3 * i + 0] * v[0] + T2[3 * i + 1] * v[1] + T2[3 * i + 2] * v[2];
-    for (i = 0; i < 9; ++i) P[i] = (i % 4 == 0 ? 1 : 0) + SR_C(0.5) * T[i] + c * T2[i];   /* dk/dv */
+    for (i = 0; i < 9; ++i) P[i] = (i % 4 == 0 ? 1 : 0) + SR_C(0.5) * T[i] + c * T2[i];
     /* dk/dt = -[v]/2 + c ((t.v) I + t v^T - 2 v t^T) + 2 c' b t^T  (b = t x (t x v)) */
     Q[0] = 0;                 Q[1] = SR_C(0.5) * v[2];  Q[2] = -SR_C(0.5) * v[1];
     Q[3] = -SR_C(0.5) * v[2]; Q[4] = 0;                 Q[5] = SR_C(0.5) * v[0];
@@ -150,18 +154,145 @@ static void dexpinv_jacobian(const sr_real th[SR_NT], const tangent dth, sr_real
     for (i = 0; i < 3; ++i)
         for (j = 0; j < 3; ++j)
             Q[3 * i + j] += c * ((i == j ? tv : 0) + t[i] * v[j] - 2 * v[i] * t[j]) + 2 * dc * b[i] * t[j];
-    {
-        sr_real out[3][NC];
-        for (i = 0; i < 3; ++i) {
-            for (col = 0; col < NC; ++col) out[i][col] = 0;
-            for (j = 0; j < 3; ++j) {
-                const sr_real pij = P[3 * i + j], qij = Q[3 * i + j], *a = df[SR_T_S + j], *b = dth[SR_T_S + j];
-                for (col = 0; col < NC; ++col) out[i][col] += pij * a[col] + qij * b[col];
-            }
-        }
-        memcpy(df[SR_T_S], out, sizeof out);
+}
+
+/* ---- RKMK4's stages, fused ------------------------------------------------------------------
+ * Stage s > 1 of RKMK4 is k = dexp^-1(th, f(y)) with y = x . exp(th), th = h K', K' the previous
+ * stage.  By the rules above, with dth = h dK': dy = A(th) [I | 0] + B(th) dth, df = J_f(y) dy,
+ * dk = P df + Q dth.  Every row of dk is a combination a . dy of the rows of dy that the dynamics
+ * reads (xi_S, th_Y, th_P, nu: READ; nothing depends on q), plus Q dth on the SO(3) block, and
+ *     a . dy = base(a) + sum_l coef_l(a) dK'[READ[l]]
+ * where base(a) is a . A(th) [I | 0] and coef(a) is h a . B(th) on the read rows: `pull` forms
+ * both.  So dy and dth are never formed, h and B(th) are folded into ten coefficients per row, and
+ * each row costs one pass over the rows of dK' it uses (`combine_rows`). */
+enum { NREAD = 10 };
+
+/* base = a . A(th) [I | 0] and coef = h a . B(th) on the read rows, for a row functional a on the
+ * read rows of an error (xi_S 3, th_Y, th_P, nu 5); D = Exp(th_S) - I, Jr = Jr(th_S). */
+static void pull(const sr_real a[NREAD], const sr_real D[9], const sr_real Jr[9], sr_real h,
+                 sr_real base[NC], sr_real coef[NREAD])
+{
+    int j, l;
+    for (l = 0; l < NC; ++l) base[l] = 0;
+    for (l = 0; l < 3; ++l) {   /* the xi rows of A [I | 0]: Exp(th_S)^T on the xi columns */
+        base[l] = a[l] + a[0] * D[3 * l + 0] + a[1] * D[3 * l + 1] + a[2] * D[3 * l + 2];
+        coef[l] = 0;
+        for (j = 0; j < 3; ++j) coef[l] += a[j] * Jr[3 * j + l];
+        coef[l] *= h;
     }
-    sr_internal_dexpinv(th, f, f);
+    for (l = 3; l < NREAD; ++l) {   /* th_Y, th_P, nu: the identity (carried columns 3, 4, 5..9) */
+        base[l] = a[l];
+        coef[l] = h * a[l];
+    }
+}
+
+/* out = base + sum_l coef[l] dK[l] (l < n) + sum_l coef[n + l] dK[SR_T_V + l] (l < m): the rows of
+ * th_S first (then th_Y, th_P if n = 5), then those of nu (n, m constants where inlined). */
+static inline void combine_rows(const sr_real base[NC], int n, int m, const sr_real *coef, const tangent dK,
+                                sr_real out[NC])
+{
+    sr_real o[NC];   /* local, as in field_jacobian */
+    int c, l;
+    for (c = 0; c < NC; ++c) o[c] = base[c];
+    for (l = 0; l < n; ++l)
+        for (c = 0; c < NC; ++c) o[c] += coef[l] * dK[l][c];
+    for (l = 0; l < m; ++l)
+        for (c = 0; c < NC; ++c) o[c] += coef[n + l] * dK[SR_T_V + l][c];
+    memcpy(out, o, sizeof o);
+}
+
+/* The rows of J_f(y) on the read rows of the error: the accelerations' Ja (without its zero dq
+ * columns) and the rolling q' = p . w with d(q') = p . dw + (w x p) . dxi (as in field_jacobian). */
+static void field_rows(const sr_model *model, const sr_real y[SR_NX], const sr_real Ja[SR_NV * SR_NE],
+                       sr_real rows[2 + SR_NV][NREAD])
+{
+    const sr_real *R = y + SR_X_R_S, *w = y + SR_X_w_S, r = model->p[SR_P_r];
+    int i, l;
+    for (i = 0; i < 2; ++i) {
+        sr_real p[3];
+        for (l = 0; l < 3; ++l) p[l] = i == 0 ? r * R[3 + l] : -r * R[l];   /* q_x' = r (R_S w)_y, q_y' = -r (R_S w)_x */
+        rows[i][0] = w[1] * p[2] - w[2] * p[1];
+        rows[i][1] = w[2] * p[0] - w[0] * p[2];
+        rows[i][2] = w[0] * p[1] - w[1] * p[0];
+        rows[i][3] = rows[i][4] = 0;
+        for (l = 0; l < 3; ++l) rows[i][5 + l] = p[l];
+        rows[i][8] = rows[i][9] = 0;
+    }
+    for (i = 0; i < SR_NV; ++i)
+        for (l = 0; l < NREAD; ++l) rows[2 + i][l] = Ja[SR_NE * i + full_column(l)];
+}
+
+/* The values and the accelerations' Jacobian at a stage state (see field_jacobian). */
+static int field_and_jacobian(const sr_model *model, const sr_real y[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NT],
+                              sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU])
+{
+    int status;
+    sr_internal_kinematics(model, y, f);
+    status = sr_internal_accel_jacobian(model, y, u, f + SR_T_V, Ja, Jb);
+    /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
+    return status == SR_ERR_SINGULAR && !all_finite(y, SR_NX) ? SR_ERR_NONFINITE : status;
+}
+
+/* K = f(x) and dK = J_f(x) [I | 0] + [0 | J_u]: RKMK4's and CF4's first stage (no product). */
+static int first_stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                sr_real K[SR_NT], tangent dK)
+{
+    sr_real Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], rows[2 + SR_NV][NREAD];
+    int i, l, status = field_and_jacobian(model, x, u, K, Ja, Jb);
+    if (status != SR_OK) return status;
+    field_rows(model, x, Ja, rows);
+    memset(dK, 0, sizeof(tangent));
+    for (i = 0; i < 3; ++i) dK[SR_T_S + i][5 + i] = 1;   /* th_S' = w_S: carried column 5 + i is d_nu_i */
+    dK[SR_T_Y][8] = 1;
+    dK[SR_T_P][9] = 1;
+    for (i = 0; i < 2; ++i)
+        for (l = 0; l < NREAD; ++l) dK[SR_T_Q + i][l] = rows[i][l];
+    for (i = 0; i < SR_NV; ++i) {
+        for (l = 0; l < NREAD; ++l) dK[SR_T_V + i][l] = rows[2 + i][l];
+        for (l = 0; l < SR_NU; ++l) dK[SR_T_V + i][NREAD + l] = Jb[SR_NU * i + l];
+    }
+    return SR_OK;
+}
+
+/* RKMK4's stage k = dexp^-1(th, f(x . exp(th))), th = h Kp, and dk (see above). */
+static int rkmk4_stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
+                                const sr_real Kp[SR_NT], const tangent dKp, sr_real k[SR_NT], tangent dk)
+{
+    sr_real th[SR_NT], y[SR_NX], D[9], Jr[9], P[9], Q[9], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU];
+    sr_real rows[2 + SR_NV][NREAD], a[NREAD], base[NC], coef[NREAD], shell[6];
+    int i, l, status;
+    for (i = 0; i < SR_NT; ++i) th[i] = h * Kp[i];
+    sr_internal_act(x, th, y);
+    status = field_and_jacobian(model, y, u, k, Ja, Jb);
+    if (status != SR_OK) return status;
+    so3_exp_minus_identity(th + SR_T_S, D);
+    so3_right_jacobian(th + SR_T_S, Jr);
+    field_rows(model, y, Ja, rows);
+    for (i = 0; i < SR_NV; ++i) {                       /* dk_nu = df_nu = Ja dy + [0 | Jb] */
+        pull(rows[2 + i], D, Jr, h, base, coef);
+        for (l = 0; l < SR_NU; ++l) base[NREAD + l] = Jb[SR_NU * i + l];
+        combine_rows(base, 5, 5, coef, dKp, dk[SR_T_V + i]);
+    }
+    for (i = 0; i < 2; ++i) {                           /* dk_q = df_q: reads xi_S and nu_S only */
+        pull(rows[i], D, Jr, h, base, coef);
+        for (l = 0; l < 3; ++l) shell[l] = coef[l], shell[3 + l] = coef[5 + l];
+        combine_rows(base, 3, 3, shell, dKp, dk[SR_T_Q + i]);
+    }
+    for (l = 0; l < NC; ++l) dk[SR_T_Q + 2][l] = 0;
+    dexpinv_derivatives(th, k, P, Q);                   /* dk_S = P dy_nu_S + Q h dK'_S */
+    for (i = 0; i < 3; ++i) {
+        for (l = 0; l < NREAD; ++l) a[l] = 0;
+        for (l = 0; l < 3; ++l) a[5 + l] = P[3 * i + l];
+        pull(a, D, Jr, h, base, coef);
+        for (l = 0; l < 3; ++l) shell[l] = h * Q[3 * i + l], shell[3 + l] = coef[5 + l];
+        combine_rows(base, 3, 3, shell, dKp, dk[SR_T_S + i]);
+    }
+    for (l = 0; l < NC; ++l) {                          /* dk_Y, dk_P = dy_nu_Y, dy_nu_P */
+        dk[SR_T_Y][l] = (sr_real)(l == 8) + h * dKp[SR_T_V + 3][l];
+        dk[SR_T_P][l] = (sr_real)(l == 9) + h * dKp[SR_T_V + 4][l];
+    }
+    sr_internal_dexpinv(th, k, k);
+    return SR_OK;
 }
 
 /* th = sum_k coef[k] K[k] and its derivative. */
@@ -215,30 +346,22 @@ static int check_step_arguments(const sr_model *model, const sr_real x[SR_NX], c
     return (dt > 0) && isfinite(dt) ? SR_OK : SR_ERR_ARG;
 }
 
-int sr_step_jacobian_rkmk4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+SR_JACOBIAN_CLONES int sr_step_jacobian_rkmk4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                            sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
 {
     static const sr_real zero_u[SR_NU] = {0, 0};
     static const sr_real a_diag[3] = {SR_C(0.5), SR_C(0.5), SR_C(1.0)};
     const sr_real b[4] = {dt / 6, dt / 3, dt / 3, dt / 6};
-    sr_real K[4][SR_NT], th[SR_NT], y[SR_NX], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
+    sr_real K[4][SR_NT], th[SR_NT], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
     tangent dK[4], dth;
     error dy;
-    int i, c, s, status = check_step_arguments(model, x, u, dt, F, G);
+    int s, status = check_step_arguments(model, x, u, dt, F, G);
     if (status != SR_OK) return status;
     if (!u) u = zero_u;
-    identity(dy);
-    status = field_jacobian(model, x, u, dy, K[0], dK[0]);
-    for (s = 1; s < 4 && status == SR_OK; ++s) {
-        for (i = 0; i < SR_NT; ++i) {
-            th[i] = a_diag[s - 1] * dt * K[s - 1][i];
-            for (c = 0; c < NC; ++c) dth[i][c] = a_diag[s - 1] * dt * dK[s - 1][i][c];
-        }
-        sr_internal_act(x, th, y);
-        act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dy);
-        status = field_jacobian(model, y, u, dy, K[s], dK[s]);
-        if (status == SR_OK) dexpinv_jacobian(th, (const sr_real(*)[NC])dth, K[s], dK[s]);
-    }
+    status = first_stage_jacobian(model, x, u, K[0], dK[0]);
+    for (s = 1; s < 4 && status == SR_OK; ++s)
+        status = rkmk4_stage_jacobian(model, x, u, a_diag[s - 1] * dt, K[s - 1], (const sr_real(*)[NC])dK[s - 1],
+                                      K[s], dK[s]);
     if (status != SR_OK) return status;
     combine_jacobian(4, b, (const sr_real(*)[SR_NT])K, dK, th, dth);
     act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dy);
@@ -249,7 +372,7 @@ int sr_step_jacobian_rkmk4(const sr_model *model, const sr_real x[SR_NX], const 
     return SR_OK;
 }
 
-int sr_step_jacobian_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+SR_JACOBIAN_CLONES int sr_step_jacobian_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                          sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
 {
     static const sr_real zero_u[SR_NU] = {0, 0};

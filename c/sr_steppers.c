@@ -45,8 +45,7 @@
 /* f = the velocity of the state in the Lie algebra: (w_S, w_Y, w_P, q', nu').
  * q' = r R_S (w_S x gamma) with its z component set to 0: gamma . (w_S x gamma) = 0 exactly,
  * so the centre moves in its plane and q_z = r is kept to the last bit. */
-int sr_internal_vector_field(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                             sr_real f[SR_NT], long *evaluations)
+void sr_internal_kinematics(const sr_model *model, const sr_real x[SR_NX], sr_real f[SR_NT])
 {
     const sr_real *R = x + SR_X_R_S, *w = x + SR_X_w_S, *gam = x + SR_X_R_S + 6;
     const sr_real r = model->p[SR_P_r];
@@ -61,11 +60,18 @@ int sr_internal_vector_field(const sr_model *model, const sr_real x[SR_NX], cons
     f[SR_T_Q + 0] = r * (R[0] * v[0] + R[1] * v[1] + R[2] * v[2]);
     f[SR_T_Q + 1] = r * (R[3] * v[0] + R[4] * v[1] + R[5] * v[2]);
     f[SR_T_Q + 2] = 0;
+}
+
+int sr_internal_vector_field(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                             sr_real f[SR_NT], long *evaluations)
+{
+    int status;
+    sr_internal_kinematics(model, x, f);
     if (evaluations) ++*evaluations;
-    i = sr_internal_accel(model, x, u, f + SR_T_V);
+    status = sr_internal_accel(model, x, u, f + SR_T_V);
     /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
-    if (i == SR_ERR_SINGULAR && !all_finite(x, SR_NX)) return SR_ERR_NONFINITE;
-    return i;
+    if (status == SR_ERR_SINGULAR && !all_finite(x, SR_NX)) return SR_ERR_NONFINITE;
+    return status;
 }
 
 /* Rounding and orthogonality.  Forming E = Exp(...) and then R E rounds the diagonal of E to
