@@ -254,9 +254,10 @@ static int first_stage_jacobian(const sr_model *model, const sr_real x[SR_NX], c
     return SR_OK;
 }
 
-/* RKMK4's stage k = dexp^-1(th, f(x . exp(th))), th = h Kp, and dk (see above). */
-static int rkmk4_stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
-                                const sr_real Kp[SR_NT], const tangent dKp, sr_real k[SR_NT], tangent dk)
+/* The stage k = dexp^-1(th, f(x . exp(th))) of RKMK4 (dexpinv set), or k = f(x . exp(th)) of CF4's
+ * second and third stages, th = h Kp, and dk (see above). */
+static int stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
+                          const sr_real Kp[SR_NT], const tangent dKp, int dexpinv, sr_real k[SR_NT], tangent dk)
 {
     sr_real th[SR_NT], y[SR_NX], D[9], Jr[9], P[9], Q[9], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU];
     sr_real rows[2 + SR_NV][NREAD], a[NREAD], base[NC], coef[NREAD], shell[6];
@@ -279,19 +280,24 @@ static int rkmk4_stage_jacobian(const sr_model *model, const sr_real x[SR_NX], c
         combine_rows(base, 3, 3, shell, dKp, dk[SR_T_Q + i]);
     }
     for (l = 0; l < NC; ++l) dk[SR_T_Q + 2][l] = 0;
-    dexpinv_derivatives(th, k, P, Q);                   /* dk_S = P dy_nu_S + Q h dK'_S */
-    for (i = 0; i < 3; ++i) {
-        for (l = 0; l < NREAD; ++l) a[l] = 0;
-        for (l = 0; l < 3; ++l) a[5 + l] = P[3 * i + l];
-        pull(a, D, Jr, h, base, coef);
-        for (l = 0; l < 3; ++l) shell[l] = h * Q[3 * i + l], shell[3 + l] = coef[5 + l];
-        combine_rows(base, 3, 3, shell, dKp, dk[SR_T_S + i]);
+    if (dexpinv) {
+        dexpinv_derivatives(th, k, P, Q);               /* dk_S = P dy_nu_S + Q h dK'_S */
+        for (i = 0; i < 3; ++i) {
+            for (l = 0; l < NREAD; ++l) a[l] = 0;
+            for (l = 0; l < 3; ++l) a[5 + l] = P[3 * i + l];
+            pull(a, D, Jr, h, base, coef);
+            for (l = 0; l < 3; ++l) shell[l] = h * Q[3 * i + l], shell[3 + l] = coef[5 + l];
+            combine_rows(base, 3, 3, shell, dKp, dk[SR_T_S + i]);
+        }
+        sr_internal_dexpinv(th, k, k);
+    } else {
+        for (i = 0; i < 3; ++i)                         /* dk_S = dy_nu_S */
+            for (l = 0; l < NC; ++l) dk[SR_T_S + i][l] = (sr_real)(l == 5 + i) + h * dKp[SR_T_V + i][l];
     }
     for (l = 0; l < NC; ++l) {                          /* dk_Y, dk_P = dy_nu_Y, dy_nu_P */
         dk[SR_T_Y][l] = (sr_real)(l == 8) + h * dKp[SR_T_V + 3][l];
         dk[SR_T_P][l] = (sr_real)(l == 9) + h * dKp[SR_T_V + 4][l];
     }
-    sr_internal_dexpinv(th, k, k);
     return SR_OK;
 }
 
@@ -311,14 +317,6 @@ static void combine_jacobian(int n, const sr_real *coef, const sr_real (*K)[SR_N
         }
         memcpy(dth[i], o, sizeof o);
     }
-}
-
-/* The error of x itself: [I | 0]. */
-static void identity(error e)
-{
-    int i, c;
-    for (i = 0; i < SR_NE; ++i)
-        for (c = 0; c < NC; ++c) e[i][c] = (sr_real)(i == full_column(c));
 }
 
 static void deliver_jacobians(error dy, sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
@@ -360,8 +358,8 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_rkmk4(const sr_model *model, const sr_re
     if (!u) u = zero_u;
     status = first_stage_jacobian(model, x, u, K[0], dK[0]);
     for (s = 1; s < 4 && status == SR_OK; ++s)
-        status = rkmk4_stage_jacobian(model, x, u, a_diag[s - 1] * dt, K[s - 1], (const sr_real(*)[NC])dK[s - 1],
-                                      K[s], dK[s]);
+        status = stage_jacobian(model, x, u, a_diag[s - 1] * dt, K[s - 1], (const sr_real(*)[NC])dK[s - 1], 1,
+                                K[s], dK[s]);
     if (status != SR_OK) return status;
     combine_jacobian(4, b, (const sr_real(*)[SR_NT])K, dK, th, dth);
     act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dy);
@@ -381,24 +379,19 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_cf4(const sr_model *model, const sr_real
     const sr_real half[2] = {SR_C(0.5) * dt, 0}, one[2] = {dt, -SR_C(0.5) * dt};
     sr_real Fk[4][SR_NT], th[SR_NT], th2[SR_NT], Y2[SR_NX], Y[SR_NX], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
     tangent dF[4], dth, dth2;
-    error dx, dY2, dY;
+    error dY2, dY;
     int status = check_step_arguments(model, x, u, dt, F, G);
     if (status != SR_OK) return status;
     if (!u) u = zero_u;
-    identity(dx);
-    status = field_jacobian(model, x, u, dx, Fk[0], dF[0]);                        /* F1 = f(x) */
+    status = first_stage_jacobian(model, x, u, Fk[0], dF[0]);                     /* F1 = f(x) */
     if (status == SR_OK) {                                                         /* Y2 = x . exp(h/2 F1) */
-        combine_jacobian(1, half, (const sr_real(*)[SR_NT])Fk, dF, th, dth);
+        status = stage_jacobian(model, x, u, half[0], Fk[0], (const sr_real(*)[NC])dF[0], 0, Fk[1], dF[1]);
+        combine_jacobian(1, half, (const sr_real(*)[SR_NT])Fk, dF, th, dth);      /* F2 = f(Y2), and dY2 */
         sr_internal_act(x, th, Y2);
         act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dY2);
-        status = field_jacobian(model, Y2, u, dY2, Fk[1], dF[1]);                  /* F2 = f(Y2) */
     }
-    if (status == SR_OK) {                                                         /* Y3 = x . exp(h/2 F2) */
-        combine_jacobian(1, half, (const sr_real(*)[SR_NT])Fk + 1, dF + 1, th, dth);
-        sr_internal_act(x, th, Y);
-        act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dY);
-        status = field_jacobian(model, Y, u, dY, Fk[2], dF[2]);                    /* F3 = f(Y3) */
-    }
+    if (status == SR_OK)                                                           /* F3 = f(x . exp(h/2 F2)) */
+        status = stage_jacobian(model, x, u, half[0], Fk[1], (const sr_real(*)[NC])dF[1], 0, Fk[2], dF[2]);
     if (status == SR_OK) {                                                         /* Y4 = Y2 . exp(h (F3 - F1/2)) */
         const sr_real (*pair)[SR_NT] = (const sr_real(*)[SR_NT])Fk;
         tangent dpair[2];
