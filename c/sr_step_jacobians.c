@@ -9,7 +9,7 @@
  *                                              B = diag(Jr(th_S), 1, 1, [I_2 0], I_5)
  * (the right Jacobian Jr of SO(3); q_z does not move); for the vector field f of
  * sr_internal_vector_field at a stage state y with error e: df = J_f(y) e + [0 | J_u] w, from
- * sr_accel_jacobian (the accelerations) and the rolling kinematics (q' = r (R_S w) x e_z, as in
+ * sr_internal_accel_jacobian (the accelerations) and the rolling kinematics (q' = r (R_S w) x e_z, as in
  * sr_step_jacobian_lie_euler); and for k = dexp^-1(th, f) = f + th x f / 2 + c(|th|^2) th x (th x f)
  * on the SO(3) block: dk = (I + [th]/2 + c [th]^2) df + (-[f]/2 + c ((th.f) I + th f^T - 2 f th^T)
  * + 2 c'(|th|^2) (th x (th x f)) th^T) dth.
@@ -159,12 +159,14 @@ static void dexpinv_derivatives(const sr_real th[SR_NT], const sr_real f[SR_NT],
 /* ---- RKMK4's stages, fused ------------------------------------------------------------------
  * Stage s > 1 of RKMK4 is k = dexp^-1(th, f(y)) with y = x . exp(th), th = h K', K' the previous
  * stage.  By the rules above, with dth = h dK': dy = A(th) [I | 0] + B(th) dth, df = J_f(y) dy,
- * dk = P df + Q dth.  Every row of dk is a combination a . dy of the rows of dy that the dynamics
- * reads (xi_S, th_Y, th_P, nu: READ; nothing depends on q), plus Q dth on the SO(3) block, and
- *     a . dy = base(a) + sum_l coef_l(a) dK'[READ[l]]
+ * dk = P df + Q dth.  Every row of dk is a combination a . dy of the NREAD rows of dy that the
+ * dynamics reads (xi_S, th_Y, th_P and nu; nothing depends on q), plus Q dth on the SO(3) block, and
+ *     a . dy = base(a) + sum_l coef_l(a) dK'_l      (l over th_S, th_Y, th_P and th_nu of dK')
  * where base(a) is a . A(th) [I | 0] and coef(a) is h a . B(th) on the read rows: `pull` forms
  * both.  So dy and dth are never formed, h and B(th) are folded into ten coefficients per row, and
- * each row costs one pass over the rows of dK' it uses (`combine_rows`). */
+ * each row costs one pass over the rows of dK' it uses (`combine_rows`).  Measured on an AMD EPYC
+ * (Zen 4), with the first stage's product skipped and one unchecked accel Jacobian per stage that
+ * also gives the accelerations: RKMK4 3.70 -> 1.8 us. */
 enum { NREAD = 10 };
 
 /* base = a . A(th) [I | 0] and coef = h a . B(th) on the read rows, for a row functional a on the
