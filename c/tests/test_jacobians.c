@@ -1,8 +1,10 @@
 /*
  * test_jacobians.c -- sr_accel_jacobian (c/sr_jacobians.c): each column is the central difference
- * of sr_accel along sr_retract (or along u); status codes and untouched outputs on error.
+ * of sr_accel along sr_retract (or along u); status codes and untouched outputs on error; the
+ * accelerations its internal form gives the step Jacobians are sr_accel's.
  */
 #include "sr_test.h"
+#include "sr_internal.h" /* sr_internal_accel_jacobian: the step Jacobians' stage values, tested directly */
 
 #include <math.h>
 #include <string.h>
@@ -40,6 +42,32 @@ static void test_accel_jacobian_columns_are_central_differences_along_retract(vo
         }
         for (i = 0; i < SR_NV; ++i)
             CHECK_NEAR(Jb[SR_NU * i + k], ((double)ap[i] - (double)am[i]) / (2 * h), tol * scale);
+    }
+}
+
+/* The step Jacobians take each stage's accelerations from sr_internal_accel_jacobian (for the
+ * paper's robot solved in the yoke frame and turned by R_Y; for a general one by Cholesky), not
+ * from sr_accel: both robots, to rounding. */
+static void test_internal_accel_jacobian_gives_the_accelerations_of_sr_accel(void)
+{
+    sr_real p[SR_NPARAM], x[SR_NX], u[SR_NU] = {SR_C(0.05), SR_C(-0.02)}, a[SR_NV], b[SR_NV];
+    sr_real Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU];
+    test_rng rng = {31};
+    sr_model m;
+    int robot, n, i;
+    for (robot = 0; robot < 2; ++robot) {
+        if (robot) general_robot_params(p);
+        else paper_simulation_params(p);
+        CHECK_STATUS(sr_model_init(&m, p), SR_OK);
+        CHECK(m.general == robot);
+        for (n = 0; n < 20; ++n) {
+            double scale = 1;
+            random_state(&rng, p[SR_P_r], 3.0, x);
+            CHECK_STATUS(sr_accel(&m, x, u, a), SR_OK);
+            CHECK_STATUS(sr_internal_accel_jacobian(&m, x, u, b, Ja, Jb), SR_OK);
+            for (i = 0; i < SR_NV; ++i) scale = fabs((double)a[i]) > scale ? fabs((double)a[i]) : scale;
+            for (i = 0; i < SR_NV; ++i) CHECK_NEAR(b[i], a[i], 64 * TEST_EPS * scale);
+        }
     }
 }
 
@@ -180,6 +208,7 @@ void suite_jacobians(void)
 {
     RUN_TEST(test_accel_jacobian_columns_are_central_differences_along_retract);
     RUN_TEST(test_accel_jacobian_bad_input_leaves_outputs_untouched);
+    RUN_TEST(test_internal_accel_jacobian_gives_the_accelerations_of_sr_accel);
     RUN_TEST(test_lie_euler_step_jacobian_columns_are_central_differences_through_retract_and_local);
     RUN_TEST(test_rkmk4_and_cf4_step_jacobians_are_central_differences_through_retract_and_local);
     RUN_TEST(test_step_jacobians_of_a_general_robot_are_central_differences);
