@@ -386,7 +386,8 @@ int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[SR_
  *   status   n: the status of each sample: SR_OK, or the error of sr_model_init (its
  *            parameters), sr_check_state (its x0), sr_simulate_guarded (its run) or
  *            sr_energy (SR_ERR_NONFINITE with steps_done = steps: every step ran, but the final
- *            energy overflowed, so the sample has no finite metrics)
+ *            energy, or the path length or a distance of far-out positions, overflowed, so the
+ *            sample has no finite metrics)
  *   steps_done n: the steps completed before the sample stopped (steps on SR_OK)
  * One failing sample never touches another's outputs; its own x_final and metrics rows are
  * left untouched.  status[i] and steps_done[i] are written when sample i is finished, in

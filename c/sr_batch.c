@@ -11,7 +11,21 @@ typedef struct metrics_acc {
     sr_real path, max_distance, max_rate;
 } metrics_acc;
 
-static sr_real norm3(sr_real a, sr_real b, sr_real c) { return SR_SQRT(a * a + b * b + c * c); }
+/* |(a, b, c)|, finite whenever it is representable: where the squares overflow (components past
+ * ~1e154, a state far out but finite), scaled by the largest magnitude. */
+static sr_real norm3(sr_real a, sr_real b, sr_real c)
+{
+    const sr_real s = a * a + b * b + c * c;
+    sr_real m;
+    if (isfinite(s)) return SR_SQRT(s);
+    m = SR_FABS(a) > SR_FABS(b) ? SR_FABS(a) : SR_FABS(b);
+    m = m > SR_FABS(c) ? m : SR_FABS(c);
+    if (!isfinite(m)) return m;
+    a /= m;
+    b /= m;
+    c /= m;
+    return m * SR_SQRT(a * a + b * b + c * c);
+}
 
 static void metrics_start(metrics_acc *m, const sr_real x0[SR_NX])
 {
@@ -76,6 +90,9 @@ static int run_sample(int method, const sr_real params[SR_NPARAM], const sr_real
     }
     status = sr_energy(&model, last, &energy);
     if (status != SR_OK) return status;
+    /* Every row finite, but a sum or a difference of positions may still overflow (a path longer
+     * than the largest number): no finite metrics, as for an energy that overflows. */
+    if (!isfinite(acc.path) || !isfinite(acc.max_distance) || !isfinite(acc.max_rate)) return SR_ERR_NONFINITE;
     if (x_final) for (i = 0; i < SR_NX; ++i) x_final[i] = last[i];
     if (metrics) {
         metrics[SR_BATCH_PATH_LENGTH] = acc.path;

@@ -76,6 +76,20 @@ def test_api_contract_holds_for_random_inputs_under_sanitizers(fuzz_build, progr
     assert m and int(m.group(1)) > 1000, result.stdout
 
 
+#: Inputs that once broke the contract (libFuzzer's crash files), replayed on every run and given to
+#: libFuzzer as seeds (c/fuzz/regressions/, c/Makefile fuzz-libfuzzer).
+REGRESSIONS = sorted((C_DIR / "fuzz" / "regressions").iterdir())
+
+
+@pytest.mark.parametrize("program", ["fuzz_driver", "fuzz_driver_f"])
+def test_inputs_that_once_broke_the_contract_now_hold_it(fuzz_build, program):
+    build, _ = fuzz_build
+    assert REGRESSIONS, "c/fuzz/regressions/ is empty"
+    result = subprocess.run([build / program, *map(str, REGRESSIONS)], capture_output=True, text=True, env=ENV,
+                            timeout=120)
+    assert result.returncode == 0, result.stdout[-2000:] + result.stderr[-4000:]
+
+
 def test_api_contract_holds_under_libfuzzer(fuzz_build):
     build, have_libfuzzer = fuzz_build
     if not have_libfuzzer:
