@@ -447,10 +447,12 @@ int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 /* Jacobians of the accelerations in the error coordinates:
  *   nu'(x (+) d, u + w) = nu'(x, u) + Ja d + Jb w + O(|d|^2 + |w|^2),
  * Ja row-major SR_NV x SR_NE, Jb row-major SR_NV x SR_NU.  Derived symbolically from the same
- * derivation as sr_accel (derive/derivatives.py): d(nu') = M^-1 (df - (dM) nu'), one Cholesky
- * factorisation of M for nu' and every column; cost SR_GEN_ACCEL_JACOBIAN_TERMS_FLOPS plus the
- * solves.  Checks and status codes as sr_accel (u may be NULL: zero torque); the outputs are
- * written only on SR_OK. */
+ * derivation as sr_accel (derive/derivatives.py): d(nu') = M^-1 (df - (dM) nu'), one
+ * factorisation of M for nu' and every column.  For a robot of the paper's geometry in the yoke
+ * frame, as sr_accel (SR_GEN_ACCEL_JACOBIAN_YOKE_TERMS_FLOPS, then the joint-first solve of 11
+ * columns and the chain rule through R_Y); for a general robot in the shell frame
+ * (SR_GEN_GENERAL_ACCEL_JACOBIAN_TERMS_FLOPS, then a Cholesky solve).  Checks and status codes as
+ * sr_accel (u may be NULL: zero torque); the outputs are written only on SR_OK. */
 int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                       sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU]);
 
@@ -465,7 +467,7 @@ int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, con
  * implemented (R_S Exp(h w_S) through the right Jacobian of SO(3), the joint angles, q by the
  * rolling kinematics, nu by sr_accel_jacobian).  Checks and status codes as sr_step_lie_euler
  * (the full state check; dt > 0 and finite, else SR_ERR_ARG; u may be NULL); outputs written
- * only on SR_OK.  (RKMK4 and CF4: runtime.step_jacobian, by CasADi AD, for now.) */
+ * only on SR_OK. */
 int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                                sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU]);
 
@@ -475,8 +477,10 @@ int sr_step_jacobian_lie_euler_batch(const sr_model *model, long n, const sr_rea
                                      sr_real *F, sr_real *G, long *failed_row);
 
 /* The same for one RKMK4 and one CF4 step (c/sr_step_jacobians.c): the exact derivatives of the
- * steps of c/sr_steppers.c, stage by stage (four sr_accel_jacobian calls, dexp^-1 differentiated
- * for RKMK4); checks, status codes and outputs as sr_step_jacobian_lie_euler. */
+ * steps of c/sr_steppers.c, stage by stage (an accel Jacobian at each of the four stage states,
+ * dexp^-1 differentiated for RKMK4); checks, status codes and outputs as
+ * sr_step_jacobian_lie_euler.  Built with -DSR_CLONES on x86-64 (GCC, glibc), each is compiled
+ * for AVX2 too and the loader picks (SR_JACOBIAN_CLONES, sr_real.h). */
 int sr_step_jacobian_rkmk4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                            sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU]);
 int sr_step_jacobian_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,

@@ -2,8 +2,9 @@
  * fuzz_api.c -- fuzz target for every public entry point of the spherical-robot library.
  *
  * LLVMFuzzerTestOneInput turns the input bytes into parameters, a state, torques, a time
- * step, a method and small step counts, calls every function of spherical_robot.h and
- * checks its contract (abort() on a violation, so libFuzzer and the plain driver both
+ * step, a method and small step counts, calls the functions of spherical_robot.h (all but the
+ * controller's sr_lqr_*, whose gain tables tests/test_control.c and the Python tests cover) and
+ * checks their contract (abort() on a violation, so libFuzzer and the plain driver both
  * report it with the input that caused it):
  *
  *   - the status is one of the codes the header documents for that function;
@@ -385,6 +386,51 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                     if (!is_canary(row_out + i)) fail("sr_simulate_batch", bstatus[s], "wrote a failed sample's final row");
             }
         }
+    }
+
+    /* The group, the derivatives and the batch steps (issues 19, 21); read last, so that the
+     * inputs kept in fuzz/regressions/ still mean what they meant. */
+    {
+        static guarded g2;   /* a second output (G of a step Jacobian, Jb) */
+        sr_real d[SR_NE], y[SR_NX];
+        const int jmethod = read_u8(&rd) % 8 == 7 ? method : (int)(read_u8(&rd) % 3);
+        for (i = 0; i < SR_NE; ++i) d[i] = pick(&rd, 0.5 * unit(&rd));
+
+        status = sr_retract(&model, x, d, arm(&g, SR_NX));
+        EXPECT_STATUS("sr_retract", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+        expect("sr_retract", status, &g, status == SR_OK ? SR_NX : 0, 1);
+        memcpy(y, status == SR_OK ? g.buf + GUARD : x2 + SR_NX, sizeof y);
+        status = sr_local(&model, x, y, arm(&g, SR_NE));
+        EXPECT_STATUS("sr_local", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+        expect("sr_local", status, &g, status == SR_OK ? SR_NE : 0, 1);
+
+        status = sr_accel_jacobian(&model, x, u_or_null, arm(&g, SR_NV * SR_NE), arm(&g2, SR_NV * SR_NU));
+        EXPECT_STATUS("sr_accel_jacobian", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_SINGULAR);
+        expect("sr_accel_jacobian", status, &g, status == SR_OK ? SR_NV * SR_NE : 0, 1);
+        expect("sr_accel_jacobian", status, &g2, status == SR_OK ? SR_NV * SR_NU : 0, 1);
+
+        status = sr_step_jacobian(&model, jmethod, x, u_or_null, dt, arm(&g, SR_NE * SR_NE), arm(&g2, SR_NE * SR_NU));
+        EXPECT_STATUS("sr_step_jacobian", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT,
+                      SR_ERR_SINGULAR, SR_ERR_ARG);
+        expect("sr_step_jacobian", status, &g, status == SR_OK ? SR_NE * SR_NE : 0, 1);
+        expect("sr_step_jacobian", status, &g2, status == SR_OK ? SR_NE * SR_NU : 0, 1);
+
+        /* two rows: all rows before the failing one written (finite), none after it */
+        status = sr_step_batch(&model, method, 2, x2, u_or_null, dt, arm(&g, 2 * SR_NX), &row);
+        EXPECT_STATUS("sr_step_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT,
+                      SR_ERR_SINGULAR, SR_ERR_ARG);
+        if ((status == SR_OK) != (row == -1) || row < -1 || row > 1) fail("sr_step_batch", status, "bad failed_row");
+        expect("sr_step_batch", status, &g, status == SR_OK ? 2 * SR_NX : (row > 0 ? (int)row * SR_NX : 0), 1);
+        if (status == SR_OK || row == 1) { /* each written row is sr_step's, bit for bit */
+            sr_real one[SR_NX];
+            if (sr_step(&model, method, x2, u_or_null, dt, one) != SR_OK || memcmp(one, g.buf + GUARD, sizeof one) != 0)
+                fail("sr_step_batch", status, "row 0 differs from sr_step");
+        }
+        status = sr_checked_accel_batch(&model, 2, x2, u_or_null, arm(&g, 2 * SR_NV), &row);
+        EXPECT_STATUS("sr_checked_accel_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
+        if ((status == SR_OK) != (row == -1) || row < -1 || row > 1) fail("sr_checked_accel_batch", status, "bad failed_row");
+        expect("sr_checked_accel_batch", status, &g, status == SR_OK ? 2 * SR_NV : (row > 0 ? (int)row * SR_NV : 0), 1);
     }
 
     /* NULL pointers */
