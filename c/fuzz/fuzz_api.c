@@ -33,7 +33,7 @@
 #define GUARD 8             /* canary reals on each side of an output */
 #define CANARY 0xA5      /* byte pattern of the model before sr_model_init */
 #define MAX_STEPS 6         /* largest step count of a fuzzed simulation */
-#define MAX_OUT ((MAX_STEPS + 1) * SR_NX)
+#define MAX_OUT (2 * SR_NE * SR_NE)  /* two step Jacobians; more than (MAX_STEPS + 1) rows of a simulation */
 
 typedef struct reader {
     const uint8_t *p;
@@ -425,6 +425,34 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             sr_real one[SR_NX];
             if (sr_step(&model, method, x2, u_or_null, dt, one) != SR_OK || memcmp(one, g.buf + GUARD, sizeof one) != 0)
                 fail("sr_step_batch", status, "row 0 differs from sr_step");
+        }
+        /* the batch forms of the Jacobians and of the group: rows before the failing one written */
+        status = sr_accel_jacobian_batch(&model, 2, x2, u_or_null, arm(&g, 2 * SR_NV * SR_NE), arm(&g2, 2 * SR_NV * SR_NU), &row);
+        EXPECT_STATUS("sr_accel_jacobian_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_SINGULAR);
+        if ((status == SR_OK) != (row == -1) || row < -1 || row > 1) fail("sr_accel_jacobian_batch", status, "bad failed_row");
+        expect("sr_accel_jacobian_batch", status, &g, status == SR_OK ? 2 * SR_NV * SR_NE : (row > 0 ? (int)row * SR_NV * SR_NE : 0), 1);
+        expect("sr_accel_jacobian_batch", status, &g2, status == SR_OK ? 2 * SR_NV * SR_NU : (row > 0 ? (int)row * SR_NV * SR_NU : 0), 1);
+        status = sr_step_jacobian_batch(&model, jmethod, 2, x2, u_or_null, dt, arm(&g, 2 * SR_NE * SR_NE),
+                                        arm(&g2, 2 * SR_NE * SR_NU), &row);
+        EXPECT_STATUS("sr_step_jacobian_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT,
+                      SR_ERR_SINGULAR, SR_ERR_ARG);
+        /* SR_ERR_ARG: an unknown method is refused before any row (-1), a bad dt at row 0 */
+        if (status == SR_ERR_ARG ? row != -1 && row != 0 : ((status == SR_OK) != (row == -1) || row < -1 || row > 1))
+            fail("sr_step_jacobian_batch", status, "bad failed_row");
+        expect("sr_step_jacobian_batch", status, &g, status == SR_OK ? 2 * SR_NE * SR_NE : (row > 0 ? (int)row * SR_NE * SR_NE : 0), 1);
+        expect("sr_step_jacobian_batch", status, &g2, status == SR_OK ? 2 * SR_NE * SR_NU : (row > 0 ? (int)row * SR_NE * SR_NU : 0), 1);
+        {
+            sr_real d2[2 * SR_NE];
+            memcpy(d2, d, sizeof d);
+            memcpy(d2 + SR_NE, d, sizeof d);
+            status = sr_retract_batch(&model, 2, x2, d2, arm(&g, 2 * SR_NX), &row);
+            EXPECT_STATUS("sr_retract_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+            if ((status == SR_OK) != (row == -1) || row < -1 || row > 1) fail("sr_retract_batch", status, "bad failed_row");
+            expect("sr_retract_batch", status, &g, status == SR_OK ? 2 * SR_NX : (row > 0 ? (int)row * SR_NX : 0), 1);
+            status = sr_local_batch(&model, 2, x2, x2, arm(&g, 2 * SR_NE), &row);
+            EXPECT_STATUS("sr_local_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+            if ((status == SR_OK) != (row == -1) || row < -1 || row > 1) fail("sr_local_batch", status, "bad failed_row");
+            expect("sr_local_batch", status, &g, status == SR_OK ? 2 * SR_NE : (row > 0 ? (int)row * SR_NE : 0), 1);
         }
         status = sr_checked_accel_batch(&model, 2, x2, u_or_null, arm(&g, 2 * SR_NV), &row);
         EXPECT_STATUS("sr_checked_accel_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
