@@ -86,52 +86,6 @@ static void act_jacobian(const sr_real th[SR_NT], const error *dx, const tangent
     memcpy(dy, out, sizeof out);
 }
 
-/* f = f(y) and df = J_f(y) dy + [0 | J_u] (see the top of the file). */
-static int field_jacobian(const sr_model *model, const sr_real y[SR_NX], const sr_real u[SR_NU], error dy,
-                          sr_real f[SR_NT], tangent df)
-{
-    const sr_real *R = y + SR_X_R_S, *w = y + SR_X_w_S, r = model->p[SR_P_r];
-    sr_real Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], p[2][3];
-    int i, j, k, c, status;
-    sr_internal_kinematics(model, y, f);
-    status = sr_internal_accel_jacobian(model, y, u, f + SR_T_V, Ja, Jb);
-    /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
-    if (status == SR_ERR_SINGULAR && !all_finite(y, SR_NX)) status = SR_ERR_NONFINITE;
-    if (status != SR_OK) return status;
-    for (j = 0; j < 3; ++j) {
-        p[0][j] = r * R[3 + j];     /* q_x' = r (R_S w)_y */
-        p[1][j] = -r * R[j];        /* q_y' = -r (R_S w)_x */
-    }
-    for (i = 0; i < 3; ++i) memcpy(df[SR_T_S + i], dy[SR_E_nu + i], sizeof df[0]);
-    memcpy(df[SR_T_Y], dy[SR_E_nu + 3], sizeof df[0]);
-    memcpy(df[SR_T_P], dy[SR_E_nu + 4], sizeof df[0]);
-    /* The rows are summed in local arrays, which the compiler knows alias nothing: summed in
-     * place, in df, the loops stayed scalar (df and dy could overlap as far as it knows). */
-    for (i = 0; i < 2; ++i) {   /* d(q') = p . (dw - w x dxi) = p . dw + (w x p) . dxi */
-        const sr_real *q = p[i];
-        const sr_real wxp[3] = {w[1] * q[2] - w[2] * q[1], w[2] * q[0] - w[0] * q[2], w[0] * q[1] - w[1] * q[0]};
-        sr_real o[NC];
-        for (c = 0; c < NC; ++c) o[c] = 0;
-        for (j = 0; j < 3; ++j) {
-            const sr_real *a = dy[SR_E_nu + j], *b = dy[SR_E_xi_S + j];
-            for (c = 0; c < NC; ++c) o[c] += q[j] * a[c] + wxp[j] * b[c];
-        }
-        memcpy(df[SR_T_Q + i], o, sizeof o);
-    }
-    for (c = 0; c < NC; ++c) df[SR_T_Q + 2][c] = 0;
-    for (i = 0; i < SR_NV; ++i) {
-        sr_real o[NC];
-        for (c = 0; c < NC; ++c) o[c] = full_column(c) >= SR_NE ? Jb[SR_NU * i + (full_column(c) - SR_NE)] : 0;
-        for (k = 0; k < SR_NE; ++k) {
-            const sr_real jik = Ja[SR_NE * i + k], *a = dy[k];
-            if (k == SR_E_q || k == SR_E_q + 1) continue;   /* exact zeros of Ja: q moves no acceleration */
-            for (c = 0; c < NC; ++c) o[c] += jik * a[c];
-        }
-        memcpy(df[SR_T_V + i], o, sizeof o);
-    }
-    return SR_OK;
-}
-
 /* The derivatives of k = dexp^-1(th, f) on the SO(3) block, k_S = v + t x v / 2 + c t x (t x v) with
  * t = th_S, v = f_S: P = dk_S/dv, Q = dk_S/dt (see the top of the file). */
 static void dexpinv_derivatives(const sr_real th[SR_NT], const sr_real f[SR_NT], sr_real P[9], sr_real Q[9])
@@ -228,7 +182,7 @@ static void field_rows(const sr_model *model, const sr_real y[SR_NX], const sr_r
         for (l = 0; l < NREAD; ++l) rows[2 + i][l] = Ja[SR_NE * i + full_column(l)];
 }
 
-/* The values and the accelerations' Jacobian at a stage state (see field_jacobian). */
+/* The values and the accelerations' Jacobian at a stage state. */
 static int field_and_jacobian(const sr_model *model, const sr_real y[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NT],
                               sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU])
 {
@@ -237,6 +191,49 @@ static int field_and_jacobian(const sr_model *model, const sr_real y[SR_NX], con
     status = sr_internal_accel_jacobian(model, y, u, f + SR_T_V, Ja, Jb);
     /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
     return status == SR_ERR_SINGULAR && !all_finite(y, SR_NX) ? SR_ERR_NONFINITE : status;
+}
+
+/* f = f(y) and df = J_f(y) dy + [0 | J_u] for a state whose error dy is any (CF4's last stage; see
+ * the top of the file). */
+static int field_jacobian(const sr_model *model, const sr_real y[SR_NX], const sr_real u[SR_NU], error dy,
+                          sr_real f[SR_NT], tangent df)
+{
+    const sr_real *R = y + SR_X_R_S, *w = y + SR_X_w_S, r = model->p[SR_P_r];
+    sr_real Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], p[2][3];
+    int i, j, k, c, status = field_and_jacobian(model, y, u, f, Ja, Jb);
+    if (status != SR_OK) return status;
+    for (j = 0; j < 3; ++j) {
+        p[0][j] = r * R[3 + j];     /* q_x' = r (R_S w)_y */
+        p[1][j] = -r * R[j];        /* q_y' = -r (R_S w)_x */
+    }
+    for (i = 0; i < 3; ++i) memcpy(df[SR_T_S + i], dy[SR_E_nu + i], sizeof df[0]);
+    memcpy(df[SR_T_Y], dy[SR_E_nu + 3], sizeof df[0]);
+    memcpy(df[SR_T_P], dy[SR_E_nu + 4], sizeof df[0]);
+    /* The rows are summed in local arrays, which the compiler knows alias nothing: summed in
+     * place, in df, the loops stayed scalar (df and dy could overlap as far as it knows). */
+    for (i = 0; i < 2; ++i) {   /* d(q') = p . (dw - w x dxi) = p . dw + (w x p) . dxi */
+        const sr_real *q = p[i];
+        const sr_real wxp[3] = {w[1] * q[2] - w[2] * q[1], w[2] * q[0] - w[0] * q[2], w[0] * q[1] - w[1] * q[0]};
+        sr_real o[NC];
+        for (c = 0; c < NC; ++c) o[c] = 0;
+        for (j = 0; j < 3; ++j) {
+            const sr_real *a = dy[SR_E_nu + j], *b = dy[SR_E_xi_S + j];
+            for (c = 0; c < NC; ++c) o[c] += q[j] * a[c] + wxp[j] * b[c];
+        }
+        memcpy(df[SR_T_Q + i], o, sizeof o);
+    }
+    for (c = 0; c < NC; ++c) df[SR_T_Q + 2][c] = 0;
+    for (i = 0; i < SR_NV; ++i) {
+        sr_real o[NC];
+        for (c = 0; c < NC; ++c) o[c] = full_column(c) >= SR_NE ? Jb[SR_NU * i + (full_column(c) - SR_NE)] : 0;
+        for (k = 0; k < SR_NE; ++k) {
+            const sr_real jik = Ja[SR_NE * i + k], *a = dy[k];
+            if (k == SR_E_q || k == SR_E_q + 1) continue;   /* exact zeros of Ja: q moves no acceleration */
+            for (c = 0; c < NC; ++c) o[c] += jik * a[c];
+        }
+        memcpy(df[SR_T_V + i], o, sizeof o);
+    }
+    return SR_OK;
 }
 
 /* K = f(x) and dK = J_f(x) [I | 0] + [0 | J_u]: RKMK4's and CF4's first stage (no product). */

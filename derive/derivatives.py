@@ -95,12 +95,11 @@ def accel_jacobian(M=None, f=None):
 # manifold (yoke_frame.check_equivalence), so their tangent derivatives agree too.
 
 def yoke_configuration_directions():
-    """The rates of γ' and R_P along δξ'_x, δξ'_y, δξ'_z and δθ_P (unit steps; γ' stands as γ)."""
-    none, still = sp.zeros(3, 3), sp.zeros(3, 1)
-    units = [S.hat([int(i == k) for i in range(3)]) for k in range(3)]
-    directions = [S.configuration_rates(none, none, -E * S.gamma) for E in units]
-    directions.append(S.configuration_rates(none, S.R_P * S.Sigma_P, still))
-    return directions
+    """The rates of γ' and R_P along δξ'_x, δξ'_y, δξ'_z and δθ_P (unit steps; γ' stands as γ): the
+    shell frame's directions but δθ_Y, which the yoke-frame forms do not have (their χ rates meet
+    no χ there)."""
+    xi_x, xi_y, xi_z, _, th_P = configuration_directions()
+    return [xi_x, xi_y, xi_z, th_P]
 
 
 @functools.lru_cache(maxsize=None)
