@@ -342,6 +342,7 @@ int sr_internal_cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real
 #define sr_internal_vector_field sr_internal_vector_field_f
 #define sr_internal_kinematics sr_internal_kinematics_f
 #define sr_internal_accel_jacobian sr_internal_accel_jacobian_f
+#define sr_internal_accel_jacobian_along sr_internal_accel_jacobian_along_f
 #define sr_internal_rkmk4_core sr_internal_rkmk4_core_f
 #define sr_internal_dexpinv sr_internal_dexpinv_f
 #define sr_internal_project sr_internal_project_f
@@ -398,6 +399,16 @@ void sr_internal_kinematics(const sr_model *model, const sr_real x[SR_NX], sr_re
  * finiteness.  c/sr_jacobians.c. */
 int sr_internal_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                                sr_real a[SR_NV], sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU]);
+
+/* The accelerations' derivative along given directions, for the step Jacobians' stages: out = Ja V
+ * (5 x SR_J_NC) for V the derivatives of the error's rows that the dynamics reads (SR_J_READ rows:
+ * xi_S, th_Y, th_P, nu; nothing depends on q) along SR_J_NC directions; also Jb and the
+ * accelerations a, as sr_internal_accel_jacobian.  For the paper's robot Ja is never formed: the
+ * yoke frame's chain rule acts on V (c/sr_jacobians.c). */
+enum { SR_J_XI = 0, SR_J_TH_Y = 3, SR_J_TH_P = 4, SR_J_NU = 5, SR_J_READ = 10, SR_J_NC = 12 };
+int sr_internal_accel_jacobian_along(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                     const sr_real V[SR_J_READ][SR_J_NC], sr_real a[SR_NV],
+                                     sr_real out[SR_NV][SR_J_NC], sr_real Jb[SR_NV * SR_NU]);
 
 /* The stages of RKMK4 from K[0] = f(x) (filled by the caller): K[1..3] and the final Theta;
  * out = x . exp(Theta) (out must not alias x). */

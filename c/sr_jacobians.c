@@ -191,6 +191,112 @@ int sr_internal_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], co
     return model->general ? general_accel_jacobian(model, x, u, a, Ja, Jb) : paper_accel_jacobian(model, x, u, a, Ja, Jb);
 }
 
+/* out = Ja V on the read rows (see sr_internal.h), the paper's robot: the chain rule of
+ * paper_accel_jacobian applied to the directions V instead of to the unit ones, so that the
+ * shell-frame Ja is never formed.  With z the yoke frame's directions (d_xi', d_th_P, d_nu'),
+ *   z_xi' = R_Y^T V_xi + e_x V_th_Y,   z_th_P = V_th_P,
+ *   z_w'  = R_Y^T V_w + (w' x e_x) V_th_Y,   z_w_Y, z_w_P = V_w_Y, V_w_P,
+ * and out = T^T (G z) + R_Y (e_x x g_S) V_th_Y, G = M'^-1 (df' - (dM') g) as there. */
+static int paper_accel_jacobian_along(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                      const sr_real V[SR_J_READ][SR_J_NC], sr_real acc[SR_NV],
+                                      sr_real out[SR_NV][SR_J_NC], sr_real jb[SR_NV * SR_NU])
+{
+    enum { NZ = 9 };   /* the yoke frame's directions: Y_XI (3), Y_TH_P, Y_W (5) */
+    const sr_real c = x[SR_X_R_Y + 4], s = x[SR_X_R_Y + 7];
+    const sr_real *w = x + SR_X_w_S;
+    const sr_real wy = c * w[1] + s * w[2], wz = c * w[2] - s * w[1];   /* w' = R_Y^T w_S */
+    sr_real Mu[15], f[SR_NV], df[SR_NV * 9], dfdu[SR_NV * SR_NU], dM[4 * 15];
+    sr_real g[SR_NV][NCOL], B[SR_NV][NCOL], Z[NZ][SR_J_NC], o[SR_NV][SR_J_NC];
+    joint_first jf;
+    int status, i, j, k, l;
+    status = sr_gen_accel_jacobian_yoke_terms(model->c, x, u, Mu, f, df, dfdu, dM);
+    if (status != SR_OK) return status;
+    status = joint_first_factor(Mu, &jf);
+    if (status != SR_OK) return status;
+    for (i = 0; i < SR_NV; ++i) g[i][0] = f[i];
+    joint_first_solve(&jf, g, 1);
+    acc[0] = g[0][0];
+    acc[1] = c * g[1][0] - s * g[2][0];
+    acc[2] = s * g[1][0] + c * g[2][0];
+    acc[3] = g[3][0];
+    acc[4] = g[4][0];
+    for (i = 0; i < SR_NV; ++i) {
+        for (k = 0; k < 9; ++k) B[i][k] = df[9 * i + k];
+        for (k = 0; k < SR_NU; ++k) B[i][Y_U + k] = dfdu[SR_NU * i + k];
+        for (k = 0; k < 4; ++k)
+            for (j = 0; j < SR_NV; ++j) B[i][k] -= dM[15 * k + SR_UPPER[i][j]] * g[j][0];
+    }
+    joint_first_solve(&jf, B, Y_NCOL);
+    for (l = 0; l < SR_J_NC; ++l) {
+        const sr_real vY = V[SR_J_TH_Y][l];
+        Z[Y_XI + 0][l] = V[SR_J_XI + 0][l] + vY;
+        Z[Y_XI + 1][l] = c * V[SR_J_XI + 1][l] + s * V[SR_J_XI + 2][l];
+        Z[Y_XI + 2][l] = c * V[SR_J_XI + 2][l] - s * V[SR_J_XI + 1][l];
+        Z[Y_TH_P][l] = V[SR_J_TH_P][l];
+        Z[Y_W + 0][l] = V[SR_J_NU + 0][l];
+        Z[Y_W + 1][l] = (c * V[SR_J_NU + 1][l] + s * V[SR_J_NU + 2][l]) + wz * vY;
+        Z[Y_W + 2][l] = (c * V[SR_J_NU + 2][l] - s * V[SR_J_NU + 1][l]) - wy * vY;
+        Z[Y_W + 3][l] = V[SR_J_NU + 3][l];
+        Z[Y_W + 4][l] = V[SR_J_NU + 4][l];
+    }
+    for (i = 0; i < SR_NV; ++i) {   /* o = G z, row by row over the contiguous columns */
+        for (l = 0; l < SR_J_NC; ++l) o[i][l] = B[i][0] * Z[0][l];
+        for (k = 1; k < NZ; ++k)
+            for (l = 0; l < SR_J_NC; ++l) o[i][l] += B[i][k] * Z[k][l];
+    }
+    {
+        const sr_real e1 = -(c * g[2][0] + s * g[1][0]), e2 = c * g[1][0] - s * g[2][0];   /* R_Y (e_x x g_S) */
+        for (l = 0; l < SR_J_NC; ++l) {
+            const sr_real vY = V[SR_J_TH_Y][l];
+            out[0][l] = o[0][l];
+            out[1][l] = (c * o[1][l] - s * o[2][l]) + e1 * vY;
+            out[2][l] = (s * o[1][l] + c * o[2][l]) + e2 * vY;
+            out[3][l] = o[3][l];
+            out[4][l] = o[4][l];
+        }
+    }
+    for (k = 0; k < SR_NU; ++k) {
+        jb[SR_NU * 0 + k] = B[0][Y_U + k];
+        jb[SR_NU * 1 + k] = c * B[1][Y_U + k] - s * B[2][Y_U + k];
+        jb[SR_NU * 2 + k] = s * B[1][Y_U + k] + c * B[2][Y_U + k];
+        jb[SR_NU * 3 + k] = B[3][Y_U + k];
+        jb[SR_NU * 4 + k] = B[4][Y_U + k];
+    }
+    return SR_OK;
+}
+
+/* The general robot: Ja itself, then its read columns times V. */
+static int general_accel_jacobian_along(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                        const sr_real V[SR_J_READ][SR_J_NC], sr_real acc[SR_NV],
+                                        sr_real out[SR_NV][SR_J_NC], sr_real jb[SR_NV * SR_NU])
+{
+    static const unsigned char column[SR_J_READ] = {SR_E_xi_S + 0, SR_E_xi_S + 1, SR_E_xi_S + 2, SR_E_th_Y,
+                                                   SR_E_th_P, SR_E_nu + 0, SR_E_nu + 1, SR_E_nu + 2,
+                                                   SR_E_nu + 3, SR_E_nu + 4};
+    sr_real ja[SR_NV * SR_NE];
+    int i, k, l, status = general_accel_jacobian(model, x, u, acc, ja, jb);
+    if (status != SR_OK) return status;
+    for (i = 0; i < SR_NV; ++i) {
+        sr_real o[SR_J_NC];
+        for (l = 0; l < SR_J_NC; ++l) o[l] = 0;
+        for (k = 0; k < SR_J_READ; ++k) {
+            const sr_real jik = ja[SR_NE * i + column[k]];
+            for (l = 0; l < SR_J_NC; ++l) o[l] += jik * V[k][l];
+        }
+        memcpy(out[i], o, sizeof o);
+    }
+    return SR_OK;
+}
+
+SR_JACOBIAN_CLONES int sr_internal_accel_jacobian_along(const sr_model *model, const sr_real x[SR_NX],
+                                                        const sr_real u[SR_NU], const sr_real V[SR_J_READ][SR_J_NC],
+                                                        sr_real a[SR_NV], sr_real out[SR_NV][SR_J_NC],
+                                                        sr_real Jb[SR_NV * SR_NU])
+{
+    return model->general ? general_accel_jacobian_along(model, x, u, V, a, out, Jb)
+                          : paper_accel_jacobian_along(model, x, u, V, a, out, Jb);
+}
+
 int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                       sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU])
 {

@@ -27,6 +27,7 @@
  * [F | G]. */
 #define NC (SR_NE + SR_NU - 2)
 #define full_column(a) ((a) < SR_E_q ? (a) : (a) + 2)
+#define NU_COLUMN(i) (SR_E_nu - 2 + (i))   /* the carried column of d_nu_i */
 
 typedef sr_real tangent[SR_NT][NC];   /* d(13-vector)/d(d, w), carried columns */
 typedef sr_real error[SR_NE][NC];     /* d(state error)/d(d, w), carried columns */
@@ -110,197 +111,177 @@ static void dexpinv_derivatives(const sr_real th[SR_NT], const sr_real f[SR_NT],
             Q[3 * i + j] += c * ((i == j ? tv : 0) + t[i] * v[j] - 2 * v[i] * t[j]) + 2 * dc * b[i] * t[j];
 }
 
-/* ---- RKMK4's stages, fused ------------------------------------------------------------------
- * Stage s > 1 of RKMK4 is k = dexp^-1(th, f(y)) with y = x . exp(th), th = h K', K' the previous
- * stage.  By the rules above, with dth = h dK': dy = A(th) [I | 0] + B(th) dth, df = J_f(y) dy,
- * dk = P df + Q dth.  Every row of dk is a combination a . dy of the NREAD rows of dy that the
- * dynamics reads (xi_S, th_Y, th_P and nu; nothing depends on q), plus Q dth on the SO(3) block, and
- *     a . dy = base(a) + sum_l coef_l(a) dK'_l      (l over th_S, th_Y, th_P and th_nu of dK')
- * where base(a) is a . A(th) [I | 0] and coef(a) is h a . B(th) on the read rows: `pull` forms
- * both.  So dy and dth are never formed, h and B(th) are folded into ten coefficients per row, and
- * each row costs one pass over the rows of dK' it uses (`combine_rows`).  Measured on an AMD EPYC
- * (Zen 4), with the first stage's product skipped and one unchecked accel Jacobian per stage that
- * also gives the accelerations: RKMK4 3.70 -> 1.8 us. */
-enum { NREAD = 10 };
+/* ---- the stages -----------------------------------------------------------------------------
+ * A stage's rows that the dynamics reads, dy_read (xi_S, th_Y, th_P and nu: SR_J_READ rows of NC
+ * columns; nothing depends on q), are formed once; the accelerations' rows are then Ja dy_read + [0 | Jb]
+ * from sr_internal_accel_jacobian_along, which for the paper's robot applies the yoke frame's chain
+ * rule to dy_read and never forms the shell-frame Ja.  Measured on an AMD EPYC (Zen 4), RKMK4:
+ * 1.81 us with the shell-frame Ja pulled through A(th) and B(th) row by row (pull and combine_rows
+ * until 2026-11-25), 1.74 us so; CF4 1.89 us either way.  The column loops hold one product per
+ * statement: GCC 12 vectorises those, and left a sum of two products per statement scalar (1.89 us). */
+enum { NREAD = SR_J_READ };
+typedef char nc_matches[(NC == SR_J_NC && SR_E_th_Y == 3 && SR_E_th_P == 4 && SR_E_q == 5) ? 1 : -1];
 
-/* base = a . A(th) [I | 0] and coef = h a . B(th) on the read rows, for a row functional a on the
- * read rows of an error (xi_S 3, th_Y, th_P, nu 5); D = Exp(th_S) - I, Jr = Jr(th_S). */
-static void pull(const sr_real a[NREAD], const sr_real D[9], const sr_real Jr[9], sr_real h,
-                 sr_real base[NC], sr_real coef[NREAD])
-{
-    int j, l;
-    for (l = 0; l < NC; ++l) base[l] = 0;
-    for (l = 0; l < 3; ++l) {   /* the xi rows of A [I | 0]: Exp(th_S)^T on the xi columns */
-        base[l] = a[l] + a[0] * D[3 * l + 0] + a[1] * D[3 * l + 1] + a[2] * D[3 * l + 2];
-        coef[l] = 0;
-        for (j = 0; j < 3; ++j) coef[l] += a[j] * Jr[3 * j + l];
-        coef[l] *= h;
-    }
-    for (l = 3; l < NREAD; ++l) {   /* th_Y, th_P, nu: the identity (carried columns 3, 4, 5..9) */
-        base[l] = a[l];
-        coef[l] = h * a[l];
-    }
-}
-
-/* out = base + sum_l coef[l] dK[l] (l < n) + sum_l coef[n + l] dK[SR_T_V + l] (l < m): the rows of
- * th_S first (then th_Y, th_P if n = 5), then those of nu (n, m constants where inlined, m > 0).
- * Two sums, one per group of rows, added at the end: the stages are a chain (each needs the
- * previous one's rows), so the depth of the sums counts (one sum of ten: RKMK4's step Jacobian
- * 1.81 us, two of five 1.76 us; a full tree, or partial sums summed in place, were slower). */
-static inline void combine_rows(const sr_real base[NC], int n, int m, const sr_real *coef, const tangent dK,
-                                sr_real out[NC])
-{
-    sr_real o[NC], p[NC];   /* local, as in field_jacobian; two sums, half as long */
-    int c, l;
-    for (c = 0; c < NC; ++c) o[c] = base[c];
-    for (c = 0; c < NC; ++c) p[c] = coef[n] * dK[SR_T_V][c];
-    for (l = 0; l < n; ++l)
-        for (c = 0; c < NC; ++c) o[c] += coef[l] * dK[l][c];
-    for (l = 1; l < m; ++l)
-        for (c = 0; c < NC; ++c) p[c] += coef[n + l] * dK[SR_T_V + l][c];
-    for (c = 0; c < NC; ++c) out[c] = o[c] + p[c];
-}
-
-/* The rows of J_f(y) on the read rows of the error: the accelerations' Ja (without its zero dq
- * columns) and the rolling q' = p . w with d(q') = p . dw + (w x p) . dxi (as in field_jacobian). */
-static void field_rows(const sr_model *model, const sr_real y[SR_NX], const sr_real Ja[SR_NV * SR_NE],
-                       sr_real rows[2 + SR_NV][NREAD])
+/* The rows of J_f(y) that are not the accelerations' (the rolling q' = p . w, d(q') = p . dw +
+ * (w x p) . dxi, as in sr_step_jacobian_lie_euler): wxp[i] and p[i] for q'_x, q'_y. */
+static void rolling_rows(const sr_model *model, const sr_real y[SR_NX], sr_real p[2][3], sr_real wxp[2][3])
 {
     const sr_real *R = y + SR_X_R_S, *w = y + SR_X_w_S, r = model->p[SR_P_r];
     int i, l;
+    for (l = 0; l < 3; ++l) {
+        p[0][l] = r * R[3 + l];    /* q_x' = r (R_S w)_y */
+        p[1][l] = -r * R[l];       /* q_y' = -r (R_S w)_x */
+    }
     for (i = 0; i < 2; ++i) {
-        sr_real p[3];
-        for (l = 0; l < 3; ++l) p[l] = i == 0 ? r * R[3 + l] : -r * R[l];   /* q_x' = r (R_S w)_y, q_y' = -r (R_S w)_x */
-        rows[i][0] = w[1] * p[2] - w[2] * p[1];
-        rows[i][1] = w[2] * p[0] - w[0] * p[2];
-        rows[i][2] = w[0] * p[1] - w[1] * p[0];
-        rows[i][3] = rows[i][4] = 0;
-        for (l = 0; l < 3; ++l) rows[i][5 + l] = p[l];
-        rows[i][8] = rows[i][9] = 0;
+        wxp[i][0] = w[1] * p[i][2] - w[2] * p[i][1];
+        wxp[i][1] = w[2] * p[i][0] - w[0] * p[i][2];
+        wxp[i][2] = w[0] * p[i][1] - w[1] * p[i][0];
     }
-    for (i = 0; i < SR_NV; ++i)
-        for (l = 0; l < NREAD; ++l) rows[2 + i][l] = Ja[SR_NE * i + full_column(l)];
 }
 
-/* The values and the accelerations' Jacobian at a stage state. */
-static int field_and_jacobian(const sr_model *model, const sr_real y[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NT],
-                              sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU])
+/* The kinematic rows of a stage, for dy_read the derivatives of the read rows of y's error: f's
+ * entries before SR_T_V (f_S, f_Y, f_P, q') and df_q; nothing here waits for the dynamics. */
+static void kinematic_rows(const sr_model *model, const sr_real y[SR_NX], const sr_real dy[NREAD][NC],
+                           sr_real f[SR_NT], tangent df)
 {
-    int status;
+    sr_real p[2][3], wxp[2][3];
+    int i, j, c;
     sr_internal_kinematics(model, y, f);
-    status = sr_internal_accel_jacobian(model, y, u, f + SR_T_V, Ja, Jb);
-    /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
-    return status == SR_ERR_SINGULAR && !all_finite(y, SR_NX) ? SR_ERR_NONFINITE : status;
-}
-
-/* f = f(y) and df = J_f(y) dy + [0 | J_u] for a state whose error dy is any (CF4's last stage; see
- * the top of the file). */
-static int field_jacobian(const sr_model *model, const sr_real y[SR_NX], const sr_real u[SR_NU], error dy,
-                          sr_real f[SR_NT], tangent df)
-{
-    const sr_real *R = y + SR_X_R_S, *w = y + SR_X_w_S, r = model->p[SR_P_r];
-    sr_real Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], p[2][3];
-    int i, j, k, c, status = field_and_jacobian(model, y, u, f, Ja, Jb);
-    if (status != SR_OK) return status;
-    for (j = 0; j < 3; ++j) {
-        p[0][j] = r * R[3 + j];     /* q_x' = r (R_S w)_y */
-        p[1][j] = -r * R[j];        /* q_y' = -r (R_S w)_x */
-    }
-    for (i = 0; i < 3; ++i) memcpy(df[SR_T_S + i], dy[SR_E_nu + i], sizeof df[0]);
-    memcpy(df[SR_T_Y], dy[SR_E_nu + 3], sizeof df[0]);
-    memcpy(df[SR_T_P], dy[SR_E_nu + 4], sizeof df[0]);
-    /* The rows are summed in local arrays, which the compiler knows alias nothing: summed in
-     * place, in df, the loops stayed scalar (df and dy could overlap as far as it knows). */
-    for (i = 0; i < 2; ++i) {   /* d(q') = p . (dw - w x dxi) = p . dw + (w x p) . dxi */
-        const sr_real *q = p[i];
-        const sr_real wxp[3] = {w[1] * q[2] - w[2] * q[1], w[2] * q[0] - w[0] * q[2], w[0] * q[1] - w[1] * q[0]};
+    rolling_rows(model, y, p, wxp);
+    for (i = 0; i < 2; ++i) {   /* local sums: in place, in df, the loops stayed scalar (aliasing) */
         sr_real o[NC];
         for (c = 0; c < NC; ++c) o[c] = 0;
         for (j = 0; j < 3; ++j) {
-            const sr_real *a = dy[SR_E_nu + j], *b = dy[SR_E_xi_S + j];
-            for (c = 0; c < NC; ++c) o[c] += q[j] * a[c] + wxp[j] * b[c];
+            const sr_real pij = p[i][j], *a = dy[SR_J_NU + j];
+            for (c = 0; c < NC; ++c) o[c] += pij * a[c];
+        }
+        for (j = 0; j < 3; ++j) {
+            const sr_real wij = wxp[i][j], *b = dy[SR_J_XI + j];
+            for (c = 0; c < NC; ++c) o[c] += wij * b[c];
         }
         memcpy(df[SR_T_Q + i], o, sizeof o);
     }
     for (c = 0; c < NC; ++c) df[SR_T_Q + 2][c] = 0;
+}
+
+/* The dynamic rows: f's accelerations and df_nu = Ja dy_read + [0 | Jb]. */
+static int accel_rows(const sr_model *model, const sr_real y[SR_NX], const sr_real u[SR_NU],
+                      const sr_real dy[NREAD][NC], sr_real f[SR_NT], tangent df)
+{
+    sr_real acc[SR_NV][NC], Jb[SR_NV * SR_NU];
+    int i, c, status = sr_internal_accel_jacobian_along(model, y, u, dy, f + SR_T_V, acc, Jb);
+    /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
+    if (status != SR_OK) return status == SR_ERR_SINGULAR && !all_finite(y, SR_NX) ? SR_ERR_NONFINITE : status;
     for (i = 0; i < SR_NV; ++i) {
-        sr_real o[NC];
-        for (c = 0; c < NC; ++c) o[c] = full_column(c) >= SR_NE ? Jb[SR_NU * i + (full_column(c) - SR_NE)] : 0;
-        for (k = 0; k < SR_NE; ++k) {
-            const sr_real jik = Ja[SR_NE * i + k], *a = dy[k];
-            if (k == SR_E_q || k == SR_E_q + 1) continue;   /* exact zeros of Ja: q moves no acceleration */
-            for (c = 0; c < NC; ++c) o[c] += jik * a[c];
-        }
-        memcpy(df[SR_T_V + i], o, sizeof o);
+        for (c = 0; c < NC - SR_NU; ++c) df[SR_T_V + i][c] = acc[i][c];
+        for (c = 0; c < SR_NU; ++c) df[SR_T_V + i][NC - SR_NU + c] = acc[i][NC - SR_NU + c] + Jb[SR_NU * i + c];
     }
     return SR_OK;
+}
+
+/* The stage k = dexp^-1(th, f(x . exp(th))) of RKMK4 (dexpinv set), or k = f(x . exp(th)) of CF4's
+ * second and third stages, th = h Kp, and dk: dy_read = A(th) [I | 0] + B(th) h dKp on the read
+ * rows (see the top of the file), then the rows of dk that need no dynamics (dk_S = P dy_nu_S +
+ * Q h dKp_S, or dy_nu_S; dk_q, dk_Y, dk_P), the accelerations' rows last. */
+static int stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
+                          const sr_real Kp[SR_NT], const tangent dKp, int dexpinv, sr_real k[SR_NT], tangent dk)
+{
+    sr_real th[SR_NT], y[SR_NX], D[9], Jr[9], dy[NREAD][NC];
+    int i, j, c;
+    for (i = 0; i < SR_NT; ++i) th[i] = h * Kp[i];
+    sr_internal_act(x, th, y);
+    so3_exp_minus_identity(th + SR_T_S, D);
+    so3_right_jacobian(th + SR_T_S, Jr);
+    for (i = 0; i < 3; ++i) {   /* dy_xi = Exp(th_S)^T [I | 0] + Jr h dKp_S */
+        sr_real o[NC];
+        for (c = 0; c < NC; ++c) o[c] = h * Jr[3 * i] * dKp[SR_T_S][c];
+        for (j = 1; j < 3; ++j) {
+            const sr_real jrij = h * Jr[3 * i + j], *b = dKp[SR_T_S + j];
+            for (c = 0; c < NC; ++c) o[c] += jrij * b[c];
+        }
+        for (j = 0; j < 3; ++j) o[j] += D[3 * j + i];
+        o[i] += 1;
+        memcpy(dy[SR_J_XI + i], o, sizeof o);
+    }
+    for (c = 0; c < NC; ++c) {  /* the abelian rows: the identity + h dKp */
+        dy[SR_J_TH_Y][c] = h * dKp[SR_T_Y][c];
+        dy[SR_J_TH_P][c] = h * dKp[SR_T_P][c];
+    }
+    for (i = 0; i < SR_NV; ++i)
+        for (c = 0; c < NC; ++c) dy[SR_J_NU + i][c] = h * dKp[SR_T_V + i][c];
+    dy[SR_J_TH_Y][SR_E_th_Y] += 1;   /* carried column a is error row a here */
+    dy[SR_J_TH_P][SR_E_th_P] += 1;
+    for (i = 0; i < SR_NV; ++i) dy[SR_J_NU + i][NU_COLUMN(i)] += 1;
+    kinematic_rows(model, y, (const sr_real(*)[NC])dy, k, dk);
+    if (dexpinv) {   /* on the SO(3) block only: k_S = dexp^-1(th, f_S) from the kinematics alone */
+        sr_real P[9], Q[9], kS[SR_NT] = {0};
+        dexpinv_derivatives(th, k, P, Q);
+        for (i = 0; i < 3; ++i) {
+            sr_real o[NC];
+            for (c = 0; c < NC; ++c) o[c] = 0;
+            for (j = 0; j < 3; ++j) {
+                const sr_real pij = P[3 * i + j], *a = dy[SR_J_NU + j];
+                for (c = 0; c < NC; ++c) o[c] += pij * a[c];
+            }
+            for (j = 0; j < 3; ++j) {
+                const sr_real qij = h * Q[3 * i + j], *b = dKp[SR_T_S + j];
+                for (c = 0; c < NC; ++c) o[c] += qij * b[c];
+            }
+            memcpy(dk[SR_T_S + i], o, sizeof o);
+        }
+        for (i = 0; i < 3; ++i) kS[SR_T_S + i] = k[SR_T_S + i];
+        sr_internal_dexpinv(th, kS, kS);
+        for (i = 0; i < 3; ++i) k[SR_T_S + i] = kS[SR_T_S + i];
+    } else {
+        for (i = 0; i < 3; ++i) memcpy(dk[SR_T_S + i], dy[SR_J_NU + i], sizeof dk[0]);
+    }
+    memcpy(dk[SR_T_Y], dy[SR_J_NU + 3], sizeof dk[0]);
+    memcpy(dk[SR_T_P], dy[SR_J_NU + 4], sizeof dk[0]);
+    return accel_rows(model, y, u, (const sr_real(*)[NC])dy, k, dk);
 }
 
 /* K = f(x) and dK = J_f(x) [I | 0] + [0 | J_u]: RKMK4's and CF4's first stage (no product). */
 static int first_stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                                 sr_real K[SR_NT], tangent dK)
 {
-    sr_real Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], rows[2 + SR_NV][NREAD];
-    int i, l, status = field_and_jacobian(model, x, u, K, Ja, Jb);
+    sr_real Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], p[2][3], wxp[2][3];
+    int i, l, status;
+    sr_internal_kinematics(model, x, K);
+    status = sr_internal_accel_jacobian(model, x, u, K + SR_T_V, Ja, Jb);   /* x checked: finite */
     if (status != SR_OK) return status;
-    field_rows(model, x, Ja, rows);
     memset(dK, 0, sizeof(tangent));
-    for (i = 0; i < 3; ++i) dK[SR_T_S + i][5 + i] = 1;   /* th_S' = w_S: carried column 5 + i is d_nu_i */
-    dK[SR_T_Y][8] = 1;
-    dK[SR_T_P][9] = 1;
+    for (i = 0; i < 3; ++i) dK[SR_T_S + i][NU_COLUMN(i)] = 1;   /* th_S' = w_S */
+    dK[SR_T_Y][NU_COLUMN(3)] = 1;
+    dK[SR_T_P][NU_COLUMN(4)] = 1;
+    rolling_rows(model, x, p, wxp);
     for (i = 0; i < 2; ++i)
-        for (l = 0; l < NREAD; ++l) dK[SR_T_Q + i][l] = rows[i][l];
+        for (l = 0; l < 3; ++l) {
+            dK[SR_T_Q + i][SR_E_xi_S + l] = wxp[i][l];
+            dK[SR_T_Q + i][NU_COLUMN(l)] = p[i][l];
+        }
     for (i = 0; i < SR_NV; ++i) {
-        for (l = 0; l < NREAD; ++l) dK[SR_T_V + i][l] = rows[2 + i][l];
-        for (l = 0; l < SR_NU; ++l) dK[SR_T_V + i][NREAD + l] = Jb[SR_NU * i + l];
+        for (l = 0; l < NC - SR_NU; ++l) dK[SR_T_V + i][l] = Ja[SR_NE * i + full_column(l)];
+        for (l = 0; l < SR_NU; ++l) dK[SR_T_V + i][NC - SR_NU + l] = Jb[SR_NU * i + l];
     }
     return SR_OK;
 }
 
-/* The stage k = dexp^-1(th, f(x . exp(th))) of RKMK4 (dexpinv set), or k = f(x . exp(th)) of CF4's
- * second and third stages, th = h Kp, and dk (see above). */
-static int stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
-                          const sr_real Kp[SR_NT], const tangent dKp, int dexpinv, sr_real k[SR_NT], tangent dk)
+/* f = f(y) and df = J_f(y) dy + [0 | J_u] for a state whose error dy is any (CF4's last stage). */
+static int field_jacobian(const sr_model *model, const sr_real y[SR_NX], const sr_real u[SR_NU], error dy,
+                          sr_real f[SR_NT], tangent df)
 {
-    sr_real th[SR_NT], y[SR_NX], D[9], Jr[9], P[9], Q[9], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU];
-    sr_real rows[2 + SR_NV][NREAD], a[NREAD], base[NC], coef[NREAD], shell[6];
-    int i, l, status;
-    for (i = 0; i < SR_NT; ++i) th[i] = h * Kp[i];
-    sr_internal_act(x, th, y);
-    status = field_and_jacobian(model, y, u, k, Ja, Jb);
+    sr_real read[NREAD][NC];
+    int i, status;
+    for (i = 0; i < 3; ++i) memcpy(read[SR_J_XI + i], dy[SR_E_xi_S + i], sizeof read[0]);
+    memcpy(read[SR_J_TH_Y], dy[SR_E_th_Y], sizeof read[0]);
+    memcpy(read[SR_J_TH_P], dy[SR_E_th_P], sizeof read[0]);
+    for (i = 0; i < SR_NV; ++i) memcpy(read[SR_J_NU + i], dy[SR_E_nu + i], sizeof read[0]);
+    kinematic_rows(model, y, (const sr_real(*)[NC])read, f, df);
+    status = accel_rows(model, y, u, (const sr_real(*)[NC])read, f, df);
     if (status != SR_OK) return status;
-    so3_exp_minus_identity(th + SR_T_S, D);
-    so3_right_jacobian(th + SR_T_S, Jr);
-    field_rows(model, y, Ja, rows);
-    for (i = 0; i < SR_NV; ++i) {                       /* dk_nu = df_nu = Ja dy + [0 | Jb] */
-        pull(rows[2 + i], D, Jr, h, base, coef);
-        for (l = 0; l < SR_NU; ++l) base[NREAD + l] = Jb[SR_NU * i + l];
-        combine_rows(base, 5, 5, coef, dKp, dk[SR_T_V + i]);
-    }
-    for (i = 0; i < 2; ++i) {                           /* dk_q = df_q: reads xi_S and nu_S only */
-        pull(rows[i], D, Jr, h, base, coef);
-        for (l = 0; l < 3; ++l) shell[l] = coef[l], shell[3 + l] = coef[5 + l];
-        combine_rows(base, 3, 3, shell, dKp, dk[SR_T_Q + i]);
-    }
-    for (l = 0; l < NC; ++l) dk[SR_T_Q + 2][l] = 0;
-    if (dexpinv) {
-        dexpinv_derivatives(th, k, P, Q);               /* dk_S = P dy_nu_S + Q h dK'_S */
-        for (i = 0; i < 3; ++i) {
-            for (l = 0; l < NREAD; ++l) a[l] = 0;
-            for (l = 0; l < 3; ++l) a[5 + l] = P[3 * i + l];
-            pull(a, D, Jr, h, base, coef);
-            for (l = 0; l < 3; ++l) shell[l] = h * Q[3 * i + l], shell[3 + l] = coef[5 + l];
-            combine_rows(base, 3, 3, shell, dKp, dk[SR_T_S + i]);
-        }
-        sr_internal_dexpinv(th, k, k);
-    } else {
-        for (i = 0; i < 3; ++i)                         /* dk_S = dy_nu_S */
-            for (l = 0; l < NC; ++l) dk[SR_T_S + i][l] = (sr_real)(l == 5 + i) + h * dKp[SR_T_V + i][l];
-    }
-    for (l = 0; l < NC; ++l) {                          /* dk_Y, dk_P = dy_nu_Y, dy_nu_P */
-        dk[SR_T_Y][l] = (sr_real)(l == 8) + h * dKp[SR_T_V + 3][l];
-        dk[SR_T_P][l] = (sr_real)(l == 9) + h * dKp[SR_T_V + 4][l];
-    }
+    for (i = 0; i < 3; ++i) memcpy(df[SR_T_S + i], read[SR_J_NU + i], sizeof df[0]);
+    memcpy(df[SR_T_Y], read[SR_J_NU + 3], sizeof df[0]);
+    memcpy(df[SR_T_P], read[SR_J_NU + 4], sizeof df[0]);
     return SR_OK;
 }
 
@@ -310,7 +291,7 @@ static void combine_jacobian(int n, const sr_real *coef, const sr_real (*K)[SR_N
 {
     int i, c, k;
     for (i = 0; i < SR_NT; ++i) {
-        sr_real o[NC];   /* local, as in field_jacobian */
+        sr_real o[NC];   /* local, as in kinematic_rows */
         th[i] = 0;
         for (k = 0; k < n; ++k) th[i] += coef[k] * K[k][i];
         for (c = 0; c < NC; ++c) o[c] = 0;

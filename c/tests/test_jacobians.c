@@ -71,6 +71,45 @@ static void test_internal_accel_jacobian_gives_the_accelerations_of_sr_accel(voi
     }
 }
 
+/* The step Jacobians' stages take Ja dy from sr_internal_accel_jacobian_along, which for the paper's
+ * robot applies the yoke frame's chain rule to the directions and never forms Ja: it must equal Ja's
+ * read columns times the directions, Jb and the accelerations alike, for both robots (tolerance
+ * 256 eps of the largest term: a product off by 1e-9 relative is far outside it). */
+static void test_accel_jacobian_along_directions_is_ja_times_the_directions(void)
+{
+    static const int column[SR_J_READ] = {SR_E_xi_S + 0, SR_E_xi_S + 1, SR_E_xi_S + 2, SR_E_th_Y, SR_E_th_P,
+                                          SR_E_nu + 0, SR_E_nu + 1, SR_E_nu + 2, SR_E_nu + 3, SR_E_nu + 4};
+    sr_real p[SR_NPARAM], x[SR_NX], u[SR_NU] = {SR_C(0.05), SR_C(-0.02)}, a[SR_NV], b[SR_NV];
+    sr_real Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], Jb2[SR_NV * SR_NU], V[SR_J_READ][SR_J_NC], out[SR_NV][SR_J_NC];
+    test_rng rng = {37};
+    sr_model m;
+    int robot, n, i, k, l;
+    for (robot = 0; robot < 2; ++robot) {
+        if (robot) general_robot_params(p);
+        else paper_simulation_params(p);
+        CHECK_STATUS(sr_model_init(&m, p), SR_OK);
+        for (n = 0; n < 20; ++n) {
+            random_state(&rng, p[SR_P_r], 3.0, x);
+            for (k = 0; k < SR_J_READ; ++k)
+                for (l = 0; l < SR_J_NC; ++l) V[k][l] = (sr_real)rng_uniform(&rng, -1, 1);
+            CHECK_STATUS(sr_internal_accel_jacobian(&m, x, u, a, Ja, Jb), SR_OK);
+            CHECK_STATUS(sr_internal_accel_jacobian_along(&m, x, u, (const sr_real(*)[SR_J_NC])V, b, out, Jb2), SR_OK);
+            for (i = 0; i < SR_NV; ++i) {
+                double scale = 1;
+                for (k = 0; k < SR_J_READ; ++k)
+                    scale = fabs((double)Ja[SR_NE * i + column[k]]) > scale ? fabs((double)Ja[SR_NE * i + column[k]]) : scale;
+                for (l = 0; l < SR_J_NC; ++l) {
+                    double want = 0;
+                    for (k = 0; k < SR_J_READ; ++k) want += (double)Ja[SR_NE * i + column[k]] * (double)V[k][l];
+                    CHECK_NEAR(out[i][l], want, 256 * TEST_EPS * scale);
+                }
+                for (k = 0; k < SR_NU; ++k) CHECK_NEAR(Jb2[SR_NU * i + k], Jb[SR_NU * i + k], 64 * TEST_EPS * (1 + fabs((double)Jb[SR_NU * i + k])));
+                CHECK_NEAR(b[i], a[i], 64 * TEST_EPS * (1 + fabs((double)a[i])));
+            }
+        }
+    }
+}
+
 static void test_accel_jacobian_bad_input_leaves_outputs_untouched(void)
 {
     sr_real p[SR_NPARAM], x[SR_NX], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], keep[SR_NV * SR_NE];
@@ -209,6 +248,7 @@ void suite_jacobians(void)
     RUN_TEST(test_accel_jacobian_columns_are_central_differences_along_retract);
     RUN_TEST(test_accel_jacobian_bad_input_leaves_outputs_untouched);
     RUN_TEST(test_internal_accel_jacobian_gives_the_accelerations_of_sr_accel);
+    RUN_TEST(test_accel_jacobian_along_directions_is_ja_times_the_directions);
     RUN_TEST(test_lie_euler_step_jacobian_columns_are_central_differences_through_retract_and_local);
     RUN_TEST(test_rkmk4_and_cf4_step_jacobians_are_central_differences_through_retract_and_local);
     RUN_TEST(test_step_jacobians_of_a_general_robot_are_central_differences);
