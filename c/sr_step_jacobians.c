@@ -180,13 +180,15 @@ static int accel_rows(const sr_model *model, const sr_real y[SR_NX], const sr_re
 }
 
 /* The stage k = dexp^-1(th, f(x . exp(th))) of RKMK4 (dexpinv set), or k = f(x . exp(th)) of CF4's
- * second and third stages, th = h Kp, and dk: dy_read = A(th) [I | 0] + B(th) h dKp on the read
+ * second and third stages, th = h Kp, and dk; also the stage state y = x . exp(th) and the
+ * derivatives of its read rows, dy_read = A(th) [I | 0] + B(th) h dKp (CF4 goes on from its Y2).  On the read
  * rows (see the top of the file), then the rows of dk that need no dynamics (dk_S = P dy_nu_S +
  * Q h dKp_S, or dy_nu_S; dk_q, dk_Y, dk_P), the accelerations' rows last. */
 static int stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
-                          const sr_real Kp[SR_NT], const tangent dKp, int dexpinv, sr_real k[SR_NT], tangent dk)
+                          const sr_real Kp[SR_NT], const tangent dKp, int dexpinv, sr_real k[SR_NT], tangent dk,
+                          sr_real y[SR_NX], sr_real dy[NREAD][NC])
 {
-    sr_real th[SR_NT], y[SR_NX], D[9], Jr[9], dy[NREAD][NC];
+    sr_real th[SR_NT], D[9], Jr[9];
     int i, j, c;
     for (i = 0; i < SR_NT; ++i) th[i] = h * Kp[i];
     sr_internal_act(x, th, y);
@@ -207,8 +209,12 @@ static int stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const s
         dy[SR_J_TH_Y][c] = h * dKp[SR_T_Y][c];
         dy[SR_J_TH_P][c] = h * dKp[SR_T_P][c];
     }
-    for (i = 0; i < SR_NV; ++i)
-        for (c = 0; c < NC; ++c) dy[SR_J_NU + i][c] = h * dKp[SR_T_V + i][c];
+    {   /* the nu rows are contiguous in both: one loop of 60, which GCC vectorises as a loop (the nest
+         * of 5 x 12 it unrolled completely into scalar products) */
+        const sr_real *src = dKp[SR_T_V];
+        sr_real *dst = dy[SR_J_NU];
+        for (c = 0; c < SR_NV * NC; ++c) dst[c] = h * src[c];
+    }
     dy[SR_J_TH_Y][SR_E_th_Y] += 1;   /* carried column a is error row a here */
     dy[SR_J_TH_P][SR_E_th_P] += 1;
     for (i = 0; i < SR_NV; ++i) dy[SR_J_NU + i][NU_COLUMN(i)] += 1;
@@ -266,23 +272,30 @@ static int first_stage_jacobian(const sr_model *model, const sr_real x[SR_NX], c
     return SR_OK;
 }
 
-/* f = f(y) and df = J_f(y) dy + [0 | J_u] for a state whose error dy is any (CF4's last stage). */
-static int field_jacobian(const sr_model *model, const sr_real y[SR_NX], const sr_real u[SR_NU], error dy,
-                          sr_real f[SR_NT], tangent df)
+/* dy_read = A(th) dx_read + B(th) dth_read on the read rows, for y = x . exp(th) where x's read rows
+ * dx are any (CF4's Y4 = Y2 . exp(th)); dth in the read rows' order too. */
+static void move_read_rows(const sr_real th[SR_NT], const sr_real dx[NREAD][NC], const sr_real dth[NREAD][NC],
+                           sr_real dy[NREAD][NC])
 {
-    sr_real read[NREAD][NC];
-    int i, status;
-    for (i = 0; i < 3; ++i) memcpy(read[SR_J_XI + i], dy[SR_E_xi_S + i], sizeof read[0]);
-    memcpy(read[SR_J_TH_Y], dy[SR_E_th_Y], sizeof read[0]);
-    memcpy(read[SR_J_TH_P], dy[SR_E_th_P], sizeof read[0]);
-    for (i = 0; i < SR_NV; ++i) memcpy(read[SR_J_NU + i], dy[SR_E_nu + i], sizeof read[0]);
-    kinematic_rows(model, y, (const sr_real(*)[NC])read, f, df);
-    status = accel_rows(model, y, u, (const sr_real(*)[NC])read, f, df);
-    if (status != SR_OK) return status;
-    for (i = 0; i < 3; ++i) memcpy(df[SR_T_S + i], read[SR_J_NU + i], sizeof df[0]);
-    memcpy(df[SR_T_Y], read[SR_J_NU + 3], sizeof df[0]);
-    memcpy(df[SR_T_P], read[SR_J_NU + 4], sizeof df[0]);
-    return SR_OK;
+    sr_real D[9], Jr[9];
+    int i, j, c;
+    so3_exp_minus_identity(th + SR_T_S, D);
+    so3_right_jacobian(th + SR_T_S, Jr);
+    for (i = 0; i < 3; ++i) {   /* Exp(th_S)^T dx_xi + Jr dth_S */
+        sr_real o[NC];
+        for (c = 0; c < NC; ++c) o[c] = dx[SR_J_XI + i][c];
+        for (j = 0; j < 3; ++j) {
+            const sr_real dji = D[3 * j + i], *a = dx[SR_J_XI + j];
+            for (c = 0; c < NC; ++c) o[c] += dji * a[c];
+        }
+        for (j = 0; j < 3; ++j) {
+            const sr_real jrij = Jr[3 * i + j], *b = dth[SR_J_XI + j];
+            for (c = 0; c < NC; ++c) o[c] += jrij * b[c];
+        }
+        memcpy(dy[SR_J_XI + i], o, sizeof o);
+    }
+    for (i = SR_J_TH_Y; i < NREAD; ++i)
+        for (c = 0; c < NC; ++c) dy[i][c] = dx[i][c] + dth[i][c];
 }
 
 /* th = sum_k coef[k] K[k] and its derivative. */
@@ -334,7 +347,7 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_rkmk4(const sr_model *model, const sr_re
     static const sr_real zero_u[SR_NU] = {0, 0};
     static const sr_real a_diag[3] = {SR_C(0.5), SR_C(0.5), SR_C(1.0)};
     const sr_real b[4] = {dt / 6, dt / 3, dt / 3, dt / 6};
-    sr_real K[4][SR_NT], th[SR_NT], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
+    sr_real K[4][SR_NT], th[SR_NT], y[SR_NX], dy_read[NREAD][NC], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
     tangent dK[4], dth;
     error dy;
     int s, status = check_step_arguments(model, x, u, dt, F, G);
@@ -343,7 +356,7 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_rkmk4(const sr_model *model, const sr_re
     status = first_stage_jacobian(model, x, u, K[0], dK[0]);
     for (s = 1; s < 4 && status == SR_OK; ++s)
         status = stage_jacobian(model, x, u, a_diag[s - 1] * dt, K[s - 1], (const sr_real(*)[NC])dK[s - 1], 1,
-                                K[s], dK[s]);
+                                K[s], dK[s], y, dy_read);
     if (status != SR_OK) return status;
     combine_jacobian(4, b, (const sr_real(*)[SR_NT])K, dK, th, dth);
     act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dy);
@@ -360,34 +373,36 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_cf4(const sr_model *model, const sr_real
     static const sr_real zero_u[SR_NU] = {0, 0};
     const sr_real beta1[4] = {dt / 4, dt / 6, dt / 6, -dt / 12};
     const sr_real beta2[4] = {-dt / 12, dt / 6, dt / 6, dt / 4};
-    const sr_real half[2] = {SR_C(0.5) * dt, 0}, one[2] = {dt, -SR_C(0.5) * dt};
     sr_real Fk[4][SR_NT], th[SR_NT], th2[SR_NT], Y2[SR_NX], Y[SR_NX], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
+    sr_real dY2[NREAD][NC], dY4[NREAD][NC], dth4[NREAD][NC];
     tangent dF[4], dth, dth2;
-    error dY2, dY;
-    int status = check_step_arguments(model, x, u, dt, F, G);
+    error dY;
+    int i, c, status = check_step_arguments(model, x, u, dt, F, G);
     if (status != SR_OK) return status;
     if (!u) u = zero_u;
-    status = first_stage_jacobian(model, x, u, Fk[0], dF[0]);                     /* F1 = f(x) */
-    if (status == SR_OK) {                                                         /* Y2 = x . exp(h/2 F1) */
-        status = stage_jacobian(model, x, u, half[0], Fk[0], (const sr_real(*)[NC])dF[0], 0, Fk[1], dF[1]);
-        combine_jacobian(1, half, (const sr_real(*)[SR_NT])Fk, dF, th, dth);      /* F2 = f(Y2), and dY2 */
-        sr_internal_act(x, th, Y2);
-        act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dY2);
-    }
-    if (status == SR_OK)                                                           /* F3 = f(x . exp(h/2 F2)) */
-        status = stage_jacobian(model, x, u, half[0], Fk[1], (const sr_real(*)[NC])dF[1], 0, Fk[2], dF[2]);
-    if (status == SR_OK) {                                                         /* Y4 = Y2 . exp(h (F3 - F1/2)) */
-        const sr_real (*pair)[SR_NT] = (const sr_real(*)[SR_NT])Fk;
-        tangent dpair[2];
-        sr_real two[2][SR_NT];
-        memcpy(two[0], pair[2], sizeof two[0]);
-        memcpy(two[1], pair[0], sizeof two[1]);
-        memcpy(dpair[0], dF[2], sizeof dpair[0]);
-        memcpy(dpair[1], dF[0], sizeof dpair[1]);
-        combine_jacobian(2, one, (const sr_real(*)[SR_NT])two, dpair, th, dth);
+    status = first_stage_jacobian(model, x, u, Fk[0], dF[0]);                            /* F1 = f(x) */
+    if (status == SR_OK)                                              /* F2 = f(Y2), Y2 = x . exp(h/2 F1) */
+        status = stage_jacobian(model, x, u, SR_C(0.5) * dt, Fk[0], (const sr_real(*)[NC])dF[0], 0, Fk[1], dF[1],
+                                Y2, dY2);
+    if (status == SR_OK)                                                  /* F3 = f(x . exp(h/2 F2)) */
+        status = stage_jacobian(model, x, u, SR_C(0.5) * dt, Fk[1], (const sr_real(*)[NC])dF[1], 0, Fk[2], dF[2],
+                                Y, dY4);
+    if (status == SR_OK) {                                      /* F4 = f(Y4), Y4 = Y2 . exp(h (F3 - F1/2)) */
+        static const unsigned char tangent_row[NREAD] = {SR_T_S, SR_T_S + 1, SR_T_S + 2, SR_T_Y, SR_T_P,
+                                                          SR_T_V, SR_T_V + 1, SR_T_V + 2, SR_T_V + 3, SR_T_V + 4};
+        for (i = 0; i < SR_NT; ++i) th[i] = dt * (Fk[2][i] - SR_C(0.5) * Fk[0][i]);
         sr_internal_act(Y2, th, Y);
-        act_jacobian(th, (const error *)&dY2, (const sr_real(*)[NC])dth, dY);
-        status = field_jacobian(model, Y, u, dY, Fk[3], dF[3]);                    /* F4 = f(Y4) */
+        for (i = 0; i < NREAD; ++i) {
+            const sr_real *a = dF[2][tangent_row[i]], *b = dF[0][tangent_row[i]];
+            for (c = 0; c < NC; ++c) dth4[i][c] = dt * a[c];
+            for (c = 0; c < NC; ++c) dth4[i][c] -= SR_C(0.5) * dt * b[c];
+        }
+        move_read_rows(th, (const sr_real(*)[NC])dY2, (const sr_real(*)[NC])dth4, dY4);
+        kinematic_rows(model, Y, (const sr_real(*)[NC])dY4, Fk[3], dF[3]);
+        for (i = 0; i < 3; ++i) memcpy(dF[3][SR_T_S + i], dY4[SR_J_NU + i], sizeof dF[3][0]);   /* f_S = w_S */
+        memcpy(dF[3][SR_T_Y], dY4[SR_J_NU + 3], sizeof dF[3][0]);
+        memcpy(dF[3][SR_T_P], dY4[SR_J_NU + 4], sizeof dF[3][0]);
+        status = accel_rows(model, Y, u, (const sr_real(*)[NC])dY4, Fk[3], dF[3]);
     }
     if (status != SR_OK) return status;
     /* x_new = x . exp(th) . exp(th2) */
