@@ -87,22 +87,34 @@ static void act_jacobian(const sr_real th[SR_NT], const error *dx, const tangent
     memcpy(dy, out, sizeof out);
 }
 
-/* The derivatives of k = dexp^-1(th, f) on the SO(3) block, k_S = v + t x v / 2 + c t x (t x v) with
- * t = th_S, v = f_S: P = dk_S/dv, Q = dk_S/dt (see the top of the file). */
-static void dexpinv_derivatives(const sr_real th[SR_NT], const sr_real f[SR_NT], sr_real P[9], sr_real Q[9])
+/* k = dexp^-1(th, f) on the SO(3) block, k_S = v + t x v / 2 + c t x (t x v) with t = th_S, v = f_S
+ * (sr_internal_dexpinv's formula, in its order), and its derivatives P = dk_S/dv, Q = dk_S/dt (see the
+ * top of the file); the coefficient c and its derivative computed once for all three. */
+static void dexpinv_and_derivatives(const sr_real th[SR_NT], const sr_real f[SR_NT], sr_real k[3], sr_real P[9],
+                                    sr_real Q[9])
 {
     const sr_real *t = th + SR_T_S, *v = f + SR_T_S;
-    const sr_real s = t[0] * t[0] + t[1] * t[1] + t[2] * t[2], tv = t[0] * v[0] + t[1] * v[1] + t[2] * v[2];
-    sr_real c, dc, T[9], T2[9], b[3];
+    const sr_real t00 = t[0] * t[0], t11 = t[1] * t[1], t22 = t[2] * t[2];
+    const sr_real s = t00 + t11 + t22, tv = t[0] * v[0] + t[1] * v[1] + t[2] * v[2];
+    sr_real c, dc, a[3], b[3], T2[9];
     int i, j;
     dexpinv_coefficient(s, &c, &dc);
-    T[0] = 0;     T[1] = -t[2]; T[2] = t[1];
-    T[3] = t[2];  T[4] = 0;     T[5] = -t[0];
-    T[6] = -t[1]; T[7] = t[0];  T[8] = 0;
-    matmul3(T, T, T2);
-    for (i = 0; i < 3; ++i) b[i] = T2[3 * i + 0] * v[0] + T2[3 * i + 1] * v[1] + T2[3 * i + 2] * v[2];
-    for (i = 0; i < 9; ++i) P[i] = (i % 4 == 0 ? 1 : 0) + SR_C(0.5) * T[i] + c * T2[i];
-    /* dk/dt = -[v]/2 + c ((t.v) I + t v^T - 2 v t^T) + 2 c' b t^T  (b = t x (t x v)) */
+    a[0] = t[1] * v[2] - t[2] * v[1];   /* a = t x v, b = t x a */
+    a[1] = t[2] * v[0] - t[0] * v[2];
+    a[2] = t[0] * v[1] - t[1] * v[0];
+    b[0] = t[1] * a[2] - t[2] * a[1];
+    b[1] = t[2] * a[0] - t[0] * a[2];
+    b[2] = t[0] * a[1] - t[1] * a[0];
+    for (i = 0; i < 3; ++i) k[i] = v[i] + SR_C(0.5) * a[i] + c * b[i];
+    /* [t]^2 = t t^T - |t|^2 I, its diagonal without cancellation */
+    T2[0] = -(t11 + t22);   T2[1] = t[0] * t[1];    T2[2] = t[0] * t[2];
+    T2[3] = T2[1];          T2[4] = -(t00 + t22);   T2[5] = t[1] * t[2];
+    T2[6] = T2[2];          T2[7] = T2[5];          T2[8] = -(t00 + t11);
+    /* P = I + [t]/2 + c [t]^2 */
+    P[0] = 1 + c * T2[0];                  P[1] = -SR_C(0.5) * t[2] + c * T2[1]; P[2] = SR_C(0.5) * t[1] + c * T2[2];
+    P[3] = SR_C(0.5) * t[2] + c * T2[3];   P[4] = 1 + c * T2[4];                 P[5] = -SR_C(0.5) * t[0] + c * T2[5];
+    P[6] = -SR_C(0.5) * t[1] + c * T2[6];  P[7] = SR_C(0.5) * t[0] + c * T2[7];  P[8] = 1 + c * T2[8];
+    /* Q = -[v]/2 + c ((t.v) I + t v^T - 2 v t^T) + 2 c' b t^T */
     Q[0] = 0;                 Q[1] = SR_C(0.5) * v[2];  Q[2] = -SR_C(0.5) * v[1];
     Q[3] = -SR_C(0.5) * v[2]; Q[4] = 0;                 Q[5] = SR_C(0.5) * v[0];
     Q[6] = SR_C(0.5) * v[1];  Q[7] = -SR_C(0.5) * v[0]; Q[8] = 0;
@@ -191,8 +203,8 @@ static int stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const s
     sr_real th[SR_NT], D[9], Jr[9];
     int i, j, c;
     for (i = 0; i < SR_NT; ++i) th[i] = h * Kp[i];
-    sr_internal_act(x, th, y);
     so3_exp_minus_identity(th + SR_T_S, D);
+    act_increment(x, D, th, NULL, y);   /* y = x . exp(th), the stepper's stage state bit for bit */
     so3_right_jacobian(th + SR_T_S, Jr);
     for (i = 0; i < 3; ++i) {   /* dy_xi = Exp(th_S)^T [I | 0] + Jr h dKp_S */
         sr_real o[NC];
@@ -220,8 +232,8 @@ static int stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const s
     for (i = 0; i < SR_NV; ++i) dy[SR_J_NU + i][NU_COLUMN(i)] += 1;
     kinematic_rows(model, y, (const sr_real(*)[NC])dy, k, dk);
     if (dexpinv) {   /* on the SO(3) block only: k_S = dexp^-1(th, f_S) from the kinematics alone */
-        sr_real P[9], Q[9], kS[SR_NT] = {0};
-        dexpinv_derivatives(th, k, P, Q);
+        sr_real P[9], Q[9], kS[3];
+        dexpinv_and_derivatives(th, k, kS, P, Q);
         for (i = 0; i < 3; ++i) {
             sr_real o[NC];
             for (c = 0; c < NC; ++c) o[c] = 0;
@@ -235,9 +247,7 @@ static int stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const s
             }
             memcpy(dk[SR_T_S + i], o, sizeof o);
         }
-        for (i = 0; i < 3; ++i) kS[SR_T_S + i] = k[SR_T_S + i];
-        sr_internal_dexpinv(th, kS, kS);
-        for (i = 0; i < 3; ++i) k[SR_T_S + i] = kS[SR_T_S + i];
+        for (i = 0; i < 3; ++i) k[SR_T_S + i] = kS[i];
     } else {
         for (i = 0; i < 3; ++i) memcpy(dk[SR_T_S + i], dy[SR_J_NU + i], sizeof dk[0]);
     }
@@ -272,14 +282,15 @@ static int first_stage_jacobian(const sr_model *model, const sr_real x[SR_NX], c
     return SR_OK;
 }
 
-/* dy_read = A(th) dx_read + B(th) dth_read on the read rows, for y = x . exp(th) where x's read rows
+/* y = x . exp(th) and dy_read = A(th) dx_read + B(th) dth_read on the read rows, where x's read rows
  * dx are any (CF4's Y4 = Y2 . exp(th)); dth in the read rows' order too. */
-static void move_read_rows(const sr_real th[SR_NT], const sr_real dx[NREAD][NC], const sr_real dth[NREAD][NC],
-                           sr_real dy[NREAD][NC])
+static void move_read_rows(const sr_real x[SR_NX], const sr_real dx[NREAD][NC], const sr_real th[SR_NT],
+                           const sr_real dth[NREAD][NC], sr_real y[SR_NX], sr_real dy[NREAD][NC])
 {
     sr_real D[9], Jr[9];
     int i, j, c;
     so3_exp_minus_identity(th + SR_T_S, D);
+    act_increment(x, D, th, NULL, y);
     so3_right_jacobian(th + SR_T_S, Jr);
     for (i = 0; i < 3; ++i) {   /* Exp(th_S)^T dx_xi + Jr dth_S */
         sr_real o[NC];
@@ -316,18 +327,22 @@ static void combine_jacobian(int n, const sr_real *coef, const sr_real (*K)[SR_N
     }
 }
 
-static void deliver_jacobians(error dy, sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
+/* F, G from the carried columns of the step's error (checked finite first: F and G are written
+ * only on success); the dq columns are the identity's (see NC). */
+static int deliver_jacobians(const error dy, sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
 {
-    int i, c;
+    int i;
+    if (!all_finite(&dy[0][0], SR_NE * NC)) return SR_ERR_NONFINITE;
     for (i = 0; i < SR_NE; ++i) {
-        for (c = 0; c < NC; ++c) {
-            const int col = full_column(c);
-            if (col < SR_NE) F[SR_NE * i + col] = dy[i][c];
-            else G[SR_NU * i + (col - SR_NE)] = dy[i][c];
-        }
-        F[SR_NE * i + SR_E_q] = (sr_real)(i == SR_E_q);   /* the dq columns: see NC */
-        F[SR_NE * i + SR_E_q + 1] = (sr_real)(i == SR_E_q + 1);
+        sr_real *row = F + SR_NE * i;
+        int c;
+        for (c = 0; c < SR_E_q; ++c) row[c] = dy[i][c];
+        row[SR_E_q] = (sr_real)(i == SR_E_q);
+        row[SR_E_q + 1] = (sr_real)(i == SR_E_q + 1);
+        for (c = 0; c < SR_NV; ++c) row[SR_E_nu + c] = dy[i][SR_E_q + c];
+        for (c = 0; c < SR_NU; ++c) G[SR_NU * i + c] = dy[i][NC - SR_NU + c];
     }
+    return SR_OK;
 }
 
 static int check_step_arguments(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
@@ -347,7 +362,7 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_rkmk4(const sr_model *model, const sr_re
     static const sr_real zero_u[SR_NU] = {0, 0};
     static const sr_real a_diag[3] = {SR_C(0.5), SR_C(0.5), SR_C(1.0)};
     const sr_real b[4] = {dt / 6, dt / 3, dt / 3, dt / 6};
-    sr_real K[4][SR_NT], th[SR_NT], y[SR_NX], dy_read[NREAD][NC], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
+    sr_real K[4][SR_NT], th[SR_NT], y[SR_NX], dy_read[NREAD][NC];
     tangent dK[4], dth;
     error dy;
     int s, status = check_step_arguments(model, x, u, dt, F, G);
@@ -360,11 +375,7 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_rkmk4(const sr_model *model, const sr_re
     if (status != SR_OK) return status;
     combine_jacobian(4, b, (const sr_real(*)[SR_NT])K, dK, th, dth);
     act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dy);
-    deliver_jacobians(dy, f, g);
-    if (!all_finite(f, SR_NE * SR_NE) || !all_finite(g, SR_NE * SR_NU)) return SR_ERR_NONFINITE;
-    memcpy(F, f, sizeof f);
-    memcpy(G, g, sizeof g);
-    return SR_OK;
+    return deliver_jacobians((const sr_real(*)[NC])dy, F, G);
 }
 
 SR_JACOBIAN_CLONES int sr_step_jacobian_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
@@ -373,7 +384,7 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_cf4(const sr_model *model, const sr_real
     static const sr_real zero_u[SR_NU] = {0, 0};
     const sr_real beta1[4] = {dt / 4, dt / 6, dt / 6, -dt / 12};
     const sr_real beta2[4] = {-dt / 12, dt / 6, dt / 6, dt / 4};
-    sr_real Fk[4][SR_NT], th[SR_NT], th2[SR_NT], Y2[SR_NX], Y[SR_NX], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
+    sr_real Fk[4][SR_NT], th[SR_NT], th2[SR_NT], Y2[SR_NX], Y[SR_NX];
     sr_real dY2[NREAD][NC], dY4[NREAD][NC], dth4[NREAD][NC];
     tangent dF[4], dth, dth2;
     error dY;
@@ -391,13 +402,12 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_cf4(const sr_model *model, const sr_real
         static const unsigned char tangent_row[NREAD] = {SR_T_S, SR_T_S + 1, SR_T_S + 2, SR_T_Y, SR_T_P,
                                                           SR_T_V, SR_T_V + 1, SR_T_V + 2, SR_T_V + 3, SR_T_V + 4};
         for (i = 0; i < SR_NT; ++i) th[i] = dt * (Fk[2][i] - SR_C(0.5) * Fk[0][i]);
-        sr_internal_act(Y2, th, Y);
         for (i = 0; i < NREAD; ++i) {
             const sr_real *a = dF[2][tangent_row[i]], *b = dF[0][tangent_row[i]];
             for (c = 0; c < NC; ++c) dth4[i][c] = dt * a[c];
             for (c = 0; c < NC; ++c) dth4[i][c] -= SR_C(0.5) * dt * b[c];
         }
-        move_read_rows(th, (const sr_real(*)[NC])dY2, (const sr_real(*)[NC])dth4, dY4);
+        move_read_rows(Y2, (const sr_real(*)[NC])dY2, th, (const sr_real(*)[NC])dth4, Y, dY4);
         kinematic_rows(model, Y, (const sr_real(*)[NC])dY4, Fk[3], dF[3]);
         for (i = 0; i < 3; ++i) memcpy(dF[3][SR_T_S + i], dY4[SR_J_NU + i], sizeof dF[3][0]);   /* f_S = w_S */
         memcpy(dF[3][SR_T_Y], dY4[SR_J_NU + 3], sizeof dF[3][0]);
@@ -410,11 +420,7 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_cf4(const sr_model *model, const sr_real
     combine_jacobian(4, beta2, (const sr_real(*)[SR_NT])Fk, dF, th2, dth2);
     act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dY);
     act_jacobian(th2, (const error *)&dY, (const sr_real(*)[NC])dth2, dY);
-    deliver_jacobians(dY, f, g);
-    if (!all_finite(f, SR_NE * SR_NE) || !all_finite(g, SR_NE * SR_NU)) return SR_ERR_NONFINITE;
-    memcpy(F, f, sizeof f);
-    memcpy(G, g, sizeof g);
-    return SR_OK;
+    return deliver_jacobians((const sr_real(*)[NC])dY, F, G);
 }
 
 int sr_step_jacobian(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,

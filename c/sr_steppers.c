@@ -74,61 +74,13 @@ int sr_internal_vector_field(const sr_model *model, const sr_real x[SR_NX], cons
     return status;
 }
 
-/* Rounding and orthogonality.  Forming E = Exp(...) and then R E rounds the diagonal of E to
- * the grid of numbers near 1 (spacing 1.1e-16 or 2.2e-16); when the angular velocity changes
- * slowly, that rounding error is nearly the same at every step and |R^T R - I| grows
- * linearly (about 1e-11 after 10^6 steps).  We therefore form the increment D = E - I
- * directly (its entries are small and carry full relative precision) and update
- * R <- R + R D: the remaining rounding is that of one addition per entry, which does not
- * repeat from step to step. */
-
-/* out[i] = x[i] + d, Kahan-compensated when comp is not NULL: the low-order bits that one
- * addition loses are carried to the next step instead of being rounded the same way at every
- * step, which keeps |R^T R - I| at the rounding level even when a resting robot's increments
- * stay constant and below one ulp of the entries near 1 (the stagnation that otherwise grows
- * |R^T R - I| linearly). */
-static inline sr_real add(sr_real x, sr_real d, sr_real *comp)
-{
-    sr_real y, t;
-    if (!comp) return x + d;
-    y = d - *comp;
-    t = x + y;
-    *comp = (t - x) - y;
-    return t;
-}
-
-/* The one-axis rotation R = Exp(theta [[e_k]]) (k = 0: R_Y about x, entries c = R[4],
- * s = R[7]; k = 1: R_P about y, c = R[0], s = R[2]) times Exp(angle [[e_k]]): R (Exp - I)
- * changes only (c, s), by (c (cos - 1) - s sin, s (cos - 1) + c sin); the exact zeros and ones
- * are copied (an increment of exactly 0, whose compensation stays 0).  The state check has made
- * sure R has this form. */
-static void advance_axis(const sr_real R[9], int k, sr_real angle, sr_real *comp, sr_real out[9])
-{
-    const int ic = k == 0 ? 4 : 0, is = k == 0 ? 7 : 2;      /* where c and s stand */
-    const int ims = k == 0 ? 5 : 6, ic2 = 8;                   /* -s and the second c */
-    const sr_real c = R[ic], s = R[is];
-    sr_real sn, cm1, dc, ds;
-    int m;
-    sin_and_cos_minus_one(angle, &sn, &cm1);
-    dc = c * cm1 - s * sn;
-    ds = s * cm1 + c * sn;
-    for (m = 0; m < 9; ++m) out[m] = R[m];
-    out[ic] = add(R[ic], dc, comp ? comp + ic : NULL);
-    out[ic2] = add(R[ic2], dc, comp ? comp + ic2 : NULL);
-    out[is] = add(R[is], ds, comp ? comp + is : NULL);
-    out[ims] = add(R[ims], -ds, comp ? comp + ims : NULL);
-}
-
 /* out = x . exp(th1) . exp(th2), formed as x + increment (th2 may be NULL: one exponential);
- * comp as in `add`.  On SO(3): R E1 E2 = R + R (D1 + D2 + D1 D2) with D = E - I, whose small
- * entries carry full relative precision (forming E and then R E would round the diagonal of E
- * to the grid of numbers near 1 in the same way at every step when the angular velocity
- * changes slowly: |R^T R - I| would grow linearly, about 1e-11 after 10^6 steps).  The
- * one-axis rotations and the vector parts add their arguments.  out may alias x. */
+ * comp as in act_increment (sr_internal.h).  On SO(3): R E1 E2 = R + R (D1 + D2 + D1 D2) with
+ * D = E - I; the one-axis rotations and the vector parts add their arguments.  out may alias x. */
 static void advance(const sr_real x[SR_NX], const sr_real th1[SR_NT], const sr_real *th2, sr_real *comp,
                     sr_real out[SR_NX])
 {
-    sr_real D[9], dR[9];
+    sr_real D[9], th[SR_NT];
     int i;
     so3_exp_minus_identity(th1 + SR_T_S, D);
     if (th2) {
@@ -137,26 +89,14 @@ static void advance(const sr_real x[SR_NX], const sr_real th1[SR_NT], const sr_r
         matmul3(D, D2, D12);
         for (i = 0; i < 9; ++i) D[i] = D[i] + D2[i] + D12[i];
     }
-    matmul3(x + SR_X_R_S, D, dR);
-    for (i = 0; i < 9; ++i) out[SR_X_R_S + i] = add(x[SR_X_R_S + i], dR[i], comp ? comp + SR_X_R_S + i : NULL);
-    advance_axis(x + SR_X_R_Y, 0, th1[SR_T_Y] + (th2 ? th2[SR_T_Y] : 0), comp ? comp + SR_X_R_Y : NULL, out + SR_X_R_Y);
-    advance_axis(x + SR_X_R_P, 1, th1[SR_T_P] + (th2 ? th2[SR_T_P] : 0), comp ? comp + SR_X_R_P : NULL, out + SR_X_R_P);
-    for (i = 0; i < 3; ++i)
-        out[SR_X_q + i] = add(x[SR_X_q + i], th1[SR_T_Q + i] + (th2 ? th2[SR_T_Q + i] : 0), comp ? comp + SR_X_q + i : NULL);
-    for (i = 0; i < SR_NV; ++i)
-        out[SR_X_w_S + i] = add(x[SR_X_w_S + i], th1[SR_T_V + i] + (th2 ? th2[SR_T_V + i] : 0),
-                                comp ? comp + SR_X_w_S + i : NULL);
+    for (i = SR_T_Y; i < SR_NT; ++i) th[i] = th1[i] + (th2 ? th2[i] : 0);
+    act_increment(x, D, th, comp, out);
 }
 
 /* out = x . exp(th) (see the top of the file); out may alias x. */
 static void act(const sr_real x[SR_NX], const sr_real th[SR_NT], sr_real out[SR_NX])
 {
     advance(x, th, NULL, NULL, out);
-}
-
-void sr_internal_act(const sr_real x[SR_NX], const sr_real th[SR_NT], sr_real out[SR_NX])
-{
-    act(x, th, out);
 }
 
 /* k = dexp^{-1}_{-th}(f): the so(3) block gets the closed form above (its series below
