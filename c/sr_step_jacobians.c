@@ -48,6 +48,27 @@ static void dexpinv_coefficient(sr_real s, sr_real *c, sr_real *dc)
     }
 }
 
+/* out = scale M in (add 0) or out += scale M in (add 1) for nr rows of NC columns, M nr x 3 row-major
+ * and in three contiguous rows of NC.  One product per statement, restrict-qualified rows: the form
+ * GCC 12 vectorises across the columns (the same loops written in the callers, with a sum of two
+ * products per statement or rows it could not tell apart, stayed scalar: RKMK4 -0.1 us). */
+static inline void mul_rows(int nr, const sr_real *M, sr_real scale, const sr_real *restrict in, sr_real *restrict out,
+                            int add)
+{
+    int i, j, c;
+    for (i = 0; i < nr; ++i) {
+        sr_real *restrict o = out + NC * i;
+        if (!add) {
+            const sr_real m0 = scale * M[3 * i];
+            for (c = 0; c < NC; ++c) o[c] = m0 * in[c];
+        }
+        for (j = add ? 0 : 1; j < 3; ++j) {
+            const sr_real mij = scale * M[3 * i + j];
+            for (c = 0; c < NC; ++c) o[c] += mij * in[NC * j + c];
+        }
+    }
+}
+
 /* dy = A(th) dx + B(th) dth (dx may be NULL: a state that does not depend on (d, w) other than
  * through x itself, i.e. dx = [I | 0], whose products are written out).  Row by row, each row a
  * contiguous axpy over the NC columns (what the compiler vectorises). */
@@ -157,22 +178,11 @@ static void kinematic_rows(const sr_model *model, const sr_real y[SR_NX], const 
                            sr_real f[SR_NT], tangent df)
 {
     sr_real p[2][3], wxp[2][3];
-    int i, j, c;
+    int c;
     sr_internal_kinematics(model, y, f);
     rolling_rows(model, y, p, wxp);
-    for (i = 0; i < 2; ++i) {   /* local sums: in place, in df, the loops stayed scalar (aliasing) */
-        sr_real o[NC];
-        for (c = 0; c < NC; ++c) o[c] = 0;
-        for (j = 0; j < 3; ++j) {
-            const sr_real pij = p[i][j], *a = dy[SR_J_NU + j];
-            for (c = 0; c < NC; ++c) o[c] += pij * a[c];
-        }
-        for (j = 0; j < 3; ++j) {
-            const sr_real wij = wxp[i][j], *b = dy[SR_J_XI + j];
-            for (c = 0; c < NC; ++c) o[c] += wij * b[c];
-        }
-        memcpy(df[SR_T_Q + i], o, sizeof o);
-    }
+    mul_rows(2, &p[0][0], 1, dy[SR_J_NU], df[SR_T_Q], 0);   /* d(q') = p . dw + (w x p) . dxi */
+    mul_rows(2, &wxp[0][0], 1, dy[SR_J_XI], df[SR_T_Q], 1);
     for (c = 0; c < NC; ++c) df[SR_T_Q + 2][c] = 0;
 }
 
@@ -206,16 +216,10 @@ static int stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const s
     so3_exp_minus_identity(th + SR_T_S, D);
     act_increment(x, D, th, NULL, y);   /* y = x . exp(th), the stepper's stage state bit for bit */
     so3_right_jacobian(th + SR_T_S, Jr);
-    for (i = 0; i < 3; ++i) {   /* dy_xi = Exp(th_S)^T [I | 0] + Jr h dKp_S */
-        sr_real o[NC];
-        for (c = 0; c < NC; ++c) o[c] = h * Jr[3 * i] * dKp[SR_T_S][c];
-        for (j = 1; j < 3; ++j) {
-            const sr_real jrij = h * Jr[3 * i + j], *b = dKp[SR_T_S + j];
-            for (c = 0; c < NC; ++c) o[c] += jrij * b[c];
-        }
-        for (j = 0; j < 3; ++j) o[j] += D[3 * j + i];
-        o[i] += 1;
-        memcpy(dy[SR_J_XI + i], o, sizeof o);
+    mul_rows(3, Jr, h, dKp[SR_T_S], dy[SR_J_XI], 0);   /* dy_xi = Exp(th_S)^T [I | 0] + Jr h dKp_S */
+    for (i = 0; i < 3; ++i) {
+        for (j = 0; j < 3; ++j) dy[SR_J_XI + i][j] += D[3 * j + i];
+        dy[SR_J_XI + i][i] += 1;
     }
     for (c = 0; c < NC; ++c) {  /* the abelian rows: the identity + h dKp */
         dy[SR_J_TH_Y][c] = h * dKp[SR_T_Y][c];
@@ -234,19 +238,8 @@ static int stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const s
     if (dexpinv) {   /* on the SO(3) block only: k_S = dexp^-1(th, f_S) from the kinematics alone */
         sr_real P[9], Q[9], kS[3];
         dexpinv_and_derivatives(th, k, kS, P, Q);
-        for (i = 0; i < 3; ++i) {
-            sr_real o[NC];
-            for (c = 0; c < NC; ++c) o[c] = 0;
-            for (j = 0; j < 3; ++j) {
-                const sr_real pij = P[3 * i + j], *a = dy[SR_J_NU + j];
-                for (c = 0; c < NC; ++c) o[c] += pij * a[c];
-            }
-            for (j = 0; j < 3; ++j) {
-                const sr_real qij = h * Q[3 * i + j], *b = dKp[SR_T_S + j];
-                for (c = 0; c < NC; ++c) o[c] += qij * b[c];
-            }
-            memcpy(dk[SR_T_S + i], o, sizeof o);
-        }
+        mul_rows(3, P, 1, dy[SR_J_NU], dk[SR_T_S], 0);
+        mul_rows(3, Q, h, dKp[SR_T_S], dk[SR_T_S], 1);
         for (i = 0; i < 3; ++i) k[SR_T_S + i] = kS[i];
     } else {
         for (i = 0; i < 3; ++i) memcpy(dk[SR_T_S + i], dy[SR_J_NU + i], sizeof dk[0]);
@@ -287,26 +280,17 @@ static int first_stage_jacobian(const sr_model *model, const sr_real x[SR_NX], c
 static void move_read_rows(const sr_real x[SR_NX], const sr_real dx[NREAD][NC], const sr_real th[SR_NT],
                            const sr_real dth[NREAD][NC], sr_real y[SR_NX], sr_real dy[NREAD][NC])
 {
-    sr_real D[9], Jr[9];
-    int i, j, c;
+    sr_real D[9], Dt[9], Jr[9];
+    int i, j;
     so3_exp_minus_identity(th + SR_T_S, D);
     act_increment(x, D, th, NULL, y);
     so3_right_jacobian(th + SR_T_S, Jr);
-    for (i = 0; i < 3; ++i) {   /* Exp(th_S)^T dx_xi + Jr dth_S */
-        sr_real o[NC];
-        for (c = 0; c < NC; ++c) o[c] = dx[SR_J_XI + i][c];
-        for (j = 0; j < 3; ++j) {
-            const sr_real dji = D[3 * j + i], *a = dx[SR_J_XI + j];
-            for (c = 0; c < NC; ++c) o[c] += dji * a[c];
-        }
-        for (j = 0; j < 3; ++j) {
-            const sr_real jrij = Jr[3 * i + j], *b = dth[SR_J_XI + j];
-            for (c = 0; c < NC; ++c) o[c] += jrij * b[c];
-        }
-        memcpy(dy[SR_J_XI + i], o, sizeof o);
-    }
-    for (i = SR_J_TH_Y; i < NREAD; ++i)
-        for (c = 0; c < NC; ++c) dy[i][c] = dx[i][c] + dth[i][c];
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) Dt[3 * i + j] = D[3 * j + i];
+    mul_rows(3, Jr, 1, dth[SR_J_XI], dy[SR_J_XI], 0);   /* Exp(th_S)^T dx_xi + Jr dth_S */
+    mul_rows(3, Dt, 1, dx[SR_J_XI], dy[SR_J_XI], 1);
+    for (i = 0; i < NC * SR_J_TH_Y; ++i) (&dy[0][0])[i] += (&dx[0][0])[i];
+    for (i = NC * SR_J_TH_Y; i < NREAD * NC; ++i) (&dy[0][0])[i] = (&dx[0][0])[i] + (&dth[0][0])[i];
 }
 
 /* th = sum_k coef[k] K[k] and its derivative. */
