@@ -280,23 +280,31 @@ static inline int deliver(int status, const sr_real *tmp, int n, sr_real *out)
  * Jr = I - a [[phi]] + b [[phi]]^2, a = (1 - cos t)/t^2, b = (t - sin t)/t^3 (series below t = 1/4). */
 static inline void so3_right_jacobian(const sr_real phi[3], sr_real Jr[9])
 {
-    const sr_real t2 = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2];
-    sr_real a, b, W[9], W2[9];
-    int i;
+    const sr_real x2 = phi[0] * phi[0], y2 = phi[1] * phi[1], z2 = phi[2] * phi[2];
+    const sr_real t2 = x2 + y2 + z2;
+    sr_real a, b;
     if (t2 < SR_SERIES_T2) {
+        /* b = sum_k (-t2)^k / (2k + 3)! through k = 5, in Estrin's form (as the series above) */
+        const sr_real t4 = t2 * t2;
         a = cosc_series(t2);
-        b = (SR_C(1.0) / 6) * (1 - t2 * (SR_C(1.0) / 20) * (1 - t2 * (SR_C(1.0) / 42) * (1 - t2 * (SR_C(1.0) / 72) *
-            (1 - t2 * (SR_C(1.0) / 110) * (1 - t2 * (SR_C(1.0) / 156))))));
+        b = (SR_C(1.0) / 6 - t2 * (SR_C(1.0) / 120)) + t4 * (SR_C(1.0) / 5040 - t2 * (SR_C(1.0) / 362880))
+          + t4 * t4 * (SR_C(1.0) / 39916800 - t2 * (SR_C(1.0) / SR_C(6227020800.0)));
     } else {
         const sr_real t = SR_SQRT(t2), s_half = SR_SIN(SR_C(0.5) * t);
         a = SR_C(2.0) * s_half * s_half / t2;
         b = (t - SR_SIN(t)) / (t2 * t);
     }
-    W[0] = 0;       W[1] = -phi[2]; W[2] = phi[1];
-    W[3] = phi[2];  W[4] = 0;       W[5] = -phi[0];
-    W[6] = -phi[1]; W[7] = phi[0];  W[8] = 0;
-    matmul3(W, W, W2);
-    for (i = 0; i < 9; ++i) Jr[i] = (i % 4 == 0 ? 1 : 0) - a * W[i] + b * W2[i];
+    /* Jr = I - a [phi] + b [phi]^2, [phi]^2 = phi phi^T - |phi|^2 I with its diagonal written
+     * without cancellation */
+    Jr[0] = 1 - b * (y2 + z2);
+    Jr[4] = 1 - b * (x2 + z2);
+    Jr[8] = 1 - b * (x2 + y2);
+    Jr[1] = a * phi[2] + b * phi[0] * phi[1];
+    Jr[3] = -a * phi[2] + b * phi[0] * phi[1];
+    Jr[2] = -a * phi[1] + b * phi[0] * phi[2];
+    Jr[6] = a * phi[1] + b * phi[0] * phi[2];
+    Jr[5] = a * phi[0] + b * phi[1] * phi[2];
+    Jr[7] = -a * phi[0] + b * phi[1] * phi[2];
 }
 
 /* ---- sr_kernels.c: the model's kernels, of the paper's geometry or general (sr_model) ------ */

@@ -117,9 +117,10 @@ static void dexpinv_and_derivatives(const sr_real th[SR_NT], const sr_real f[SR_
     const sr_real *t = th + SR_T_S, *v = f + SR_T_S;
     const sr_real t00 = t[0] * t[0], t11 = t[1] * t[1], t22 = t[2] * t[2];
     const sr_real s = t00 + t11 + t22, tv = t[0] * v[0] + t[1] * v[1] + t[2] * v[2];
-    sr_real c, dc, a[3], b[3], T2[9];
+    sr_real c, dc, dc2, a[3], b[3], T2[9];
     int i, j;
     dexpinv_coefficient(s, &c, &dc);
+    dc2 = 2 * dc;
     a[0] = t[1] * v[2] - t[2] * v[1];   /* a = t x v, b = t x a */
     a[1] = t[2] * v[0] - t[0] * v[2];
     a[2] = t[0] * v[1] - t[1] * v[0];
@@ -136,12 +137,17 @@ static void dexpinv_and_derivatives(const sr_real th[SR_NT], const sr_real f[SR_
     P[3] = SR_C(0.5) * t[2] + c * T2[3];   P[4] = 1 + c * T2[4];                 P[5] = -SR_C(0.5) * t[0] + c * T2[5];
     P[6] = -SR_C(0.5) * t[1] + c * T2[6];  P[7] = SR_C(0.5) * t[0] + c * T2[7];  P[8] = 1 + c * T2[8];
     /* Q = -[v]/2 + c ((t.v) I + t v^T - 2 v t^T) + 2 c' b t^T */
-    Q[0] = 0;                 Q[1] = SR_C(0.5) * v[2];  Q[2] = -SR_C(0.5) * v[1];
-    Q[3] = -SR_C(0.5) * v[2]; Q[4] = 0;                 Q[5] = SR_C(0.5) * v[0];
-    Q[6] = SR_C(0.5) * v[1];  Q[7] = -SR_C(0.5) * v[0]; Q[8] = 0;
     for (i = 0; i < 3; ++i)
-        for (j = 0; j < 3; ++j)
-            Q[3 * i + j] += c * ((i == j ? tv : 0) + t[i] * v[j] - 2 * v[i] * t[j]) + 2 * dc * b[i] * t[j];
+        for (j = 0; j < 3; ++j) Q[3 * i + j] = c * (t[i] * v[j] - 2 * v[i] * t[j]) + dc2 * b[i] * t[j];
+    Q[0] += c * tv;
+    Q[4] += c * tv;
+    Q[8] += c * tv;
+    Q[1] += SR_C(0.5) * v[2];
+    Q[2] -= SR_C(0.5) * v[1];
+    Q[3] -= SR_C(0.5) * v[2];
+    Q[5] += SR_C(0.5) * v[0];
+    Q[6] += SR_C(0.5) * v[1];
+    Q[7] -= SR_C(0.5) * v[0];
 }
 
 /* ---- the stages -----------------------------------------------------------------------------
@@ -190,14 +196,12 @@ static void kinematic_rows(const sr_model *model, const sr_real y[SR_NX], const 
 static int accel_rows(const sr_model *model, const sr_real y[SR_NX], const sr_real u[SR_NU],
                       const sr_real dy[NREAD][NC], sr_real f[SR_NT], tangent df)
 {
-    sr_real acc[SR_NV][NC], Jb[SR_NV * SR_NU];
-    int i, c, status = sr_internal_accel_jacobian_along(model, y, u, dy, f + SR_T_V, acc, Jb);
+    sr_real Jb[SR_NV * SR_NU];
+    int i, c, status = sr_internal_accel_jacobian_along(model, y, u, dy, f + SR_T_V, &df[SR_T_V], Jb);
     /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
     if (status != SR_OK) return status == SR_ERR_SINGULAR && !all_finite(y, SR_NX) ? SR_ERR_NONFINITE : status;
-    for (i = 0; i < SR_NV; ++i) {
-        for (c = 0; c < NC - SR_NU; ++c) df[SR_T_V + i][c] = acc[i][c];
-        for (c = 0; c < SR_NU; ++c) df[SR_T_V + i][NC - SR_NU + c] = acc[i][NC - SR_NU + c] + Jb[SR_NU * i + c];
-    }
+    for (i = 0; i < SR_NV; ++i)
+        for (c = 0; c < SR_NU; ++c) df[SR_T_V + i][NC - SR_NU + c] += Jb[SR_NU * i + c];
     return SR_OK;
 }
 
