@@ -320,7 +320,7 @@ static void combine_jacobian(int n, const sr_real *coef, const sr_real (*K)[SR_N
 static int deliver_jacobians(const error dy, sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
 {
     int i;
-    if (!all_finite(&dy[0][0], SR_NE * NC)) return SR_ERR_NONFINITE;
+    if (!all_finite_long(&dy[0][0], SR_NE * NC)) return SR_ERR_NONFINITE;
     for (i = 0; i < SR_NE; ++i) {
         sr_real *row = F + SR_NE * i;
         int c;
