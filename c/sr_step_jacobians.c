@@ -69,43 +69,24 @@ static inline void mul_rows(int nr, const sr_real *M, sr_real scale, const sr_re
     }
 }
 
-/* dy = A(th) dx + B(th) dth (dx may be NULL: a state that does not depend on (d, w) other than
- * through x itself, i.e. dx = [I | 0], whose products are written out).  Row by row, each row a
- * contiguous axpy over the NC columns (what the compiler vectorises). */
-static void act_jacobian(const sr_real th[SR_NT], const error *dx, const tangent dth, error dy)
+/* dy = A(th) [I | 0] + B(th) dth for y = x . exp(th), x the step's start (RKMK4's final exponential):
+ * Jr dth_S plus Exp(th_S)^T on the xi columns, dth on the other rows plus the identity's entries. */
+static void act_jacobian(const sr_real th[SR_NT], const tangent dth, error dy)
 {
     sr_real D[9], Jr[9];
-    error out;
-    int i, j, c;
+    int i, j;
     so3_exp_minus_identity(th + SR_T_S, D);
     so3_right_jacobian(th + SR_T_S, Jr);
-    for (i = 0; i < 3; ++i) {   /* Exp(th)^T = I + D^T, then + Jr dth_S */
-        sr_real *o = out[SR_E_xi_S + i];
-        if (dx) {
-            for (c = 0; c < NC; ++c) o[c] = (*dx)[SR_E_xi_S + i][c];
-            for (j = 0; j < 3; ++j) {
-                const sr_real dji = D[3 * j + i], *a = (*dx)[SR_E_xi_S + j];
-                for (c = 0; c < NC; ++c) o[c] += dji * a[c];
-            }
-        } else {
-            for (c = 0; c < NC; ++c) o[c] = c < 3 ? (c == i) + D[3 * c + i] : 0;
-        }
-        for (j = 0; j < 3; ++j) {
-            const sr_real jrij = Jr[3 * i + j], *b = dth[SR_T_S + j];
-            for (c = 0; c < NC; ++c) o[c] += jrij * b[c];
-        }
+    mul_rows(3, Jr, 1, dth[SR_T_S], dy[SR_E_xi_S], 0);
+    for (i = 0; i < 3; ++i) {
+        for (j = 0; j < 3; ++j) dy[SR_E_xi_S + i][j] += D[3 * j + i];
+        dy[SR_E_xi_S + i][i] += 1;
     }
-    for (c = 0; c < NC; ++c) {   /* the identity's rows, where dx is NULL: carried column a is full_column(a) */
-        out[SR_E_th_Y][c] = (dx ? (*dx)[SR_E_th_Y][c] : (sr_real)(c == SR_E_th_Y)) + dth[SR_T_Y][c];
-        out[SR_E_th_P][c] = (dx ? (*dx)[SR_E_th_P][c] : (sr_real)(c == SR_E_th_P)) + dth[SR_T_P][c];
-    }
-    for (i = 0; i < 2; ++i)   /* the dq columns are not carried: the identity has no entries here */
-        for (c = 0; c < NC; ++c) out[SR_E_q + i][c] = (dx ? (*dx)[SR_E_q + i][c] : 0) + dth[SR_T_Q + i][c];
-    for (i = 0; i < SR_NV; ++i)
-        for (c = 0; c < NC; ++c)
-            out[SR_E_nu + i][c] = (dx ? (*dx)[SR_E_nu + i][c] : (sr_real)(full_column(c) == SR_E_nu + i))
-                                + dth[SR_T_V + i][c];
-    memcpy(dy, out, sizeof out);
+    memcpy(dy[SR_E_th_Y], dth[SR_T_Y], sizeof(dy[0]) * 4);   /* th_Y, th_P, q_x, q_y (q_z does not move) */
+    memcpy(dy[SR_E_nu], dth[SR_T_V], sizeof(dy[0]) * SR_NV);
+    dy[SR_E_th_Y][SR_E_th_Y] += 1;   /* carried column a is error row a before q, NU_COLUMN after */
+    dy[SR_E_th_P][SR_E_th_P] += 1;
+    for (i = 0; i < SR_NV; ++i) dy[SR_E_nu + i][NU_COLUMN(i)] += 1;
 }
 
 /* k = dexp^-1(th, f) on the SO(3) block, k_S = v + t x v / 2 + c t x (t x v) with t = th_S, v = f_S
@@ -315,6 +296,56 @@ static void combine_jacobian(int n, const sr_real *coef, const sr_real (*K)[SR_N
     }
 }
 
+/* CF4's update x_new = x . exp(th) . exp(th2), th = sum_k beta1_k F_k, th2 = sum_k beta2_k F_k, and
+ * its error dy: by the rules at the top of the file, dy = A(th2) (A(th) [I | 0] + B(th) dth) + B(th2) dth2,
+ *   xi rows:   (E E2)^T [I | 0] + sum_k (beta1_k E2^T Jr(th_S) + beta2_k Jr(th2_S)) dF_k,S,
+ *   the rest:  [I | 0] + sum_k (beta1_k + beta2_k) dF_k          (E = Exp(th_S), E2 = Exp(th2_S)):
+ * one pass over the stages' rows, not two sums and two actions (CF4's step Jacobian -35 ns). */
+static void cf4_final_jacobian(sr_real h, const sr_real (*F)[SR_NT], tangent *dF, error dy)
+{
+    const sr_real beta1[4] = {h / 4, h / 6, h / 6, -h / 12};
+    const sr_real beta2[4] = {-h / 12, h / 6, h / 6, h / 4};
+    sr_real th[3], th2[3], D1[9], D2[9], Jr1[9], Jr2[9], E2tJr1[9], M[9], *o = &dy[0][0];
+    int i, j, k, c;
+    for (i = 0; i < 3; ++i) {   /* as the stepper's combine */
+        th[i] = 0;
+        th2[i] = 0;
+        for (k = 0; k < 4; ++k) th[i] += beta1[k] * F[k][SR_T_S + i];
+        for (k = 0; k < 4; ++k) th2[i] += beta2[k] * F[k][SR_T_S + i];
+    }
+    so3_exp_minus_identity(th, D1);
+    so3_exp_minus_identity(th2, D2);
+    so3_right_jacobian(th, Jr1);
+    so3_right_jacobian(th2, Jr2);
+    for (i = 0; i < 3; ++i)   /* E2^T Jr1 = Jr1 + D2^T Jr1 */
+        for (j = 0; j < 3; ++j)
+            E2tJr1[3 * i + j] = Jr1[3 * i + j] + (D2[i] * Jr1[j] + D2[3 + i] * Jr1[3 + j] + D2[6 + i] * Jr1[6 + j]);
+    for (k = 0; k < 4; ++k) {
+        for (i = 0; i < 9; ++i) M[i] = beta1[k] * E2tJr1[i] + beta2[k] * Jr2[i];
+        mul_rows(3, M, 1, dF[k][SR_T_S], dy[SR_E_xi_S], k > 0);
+    }
+    for (i = 0; i < 3; ++i) {   /* (E E2)^T = I + (D1 + D2 + D1 D2)^T on the xi columns */
+        for (j = 0; j < 3; ++j)
+            dy[SR_E_xi_S + i][j] += (D1[3 * j + i] + D2[3 * j + i])
+                                    + (D1[3 * j] * D2[i] + D1[3 * j + 1] * D2[3 + i] + D1[3 * j + 2] * D2[6 + i]);
+        dy[SR_E_xi_S + i][i] += 1;
+    }
+    for (k = 0; k < 4; ++k) {   /* error rows th_Y .. q_y are the tangent's th_Y .. q_y, then nu */
+        const sr_real g = beta1[k] + beta2[k], *a = &dF[k][SR_T_Y][0], *b = &dF[k][SR_T_V][0];
+        sr_real *oq = o + NC * SR_E_th_Y, *on = o + NC * SR_E_nu;
+        if (k == 0) {
+            for (c = 0; c < 4 * NC; ++c) oq[c] = g * a[c];
+            for (c = 0; c < SR_NV * NC; ++c) on[c] = g * b[c];
+        } else {
+            for (c = 0; c < 4 * NC; ++c) oq[c] += g * a[c];
+            for (c = 0; c < SR_NV * NC; ++c) on[c] += g * b[c];
+        }
+    }
+    dy[SR_E_th_Y][SR_E_th_Y] += 1;
+    dy[SR_E_th_P][SR_E_th_P] += 1;
+    for (i = 0; i < SR_NV; ++i) dy[SR_E_nu + i][NU_COLUMN(i)] += 1;
+}
+
 /* F, G from the carried columns of the step's error (checked finite first: F and G are written
  * only on success); the dq columns are the identity's (see NC). */
 static int deliver_jacobians(const error dy, sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
@@ -362,7 +393,7 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_rkmk4(const sr_model *model, const sr_re
                                 K[s], dK[s], y, dy_read);
     if (status != SR_OK) return status;
     combine_jacobian(4, b, (const sr_real(*)[SR_NT])K, dK, th, dth);
-    act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dy);
+    act_jacobian(th, (const sr_real(*)[NC])dth, dy);
     return deliver_jacobians((const sr_real(*)[NC])dy, F, G);
 }
 
@@ -370,11 +401,9 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_cf4(const sr_model *model, const sr_real
                          sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
 {
     static const sr_real zero_u[SR_NU] = {0, 0};
-    const sr_real beta1[4] = {dt / 4, dt / 6, dt / 6, -dt / 12};
-    const sr_real beta2[4] = {-dt / 12, dt / 6, dt / 6, dt / 4};
-    sr_real Fk[4][SR_NT], th[SR_NT], th2[SR_NT], Y2[SR_NX], Y[SR_NX];
+    sr_real Fk[4][SR_NT], th[SR_NT], Y2[SR_NX], Y[SR_NX];
     sr_real dY2[NREAD][NC], dY4[NREAD][NC], dth4[NREAD][NC];
-    tangent dF[4], dth, dth2;
+    tangent dF[4];
     error dY;
     int i, c, status = check_step_arguments(model, x, u, dt, F, G);
     if (status != SR_OK) return status;
@@ -403,11 +432,7 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_cf4(const sr_model *model, const sr_real
         status = accel_rows(model, Y, u, (const sr_real(*)[NC])dY4, Fk[3], dF[3]);
     }
     if (status != SR_OK) return status;
-    /* x_new = x . exp(th) . exp(th2) */
-    combine_jacobian(4, beta1, (const sr_real(*)[SR_NT])Fk, dF, th, dth);
-    combine_jacobian(4, beta2, (const sr_real(*)[SR_NT])Fk, dF, th2, dth2);
-    act_jacobian(th, NULL, (const sr_real(*)[NC])dth, dY);
-    act_jacobian(th2, (const error *)&dY, (const sr_real(*)[NC])dth2, dY);
+    cf4_final_jacobian(dt, (const sr_real(*)[SR_NT])Fk, dF, dY);   /* x_new = x . exp(th) . exp(th2) */
     return deliver_jacobians((const sr_real(*)[NC])dY, F, G);
 }
 
