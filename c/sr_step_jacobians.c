@@ -69,26 +69,6 @@ static inline void mul_rows(int nr, const sr_real *M, sr_real scale, const sr_re
     }
 }
 
-/* dy = A(th) [I | 0] + B(th) dth for y = x . exp(th), x the step's start (RKMK4's final exponential):
- * Jr dth_S plus Exp(th_S)^T on the xi columns, dth on the other rows plus the identity's entries. */
-static void act_jacobian(const sr_real th[SR_NT], const tangent dth, error dy)
-{
-    sr_real D[9], Jr[9];
-    int i, j;
-    so3_exp_minus_identity(th + SR_T_S, D);
-    so3_right_jacobian(th + SR_T_S, Jr);
-    mul_rows(3, Jr, 1, dth[SR_T_S], dy[SR_E_xi_S], 0);
-    for (i = 0; i < 3; ++i) {
-        for (j = 0; j < 3; ++j) dy[SR_E_xi_S + i][j] += D[3 * j + i];
-        dy[SR_E_xi_S + i][i] += 1;
-    }
-    memcpy(dy[SR_E_th_Y], dth[SR_T_Y], sizeof(dy[0]) * 4);   /* th_Y, th_P, q_x, q_y (q_z does not move) */
-    memcpy(dy[SR_E_nu], dth[SR_T_V], sizeof(dy[0]) * SR_NV);
-    dy[SR_E_th_Y][SR_E_th_Y] += 1;   /* carried column a is error row a before q, NU_COLUMN after */
-    dy[SR_E_th_P][SR_E_th_P] += 1;
-    for (i = 0; i < SR_NV; ++i) dy[SR_E_nu + i][NU_COLUMN(i)] += 1;
-}
-
 /* k = dexp^-1(th, f) on the SO(3) block, k_S = v + t x v / 2 + c t x (t x v) with t = th_S, v = f_S
  * (sr_internal_dexpinv's formula, in its order), and its derivatives P = dk_S/dv, Q = dk_S/dt (see the
  * top of the file); the coefficient c and its derivative computed once for all three. */
@@ -278,22 +258,41 @@ static void move_read_rows(const sr_real x[SR_NX], const sr_real dx[NREAD][NC], 
     for (i = NC * SR_J_TH_Y; i < NREAD * NC; ++i) (&dy[0][0])[i] = (&dx[0][0])[i] + (&dth[0][0])[i];
 }
 
-/* th = sum_k coef[k] K[k] and its derivative. */
-static void combine_jacobian(int n, const sr_real *coef, const sr_real (*K)[SR_NT], tangent *dK,
-                             sr_real th[SR_NT], tangent dth)
+/* RKMK4's update x_new = x . exp(th), th = sum_k b_k K_k, and its error dy = A(th) [I | 0] + B(th) dth:
+ * the xi rows Jr(th_S) dth_S plus Exp(th_S)^T on the xi columns, the others dth plus the identity's
+ * entries, dth's rows summed straight into dy. */
+static void rkmk4_final_jacobian(sr_real h, const sr_real (*K)[SR_NT], tangent *dK, error dy)
 {
-    int i, c, k;
-    for (i = 0; i < SR_NT; ++i) {
-        sr_real o[NC];   /* local, as in kinematic_rows */
+    const sr_real b[4] = {h / 6, h / 3, h / 3, h / 6};
+    sr_real th[3], D[9], Jr[9], dth_S[3][NC], *o = &dy[0][0];
+    int i, j, k, c;
+    for (i = 0; i < 3; ++i) {   /* as the stepper's combine */
         th[i] = 0;
-        for (k = 0; k < n; ++k) th[i] += coef[k] * K[k][i];
-        for (c = 0; c < NC; ++c) o[c] = 0;
-        for (k = 0; k < n; ++k) {
-            const sr_real ck = coef[k], *a = dK[k][i];
-            for (c = 0; c < NC; ++c) o[c] += ck * a[c];
-        }
-        memcpy(dth[i], o, sizeof o);
+        for (k = 0; k < 4; ++k) th[i] += b[k] * K[k][SR_T_S + i];
     }
+    so3_exp_minus_identity(th, D);
+    so3_right_jacobian(th, Jr);
+    for (k = 0; k < 4; ++k) {   /* dth_S, then the rows th_Y .. q_y and nu of dy (tangent rows alike) */
+        const sr_real *s = &dK[k][SR_T_S][0], *a = &dK[k][SR_T_Y][0], *v = &dK[k][SR_T_V][0];
+        sr_real *ds = &dth_S[0][0], *oq = o + NC * SR_E_th_Y, *on = o + NC * SR_E_nu;
+        if (k == 0) {
+            for (c = 0; c < 3 * NC; ++c) ds[c] = b[k] * s[c];
+            for (c = 0; c < 4 * NC; ++c) oq[c] = b[k] * a[c];
+            for (c = 0; c < SR_NV * NC; ++c) on[c] = b[k] * v[c];
+        } else {
+            for (c = 0; c < 3 * NC; ++c) ds[c] += b[k] * s[c];
+            for (c = 0; c < 4 * NC; ++c) oq[c] += b[k] * a[c];
+            for (c = 0; c < SR_NV * NC; ++c) on[c] += b[k] * v[c];
+        }
+    }
+    mul_rows(3, Jr, 1, dth_S[0], dy[SR_E_xi_S], 0);
+    for (i = 0; i < 3; ++i) {
+        for (j = 0; j < 3; ++j) dy[SR_E_xi_S + i][j] += D[3 * j + i];
+        dy[SR_E_xi_S + i][i] += 1;
+    }
+    dy[SR_E_th_Y][SR_E_th_Y] += 1;   /* carried column a is error row a before q, NU_COLUMN after */
+    dy[SR_E_th_P][SR_E_th_P] += 1;
+    for (i = 0; i < SR_NV; ++i) dy[SR_E_nu + i][NU_COLUMN(i)] += 1;
 }
 
 /* CF4's update x_new = x . exp(th) . exp(th2), th = sum_k beta1_k F_k, th2 = sum_k beta2_k F_k, and
@@ -380,9 +379,8 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_rkmk4(const sr_model *model, const sr_re
 {
     static const sr_real zero_u[SR_NU] = {0, 0};
     static const sr_real a_diag[3] = {SR_C(0.5), SR_C(0.5), SR_C(1.0)};
-    const sr_real b[4] = {dt / 6, dt / 3, dt / 3, dt / 6};
-    sr_real K[4][SR_NT], th[SR_NT], y[SR_NX], dy_read[NREAD][NC];
-    tangent dK[4], dth;
+    sr_real K[4][SR_NT], y[SR_NX], dy_read[NREAD][NC];
+    tangent dK[4];
     error dy;
     int s, status = check_step_arguments(model, x, u, dt, F, G);
     if (status != SR_OK) return status;
@@ -392,8 +390,7 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_rkmk4(const sr_model *model, const sr_re
         status = stage_jacobian(model, x, u, a_diag[s - 1] * dt, K[s - 1], (const sr_real(*)[NC])dK[s - 1], 1,
                                 K[s], dK[s], y, dy_read);
     if (status != SR_OK) return status;
-    combine_jacobian(4, b, (const sr_real(*)[SR_NT])K, dK, th, dth);
-    act_jacobian(th, (const sr_real(*)[NC])dth, dy);
+    rkmk4_final_jacobian(dt, (const sr_real(*)[SR_NT])K, dK, dy);
     return deliver_jacobians((const sr_real(*)[NC])dy, F, G);
 }
 
