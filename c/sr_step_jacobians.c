@@ -9,7 +9,7 @@
  *                                              B = diag(Jr(th_S), 1, 1, [I_2 0], I_5)
  * (the right Jacobian Jr of SO(3); q_z does not move); for the vector field f of
  * sr_internal_vector_field at a stage state y with error e: df = J_f(y) e + [0 | J_u] w, from
- * sr_internal_accel_jacobian (the accelerations) and the rolling kinematics (q' = r (R_S w) x e_z, as in
+ * sr_internal_accel_jacobian(_along) (the accelerations) and the rolling kinematics (q' = r (R_S w) x e_z, as in
  * sr_step_jacobian_lie_euler); and for k = dexp^-1(th, f) = f + th x f / 2 + c(|th|^2) th x (th x f)
  * on the SO(3) block: dk = (I + [th]/2 + c [th]^2) df + (-[f]/2 + c ((th.f) I + th f^T - 2 f th^T)
  * + 2 c'(|th|^2) (th x (th x f)) th^T) dth.
@@ -116,9 +116,11 @@ static void dexpinv_and_derivatives(const sr_real th[SR_NT], const sr_real f[SR_
  * columns; nothing depends on q), are formed once; the accelerations' rows are then Ja dy_read + [0 | Jb]
  * from sr_internal_accel_jacobian_along, which for the paper's robot applies the yoke frame's chain
  * rule to dy_read and never forms the shell-frame Ja.  Measured on an AMD EPYC (Zen 4), RKMK4:
- * 1.81 us with the shell-frame Ja pulled through A(th) and B(th) row by row (pull and combine_rows
- * until 2026-11-25), 1.74 us so; CF4 1.89 us either way.  The column loops hold one product per
- * statement: GCC 12 vectorises those, and left a sum of two products per statement scalar (1.89 us). */
+ * 1.81 us with the shell-frame Ja pulled through A(th) and B(th) row by row (until 2026-11-25),
+ * 1.74 us so.  The column loops hold one product per statement (mul_rows): GCC 12 vectorises those,
+ * and left a sum of two products per statement scalar.  With the rest of that day's changes (README,
+ * "Benchmarks"): RKMK4 and CF4 1.45 us, 5.9x accel_jacobian.  GCC's code for the flattened clones
+ * moves by +-30 ns with unrelated edits in this file: time a change in interleaved runs. */
 enum { NREAD = SR_J_READ };
 typedef char nc_matches[(NC == SR_J_NC && SR_E_th_Y == 3 && SR_E_th_P == 4 && SR_E_q == 5) ? 1 : -1];
 
