@@ -2,10 +2,10 @@
  * fuzz_api.c -- fuzz target for every public entry point of the spherical-robot library.
  *
  * LLVMFuzzerTestOneInput turns the input bytes into parameters, a state, torques, a time
- * step, a method and small step counts, calls the functions of spherical_robot.h (all but the
- * controller's sr_lqr_*, whose gain tables tests/test_control.c and the Python tests cover) and
- * checks their contract (abort() on a violation, so libFuzzer and the plain driver both
- * report it with the input that caused it):
+ * step, a method and small step counts, calls every function of spherical_robot.h (the
+ * controller's sr_lqr_* with a fuzzed gain schedule, target and memory) and checks their
+ * contract (abort() on a violation, so libFuzzer and the plain driver both report it with the
+ * input that caused it):
  *
  *   - the status is one of the codes the header documents for that function;
  *   - whenever the status is SR_OK, every output is finite;
@@ -187,6 +187,89 @@ static void read_state(reader *r, sr_real radius, sr_real x[SR_NX])
     x[SR_X_q + 2] = isfinite(radius) ? radius : SR_C(0.3);
     for (i = 30; i < SR_NX; ++i) x[i] = (sr_real)(speed * unit(r));
     for (i = 0; i < SR_NX; ++i) x[i] = pick(r, (double)x[i]);
+}
+
+/* ---- the controller: sr_lqr_check, sr_lqr_reset, sr_lqr_error, sr_lqr_control ---------------
+ * A schedule of fuzzed sizes, grids strictly increasing unless a pick perturbs them, gains and
+ * operating points mostly small and finite; a target and a memory likewise.  Contract: documented
+ * status; z, u and u_raw finite on SR_OK (|u| <= u_max) and untouched otherwise; the memory
+ * untouched on error. */
+static void fuzz_controller(reader *r, const sr_model *model, const sr_real x[SR_NX])
+{
+    static sr_lqr lqr;   /* 9 KB: not on the stack of the fuzz target */
+    static guarded gz, gu, gr;
+    sr_lqr_target target;
+    sr_lqr_memory memory, before, ran;
+    sr_real integrals[2];
+    int i, j, status, no_integrals, has_run, raw[2];
+    memset(&lqr, 0, sizeof lqr);
+    /* the small choices first, the long tables last: an input that runs out leaves valid gains */
+    lqr.n_speeds = 1 + (int)(read_u8(r) % SR_LQR_MAX_SPEEDS);
+    lqr.n_curvatures = 1 + (int)(read_u8(r) % SR_LQR_MAX_CURVATURES);
+    if (read_u8(r) % 16 == 15) lqr.n_speeds = (int)read_u8(r) - 128;         /* out of range, sometimes */
+    if (read_u8(r) % 16 == 15) lqr.n_curvatures = (int)read_u8(r) - 128;
+    lqr.period = pick(r, 0.01);
+    lqr.u_max = pick(r, 2.0);
+    lqr.kappa_rate = pick(r, 1.0);
+    lqr.integral_zone = pick(r, 0.5);
+    target.speed = pick(r, 0.5 * unit(r));
+    target.heading = pick(r, 3.2 * unit(r));
+    target.curvature = pick(r, unit(r));
+    target.cross_track = pick(r, 0.2 * unit(r));
+    target.path = (int)(read_u8(r) % 2);
+    integrals[0] = pick(r, 0.1 * unit(r));
+    integrals[1] = pick(r, 0.1 * unit(r));
+    no_integrals = read_u8(r) % 4 == 3;
+    has_run = read_u8(r) % 4 == 3;   /* a memory that has run before, possibly corrupt */
+    memset(&ran, 0, sizeof ran);
+    ran.started = 1;
+    ran.integrals[0] = pick(r, 0.05 * unit(r));
+    ran.integrals[1] = pick(r, 0.05 * unit(r));
+    ran.kappa = pick(r, 0.5 * unit(r));
+    raw[0] = read_u8(r) % 4 != 3;    /* u_raw asked for */
+    raw[1] = read_u8(r) % 4 != 3;
+    for (i = 0; i < SR_LQR_MAX_SPEEDS; ++i) lqr.speeds[i] = pick(r, 0.25 * (i + 1));
+    for (i = 0; i < SR_LQR_MAX_CURVATURES; ++i) lqr.curvatures[i] = pick(r, -1.0 + 0.5 * i);
+    for (i = 0; i < SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES; ++i) {
+        for (j = 0; j < SR_LQR_NZ; ++j) lqr.z_star[i][j] = pick(r, 0.1 * unit(r));
+        for (j = 0; j < SR_NU; ++j) lqr.u_star[i][j] = pick(r, 0.1 * unit(r));
+        for (j = 0; j < SR_NU * SR_LQR_NZ; ++j) {
+            lqr.K_path[i][j] = pick(r, 2.0 * unit(r));
+            lqr.K_heading[i][j] = pick(r, 2.0 * unit(r));
+        }
+    }
+
+    status = sr_lqr_check(&lqr);
+    EXPECT_STATUS("sr_lqr_check", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_ARG);
+    EXPECT_STATUS("sr_lqr_check(NULL)", sr_lqr_check(NULL), SR_ERR_NULL);
+
+    status = sr_lqr_error(model, x, &target, no_integrals ? NULL : integrals, arm(&gz, SR_LQR_NZ));
+    EXPECT_STATUS("sr_lqr_error", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+    expect("sr_lqr_error", status, &gz, status == SR_OK ? SR_LQR_NZ : 0, 1);
+
+    EXPECT_STATUS("sr_lqr_reset", sr_lqr_reset(&memory), SR_OK);
+    if (memory.started != 0 || memory.integrals[0] != 0 || memory.integrals[1] != 0 || memory.kappa != 0)
+        fail("sr_lqr_reset", SR_OK, "left the memory unzeroed");
+    if (has_run) memory = ran;
+    for (i = 0; i < 2; ++i) {   /* two samples: the second from the memory the first left */
+        before = memory;
+        status = sr_lqr_control(&lqr, model, x, &target, &memory, arm(&gu, SR_NU), raw[i] ? arm(&gr, SR_NU) : NULL);
+        EXPECT_STATUS("sr_lqr_control", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT,
+                      SR_ERR_ARG);
+        expect("sr_lqr_control", status, &gu, status == SR_OK ? SR_NU : 0, 1);
+        if (raw[i]) expect("sr_lqr_control", status, &gr, status == SR_OK ? SR_NU : 0, 1);
+        if (status == SR_OK) {
+            for (j = 0; j < SR_NU; ++j)
+                if (!(fabs((double)gu.buf[GUARD + j]) <= (double)lqr.u_max)) fail("sr_lqr_control", status, "torque beyond u_max");
+            if (lqr.n_speeds < 1 || lqr.n_speeds > SR_LQR_MAX_SPEEDS || lqr.n_curvatures < 1 ||
+                lqr.n_curvatures > SR_LQR_MAX_CURVATURES || !(lqr.period > 0) || !(lqr.u_max > 0))
+                fail("sr_lqr_control", status, "accepted a schedule of bad sizes, period or u_max");
+        } else if (memcmp(&before, &memory, sizeof memory) != 0) {
+            fail("sr_lqr_control", status, "changed the memory on error");
+        }
+    }
+    EXPECT_STATUS("sr_lqr_control(NULL)", sr_lqr_control(&lqr, model, x, &target, NULL, arm(&gu, SR_NU), NULL),
+                  SR_ERR_NULL);
 }
 
 /* ---- the target ------------------------------------------------------------------------------ */
@@ -460,6 +543,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if ((status == SR_OK) != (row == -1) || row < -1 || row > 1) fail("sr_checked_accel_batch", status, "bad failed_row");
         expect("sr_checked_accel_batch", status, &g, status == SR_OK ? 2 * SR_NV : (row > 0 ? (int)row * SR_NV : 0), 1);
     }
+
+    /* The controller (issue 20); read last, for the same reason. */
+    fuzz_controller(&rd, &model, x);
 
     /* NULL pointers */
     EXPECT_STATUS("sr_accel(NULL)", sr_accel(&model, x, u, NULL), SR_ERR_NULL);
