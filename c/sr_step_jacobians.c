@@ -169,9 +169,9 @@ static int accel_rows(const sr_model *model, const sr_real y[SR_NX], const sr_re
 }
 
 /* The stage k = dexp^-1(th, f(x . exp(th))) of RKMK4 (dexpinv set), or k = f(x . exp(th)) of CF4's
- * second and third stages, th = h Kp, and dk; also the stage state y = x . exp(th) and the
- * derivatives of its read rows, dy_read = A(th) [I | 0] + B(th) h dKp (CF4 goes on from its Y2).  On the read
- * rows (see the top of the file), then the rows of dk that need no dynamics (dk_S = P dy_nu_S +
+ * second and third stages, th = h Kp, and dk.  Also returns the stage state y = x . exp(th) and the
+ * derivatives of its read rows, dy_read = A(th) [I | 0] + B(th) h dKp (see the top of the file; CF4
+ * goes on from its Y2).  The rows of dk that need no dynamics come first (dk_S = P dy_nu_S +
  * Q h dKp_S, or dy_nu_S; dk_q, dk_Y, dk_P), the accelerations' rows last. */
 static int stage_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
                           const sr_real Kp[SR_NT], const tangent dKp, int dexpinv, sr_real k[SR_NT], tangent dk,
