@@ -6,6 +6,9 @@ C against C (bench/bench_kernels.c, no Python in the timed region, one pinned co
   (sympy.physics.mechanics) compiled the ways its users ship it: CasADi's C of M and F with
   ca.solve, SymPy's C printer with a generic LU, PyDy's C with the same LU
   (`kane_compiled`); and the CasADi C of our own 9x9 KKT reference, a verification model.
+The anatomy of a fourth-order step (bench/step_anatomy.c, item 9): the checked accel, four accels
+  chained as a step's stages chain them, the RKMK4 and CF4 steps, and the same steps with the
+  dynamics replaced by a stub (everything but the four accelerations).
 Python call against Python call: Model.accel and Model.step against the raw cffi call of the
   checked C function with prepared buffers (item 8), PyDy's Cython ODE function, the lambdified
   Kane model (three ways), a CasADi Function call of the Kane model, the CasADi reference and the

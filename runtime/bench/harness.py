@@ -57,6 +57,28 @@ def build_harness(build, native, with_casadi, kane=None):
     return exe
 
 
+def step_anatomy(build, input_file, repeats):
+    """Where a fourth-order step's time goes (bench/step_anatomy.c; issue 17, item 9): the checked
+    accel, four accels chained as a step's stages chain them, and the steps; then the same steps
+    with the dynamics replaced by a two-flop stub (the library's c/sr_steppers.c compiled into the
+    program with -DANATOMY_GLUE_ONLY), i.e. everything a step does but its four accelerations.
+    Built like the C loop (build_harness, portable flags); `input_file` is the C loop's input."""
+    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+    flags = ["-std=c99", "-O3", "-DSR_CLONES", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c'}"]
+    generated = [str(p) for p in sorted((ROOT / "generated").glob("*.c"))]
+    library = sorted((ROOT / "c").glob("*.c"))
+    out = {}
+    for name, extra, sources in (
+            ("full", [], library),
+            ("glue_only", ["-DANATOMY_GLUE_ONLY"], [p for p in library if p.name != "sr_steppers.c"])):
+        exe = build / f"step_anatomy_{name}"
+        subprocess.run([cc, *flags, *extra, str(ROOT / "bench" / "step_anatomy.c"), *generated,
+                        *map(str, sources), "-lm", "-o", str(exe)], check=True)
+        run = subprocess.run([str(exe), str(input_file), str(repeats)], check=True, capture_output=True, text=True)
+        out[name] = json.loads(run.stdout)
+    return out
+
+
 def memory_floor(build, states, rounds=7):
     """ns per state of bench/memory_floor.c on `states` states: the batch accel's memory traffic
     alone (read x and u, write 5 numbers a state), compiled as fast as it goes."""
@@ -90,9 +112,10 @@ def lqr_target():
     return Target(speed=0.3, heading=0.5, curvature=0.2, cross_track=0.05)
 
 
-def run_harness(exe, params, X, U, repeats, kane_inputs=None):
-    data = build_dir_input = exe.parent / "input.bin"
-    with open(build_dir_input, "wb") as f:
+def write_input(path, params, X, U, kane_inputs=None):
+    """The C loop's input file (bench/bench_kernels.c; bench/step_anatomy.c reads its first four
+    parts): n, the parameters, the states, the torques, then what only the C loop reads."""
+    with open(path, "wb") as f:
         f.write(struct.pack("i", len(X)))
         f.write(np.ascontiguousarray(params.as_array()).tobytes())
         f.write(np.ascontiguousarray(X).tobytes())
@@ -103,6 +126,11 @@ def run_harness(exe, params, X, U, repeats, kane_inputs=None):
         if kane_inputs is not None:     # the Kane model's coordinates, then its (the paper's) parameters
             f.write(np.ascontiguousarray(kane_inputs, dtype=np.float64).tobytes())
             f.write(np.ascontiguousarray(params.paper_params.as_array(), dtype=np.float64).tobytes())
+    return path
+
+
+def run_harness(exe, params, X, U, repeats, kane_inputs=None):
+    data = write_input(exe.parent / "input.bin", params, X, U, kane_inputs)
     out = subprocess.run([str(exe), str(data), str(repeats)], check=True, capture_output=True, text=True)
     return json.loads(out.stdout)
 

@@ -169,7 +169,31 @@ def sections(res):
             rows.append((f"t-shape {py['lie_euler_loop_steps']:,} steps, Lie-Euler in a Python loop, {name}",
                          f"{ms:,.1f} ms", f"{ms / ours_le:,.0f}x our C lie-euler"))
     out.append(("Batches (per state) and the t-shape run (10,000 steps, end to end from Python)", rows))
+    if "step_anatomy" in res:
+        out.append(anatomy_section(res["step_anatomy"]))
     return out
+
+
+def anatomy_section(anatomy):
+    """Where a fourth-order step's time goes (runtime.bench.harness.step_anatomy), against the checked
+    accel of the same program: what 6x (issue 17, item 9) would leave for the step's work besides
+    its four accelerations, and what that work takes alone."""
+    full, glue = anatomy["full"], anatomy["glue_only"]
+    one = full["accel"]
+    rows = [("quantity", "time", "vs its checked accel"), ("checked accel (sr_accel), independent calls",
+                                                           f"{one:,.1f} ns", "1")]
+    for key, label in (("accels_chained_through_nu", "four accels, each one's nu from the previous output"),
+                       ("accels_chained_through_state", "four accels, every entry they read from the previous output")):
+        rows.append((label, f"{full[key]:,.1f} ns", f"{full[key] / one:.2f}x"))
+    for method in ("rkmk4", "cf4"):
+        step, rest = full[f"step_{method}"], glue[f"step_{method}"]
+        rows.append((f"{method} step (sr_step)", f"{step:,.1f} ns", f"{step / one:.2f}x"))
+        rows.append((f"{method} step with the dynamics stubbed: check, group action, kinematics, tableau",
+                     f"{rest:,.1f} ns", f"{rest / one:.2f}x"))
+    budget = 6 * one - full["accels_chained_through_nu"]
+    rows.append(("6x one accel minus four chained accels: left for all but the accelerations",
+                 f"{budget:,.1f} ns", f"{budget / one:.2f}x"))
+    return ("Anatomy of a fourth-order step (C loop; issue 17, item 9)", rows)
 
 
 def format_report(res):

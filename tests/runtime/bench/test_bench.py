@@ -3,7 +3,7 @@ import json
 
 import numpy as np
 
-from runtime.bench import baselines, checks, cli, report
+from runtime.bench import baselines, checks, cli, harness, report
 from runtime.model import Model
 from runtime.params import Params
 from runtime.state import initial_state
@@ -66,3 +66,27 @@ def test_a_stored_run_renders_as_the_readmes_markdown_tables(capsys):
         assert title in text
     assert "| Kane model, CasADi C: M, F and ca.solve (what a CasADi user ships) |" in text
     assert text.rstrip().splitlines()[-1].startswith("targets: accel <= 150 ns: met")
+
+
+def test_step_anatomy_stubs_the_dynamics_in_its_glue_only_build_and_nowhere_else(tmp_path):
+    params = Params.paper_simulation()
+    rng = np.random.default_rng(5)
+    X, U = random_states(rng, 8, params), random_inputs(rng, 8)
+    out = harness.step_anatomy(tmp_path, harness.write_input(tmp_path / "input.bin", params, X, U), 1)
+    full, glue = out["full"], out["glue_only"]
+    for key in ("accel", "accels_chained_through_nu", "accels_chained_through_state"):
+        assert full[f"{key}_sink"] == glue[f"{key}_sink"]      # the real kernel in both builds
+    for key in ("step_rkmk4", "step_cf4"):
+        assert full[f"{key}_sink"] != glue[f"{key}_sink"]      # the steps' dynamics stubbed
+        assert full[key] > 0 and glue[key] > 0
+
+
+def test_step_anatomy_section_reports_what_six_times_one_accel_leaves_besides_the_accelerations():
+    anatomy = {"full": {"accel": 40.0, "accels_chained_through_nu": 180.0, "accels_chained_through_state": 200.0,
+                        "step_rkmk4": 340.0, "step_cf4": 350.0},
+               "glue_only": {"step_rkmk4": 220.0, "step_cf4": 230.0}}
+    title, rows = report.anatomy_section(anatomy)
+    assert "issue 17" in title
+    assert rows[-1][1:] == ("60.0 ns", "1.50x")                 # 6 x 40 - 180
+    assert ("rkmk4 step with the dynamics stubbed: check, group action, kinematics, tableau", "220.0 ns",
+            "5.50x") in rows
