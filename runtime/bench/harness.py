@@ -37,11 +37,24 @@ def casadi_reference_c(params, build):
     return build / "ref_accel.c"
 
 
+def _compiler():
+    return os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+
+
+#: How the timed programs build the library (portable: no -march; the AVX2 clones as the extension has them).
+LIBRARY_FLAGS = ["-std=c99", "-O3", "-DSR_CLONES", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c'}"]
+
+
+def _library_sources():
+    """The generated and the hand-written C of the library."""
+    return [p for d in ("generated", "c") for p in sorted((ROOT / d).glob("*.c"))]
+
+
 def build_harness(build, native, with_casadi, kane=None):
     """The C loop's executable; `kane` = (sources, macros) of runtime/bench/kane_compiled.write_kane_c."""
-    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
-    sources = [str(p) for d in ("generated", "c") for p in sorted((ROOT / d).glob("*.c"))]
-    flags = ["-std=c99", "-O3", "-DSR_CLONES", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c'}", f"-I{build}"]
+    cc = _compiler()
+    sources = [str(p) for p in _library_sources()]
+    flags = [*LIBRARY_FLAGS, f"-I{build}"]
     if native:
         flags.append("-march=native")
     if with_casadi:
@@ -62,17 +75,14 @@ def step_anatomy(build, input_file, repeats):
     accel, four accels chained as a step's stages chain them, and the steps; then the same steps
     with the dynamics replaced by a two-flop stub (the library's c/sr_steppers.c compiled into the
     program with -DANATOMY_GLUE_ONLY), i.e. everything a step does but its four accelerations.
-    Built like the C loop (build_harness, portable flags); `input_file` is the C loop's input."""
-    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
-    flags = ["-std=c99", "-O3", "-DSR_CLONES", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c'}"]
-    generated = [str(p) for p in sorted((ROOT / "generated").glob("*.c"))]
-    library = sorted((ROOT / "c").glob("*.c"))
+    Built with the C loop's LIBRARY_FLAGS; `input_file` is the C loop's input."""
+    library = _library_sources()
     out = {}
     for name, extra, sources in (
             ("full", [], library),
             ("glue_only", ["-DANATOMY_GLUE_ONLY"], [p for p in library if p.name != "sr_steppers.c"])):
         exe = build / f"step_anatomy_{name}"
-        subprocess.run([cc, *flags, *extra, str(ROOT / "bench" / "step_anatomy.c"), *generated,
+        subprocess.run([_compiler(), *LIBRARY_FLAGS, *extra, str(ROOT / "bench" / "step_anatomy.c"),
                         *map(str, sources), "-lm", "-o", str(exe)], check=True)
         run = subprocess.run([str(exe), str(input_file), str(repeats)], check=True, capture_output=True, text=True)
         out[name] = json.loads(run.stdout)
@@ -82,9 +92,8 @@ def step_anatomy(build, input_file, repeats):
 def memory_floor(build, states, rounds=7):
     """ns per state of bench/memory_floor.c on `states` states: the batch accel's memory traffic
     alone (read x and u, write 5 numbers a state), compiled as fast as it goes."""
-    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
     exe = build / "memory_floor"
-    subprocess.run([cc, "-std=c99", "-O3", "-ffast-math", "-march=native", str(ROOT / "bench" / "memory_floor.c"),
+    subprocess.run([_compiler(), "-std=c99", "-O3", "-ffast-math", "-march=native", str(ROOT / "bench" / "memory_floor.c"),
                     "-o", str(exe)], check=True)
     out = subprocess.run([str(exe), str(states), str(rounds)], check=True, capture_output=True, text=True).stdout
     return json.loads(out)["ns_per_state"]
