@@ -8,6 +8,7 @@ COMMANDS = {
     "verify": ("runtime.verification.verify", "cross-check the kernels against the reference and the invariants"),
     "convergence": ("runtime.verification.convergence", "convergence and energy study of the integrators"),
     "bench": ("runtime.bench.cli", "benchmarks against the alternatives"),
+    "bench-table": ("runtime.bench.headline", "the benchmark tables of README.md and docs/performance.md, from the pinned run"),
     "figures": ("runtime.scenarios.figures", "regenerate the committed figures under docs/figures/"),
     "sweep": ("runtime.sweep.cli", "many runs of a scenario with varied inputs, on Dask (results in Parquet)"),
     "control": ("runtime.control.benchmark", "closed-loop benchmark: every controller on every task (make control)"),
