@@ -120,7 +120,9 @@ class SweepStore:
         identity = json.loads(json.dumps(spec.identity()))
         manifest = folder / MANIFEST
         if manifest.is_file():
-            return cls(folder, spec, _read_manifest(manifest, identity))
+            per_task = _read_manifest(manifest, identity)
+            (folder / CHUNKS).mkdir(exist_ok=True)
+            return cls(folder, spec, per_task)
         if folder.is_dir() and any(folder.iterdir()):
             raise ValueError(f"--out: {folder} is not empty and holds no sweep; choose another folder")
         per_task = int(choose_samples_per_task())
