@@ -52,8 +52,8 @@ INITIAL_KEYS = ("theta_Y", "theta_P", "w_Y", "w_P")
 TORQUE_KEYS = ("u_Y_scale", "u_P_scale")
 #: Largest sample count (the sample index is part of every seed; results are one row each).
 MAX_SAMPLES = 10**9
-#: A normal draw is mean + sd z, |z| < 14 in NumPy's ziggurat (its tail ends at 3.65 + 36.7/3.65): |mean| + NORMAL_REACH
-#: sd finite keeps every draw finite.
+#: A normal draw is mean + sd z with |z| < 14 (NumPy's ziggurat: its tail ends near 3.65 + 36.7/3.65),
+#: so |mean| + NORMAL_REACH sd finite keeps every draw finite.
 NORMAL_REACH = 100.0
 
 
