@@ -28,6 +28,7 @@ import dataclasses
 import importlib.resources
 import math
 import pathlib
+import sys
 import tomllib
 
 import numpy as np
@@ -51,6 +52,9 @@ INITIAL_KEYS = ("theta_Y", "theta_P", "w_Y", "w_P")
 TORQUE_KEYS = ("u_Y_scale", "u_P_scale")
 #: Largest sample count (the sample index is part of every seed; results are one row each).
 MAX_SAMPLES = 10**9
+#: A normal draw is mean + sd z with |z| < 14 (NumPy's ziggurat: its tail ends near 3.65 + 36.7/3.65),
+#: so |mean| + NORMAL_REACH sd finite keeps every draw finite.
+NORMAL_REACH = 100.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -115,6 +119,8 @@ def load_sweep(name_or_path):
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{path}: not valid TOML ({exc})") from None
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot be read ({exc.strerror})") from None
     return parse_sweep(data, source=str(path), name=path.stem, folder=path.parent)
 
 
@@ -186,8 +192,14 @@ def _quantity(name, table, where):
         raise ValueError(f"{where}.values: the grid is empty")
     if kind == "uniform" and (len(numbers) != 2 or not numbers[0] <= numbers[1]):
         raise ValueError(f"{where}.uniform: expected [low, high] with low <= high, got {list(numbers)}")
+    if kind == "uniform" and not math.isfinite(numbers[1] - numbers[0]):
+        raise ValueError(f"{where}.uniform: the width high - low of {list(numbers)} overflows; "
+                         f"expected a width below {sys.float_info.max:.4g}")
     if kind == "normal" and (len(numbers) != 2 or not numbers[1] >= 0):
         raise ValueError(f"{where}.normal: expected [mean, sd] with sd >= 0, got {list(numbers)}")
+    if kind == "normal" and not math.isfinite(abs(numbers[0]) + NORMAL_REACH * numbers[1]):
+        raise ValueError(f"{where}.normal: |mean| + {NORMAL_REACH:g} sd of {list(numbers)} overflows; "
+                         f"expected it below {sys.float_info.max:.4g} (every draw must be finite)")
     relative = table.get("relative", False)
     if not isinstance(relative, bool):
         raise ValueError(f"{where}.relative: expected true or false, got {relative!r}")
