@@ -1,4 +1,4 @@
-"""Climbing a slope under a constant yoke torque (issue 18): the limit, and the speed either side of it.
+"""Climbing a slope under a constant yoke torque: the limit, and the speed either side of it.
 
 In steady climbing the yoke and the pendulum hang still in the world while the shell rolls up the
 slope at ω, so the yoke motor turns at ω relative to the shell and the rotors at constant speeds
@@ -13,10 +13,9 @@ yoke and the pendulum (m_P g l/2 for the paper's robot); a larger torque flips t
 Both follow from the physics alone, not from the kernels; `simulate_climb` runs the kernels, and
 tests/runtime/control/test_climbing.py holds one against the other on both sides of the limit.
 
-    python -m runtime.control.climbing      # prints the limit, writes docs/figures/climbing-limit.png
+    python -m runtime climbing      # prints the limit, writes docs/figures/climbing-limit.png
 """
 import math
-import sys
 
 import numpy as np
 
@@ -66,7 +65,7 @@ def main(argv=()):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..scenarios.scenario import load_scenario
+    from ..scenario import load_scenario
     base = Params.paper_simulation()
     u_Y = 0.5
     limit = climbing_limit(base, u_Y)
@@ -93,7 +92,3 @@ def main(argv=()):
     fig.savefig(out, dpi=100)
     print(f"wrote {out}")
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

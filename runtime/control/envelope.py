@@ -1,4 +1,4 @@
-"""The envelope: what the torque limits allow (issue #20, item 1; docs/control.md).
+"""The envelope: what the torque limits allow (docs/control.md).
 
 Computed by simulation with the verified kernels (RKMK4, dt = 0.005 s), Params.paper_simulation():
 * steady rolling speed against a constant yoke torque from rest: "steady" = the speed of the
@@ -9,9 +9,8 @@ Computed by simulation with the verified kernels (RKMK4, dt = 0.005 s), Params.p
   the PID's inner lean loop; the steady turn radius is v / mean yaw rate over the last 10 s of a
   40 s run, and the largest |u_P| over those 10 s says whether |u| ≤ u_max holds the turn.
 
-    python -m runtime.control.envelope      # prints the numbers, writes docs/figures/control-envelope.png
+    python -m runtime envelope      # prints the numbers, writes docs/figures/control-envelope.png
 """
-import sys
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -150,7 +149,3 @@ def main(argv=()):
     fig.savefig(out, dpi=100)
     print(f"wrote {out}")
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

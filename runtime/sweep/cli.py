@@ -15,7 +15,7 @@ import sys
 
 from ..errors import SimulationStopped
 from ..model import Model
-from ..scenarios.atomic import write_text
+from ..atomic import write_text
 from ..state import IDX_Q
 from .runner import SERIAL, run_sweep
 from .spec import load_sweep, shipped_sweeps

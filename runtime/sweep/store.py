@@ -15,7 +15,7 @@ import pathlib
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from ..scenarios.atomic import atomic_path, write_text
+from ..atomic import atomic_path, write_text
 
 MANIFEST = "sweep.json"
 RESULTS = "results.parquet"

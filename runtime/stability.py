@@ -1,8 +1,8 @@
-"""Linearisations people ask for (issue 19): eigenvalues at the equilibria, from `Model.linearize`,
+"""Linearisations: eigenvalues at the equilibria, from `Model.linearize`,
 and the Floquet exponents of steady straight rolling, from `Model.step_jacobian` (the error
 coordinates of runtime.group).
 
-    python -m runtime.control.stability [FIGURE]    # prints the tables, writes docs/figures/rolling-stability.png
+    python -m runtime stability [FIGURE]    # prints the tables, writes docs/figures/rolling-stability.png
 
 Steady straight rolling at speed v: the shell spins at ω = v/r about its x axis (the yoke's
 hinge, kept horizontal), the yoke turns back at ω_Y = −ω so that it keeps its attitude in the
@@ -28,13 +28,12 @@ the heading (rotation about the vertical), and, at rest, turning the shell about
 pendulum's hinge with the joint angle compensating (2 more; while rolling, 1: the phase along the
 motion).  `nontrivial` drops the eigenvalues within 1e-9 of zero.
 """
-import sys
 
 import numpy as np
 
-from ..model import Model
-from ..params import Params
-from ..state import IDX_E_TH_Y, IDX_RY, NE, initial_state
+from .model import Model
+from .params import Params
+from .state import IDX_E_TH_Y, IDX_RY, NE, initial_state
 
 SIN_ALPHA = IDX_RY.start + 7      # sin of the yoke's tilt, R_Y[2, 1]
 SPEEDS = np.linspace(0.0, 1.8, 37)   # m/s; above 1.84 m/s the paper's robot cannot hold steady rolling
@@ -138,7 +137,4 @@ def main(argv=()):
     out = argv[0] if argv else "docs/figures/rolling-stability.png"
     figure(model, out)
     print(f"written: {out}")
-
-
-if __name__ == "__main__":
-    main(sys.argv[1:])
+    return 0
