@@ -29,6 +29,8 @@ pendulum's hinge with the joint angle compensating (2 more; while rolling, 1: th
 motion).  `nontrivial` drops the eigenvalues within 1e-9 of zero.
 """
 
+import argparse
+
 import numpy as np
 
 from .model import Model
@@ -126,6 +128,9 @@ def figure(model, out, speeds=SPEEDS):
 
 
 def main(argv=()):
+    parser = argparse.ArgumentParser(prog="python -m runtime stability")
+    parser.add_argument("figure", nargs="?", default="docs/figures/rolling-stability.png", help="where to write the figure")
+    args = parser.parse_args(list(argv))
     model = Model(Params.paper_simulation())
     np.set_printoptions(precision=4, suppress=True, linewidth=120)
     for pendulum in ("down", "up"):
@@ -134,7 +139,7 @@ def main(argv=()):
     for v, u_Y, ev in rolling_table(model, SPEEDS[::5]):
         top = ev[np.argmax(ev.real)]
         print(f"  {v:4.2f}  {u_Y:8.5f}  {top.real:8.4f}  {abs(top.imag):8.4f}")
-    out = argv[0] if argv else "docs/figures/rolling-stability.png"
+    out = args.figure
     figure(model, out)
     print(f"written: {out}")
     return 0

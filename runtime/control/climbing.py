@@ -15,6 +15,7 @@ tests/runtime/control/test_climbing.py holds one against the other on both sides
 
     python -m runtime climbing      # prints the limit, writes docs/figures/climbing-limit.png
 """
+import argparse
 import math
 
 import numpy as np
@@ -58,9 +59,12 @@ def simulate_climb(params, u_Y, duration=60.0, window=5.0):
 
 
 def main(argv=()):
-    """Prints the limit and both sides for the paper's robot; writes the figure (argv[0], default
+    """Prints the limit and both sides for the paper's robot; writes the figure (FIGURE, default
     docs/figures/climbing-limit.png): simulated against predicted speed over slopes for the paper's
     robot and the battery robot of runtime/scenarios/robots/battery-geared.toml."""
+    parser = argparse.ArgumentParser(prog="python -m runtime climbing")
+    parser.add_argument("figure", nargs="?", default="docs/figures/climbing-limit.png", help="where to write the figure")
+    args = parser.parse_args(list(argv))
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -88,7 +92,7 @@ def main(argv=()):
     ax.set_xlabel("slope [deg]"), ax.set_ylabel("steady speed up the slope [m/s]")
     ax.set_title(f"climbing under a held yoke torque of {u_Y} N m"), ax.legend(fontsize=7)
     fig.tight_layout()
-    out = argv[0] if argv else "docs/figures/climbing-limit.png"
+    out = args.figure
     fig.savefig(out, dpi=100)
     print(f"wrote {out}")
     return 0

@@ -12,6 +12,8 @@ Computed by simulation with the verified kernels (RKMK4, dt = 0.005 s), Params.p
     python -m runtime envelope      # prints the numbers, writes docs/figures/control-envelope.png
 """
 
+import argparse
+
 import numpy as np
 from tqdm.auto import tqdm
 
@@ -117,6 +119,9 @@ def tightest_turn(rows, leans, u_max):
 
 
 def main(argv=()):
+    parser = argparse.ArgumentParser(prog="python -m runtime envelope")
+    parser.add_argument("figure", nargs="?", default="docs/figures/control-envelope.png", help="where to write the figure")
+    args = parser.parse_args(list(argv))
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -145,7 +150,7 @@ def main(argv=()):
     b.set_xlabel("lean of the rolling axis φ [deg]"), b.set_ylabel("steady turn radius [m]"), b.legend()
     b.set_yscale("log"), b.set_title(f"turns (o: held with |u_P| < {env['u_max']} N m, x: saturated)")
     fig.tight_layout()
-    out = argv[0] if argv else "docs/figures/control-envelope.png"
+    out = args.figure
     fig.savefig(out, dpi=100)
     print(f"wrote {out}")
     return 0
