@@ -36,7 +36,7 @@ bench: $(STAMP)
 # Sweep throughput on Dask (1 and 2 workers), overhead against the C batch, per-task cost, bytes
 # per result: bench/results/sweep/<date>.json (docs/sweeps.md).
 sweep-bench: $(STAMP)
-	$(PY) -m runtime.sweep.bench
+	$(PY) -m runtime sweep-bench
 
 figures: $(STAMP)
 	$(PY) -m runtime figures
@@ -47,7 +47,7 @@ control: $(STAMP)
 
 # The envelope of docs/control.md (prints its numbers, rewrites docs/figures/control-envelope.png).
 envelope: $(STAMP)
-	$(PY) -m runtime.control.envelope
+	$(PY) -m runtime envelope
 
 soak: $(STAMP)
 	$(PY) -m runtime soak

@@ -1,4 +1,4 @@
-"""Robot parameters, physical SI units: the general robot (issue 18) and the paper's twelve.
+"""Robot parameters, physical SI units: the general robot and the paper's twelve.
 
 `Params` describes any robot of the yoke–pendulum architecture: each body by its
 mass, centre of mass and inertia tensor about that centre, the motors' rotors
@@ -131,8 +131,24 @@ def _as_shape(name, value, shape):
     if array.shape != shape:
         raise ValueError(f"Params.{name}: expected an array of shape {shape}, got shape {array.shape}")
     if len(shape) == 2 and not np.array_equal(array, array.T, equal_nan=True):
-        raise ValueError(f"Params.{name}: an inertia tensor must be symmetric, got {array.tolist()}")
+        array = _symmetric(name, array)
     return tuple(map(tuple, array.tolist())) if len(shape) == 2 else tuple(array.tolist())
+
+
+#: Largest asymmetry of an inertia tensor, relative to its largest entry, that is taken as rounding:
+#: a tensor computed as R D Rᵀ is symmetric only to a few ulps.
+SYMMETRY_TOL = 1e-12
+
+
+def _symmetric(name, array):
+    """The symmetric part of a tensor whose asymmetry is rounding; ValueError with the asymmetry otherwise."""
+    scale = np.abs(array).max()
+    asymmetry = np.abs(array - array.T).max()
+    if not asymmetry <= SYMMETRY_TOL * scale:       # also refuses NaN and inf off the diagonal
+        raise ValueError(f"Params.{name}: an inertia tensor must be symmetric, got {array.tolist()} "
+                         f"(largest |J - Jᵀ| = {asymmetry:.3g}, relative to its largest entry "
+                         f"{asymmetry / scale if scale > 0 else float('inf'):.3g} > {SYMMETRY_TOL:g})")
+    return 0.5 * array + 0.5 * array.T
 
 
 #: The default of every Params field: the paper's robot's value.
@@ -141,7 +157,7 @@ DEFAULT = type("PaperDefault", (), {"__repr__": lambda self: "<the paper's value
 
 @dataclasses.dataclass(frozen=True)
 class Params:
-    """A robot of the yoke–pendulum architecture (issue 18); defaults: the paper's robot, Section 5.2.
+    """A robot of the yoke–pendulum architecture; defaults: the paper's robot, Section 5.2.
 
     Shell: radius r, mass m_S, isotropic inertia j_S about its centre, damping k_S.  Yoke (rotates
     about the shell's x axis, hinge at the shell centre): mass m_Y, centre of mass c_Y (yoke frame,

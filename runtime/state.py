@@ -32,7 +32,7 @@ ROTATION_BLOCKS = {"R_S": IDX_RS, "R_Y": IDX_RY, "R_P": IDX_RP}
 #: Indices of the inputs u = (u_Y, u_P).
 IDX_UY, IDX_UP = lib.SR_U_u_Y, lib.SR_U_u_P
 
-#: The error state d (12,) of `Model.retract` / `Model.local` and of every Jacobian (issue 19,
+#: The error state d (12,) of `Model.retract` / `Model.local` and of every Jacobian (
 #: right-trivialised; generated SR_E_* offsets): shell rotation vector, yoke and pendulum
 #: angles, in-plane shift of q, change of ν.
 NE = lib.SR_NE

@@ -1,4 +1,4 @@
-"""The embeddable C library on its own (issue 6), built with c/Makefile and c/CMakeLists.txt.
+"""The embeddable C library on its own, built with c/Makefile and c/CMakeLists.txt.
 
 * the C tests (c/tests/) pass in the double and the float build, and under
   AddressSanitizer + UndefinedBehaviorSanitizer;

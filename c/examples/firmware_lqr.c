@@ -2,7 +2,7 @@
  * firmware_lqr.c -- a closed-loop firmware example: the LQR controller (sr_lqr_control) at a
  * fixed rate, driving the simulated robot; no Python, no heap.
  *
- * The scenario comes from lqr_task.h, written by `python -m runtime.control.firmware` (by
+ * The scenario comes from lqr_task.h, written by `python -m runtime firmware-table` (by
  * default: the heading-step task, a heading step of pi/2 while rolling at 0.3 m/s, with the LQR
  * at 100 Hz; its gain schedule designed for the task's model).  Every controller sample reads
  * the state, computes the torques, and holds them for LQR_TASK_STEPS_PER_SAMPLE plant steps of

@@ -71,7 +71,7 @@ def build_harness(build, native, with_casadi, kane=None):
 
 
 def step_anatomy(build, input_file, repeats):
-    """Where a fourth-order step's time goes (bench/step_anatomy.c; issue 17, item 9): the checked
+    """Where a fourth-order step's time goes (bench/step_anatomy.c): the checked
     accel, four accels chained as a step's stages chain them, and the steps; then the same steps
     with the dynamics replaced by a two-flop stub (the library's c/sr_steppers.c compiled into the
     program with -DANATOMY_GLUE_ONLY), i.e. everything a step does but its four accelerations.
@@ -100,10 +100,10 @@ def memory_floor(build, states, rounds=7):
 
 
 def general_robot(params):
-    """The general robot the C loop times beside `params` (issue 18): the same radius, so the same
+    """The general robot the C loop times beside `params`: the same radius, so the same
     states are valid, with an off-centre battery, full tensors, geared rotors and a slope (its
     kernels are the general ones)."""
-    from ..scenarios.scenario import load_scenario
+    from ..scenario import load_scenario
     return load_scenario("battery-geared").params.replace(r=params.r, slope=0.05)
 
 
@@ -221,10 +221,10 @@ def check_harness(result, model, X, U, step_dt=0.01):
         check("C RKMK4 step of a general robot vs NumPy tableau on the reference", "step_rkmk4_general_robot",
               lambda i: STEPPERS["rkmk4"](general.accel, general.params["r"], X[i], U[i], step_dt), 1e-10)
     if "lqr_control" in result:
-        from ..verification.lqr_law import numpy_law
+        from ..control.lqr_law import numpy_law
         controller, target = lqr_controller(model.params), lqr_target()
         g = controller.gains
-        check("C lqr_control vs the NumPy law (runtime.verification.lqr_law)", "lqr_control",
+        check("C lqr_control vs the NumPy law (runtime.control.lqr_law)", "lqr_control",
               lambda i: numpy_law(controller.schedule, model.params.r, X[i], target, np.zeros(2), None,
                                   controller.period, controller.u_max, g.kappa_rate, g.integral_zone_m)[1], 1e-10)
     if "casadi_generated_reference_accel" in result:

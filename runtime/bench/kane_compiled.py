@@ -1,4 +1,4 @@
-"""The Kane model compiled, as a user of each tool would ship it (issue 17, item 5): the strongest
+"""The Kane model compiled, as a user of each tool would ship it: the strongest
 baselines of their kind, C against C and Python call against Python call.
 
 C, each a function `int NAME(const double qw[12], const double u[2], const double p[12], double a[5])`

@@ -74,7 +74,7 @@ def per_call_ns(fn, calls, min_seconds=0.1, rounds=7):
     """Best of `rounds` timings of a Python loop over `calls` (list of argument tuples), each
     lasting at least `min_seconds`.  Many short rounds, like the C loop's 11, so that a host
     busy for a moment slows some rounds and not the best one; a host busy for seconds still
-    shows (2026-11-23: the Kane call read 66 us with three 0.5 s rounds, 71 us with seven
+    shows (the Kane call read 66 us with three 0.5 s rounds, 71 us with seven
     0.2 s rounds, against 47-49 us when quiet), which flatters our ratios, never theirs."""
     return min(_round_ns(fn, calls, min_seconds) for _ in range(rounds))
 

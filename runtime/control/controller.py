@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-#: Default torque limit [N m]: the low end of the paper's 0.5–2 N m (issue #20).
+#: Default torque limit [N m]: the low end of the paper's 0.5–2 N m.
 DEFAULT_U_MAX = 0.5
 #: A torque within this fraction of u_max counts as saturated: clipped (PID, LQR) or held at its
 #: bound by the optimiser (NMPC, whose QP returns the bound to rounding).

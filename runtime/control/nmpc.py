@@ -1,4 +1,4 @@
-"""NMPC on the full non-linear model, built on the model as CasADi (issue #20).
+"""NMPC on the full non-linear model, built on the model as CasADi.
 
 The model.  The reduced error coordinates of runtime/control/lqr_design.py (the yoke's attitude
 error E = Log(Q_refᵀ Q) on SO(3), the pendulum, the rates in the yoke's frame, the cross-track

@@ -4,7 +4,7 @@
     task = load_task("circle")            # a shipped name (runtime/control/tasks/), or a path
     controller, reference = task.controller(), task.reference()
 
-The scenario part is validated by runtime/scenarios/scenario.py (`parse_scenario`); every bad
+The scenario part is validated by runtime/scenario.py (`parse_scenario`); every bad
 value here raises ValueError("<file>: <section>.<key>: <what is wrong>").
 """
 import dataclasses
@@ -17,7 +17,8 @@ import numpy as np
 
 from ..params import NAMES as PARAM_NAMES
 from ..params import PAPER_NAMES, SHAPES
-from ..scenarios.scenario import parse_scenario
+from ..scenario import parse_scenario
+from ..schema import check_table
 from .closed_loop import Noise
 from .controller import DEFAULT_U_MAX
 from .geometry import heading
@@ -31,7 +32,7 @@ from .pid import GAIN_NAMES, Pid, PidGains
 from .reference import KINDS, SpeedHeading, circle_path, figure8_path, line_path, waypoints_path
 from ..state import IDX_Q
 
-#: Controller kinds of issue #20: (class, its settings, the settings' names).
+#: Controller kinds: (class, its settings, the settings' names).
 AVAILABLE_CONTROLLERS = {"pid": (Pid, PidGains, GAIN_NAMES), "lqr": (Lqr, LqrGains, LQR_GAIN_NAMES),
                          "nmpc": (Nmpc, NmpcGains, NMPC_GAIN_NAMES)}
 CONTROLLER_KINDS = tuple(AVAILABLE_CONTROLLERS)
@@ -56,7 +57,7 @@ class ControllerSpec:
 class Task:
     name: str
     source: str
-    scenario: object            # runtime.scenarios.scenario.Scenario: the controller's model and x0
+    scenario: object            # runtime.scenario.Scenario: the controller's model and x0
     reference_spec: dict
     controllers: tuple          # ControllerSpec, one per kind; the first is the task's default
     plant_params: object        # runtime.Params of the simulated robot
@@ -135,13 +136,7 @@ def load_task(name_or_path):
 
 
 def parse_task(data, source="<task>", name="task"):
-    if not isinstance(data, dict):
-        raise ValueError(f"{source}: expected a table")
-    sections = {"reference", "controller", "plant", "estimator"}
-    unknown = sorted(set(data) - _SCENARIO_KEYS - sections)
-    if unknown:
-        raise ValueError(f"{source}: unknown key(s) {', '.join(map(repr, unknown))}; allowed: "
-                         f"{', '.join(sorted(_SCENARIO_KEYS | sections))}")
+    check_table(data, _SCENARIO_KEYS | {"reference", "controller", "plant", "estimator"}, source)
     scenario = parse_scenario({k: v for k, v in data.items() if k in _SCENARIO_KEYS}, source, name)
     reference = _parse_reference(data.get("reference"), source)
     tables = data.get("controller")
@@ -164,21 +159,11 @@ def parse_task(data, source="<task>", name="task"):
 
 def _parse_estimator(table, source):
     where = f"{source}: estimator"
-    _table(table, where, {"kind", *ESTIMATOR_SETTINGS})
+    check_table(table, {"kind", *ESTIMATOR_SETTINGS}, where)
     if table.get("kind") != "ekf":
         raise ValueError(f"{where}.kind: expected \"ekf\", got {table.get('kind')!r}")
     return EkfSettings(**{k: _real(v, f"{where}.{k}", positive=k != "rate", nonnegative=k == "rate")
                           for k, v in table.items() if k != "kind"})
-
-
-def _table(value, where, allowed):
-    if not isinstance(value, dict):
-        raise ValueError(f"{where}: expected a table, got {type(value).__name__} {value!r}")
-    unknown = sorted(set(value) - set(allowed))
-    if unknown:
-        raise ValueError(f"{where}: unknown key(s) {', '.join(map(repr, unknown))}; allowed: "
-                         f"{', '.join(sorted(allowed))}")
-    return value
 
 
 def _real(value, where, positive=False, nonnegative=False):
@@ -197,7 +182,7 @@ def _parse_reference(table, source):
     where = f"{source}: reference"
     if table is None:
         raise ValueError(f"{where}: missing (required): give kind = one of {', '.join(KINDS)}")
-    _table(table, where, _REFERENCE_KEYS)
+    check_table(table, _REFERENCE_KEYS, where)
     kind = table.get("kind")
     if kind not in KINDS:
         raise ValueError(f"{where}.kind: expected one of {', '.join(KINDS)}, got {kind!r}")
@@ -232,7 +217,7 @@ def _parse_controller(table, source, name="controller"):
     if kind not in CONTROLLER_KINDS:
         raise ValueError(f"{where}.kind: expected one of {', '.join(CONTROLLER_KINDS)}, got {kind!r}")
     _, gains_cls, gain_names = AVAILABLE_CONTROLLERS[kind]
-    _table(table, where, {"kind", "rate", "u_max", *gain_names})
+    check_table(table, {"kind", "rate", "u_max", *gain_names}, where)
     rate = _real(table.get("rate", 50.0), f"{where}.rate", positive=True)
     u_max = _real(table.get("u_max", DEFAULT_U_MAX), f"{where}.u_max", positive=True)
     try:
@@ -247,7 +232,7 @@ def _parse_controller(table, source, name="controller"):
 
 def _parse_plant(table, params, source):
     where = f"{source}: plant"
-    _table(table, where, set(PARAM_NAMES) | set(PAPER_NAMES) | set(_NOISE_KEYS))
+    check_table(table, set(PARAM_NAMES) | set(PAPER_NAMES) | set(_NOISE_KEYS), where)
     overrides = {k: (_real(v, f"{where}.{k}") if SHAPES.get(k, ()) == () else v)
                  for k, v in table.items() if k not in _NOISE_KEYS}
     try:

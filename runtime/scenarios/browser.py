@@ -79,7 +79,7 @@ def console_errors(driver):
 
 def screenshot(page, target, width=1280, height=1560):
     """Save a PNG of `page` as a user first sees it, one moment into the run (frame at a third of it)."""
-    from .atomic import atomic_path
+    from ..atomic import atomic_path
 
     with open_replay(page, width, height) as driver:
         driver.execute_script("const s = document.getElementById('time');"

@@ -27,7 +27,7 @@ import sys
 from . import report
 from ..errors import KernelError, SimulationStopped
 from .parallel import RunBar, write_runs
-from .scenario import PAPER_SCENARIOS, load_scenario, run_scenario, scenario_path, shipped_scenarios
+from ..scenario import PAPER_SCENARIOS, load_scenario, run_scenario, scenario_path, shipped_scenarios
 
 
 def build_parser():
@@ -131,7 +131,3 @@ def main(argv):
               file=sys.stderr)
         return 2
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

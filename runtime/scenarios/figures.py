@@ -13,7 +13,7 @@ import tempfile
 
 from . import browser, plots
 from .replay import write_replay
-from .scenario import PAPER_SCENARIOS, load_scenario, run_scenario
+from ..scenario import PAPER_SCENARIOS, load_scenario, run_scenario
 
 DEFAULT_OUT = pathlib.Path(__file__).resolve().parents[2] / "docs" / "figures"
 
@@ -43,7 +43,3 @@ def main(argv):
         browser.screenshot(page, target)
     print(target)
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

@@ -4,7 +4,7 @@ The centre's path on the plane (start marked with an open circle), the
 relative inclinations θ_Y (yoke relative to the shell) and θ_P (pendulum
 relative to the yoke), the absolute inclinations (yoke plane normal and
 pendulum shaft against the vertical) and the energy.  Each function takes a
-`ScenarioResult` (runtime/scenarios/scenario.py) and returns a figure;
+`ScenarioResult` (runtime/scenario.py) and returns a figure;
 `save_figure` writes it atomically.
 """
 import matplotlib
@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
 
 from ..state import IDX_Q, absolute_inclinations, pendulum_angle, yoke_angle  # noqa: E402
-from .atomic import atomic_path  # noqa: E402
+from ..atomic import atomic_path  # noqa: E402
 
 FIGURE_DPI = 100
 

@@ -39,7 +39,3 @@ def main(argv):
         print("error: no browser could be started; open the page above by hand", file=sys.stderr)
         return 2
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

@@ -19,7 +19,7 @@ import sys
 
 from ..errors import SimulationStopped
 from ..model import Model
-from ..scenarios.atomic import write_text
+from ..atomic import write_text
 from ..state import IDX_Q
 from .runner import CONNECT_TIMEOUT, SERIAL, run_sweep, scheduler_address
 from .spec import MAX_SAMPLES, load_sweep, shipped_sweeps

@@ -36,7 +36,8 @@ import numpy as np
 from bindings._sr import lib
 
 from ..params import PAPER_NAMES, Params, paper_rows_to_params
-from ..scenarios.scenario import Scenario, load_scenario
+from ..schema import check_table
+from ..scenario import Scenario, load_scenario
 from ..state import IDX_QZ, IDX_RP, IDX_RY, IDX_WP, IDX_WY, IDX_UP, IDX_UY, pendulum_angle, rot_x, rot_y, yoke_angle
 
 #: A sweep varies parameters by the paper's names (r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P,
@@ -126,7 +127,7 @@ def load_sweep(name_or_path):
 
 def parse_sweep(data, source="<sweep>", name="sweep", folder=None):
     """Validate the table `data` (as read by tomllib) into a `SweepSpec`."""
-    _check_keys(data, _TOP_KEYS, source)
+    check_table(data, _TOP_KEYS, source)
     description = data.get("description", "")
     if not isinstance(description, str):
         raise ValueError(f"{source}: description: expected a string, got {description!r}")
@@ -150,7 +151,7 @@ def parse_sweep(data, source="<sweep>", name="sweep", folder=None):
     groups = {"params": PARAM_KEYS, "initial": INITIAL_KEYS, "torque": TORQUE_KEYS}
     for group, allowed in groups.items():
         table = data.get(group, {})
-        _check_keys(table, set(allowed), f"{source}: {group}")
+        check_table(table, set(allowed), f"{source}: {group}")
         for key, spec in table.items():
             quantities.append(_quantity(f"{group}.{key}", spec, f"{source}: {group}.{key}"))
     _check_param_names(data.get("params", {}), scenario, f"{source}: params")
@@ -178,7 +179,7 @@ def _check_param_names(table, scenario, where):
 def _quantity(name, table, where):
     if not isinstance(table, dict):
         raise ValueError(f"{where}: expected a table with one of {', '.join(_KINDS)}, got {table!r}")
-    _check_keys(table, set(_KINDS) | {"relative"}, where)
+    check_table(table, set(_KINDS) | {"relative"}, where)
     kinds = [k for k in _KINDS if k in table]
     if len(kinds) != 1:
         raise ValueError(f"{where}: give exactly one of {', '.join(_KINDS)}, got {kinds or 'none'}")
@@ -224,15 +225,6 @@ def _check_grid_values(spec, source):
                         Params.from_array(values)
                 except ValueError as exc:
                     raise ValueError(f"{source}: {q.name}.values: {v:g} gives invalid parameters ({exc})") from None
-
-
-def _check_keys(table, allowed, where):
-    if not isinstance(table, dict):
-        raise ValueError(f"{where}: expected a table, got {table!r}")
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise ValueError(f"{where}: unknown key{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))}; "
-                         f"allowed: {', '.join(sorted(allowed))}")
 
 
 def _count(value, where):

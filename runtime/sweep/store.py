@@ -26,7 +26,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from ..scenarios.atomic import atomic_path, write_text
+from ..atomic import atomic_path, write_text
 from .spec import MAX_SAMPLES, quantity_values
 from .task import column_names
 

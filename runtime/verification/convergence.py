@@ -21,7 +21,6 @@ ODE, with the rotations projected before every call of Model.accel).
 import argparse
 import json
 import pathlib
-import sys
 import time
 
 import numpy as np
@@ -265,7 +264,3 @@ def main(argv):
         (root / "docs" / "convergence.md").write_text(md)
     log(f"wrote {out}/convergence.png, convergence.md, convergence.json")
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

@@ -1,6 +1,6 @@
 """Evidence for docs/errata.md: each printed formula against its corrected form, at random states.
 
-`python -m runtime.verification.errata [--states N] [--seed S]` prints a markdown table: for
+`python -m runtime errata [--states N] [--seed S]` prints a markdown table: for
 every erratum, the worst relative error against the kernel (and, where it
 exists, the independent CasADi reference) with the printed form and with the
 corrected one.
@@ -80,7 +80,7 @@ def evidence(n_states=200, seed=0):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m runtime.verification.errata", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m runtime errata", description=__doc__.splitlines()[0])
     parser.add_argument("--states", type=int, default=200)
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
@@ -90,7 +90,3 @@ def main(argv=None):
         cells = ["—" if v is None else f"{v:.2e}" for v in (printed, corrected)]
         print(f"| {equation} | {quantity} | {cells[0]} | {cells[1]} |")
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

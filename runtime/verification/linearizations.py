@@ -1,4 +1,4 @@
-"""Rows of `make verify` for the linearisations of runtime/control/stability.py (issue 19).
+"""Rows of `make verify` for the linearisations of runtime/stability.py.
 
 * Eigenvalues at the equilibria (pendulum down and up): `linearize` against the same error
   dynamics with the accel Jacobian replaced by CasADi AD of the independent reference.
@@ -11,7 +11,7 @@ Each check takes the function under test as an argument, so a test can perturb i
 """
 import numpy as np
 
-from ..control import stability
+from .. import stability
 from ..model import Model
 from ..params import Params
 from ..state import IDX_E_NU

@@ -52,7 +52,7 @@ def random_centre(rng, radius):
 
 
 def random_general_params(rng):
-    """A robot of issue 18 with every feature: off-centre masses, full tensors, geared rotors, a slope."""
+    """A general robot with every feature: off-centre masses, full tensors, geared rotors, a slope."""
     r = rng.uniform(0.1, 0.6)
     m_S, m_Y, m_P = rng.uniform(0.5, 5, size=3)
     return Params(r=r, m_S=m_S, j_S=rng.uniform(0.3, 0.7) * m_S * r**2, k_S=rng.uniform(0, 0.3),

@@ -16,7 +16,6 @@ Exit status 0, or 1 if a guard stopped a run.
 """
 import argparse
 import json
-import sys
 import time
 
 import numpy as np
@@ -103,7 +102,3 @@ def main(argv):
         with open(args.json, "w", encoding="utf-8") as f:
             json.dump(total, f, indent=2)
     return 1 if failed else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

@@ -97,7 +97,7 @@ def cross_check(n_states=1000, seed=0, n_param_sets=6):
 
 
 def general_cross_check(n_states=200, seed=6, n_robots=5):
-    """The general kernels (issue 18) on random general robots against both independent models:
+    """The general kernels on random general robots against both independent models:
     the CasADi reference (accel, inertia, energy) and the Kane model (accel)."""
     from .alternatives.kane import KaneModel
     from .reference import ReferenceModel
@@ -130,7 +130,7 @@ def general_cross_check(n_states=200, seed=6, n_robots=5):
 # -- physics invariants ------------------------------------------------------------------
 def energy_conservation(n_runs=3, seed=1, t_end=20.0, general=False):
     """Energy along motions without damping or torque: the paper's robot, or (general=True) random
-    general robots of issue 18 on their slopes (the climb's potential m_R g_x q_x included)."""
+    general robots on their slopes (the climb's potential m_R g_x q_x included)."""
     rng = np.random.default_rng(seed)
     worst = (0.0, 0.0)
     for _ in range(n_runs):

@@ -13,7 +13,7 @@ from runtime.control.reference import Target
 from runtime.model import Model
 from runtime.params import Params
 from runtime.state import initial_state
-from runtime.verification.lqr_law import numpy_law
+from runtime.control.lqr_law import numpy_law
 
 PARAMS = Params.paper_simulation()
 RATE, U_MAX = 50.0, 0.5

@@ -22,14 +22,15 @@ import tomllib
 
 import numpy as np
 
-from .. import model as _model_module
-from ..errors import SimulationStopped
-from ..model import Model
-from ..params import NAMES as PARAM_NAMES
-from ..params import PAPER_NAMES, SHAPES, Params
-from ..so3 import rot_x, rot_y
-from ..state import IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NU, NX
-from ..validation import ROTATION_TOL, describe_state
+from . import model as _model_module
+from .errors import SimulationStopped
+from .model import Model
+from .params import NAMES as PARAM_NAMES
+from .params import PAPER_NAMES, SHAPES, Params
+from .so3 import rot_x, rot_y
+from .state import IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NU, NX
+from .schema import check_table, show
+from .validation import ROTATION_TOL, describe_state
 
 #: The paper's simulations in the order of Section 5.3 (`run all` runs them in this order).
 PAPER_SCENARIOS = ("tilted-pendulum", "tilted-yoke", "t-shape")
@@ -165,10 +166,10 @@ def load_scenario(name_or_path):
 
 def parse_scenario(data, source="<scenario>", name="scenario"):
     """Validate the table `data` (as read by tomllib) into a `Scenario`; `source` prefixes every error."""
-    _check_table(data, _TOP_KEYS, source)
+    check_table(data, _TOP_KEYS, source)
     description = data.get("description", "")
     if not isinstance(description, str):
-        raise ValueError(f"{source}: description: expected a string, got {_show(description)}")
+        raise ValueError(f"{source}: description: expected a string, got {show(description)}")
     params = _parse_params(data.get("params", {}), source)
     dt = _positive_real(_require(data, "dt", source), f"{source}: dt")
     if ("steps" in data) == ("duration" in data):
@@ -196,12 +197,12 @@ def _parse_params(table, source):
     """The robot: a preset (or a `robot` file, relative to the scenario's), then changes by the
     paper's names or the general ones (`Params.with_changes`); c_* as [x, y, z], J_* as 3x3 lists."""
     where = f"{source}: params"
-    _check_table(table, {"preset", "robot"} | set(PARAM_NAMES) | set(PAPER_NAMES), where)
+    check_table(table, {"preset", "robot"} | set(PARAM_NAMES) | set(PAPER_NAMES), where)
     if "preset" in table and "robot" in table:
         raise ValueError(f"{where}: give a preset or a robot file, not both")
     preset = table.get("preset", "paper")
     if preset not in PRESETS:
-        raise ValueError(f"{where}.preset: unknown preset {_show(preset)}; choose one of {sorted(PRESETS)}")
+        raise ValueError(f"{where}.preset: unknown preset {show(preset)}; choose one of {sorted(PRESETS)}")
     changes = {key: (_real(value, f"{where}.{key}") if SHAPES.get(key, ()) == () else value)
                for key, value in table.items() if key not in ("preset", "robot")}
     try:
@@ -216,7 +217,7 @@ def _parse_params(table, source):
 def _load_robot(path, source):
     """A robot file: a TOML table of general parameters (missing ones: the paper's robot's)."""
     if not isinstance(path, str):
-        raise ValueError(f"robot: expected a file name, got {_show(path)}")
+        raise ValueError(f"robot: expected a file name, got {show(path)}")
     full = pathlib.Path(source).parent / path
     try:
         table = tomllib.loads(full.read_text())
@@ -234,7 +235,7 @@ def _load_robot(path, source):
 
 def _parse_initial(table, params, source):
     where = f"{source}: initial"
-    _check_table(table, _INITIAL_KEYS, where)
+    check_table(table, _INITIAL_KEYS, where)
     for angle, matrix in (("theta_Y", "R_Y"), ("theta_P", "R_P")):
         if angle in table and matrix in table:
             raise ValueError(f"{where}: {angle}, {matrix}: give the angle or the matrix, not both")
@@ -257,13 +258,13 @@ def _parse_initial(table, params, source):
 
 def _parse_torques(windows, dt, steps, source):
     if not isinstance(windows, list):
-        raise ValueError(f"{source}: torque: expected an array of tables ([[torque]]), got {_show(windows)}")
+        raise ValueError(f"{source}: torque: expected an array of tables ([[torque]]), got {show(windows)}")
     parsed = []
     for i, table in enumerate(windows, start=1):
         where = f"{source}: torque[{i}]"
         if not isinstance(table, dict):
-            raise ValueError(f"{where}: expected a table, got {_show(table)}")
-        _check_table(table, _TORQUE_KEYS, where)
+            raise ValueError(f"{where}: expected a table, got {show(table)}")
+        check_table(table, _TORQUE_KEYS, where)
         by_step = {"from_step", "to_step"} & table.keys()
         by_time = {"from_time", "to_time"} & table.keys()
         if by_step and by_time:
@@ -295,20 +296,6 @@ def _parse_torques(windows, dt, steps, source):
 
 
 # -- value checks (each names the key it checks) ----------------------------------------------
-def _show(value):
-    text = repr(value)
-    return f"{type(value).__name__} {text if len(text) <= 60 else text[:57] + '...'}"
-
-
-def _check_table(table, allowed, where):
-    if not isinstance(table, dict):
-        raise ValueError(f"{where}: expected a table, got {_show(table)}")
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise ValueError(f"{where}: unknown key{'s' if len(unknown) > 1 else ''} "
-                         f"{', '.join(map(repr, unknown))}; allowed: {', '.join(sorted(allowed))}")
-
-
 def _require(table, key, where):
     if key not in table:
         raise ValueError(f"{where}: {key}: missing (required)")
@@ -317,7 +304,7 @@ def _require(table, key, where):
 
 def _real(value, where):
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(f"{where}: expected a number, got {_show(value)}")
+        raise ValueError(f"{where}: expected a number, got {show(value)}")
     if not math.isfinite(value):
         raise ValueError(f"{where}: must be finite, got {value!r}")
     return float(value)
@@ -332,7 +319,7 @@ def _positive_real(value, where):
 
 def _step_count(value, where):
     if isinstance(value, bool) or not isinstance(value, int):
-        raise ValueError(f"{where}: expected a whole number, got {_show(value)}")
+        raise ValueError(f"{where}: expected a whole number, got {show(value)}")
     if value < 1:
         raise ValueError(f"{where}: must be >= 1, got {value}")
     if value > MAX_STEPS:
@@ -354,13 +341,13 @@ def _whole_steps(duration, dt, where):
 def _method_name(value, where):
     methods = _model_module.METHODS      # looked up now: integrators may be registered after import
     if value not in methods:
-        raise ValueError(f"{where}: unknown integrator {_show(value)}; choose one of {sorted(methods)}")
+        raise ValueError(f"{where}: unknown integrator {show(value)}; choose one of {sorted(methods)}")
     return value
 
 
 def _vector(value, n, where):
     if not isinstance(value, list) or len(value) != n:
-        raise ValueError(f"{where}: expected a list of {n} numbers, got {_show(value)}")
+        raise ValueError(f"{where}: expected a list of {n} numbers, got {show(value)}")
     return np.array([_real(v, f"{where}[{i}]") for i, v in enumerate(value)])
 
 
@@ -370,7 +357,7 @@ def _rotation(table, key, where, axis):
     value = table.get(key, [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
     if not (isinstance(value, list) and len(value) == 3 and all(isinstance(row, list) and len(row) == 3
                                                                  for row in value)):
-        raise ValueError(f"{where}: expected a 3×3 matrix as a list of 3 rows of 3 numbers, got {_show(value)}")
+        raise ValueError(f"{where}: expected a 3×3 matrix as a list of 3 rows of 3 numbers, got {show(value)}")
     R = np.array([[_real(v, f"{where}[{i}][{j}]") for j, v in enumerate(row)] for i, row in enumerate(value)])
     if axis is not None:               # the kernels' rule: row and column `axis` exactly e_axis
         name = "xy"[axis]

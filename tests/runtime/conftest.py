@@ -1,7 +1,7 @@
-"""Fixtures shared by the scenario tests."""
+"""Fixtures shared by the tests of runtime/scenario.py and of the scenario application."""
 import pytest
 
-from runtime.scenarios.scenario import load_scenario, run_scenario
+from runtime.scenario import load_scenario, run_scenario
 
 
 @pytest.fixture(scope="module")

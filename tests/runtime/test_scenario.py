@@ -1,4 +1,4 @@
-"""Scenario files (runtime/scenarios/scenario.py) and the paper's Section 5.3 statements on our data.
+"""Scenario files (runtime/scenario.py) and the paper's Section 5.3 statements on our data.
 
 The `results` fixture (the three shipped runs) is in conftest.py next to this file.  The physics checks read the raw trajectory and compute what they need from
 the rotation matrices themselves (inclinations, rolling angle), so they do not
@@ -12,7 +12,7 @@ import pytest
 
 from conftest import ROOT
 from runtime import Model, Params, initial_state
-from runtime.scenarios.scenario import load_scenario, parse_scenario, run_scenario, shipped_scenarios
+from runtime.scenario import load_scenario, parse_scenario, run_scenario, shipped_scenarios
 
 R = 0.3   # shell radius of the paper (Section 5.2)
 
@@ -227,7 +227,7 @@ theta_P = 0.5
     (VALID + "[[torque]]\nfrom_step = 1\nto_time = 2.0\nu_P = 1.0\n", "torque[1]", "not both"),
     (VALID + "[[torque]]\nfrom_time = 1.0\nu_P = 1.0\n", "torque[1]: to_time", "missing"),
     ("dt = 0.01\nsteps = \n", "", "not valid TOML"),
-    # issue 8: the kernels' rules, resource limits, windows that select nothing
+    # the kernels' rules, resource limits, windows that select nothing
     (VALID + "R_Y = [[1, 0, 1e-9], [0, 1, 0], [0, 0, 1]]\n", "initial.R_Y[0][2]", "must be exactly 0"),
     (VALID + "R_S = [[1, 0, 0], [0, 1, 0], [0, 0, 1.00001]]\n", "initial.R_S", "max |RᵀR − I| = 2e-05"),
     (VALID.replace("steps = 10", "steps = 100000000"), "steps", "MAX_STEPS"),
@@ -235,7 +235,7 @@ theta_P = 0.5
     (VALID + "[[torque]]\nfrom_time = 0.1\nto_time = 0.2\nu_P = 1.0\n", "torque[1].from_time", "past the end"),
     (VALID.replace('preset = "paper"', 'preset = "paper"\nr = 1e-200\nb = 1e-200\nh = 1e-200\nl = 1e-200'),
      "params", "Params.j_S: must be > 0"),
-    # issue 18: the general robot's values
+    # the general robot's values
     (VALID.replace('preset = "paper"', 'preset = "paper"\nJ_P = [[0.1, 0, 0], [0, 0.1, 0], [0, 0, 0.3]]'),
      "Params.J_P", "not a physical inertia tensor"),
     (VALID.replace('preset = "paper"', 'preset = "paper"\nJ_Y = [[0.2, 0.18, 0], [0.18, 0.2, 0], [0, 0, 0.3]]'),

@@ -7,7 +7,7 @@ neither torque was clipped the integrals advance (∫e_y only while |e_y| ≤ zo
 """
 import numpy as np
 
-from ..control import lqr_design as design
+from . import lqr_design as design
 
 
 def numpy_law(schedule, r, x, target, integrals, kappa_before, period, u_max, kappa_rate, zone):

@@ -1,8 +1,8 @@
-"""Linearisations people ask for (issue 19): eigenvalues at the equilibria, from `Model.linearize`,
+"""Linearisations: eigenvalues at the equilibria, from `Model.linearize`,
 and the Floquet exponents of steady straight rolling, from `Model.step_jacobian` (the error
 coordinates of runtime.group).
 
-    python -m runtime.control.stability [FIGURE]    # prints the tables, writes docs/figures/rolling-stability.png
+    python -m runtime stability [FIGURE]    # prints the tables, writes docs/figures/rolling-stability.png
 
 Steady straight rolling at speed v: the shell spins at ω = v/r about its x axis (the yoke's
 hinge, kept horizontal), the yoke turns back at ω_Y = −ω so that it keeps its attitude in the
@@ -28,13 +28,14 @@ the heading (rotation about the vertical), and, at rest, turning the shell about
 pendulum's hinge with the joint angle compensating (2 more; while rolling, 1: the phase along the
 motion).  `nontrivial` drops the eigenvalues within 1e-9 of zero.
 """
-import sys
+
+import argparse
 
 import numpy as np
 
-from ..model import Model
-from ..params import Params
-from ..state import IDX_E_TH_Y, IDX_RY, NE, initial_state
+from .model import Model
+from .params import Params
+from .state import IDX_E_TH_Y, IDX_RY, NE, initial_state
 
 SIN_ALPHA = IDX_RY.start + 7      # sin of the yoke's tilt, R_Y[2, 1]
 SPEEDS = np.linspace(0.0, 1.8, 37)   # m/s; above 1.84 m/s the paper's robot cannot hold steady rolling
@@ -127,6 +128,9 @@ def figure(model, out, speeds=SPEEDS):
 
 
 def main(argv=()):
+    parser = argparse.ArgumentParser(prog="python -m runtime stability")
+    parser.add_argument("figure", nargs="?", default="docs/figures/rolling-stability.png", help="where to write the figure")
+    args = parser.parse_args(list(argv))
     model = Model(Params.paper_simulation())
     np.set_printoptions(precision=4, suppress=True, linewidth=120)
     for pendulum in ("down", "up"):
@@ -135,10 +139,7 @@ def main(argv=()):
     for v, u_Y, ev in rolling_table(model, SPEEDS[::5]):
         top = ev[np.argmax(ev.real)]
         print(f"  {v:4.2f}  {u_Y:8.5f}  {top.real:8.4f}  {abs(top.imag):8.4f}")
-    out = argv[0] if argv else "docs/figures/rolling-stability.png"
+    out = args.figure
     figure(model, out)
     print(f"written: {out}")
-
-
-if __name__ == "__main__":
-    main(sys.argv[1:])
+    return 0

@@ -1,4 +1,4 @@
-"""`python -m runtime.sweep.bench` (`make sweep-bench`, run by `make bench`): what a sweep costs.
+"""`python -m runtime sweep-bench` (`make sweep-bench`, run by `make bench`): what a sweep costs.
 
 On the first N samples of the shipped sweep (t-shape, +-10 % in every mass and damping):
 
@@ -26,12 +26,12 @@ import tempfile
 import time
 
 from ..batch import simulate_many
-from ..bench.report import write_results
-from ..bench.timing import cpu_name
-from .runner import dask_client, run_sweep
-from .spec import load_sweep, sample_inputs
-from .store import RESULTS, SweepStore
-from .task import run_chunk
+from .report import write_results
+from .timing import cpu_name
+from ..sweep.runner import dask_client, run_sweep
+from ..sweep.spec import load_sweep, sample_inputs
+from ..sweep.store import RESULTS, SweepStore
+from ..sweep.task import run_chunk
 
 #: The sweep the numbers are for.
 SWEEP = "t-shape-uncertainty"
@@ -174,7 +174,7 @@ def format_report(result):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(prog="python -m runtime.sweep.bench", description=__doc__.split("\n\n")[0])
+    p = argparse.ArgumentParser(prog="python -m runtime sweep-bench", description=__doc__.split("\n\n")[0])
     p.add_argument("--samples", type=int, default=4000, help="samples of the shipped sweep (default 4000)")
     p.add_argument("--samples-per-task", type=int, default=250,
                    help="task size (default 250: 16 tasks of ~0.5 s; real sweeps size them to ~2 s)")
@@ -199,7 +199,3 @@ def main(argv=None):
     print(format_report(result))
     print(f"\nwritten: {write_results(result, args.out)}")
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

@@ -1,10 +1,10 @@
-"""runtime/control/stability.py: equilibria, steady rolling, Floquet exponents (the physics of these is
+"""runtime/stability.py: equilibria, steady rolling, Floquet exponents (the physics of these is
 checked in tests/runtime/verification/test_linearizations.py)."""
 import numpy as np
 import pytest
 
 from runtime import Model, Params
-from runtime.control import stability
+from runtime import stability
 
 
 @pytest.fixture(scope="module")
