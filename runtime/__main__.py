@@ -12,6 +12,7 @@ COMMANDS = {
     "sweep": ("runtime.sweep.cli", "many runs of a scenario with varied inputs, on Dask (results in Parquet)"),
     "control": ("runtime.control.benchmark", "closed-loop benchmark: every controller on every task (make control)"),
     "soak": ("runtime.verification.soak", "10^7 steps from random states: constraint and energy drift (not a unit test)"),
+    "firmware-table": ("runtime.control.firmware", "the firmware example's LQR gain table, generated/lqr_task.h (make generate)"),
 }
 
 
