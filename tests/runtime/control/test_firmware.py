@@ -102,3 +102,10 @@ def test_the_table_comparison_fails_for_a_gain_changed_beyond_the_tolerance(fres
     value = float(fresh_table[at + 5:end])
     changed = fresh_table[:at] + f"SR_C({value * (1 + 10 * RTOL) + 10 * ATOL!r})" + fresh_table[end + 1:]
     assert not same_table(changed, fresh_table)
+
+
+def test_the_dispatcher_command_writes_the_table(fresh_table, tmp_path, capsys):
+    from runtime.__main__ import main
+    out = tmp_path / "lqr_task.h"
+    assert main(["firmware-table", "--out", str(out)]) == 0
+    assert out.read_text() == fresh_table
