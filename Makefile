@@ -4,7 +4,7 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
-C_SOURCES := $(wildcard generated/*.c generated/*.h c/*.c c/*.h)
+C_SOURCES := $(wildcard generated/*.c generated/*.h c/include/*.h c/src/*.c c/src/*.h)
 
 .PHONY: install test run generate verify bench sweep-bench figures soak fuzz c-lib c-test clean control envelope
 
@@ -22,9 +22,13 @@ test: $(STAMP)
 run: $(STAMP)
 	$(PY) -m runtime run all --out out --force
 
+# The SymPy-emitted kernels (byte-reproducible), the extension rebuilt on them, then the firmware
+# example's gain table (generated/lqr_task.h: an LQR design through LAPACK, whose last bits vary
+# with the CPU; tests/runtime/control/test_firmware.py holds it to a fresh design within 1e-7).
 generate: $(STAMP)
 	$(PY) -m derive
 	$(PY) -m pip install --quiet --no-deps -e .
+	$(PY) -m runtime firmware-table --out generated/lqr_task.h
 
 verify: $(STAMP)
 	$(PY) -m runtime verify

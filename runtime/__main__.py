@@ -18,7 +18,7 @@ COMMANDS = {
     "stability": ("runtime.stability", "eigenvalues and Floquet exponents; writes docs/figures/rolling-stability.png"),
     "envelope": ("runtime.control.envelope", "what the torque limits allow (make envelope)"),
     "climbing": ("runtime.control.climbing", "the climbing limit on a slope; writes docs/figures/climbing-limit.png"),
-    "firmware-table": ("runtime.control.firmware", "the firmware example's LQR task header (c/examples/lqr_task.h)"),
+    "firmware-table": ("runtime.control.firmware", "the firmware example's LQR gain table, generated/lqr_task.h (make generate)"),
     "sweep-bench": ("runtime.bench.sweep", "what a sweep costs (make sweep-bench)"),
 }
 

@@ -42,12 +42,12 @@ def _compiler():
 
 
 #: How the timed programs build the library (portable: no -march; the AVX2 clones as the extension has them).
-LIBRARY_FLAGS = ["-std=c99", "-O3", "-DSR_CLONES", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c'}"]
+LIBRARY_FLAGS = ["-std=c99", "-O3", "-DSR_CLONES", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c' / 'include'}"]
 
 
 def _library_sources():
     """The generated and the hand-written C of the library."""
-    return [p for d in ("generated", "c") for p in sorted((ROOT / d).glob("*.c"))]
+    return [p for d in ("generated", "c/src") for p in sorted((ROOT / d).glob("*.c"))]
 
 
 def build_harness(build, native, with_casadi, kane=None):
@@ -73,14 +73,14 @@ def build_harness(build, native, with_casadi, kane=None):
 def step_anatomy(build, input_file, repeats):
     """Where a fourth-order step's time goes (bench/step_anatomy.c): the checked
     accel, four accels chained as a step's stages chain them, and the steps; then the same steps
-    with the dynamics replaced by a two-flop stub (the library's c/sr_steppers.c compiled into the
+    with the dynamics replaced by a two-flop stub (the library's c/src/sr_steppers.c compiled into the
     program with -DANATOMY_GLUE_ONLY), i.e. everything a step does but its four accelerations.
     Built with the C loop's LIBRARY_FLAGS; `input_file` is the C loop's input."""
     library = _library_sources()
     out = {}
     for name, extra, sources in (
             ("full", [], library),
-            ("glue_only", ["-DANATOMY_GLUE_ONLY"], [p for p in library if p.name != "sr_steppers.c"])):
+            ("glue_only", ["-DANATOMY_GLUE_ONLY", f"-I{ROOT / 'c' / 'src'}"], [p for p in library if p.name != "sr_steppers.c"])):
         exe = build / f"step_anatomy_{name}"
         subprocess.run([_compiler(), *LIBRARY_FLAGS, *extra, str(ROOT / "bench" / "step_anatomy.c"),
                         *map(str, sources), "-lm", "-o", str(exe)], check=True)

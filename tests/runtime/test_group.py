@@ -1,4 +1,4 @@
-"""x ⊕ d and y ⊖ x (runtime/group.py, c/sr_group.c): inverse of each other for every angle, with
+"""x ⊕ d and y ⊖ x (runtime/group.py, c/src/sr_group.c): inverse of each other for every angle, with
 the meaning of each block as runtime/group.py defines it, and bad input named."""
 import math
 

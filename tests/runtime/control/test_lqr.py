@@ -1,4 +1,4 @@
-"""The C controller `sr_lqr_control` (c/sr_control.c) against the law written out here in NumPy:
+"""The C controller `sr_lqr_control` (c/src/sr_control.c) against the law written out here in NumPy:
 error coordinates, interpolation of the schedule, clipping, anti-windup, the curvature's rate limit."""
 import dataclasses
 

@@ -1,6 +1,6 @@
-/* sr_checks.c -- the full state check (the cheap per-call checks are inline in sr_internal.h).
+/* sr_checks.c -- the full state check (the cheap per-call checks are inline in sr_checks.h).
  * Hand-written; see spherical_robot.h for the contract of every function. */
-#include "sr_internal.h" /* spherical_robot.h, math macros, shared helpers */
+#include "sr_checks.h"
 
 #include <stddef.h>
 
@@ -62,7 +62,7 @@ int sr_check_state_batch(const sr_model *model, long n, const sr_real *x, long *
 
 /* ---- the lanes form, for the batch calls --------------------------------------------------- */
 
-/* The tests of sr_check_state and of the kernels' cheap checks (checks() in sr_internal.h), one
+/* The tests of sr_check_state and of the kernels' cheap checks (checks() in sr_checks.h), one
  * lane per state of a block, without branches, so that the loop vectorises as sr_gen_accel_lanes
  * does.  ok[i] = 1 where the lane is clean, else 0: the scalar functions then decide, and name
  * what is wrong.  The form is stricter than the scalar tests, never looser: the defects of the

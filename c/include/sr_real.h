@@ -12,7 +12,7 @@
  *   SR_GEN_SIN, SR_GEN_COS
  *                     the sine and cosine of sr_real (sr_gen_general_constants
  *                     takes those of the slope, once per model): libm's in
- *                     double, the library's own in float (c/sr_trig.c: no
+ *                     double, the library's own in float (c/src/sr_trig.c: no
  *                     4 KB libm reduction in a firmware; -DSR_LIBM_TRIG for
  *                     libm's sinf and cosf).
  *   SR_GEN_PIVOT_TOL  relative pivot tolerance of the joint-first solve in
@@ -40,15 +40,15 @@
  *                     ifunc, outside the self-contained C99 of the library.
  *   SR_JACOBIAN_CLONES
  *                     the same before the definition of a fourth-order step
- *                     Jacobian (c/sr_step_jacobians.c), with GCC's flatten, so
+ *                     Jacobian (c/src/sr_step_jacobians.c), with GCC's flatten, so
  *                     that the file's helpers (rows of 12 columns: three AVX2
  *                     vectors) are inlined into, and compiled for, each clone.
  *   SR_GEN_OK, SR_GEN_NONFINITE, SR_GEN_SINGULAR
- *                     the kernels' status codes; c/sr_internal.h asserts
+ *                     the kernels' status codes; c/src/sr_math.h asserts
  *                     that they equal SR_OK, SR_ERR_NONFINITE and
  *                     SR_ERR_SINGULAR of the public API.
  *
- * Internal to the library: use the checked API of c/spherical_robot.h.
+ * Internal to the library: use the checked API of c/include/spherical_robot.h.
  */
 #ifndef SR_REAL_H
 #define SR_REAL_H
@@ -63,7 +63,7 @@ typedef float sr_real;
 #else
 #define SR_GEN_SIN sr_internal_sinf
 #define SR_GEN_COS sr_internal_cosf
-/* c/sr_trig.c (internal to the library). */
+/* c/src/sr_trig.c (internal to the library). */
 float sr_internal_sinf(float x);
 float sr_internal_cosf(float x);
 #endif

@@ -3,7 +3,9 @@
  * (sr_simulate_adaptive).  They call the steppers of sr_steppers.c and the state check of
  * sr_checks.c; nothing calls back into this file.
  * Hand-written; see spherical_robot.h for the contract of every function. */
-#include "sr_internal.h" /* spherical_robot.h, math macros, shared helpers */
+#include "sr_checks.h"
+#include "sr_kernels.h"
+#include "sr_steppers.h"
 
 #include <stddef.h>
 

@@ -22,7 +22,7 @@
  *                       q + th_q, nu + th_nu)                                   (act below).
  *
  * We store an element of g in 13 "tangent" numbers [th_S (3) | th_Y | th_P | th_q (3) | th_nu (5)]
- * (SR_T_S ... SR_NT in sr_internal.h).  Lie-Euler is x_new = x . exp(h f(x)).
+ * (SR_T_S ... SR_NT in sr_action.h).  Lie-Euler is x_new = x . exp(h f(x)).
  * Only the so(3) factor is non-abelian; on every other factor both methods reduce to the
  * classical RK4, with q and nu treated as stage variables like the rotations (so the whole
  * method, q included, is of order 4).  R_Y and R_P are advanced by exact one-axis rotations:
@@ -33,12 +33,15 @@
  * Right trivialisation.  For R(t) = R0 Exp([[theta(t)]]) to solve R' = R [[w]] we need
  *     theta' = dexp^{-1}_{-theta}(w) = w + 1/2 theta x w + c(|theta|) theta x (theta x w),
  *     c(t) = (1 - (t/2) cot(t/2)) / t^2 = 1/12 + t^2/720 + t^4/30240 + t^6/1209600 + ...
- * (dexpinv_series in sr_internal.h)
+ * (dexpinv_series in sr_so3.h)
  * (the inverse of the right Jacobian of SO(3)).  The left-action formulas of the literature
  * (y' = A(y) y, y1 = exp(...) y0) become ours for Z = R^T; in particular, in a product of
  * exponentials the factor applied first stands next to R0.
  */
-#include "sr_internal.h"
+#include "sr_checks.h"
+#include "sr_kernels.h"
+#include "sr_so3.h"
+#include "sr_steppers.h"
 
 #include <stddef.h>
 
@@ -75,7 +78,7 @@ int sr_internal_vector_field(const sr_model *model, const sr_real x[SR_NX], cons
 }
 
 /* out = x . exp(th1) . exp(th2), formed as x + increment (th2 may be NULL: one exponential);
- * comp as in act_increment (sr_internal.h).  On SO(3): R E1 E2 = R + R (D1 + D2 + D1 D2) with
+ * comp as in act_increment (sr_action.h).  On SO(3): R E1 E2 = R + R (D1 + D2 + D1 D2) with
  * D = E - I; the one-axis rotations and the vector parts add their arguments.  out may alias x. */
 static void advance(const sr_real x[SR_NX], const sr_real th1[SR_NT], const sr_real *th2, sr_real *comp,
                     sr_real out[SR_NX])
@@ -100,7 +103,7 @@ static void act(const sr_real x[SR_NX], const sr_real th[SR_NT], sr_real out[SR_
 }
 
 /* k = dexp^{-1}_{-th}(f): the so(3) block gets the closed form above (its series below
- * |th| = 1/4 rad, dexpinv_series of sr_internal.h); the abelian blocks are copied.  k may alias f. */
+ * |th| = 1/4 rad, dexpinv_series of sr_so3.h); the abelian blocks are copied.  k may alias f. */
 void sr_internal_dexpinv(const sr_real th[SR_NT], const sr_real f[SR_NT], sr_real k[SR_NT])
 {
     const sr_real *t = th + SR_T_S, *w = f + SR_T_S;

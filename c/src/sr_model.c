@@ -1,6 +1,7 @@
 /* sr_model.c -- status strings, the parameter rules and the model's initialisation.
  * Hand-written; see spherical_robot.h for the contract of every function. */
-#include "sr_internal.h" /* spherical_robot.h, math macros, shared helpers */
+#include "sr_checks.h"
+#include "sr_kernels.h"
 
 #include <stddef.h>
 

@@ -1,7 +1,7 @@
 /* sr_batch.c -- many robots in one call: sr_simulate_batch (see spherical_robot.h).
  * Built on the public API only (sr_model_init, sr_simulate_guarded, sr_energy), so that each
  * sample is exactly the run a caller would make alone, chunk for chunk. */
-#include "sr_internal.h" /* spherical_robot.h, math macros */
+#include "sr_math.h"
 
 #include <stddef.h>
 

@@ -6,7 +6,7 @@
         are identical, bit for bit (both built with -ffp-contract=off).  Otherwise the number of
         differing entries and the largest relative difference (relative to the larger of the two
         values and of the column's largest magnitude over the run) are printed, with whether it
-        is within RELATIVE_TOL, the tolerance issue #22 allows for contraction; it still fails.
+        is within RELATIVE_TOL, the tolerance allowed for contraction; it still fails.
     compare_runs.py double-libm HOST.csv TARGET.csv
         the same, for a program whose results pass through functions that newlib and glibc round
         differently (the closed loop: atan2 in the controller's Log and pendulum angle, sin and cos
@@ -24,8 +24,8 @@ holds, 1 otherwise.
 import math
 import sys
 
-RELATIVE_TOL = 1e-12   # issue #22: double identical, or within 1e-12 relative for contraction
-Q_TOL = 1e-4           # issue #22: float t-shape after 10 s within 1e-4 m of the host float build
+RELATIVE_TOL = 1e-12   # double identical, or within 1e-12 relative for contraction
+Q_TOL = 1e-4           # float t-shape after 10 s within 1e-4 m of the host float build
 T_CHECK = 10.0         # [s]
 Q_COLUMNS = slice(28, 31)  # t, R_S (9), R_Y (9), R_P (9), then q
 

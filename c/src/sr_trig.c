@@ -1,5 +1,5 @@
 /*
- * sr_trig.c -- single-precision sine and cosine of the float build (issue 22: flash).
+ * sr_trig.c -- single-precision sine and cosine of the float build (for flash).
  *
  * Why: newlib's sinf and cosf carry a Payne-Hanek argument reduction and its 2/pi table for
  * arguments up to FLT_MAX: 4.3 KB of flash, more than the paper-geometry kernels and a Lie-Euler
@@ -18,7 +18,7 @@
  *     SR_ERR_NONFINITE (an angle of 2^24 rad in one step is no motion a valid state makes).
  * -DSR_LIBM_TRIG uses libm's sinf and cosf instead.  The double build always uses libm.
  */
-#include "sr_internal.h"
+#include "sr_math.h"
 
 #if defined(SR_USE_FLOAT) && !defined(SR_LIBM_TRIG)
 

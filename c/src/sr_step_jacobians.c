@@ -1,10 +1,10 @@
 /*
- * sr_step_jacobians.c -- the Jacobians F, G of one RKMK4 or CF4 step in the error coordinates
- * (issue 19): step(x (+) d, u + w) (-) step(x, u) = F d + G w + O(2), the exact derivatives of
- * the maps of c/sr_steppers.c as they are implemented (stage by stage, dexp^-1 differentiated).
+ * sr_step_jacobians.c -- the Jacobians F, G of one RKMK4 or CF4 step in the error coordinates:
+ * step(x (+) d, u + w) (-) step(x, u) = F d + G w + O(2), the exact derivatives of
+ * the maps of sr_steppers.c as they are implemented (stage by stage, dexp^-1 differentiated).
  *
  * Every quantity of a step carries its derivative with respect to (d, w): a matrix of
- * NC columns (see below).  The rules, for the action y = x . exp(th) of c/sr_steppers.c:
+ * NC columns (see below).  The rules, for the action y = x . exp(th) of c/src/sr_steppers.c:
  *   y (-) y0 = A(th) (x (-) x0) + B(th) dth,   A = diag(Exp(th_S)^T, 1, 1, I_2, I_5),
  *                                              B = diag(Jr(th_S), 1, 1, [I_2 0], I_5)
  * (the right Jacobian Jr of SO(3); q_z does not move); for the vector field f of
@@ -14,7 +14,10 @@
  * on the SO(3) block: dk = (I + [th]/2 + c [th]^2) df + (-[f]/2 + c ((th.f) I + th f^T - 2 f th^T)
  * + 2 c'(|th|^2) (th x (th x f)) th^T) dth.
  */
-#include "sr_internal.h"
+#include "sr_finite.h"
+#include "sr_jacobians.h"
+#include "sr_so3.h"
+#include "sr_steppers.h"
 
 #include <string.h>
 
@@ -33,7 +36,7 @@ typedef sr_real tangent[SR_NT][NC];   /* d(13-vector)/d(d, w), carried columns *
 typedef sr_real error[SR_NE][NC];     /* d(state error)/d(d, w), carried columns */
 
 /* c(s) of dexp^-1 (s = |th|^2) and its derivative dc/ds: the closed form of sr_internal_dexpinv,
- * with the same series below s = SR_SERIES_T2 (sr_internal.h). */
+ * with the same series below s = SR_SERIES_T2 (sr_so3.h). */
 static void dexpinv_coefficient(sr_real s, sr_real *c, sr_real *dc)
 {
     if (s < SR_SERIES_T2) {
@@ -115,11 +118,10 @@ static void dexpinv_and_derivatives(const sr_real th[SR_NT], const sr_real f[SR_
  * A stage's rows that the dynamics reads, dy_read (xi_S, th_Y, th_P and nu: SR_J_READ rows of NC
  * columns; nothing depends on q), are formed once; the accelerations' rows are then Ja dy_read + [0 | Jb]
  * from sr_internal_accel_jacobian_along, which for the paper's robot applies the yoke frame's chain
- * rule to dy_read and never forms the shell-frame Ja.  Measured on an AMD EPYC (Zen 4), RKMK4:
- * 1.81 us with the shell-frame Ja pulled through A(th) and B(th) row by row (until 2026-11-25),
- * 1.74 us so.  The column loops hold one product per statement (mul_rows): GCC 12 vectorises those,
- * and left a sum of two products per statement scalar.  With the rest of that day's changes (README,
- * "Benchmarks"): RKMK4 and CF4 1.45 us, 5.9x accel_jacobian.  GCC's code for the flattened clones
+ * rule to dy_read and never forms the shell-frame Ja: on an AMD EPYC (Zen 4) the RKMK4 step Jacobian
+ * takes 1.74 us so, 1.81 us with the shell-frame Ja pulled through A(th) and B(th) row by row.  The
+ * column loops hold one product per statement (mul_rows): GCC 12 vectorises those, and leaves a sum
+ * of two products per statement scalar.  GCC's code for the flattened clones
  * moves by +-30 ns with unrelated edits in this file: time a change in interleaved runs. */
 enum { NREAD = SR_J_READ };
 typedef char nc_matches[(NC == SR_J_NC && SR_E_th_Y == 3 && SR_E_th_P == 4 && SR_E_q == 5) ? 1 : -1];

@@ -1,14 +1,14 @@
 #!/usr/bin/env python3
 """Code size and worst-case stack of every public function of the C library.
 
-    python3 c/tools/size_report.py                      # print the Markdown tables
-    python3 c/tools/size_report.py --update docs/embedding.md
-    python3 c/tools/size_report.py --cc arm-none-eabi-gcc --cflags "-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16"
+    python3 tools/size_report.py                      # print the Markdown tables
+    python3 tools/size_report.py --update docs/embedding.md
+    python3 tools/size_report.py --cc arm-none-eabi-gcc --cflags "-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp-d16"
 
 (also `make size-report` in c/).  Standard library only; needs GCC >= 10 and
 binutils' nm.  A documentation tool: the library itself builds without Python.
 
-Method.  Every library source (generated/*.c, c/*.c) is compiled at -Os and at
+Method.  Every library source (generated/*.c, c/src/*.c) is compiled at -Os and at
 -O2, for double and for float, with
 
     -ffunction-sections -fstack-usage -fcallgraph-info=su
@@ -38,9 +38,10 @@ import subprocess
 import sys
 import tempfile
 
-C_DIR = pathlib.Path(__file__).resolve().parent.parent
-ROOT = C_DIR.parent
-HEADER = C_DIR / "spherical_robot.h"
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+C_DIR = ROOT / "c"
+INCLUDE = C_DIR / "include"
+HEADER = INCLUDE / "spherical_robot.h"
 BEGIN, END = "<!-- size-report:begin -->", "<!-- size-report:end -->"
 
 Node = collections.namedtuple("Node", "title symbol obj frame qualifier")
@@ -53,7 +54,7 @@ def public_functions():
 
 
 def sources():
-    return sorted((ROOT / "generated").glob("*.c")) + sorted(C_DIR.glob("*.c"))
+    return sorted((ROOT / "generated").glob("*.c")) + sorted((C_DIR / "src").glob("*.c"))
 
 
 def compile_variant(cc, cflags, opt, use_float, out_dir):
@@ -62,7 +63,7 @@ def compile_variant(cc, cflags, opt, use_float, out_dir):
     for src in sources():
         obj = out_dir / (src.stem + ".o")
         cmd = [cc, "-std=c99", opt, "-ffp-contract=off", "-ffunction-sections", "-fstack-usage",
-               "-fcallgraph-info=su", f"-I{C_DIR}", f"-I{ROOT / 'generated'}", *cflags, "-c", str(src),
+               "-fcallgraph-info=su", f"-I{INCLUDE}", f"-I{ROOT / 'generated'}", *cflags, "-c", str(src),
                "-o", str(obj)]
         if use_float:
             cmd.insert(1, "-DSR_USE_FLOAT")

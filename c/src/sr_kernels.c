@@ -1,6 +1,8 @@
 /* sr_kernels.c -- the checked wrappers of the generated kernels, and the SO(3) exponential.
  * Hand-written; see spherical_robot.h for the contract of every function. */
-#include "sr_internal.h" /* spherical_robot.h, math macros, shared helpers */
+#include "sr_checks.h"
+#include "sr_kernels.h"
+#include "sr_so3.h"
 
 #include <stddef.h>
 #include <string.h>

@@ -1,9 +1,10 @@
 /*
- * sr_control.c -- the firmware controller: LQR gain-scheduled on speed and curvature (issue 20).
+ * sr_control.c -- the firmware controller: LQR gain-scheduled on speed and curvature.
  * The law, its coordinates and its design are described in spherical_robot.h and
  * docs/control.md; the schedule comes from runtime/control/lqr_design.py.
  */
-#include "sr_internal.h"
+#include "sr_checks.h"
+#include "sr_so3.h"
 
 #include <string.h>
 

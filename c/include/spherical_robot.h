@@ -5,9 +5,9 @@
  * robot, actuated by a yoke-pendulum system, rolling over a flat surface
  * without slipping".  The equations are derived symbolically in derive/ and
  * emitted to generated/sr_generated.c; this header and the hand-written c/sr_*.c add
- * input checks, the SO(3) exponential and the time steppers (c/sr_model.c: status strings,
- * parameter rules, model; c/sr_checks.c: state checks; c/sr_kernels.c: the checked kernels;
- * c/sr_steppers.c: every stepper; c/sr_drivers.c: the simulation loops).
+ * input checks, the SO(3) exponential and the time steppers (c/src/sr_model.c: status strings,
+ * parameter rules, model; c/src/sr_checks.c: state checks; c/src/sr_kernels.c: the checked kernels;
+ * c/src/sr_steppers.c: every stepper; c/src/sr_drivers.c: the simulation loops).
  *
  * Self-contained C99: no dynamic allocation, no mutable globals, every
  * function is re-entrant, every buffer is provided by the caller, every
@@ -16,7 +16,7 @@
  * Scalar type: sr_real is double, or float when compiled with -DSR_USE_FLOAT.
  *
  * Units and frames (SI throughout):
- *   params  [SR_NPARAM] = the robot (issue 18; index of each: SR_P_r ... SR_P_slope in
+ *   params  [SR_NPARAM] = the robot (index of each: SR_P_r ... SR_P_slope in
  *           sr_generated.h):
  *           r shell radius [m], m_S shell mass [kg], j_S its isotropic inertia [kg m^2],
  *           m_Y yoke mass, c_Y (c_Y_x, c_Y_y, c_Y_z) its centre of mass [m] in the yoke
@@ -119,7 +119,7 @@ extern "C" {
 
 /* Time-stepping methods. */
 #define SR_LIE_EULER 0         /* the paper's eq. (111), first order */
-/* Fourth-order Lie-group methods (c/sr_steppers.c).  Both advance the state on
+/* Fourth-order Lie-group methods (c/src/sr_steppers.c).  Both advance the state on
  * SO(3) x SO(2)_x x SO(2)_y x R^3 x R^5: R_S by right multiplication with Exp of an so(3)
  * element, R_Y and R_P by exact rotations about x and y, q and nu additively.  The torque u
  * is held constant over the step; q is a stage variable like every other (order 4 overall).
@@ -273,7 +273,7 @@ int sr_step_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[S
 
 /* sr_step on n states of one robot (x n x SR_NX, u n x SR_NU or NULL, x_next n x SR_NX; x_next may
  * equal x, and must not overlap it otherwise), for particle filters, sampling-based controllers
- * and Monte Carlo over initial states (issue 21; c/sr_step_batch.c).  Every row gets exactly the
+ * and Monte Carlo over initial states (c/src/sr_step_batch.c).  Every row gets exactly the
  * bits and the status code sr_step gives it; the call stops at the first failing row (its index
  * in *failed_row, -1 when all succeed) and writes no row after it.  For SR_LIE_EULER, SR_RKMK4 and
  * SR_CF4 and a robot of the paper's geometry it is vectorised across the states (16 at a time, in
@@ -355,7 +355,7 @@ int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[SR_
                          long n_out, const sr_real *u, sr_real rtol, sr_real atol, sr_real h_init,
                          long max_steps, sr_real *traj, sr_adaptive_stats *stats);
 
-/* ---- Many robots in one call (c/sr_batch.c) ---------------------------------------------- */
+/* ---- Many robots in one call (c/src/sr_batch.c) ---------------------------------------------- */
 #ifdef SR_USE_FLOAT
 #define sr_simulate_batch sr_simulate_batch_f
 #endif
@@ -399,7 +399,7 @@ int sr_simulate_batch(int method, long n, const sr_real *params, long params_str
                       sr_real energy_tol, long chunk_steps, sr_real *work, sr_real *traj,
                       sr_real *x_final, sr_real *metrics, int *status, long *steps_done);
 
-/* ---- The state on its group: error coordinates (c/sr_group.c) ------------------------------ */
+/* ---- The state on its group: error coordinates (c/src/sr_group.c) ------------------------------ */
 #ifdef SR_USE_FLOAT
 #define sr_retract sr_retract_f
 #define sr_local sr_local_f
@@ -407,7 +407,7 @@ int sr_simulate_batch(int method, long n, const sr_real *params, long params_str
 #define sr_local_batch sr_local_batch_f
 #endif
 
-/* The error state d[SR_NE] = 12 entries (issue 19; offsets SR_E_* of sr_generated.h), the
+/* The error state d[SR_NE] = 12 entries (offsets SR_E_* of sr_generated.h), the
  * right-trivialised tangent coordinates in which every Jacobian of this library is expressed:
  *   d[SR_E_xi_S + 0..2]  shell rotation vector, R_S <- R_S Exp([[d]])          [rad]
  *   d[SR_E_th_Y]         yoke angle, R_Y <- R_Y Exp(d Sigma_Y)                  [rad]
@@ -432,7 +432,7 @@ int sr_retract_batch(const sr_model *model, long n, const sr_real *x, const sr_r
 int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_real *y, sr_real *d,
                    long *failed_row);
 
-/* ---- Derivatives of the dynamics (c/sr_jacobians.c) ------------------------------------------ */
+/* ---- Derivatives of the dynamics (c/src/sr_jacobians.c) ------------------------------------------ */
 #ifdef SR_USE_FLOAT
 #define sr_accel_jacobian sr_accel_jacobian_f
 #define sr_accel_jacobian_batch sr_accel_jacobian_batch_f
@@ -476,8 +476,8 @@ int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], co
 int sr_step_jacobian_lie_euler_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real dt,
                                      sr_real *F, sr_real *G, long *failed_row);
 
-/* The same for one RKMK4 and one CF4 step (c/sr_step_jacobians.c): the exact derivatives of the
- * steps of c/sr_steppers.c, stage by stage (an accel Jacobian at each of the four stage states,
+/* The same for one RKMK4 and one CF4 step (c/src/sr_step_jacobians.c): the exact derivatives of the
+ * steps of c/src/sr_steppers.c, stage by stage (an accel Jacobian at each of the four stage states,
  * dexp^-1 differentiated for RKMK4); checks, status codes and outputs as
  * sr_step_jacobian_lie_euler.  Built with -DSR_CLONES on x86-64 (GCC, glibc), each is compiled
  * for AVX2 too and the loader picks (SR_JACOBIAN_CLONES, sr_real.h). */
@@ -494,7 +494,7 @@ int sr_step_jacobian(const sr_model *model, int method, const sr_real x[SR_NX], 
 int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u, sr_real dt,
                            sr_real *F, sr_real *G, long *failed_row);
 
-/* ---- The firmware controller: LQR gain-scheduled on speed and curvature (c/sr_control.c) ----
+/* ---- The firmware controller: LQR gain-scheduled on speed and curvature (c/src/sr_control.c) ----
  *
  * Issue 20.  The controller acts through the two motor torques only.  It measures the state
  * against a reference that rolls at speed v_ref along the heading psi_ref (the heading to hold,

@@ -1,14 +1,15 @@
 /*
- * sr_step_batch.c -- one step of many states of one robot (issue 21): sr_step_batch.  Every method
+ * sr_step_batch.c -- one step of many states of one robot: sr_step_batch.  Every method
  * is vectorised across the states, like the batch accel (sr_kernels.c, docs/sweeps.md): a block of
  * states at a time goes through the lanes of the state check, the accelerations
- * (sr_gen_accel_lanes) and the steppers (c/sr_step_lanes.c), and any state those do not clear goes
+ * (sr_gen_accel_lanes) and the steppers (c/src/sr_step_lanes.c), and any state those do not clear goes
  * through sr_step itself.  So every row gets exactly the bits and the status code that sr_step
  * gives it alone, and the rows after a failing one are not written.  A general robot, and the
  * projected methods, go row by row.
  * Hand-written C99; see spherical_robot.h for the contract.
  */
-#include "sr_internal.h"
+#include "sr_checks.h"
+#include "sr_lanes.h"
 
 #include <stddef.h>
 

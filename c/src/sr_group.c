@@ -1,10 +1,11 @@
 /*
  * sr_group.c -- the state as a point of the group SO(3) x SO(2)_x x SO(2)_y x R^2 x R^5 and its
  * tangent (error) coordinates: x (+) d (sr_retract) and y (-) x (sr_local), right-trivialised
- * (issue 19, as in manif and SymForce).  The Jacobians of the dynamics and of the steps are
+ * (as in manif and SymForce).  The Jacobians of the dynamics and of the steps are
  * expressed in these coordinates, so they are the contract between them and their users.
  */
-#include "sr_internal.h"
+#include "sr_checks.h"
+#include "sr_so3.h"
 
 #include <string.h>
 

@@ -1,6 +1,6 @@
 /*
  * sr_step_lanes.c -- the steppers of sr_steppers.c in lanes form, for sr_step_batch
- * (c/sr_step_batch.c, issue 21): loops over the states of a block, one lane per state, without
+ * (sr_step_batch.c): loops over the states of a block, one lane per state, without
  * branches or inner loops, that the compiler vectorises across the states from plain C99 (at -O3;
  * SR_LANES_CLONES adds AVX2).  Each computes the same expressions in the same order as the scalar
  * code, so a lane's result is the scalar step's bit for bit wherever the scalar code takes the
@@ -12,9 +12,12 @@
  * GCC propagated the caller's constant strides into them and did not vectorise them.
  * Hand-written C99.
  */
-#include "sr_internal.h"
+#include "sr_finite.h"
+#include "sr_lanes.h"
+#include "sr_so3.h"
+#include "sr_steppers.h"
 
-/* sin(t)/t and (1 - cos t)/t^2 by the series of sr_internal.h, whose range the caller tests. */
+/* sin(t)/t and (1 - cos t)/t^2 by the series of sr_so3.h, whose range the caller tests. */
 #define SINC(t2) sinc_series(t2)
 #define COSC(t2) cosc_series(t2)
 

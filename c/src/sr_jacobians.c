@@ -1,11 +1,14 @@
 /*
- * sr_jacobians.c -- derivatives of the dynamics in the error coordinates of c/sr_group.c
- * (issue 19).  The generated kernels give M, f, df, df/du and dM (derive/derivatives.py): for a
+ * sr_jacobians.c -- derivatives of the dynamics in the error coordinates of sr_group.c.
+ * The generated kernels give M, f, df, df/du and dM (derive/derivatives.py): for a
  * general robot in the shell frame, for the paper's in the yoke frame (a third of the operations);
  * one factorisation of M (joints first for the paper's geometry, Cholesky for a general robot)
  * serves the accelerations and every column: d(nu') = M^-1 (df - (dM) nu').
  */
-#include "sr_internal.h"
+#include "sr_checks.h"
+#include "sr_jacobians.h"
+#include "sr_kernels.h"
+#include "sr_so3.h"
 
 #include <string.h>
 
@@ -191,14 +194,14 @@ int sr_internal_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], co
     return model->general ? general_accel_jacobian(model, x, u, a, Ja, Jb) : paper_accel_jacobian(model, x, u, a, Ja, Jb);
 }
 
-/* out = Ja V on the read rows (see sr_internal.h), the paper's robot: the chain rule of
+/* out = Ja V on the read rows (see sr_jacobians.h), the paper's robot: the chain rule of
  * paper_accel_jacobian applied to the directions V instead of to the unit ones, so that the
  * shell-frame Ja is never formed.  With z the yoke frame's directions (d_xi', d_th_P, d_nu'),
  *   z_xi' = R_Y^T V_xi + e_x V_th_Y,   z_th_P = V_th_P,
  *   z_w'  = R_Y^T V_w + (w' x e_x) V_th_Y,   z_w_Y, z_w_P = V_w_Y, V_w_P,
  * and out = T^T (G z) + R_Y (e_x x g_S) V_th_Y, G = M'^-1 (df' - (dM') g) as there.  Its first lines,
  * up to G, repeat paper_accel_jacobian's on purpose: the same lines as one helper of both, inlined,
- * made the RKMK4 and CF4 step Jacobians 0.1 us slower with GCC 12 (2026-11-25, AMD EPYC Zen 4). */
+ * makes the RKMK4 and CF4 step Jacobians 0.1 us slower with GCC 12 (AMD EPYC Zen 4). */
 static int paper_accel_jacobian_along(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                                       const sr_real V[SR_J_READ][SR_J_NC], sr_real acc[SR_NV],
                                       sr_real out[SR_NV][SR_J_NC], sr_real jb[SR_NV * SR_NU])
