@@ -24,6 +24,7 @@ RESULTS = ROOT / "bench" / "results"
 
 
 def main(argv=None):
+    """`python -m runtime bench`: parse the arguments, run the benchmarks, write and print the report."""
     parser = argparse.ArgumentParser(prog="python -m runtime bench", description="Benchmarks against the alternatives.")
     parser.add_argument("--states", type=int, default=1024, help="states in the C loop (<= 4096)")
     parser.add_argument("--repeats", type=int, default=200, help="sweeps over the states per timing")
@@ -60,6 +61,8 @@ def main(argv=None):
 
 
 def run(args, core, progress):
+    """Runs every benchmark of `args` (pinned to `core`, reporting through `progress`) and returns the
+    result dict."""
     rng = np.random.default_rng(0)
     params = Params.paper_simulation()
     model = Model(params)

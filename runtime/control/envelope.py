@@ -118,6 +118,7 @@ def tightest_turn(rows, leans, u_max):
 
 
 def main(argv=()):
+    """Prints the envelope's numbers and rewrites its figure (docs/control.md)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

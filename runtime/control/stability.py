@@ -48,6 +48,8 @@ def equilibrium(params, pendulum="down"):
 
 
 def rolling_state(params, speed, alpha):
+    """The state of steady rolling at `speed` [m/s], the shell spinning about its x axis, the yoke at angle
+    `alpha` [rad]."""
     w = speed / params.r
     return initial_state(theta_Y=alpha, w_S=(w, 0.0, 0.0), w_Y=-w, r=params.r)
 
@@ -76,6 +78,7 @@ def eigenvalues(model, x, u=None):
 
 
 def nontrivial(ev, tol=1e-9):
+    """The eigenvalues `ev` larger in modulus than `tol` (drops the zeros of the symmetries)."""
     return ev[np.abs(ev) > tol]
 
 
@@ -108,6 +111,7 @@ def rolling_table(model, speeds=SPEEDS):
 
 
 def figure(model, out, speeds=SPEEDS):
+    """Draws the Floquet exponents of steady rolling against speed and saves the figure to `out`."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -127,6 +131,7 @@ def figure(model, out, speeds=SPEEDS):
 
 
 def main(argv=()):
+    """Prints the eigenvalues of the equilibria and the Floquet exponents of steady rolling."""
     model = Model(Params.paper_simulation())
     np.set_printoptions(precision=4, suppress=True, linewidth=120)
     for pendulum in ("down", "up"):

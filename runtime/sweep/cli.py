@@ -23,6 +23,7 @@ from .summary import percentile_table, write_summary_figure
 
 
 def build_parser():
+    """The argument parser of `python -m runtime sweep`."""
     p = argparse.ArgumentParser(prog="python -m runtime sweep", description=__doc__.split("\n\n")[1])
     p.add_argument("sweep", help=f"a shipped sweep ({', '.join(shipped_sweeps())}) or a sweep file")
     p.add_argument("--out", required=True, help="output folder (resumed if it holds this sweep)")
@@ -45,6 +46,7 @@ def nominal_end_point(spec):
 
 
 def main(argv):
+    """`python -m runtime sweep`: run (or resume) a sweep and write its store and summary."""
     args = build_parser().parse_args(argv)
     try:
         spec = load_sweep(args.sweep)

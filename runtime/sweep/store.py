@@ -66,6 +66,7 @@ class SweepStore:
         return [(a, min(a + k, n)) for a in range(0, n, k)]
 
     def chunk_path(self, start, stop):
+        """The Parquet file of the samples start .. stop-1."""
         return self.folder / CHUNKS / f"part-{start:010d}-{stop:010d}.parquet"
 
     def missing(self):
@@ -73,6 +74,7 @@ class SweepStore:
         return [c for c in self.chunks() if not self.chunk_path(*c).is_file()]
 
     def write_chunk(self, start, stop, columns):
+        """Writes the columns of the samples start .. stop-1 to their Parquet file, atomically."""
         with atomic_path(self.chunk_path(start, stop)) as tmp:
             pq.write_table(pa.table(columns), tmp)
 
