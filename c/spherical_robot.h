@@ -16,7 +16,7 @@
  * Scalar type: sr_real is double, or float when compiled with -DSR_USE_FLOAT.
  *
  * Units and frames (SI throughout):
- *   params  [SR_NPARAM] = the robot (issue 18; index of each: SR_P_r ... SR_P_slope in
+ *   params  [SR_NPARAM] = the robot (index of each: SR_P_r ... SR_P_slope in
  *           sr_generated.h):
  *           r shell radius [m], m_S shell mass [kg], j_S its isotropic inertia [kg m^2],
  *           m_Y yoke mass, c_Y (c_Y_x, c_Y_y, c_Y_z) its centre of mass [m] in the yoke
@@ -92,8 +92,9 @@ extern "C" {
 #define SR_NV SR_GEN_NV         /**< generalized velocities (nu) and accelerations */
 #define SR_NE SR_GEN_NE         /**< entries of an error state (d): the tangent coordinates */
 
-/** Status codes. */
-#define SR_OK 0
+/** @name Status codes */
+/** @{ */
+#define SR_OK 0                /**< success */
 #define SR_ERR_NULL 1          /**< a required pointer is NULL */
 #define SR_ERR_NONFINITE 2     /**< an input is NaN or infinite, or a result overflowed (outputs are
                                   finite whenever a function returns SR_OK) */
@@ -106,6 +107,7 @@ extern "C" {
 #define SR_ERR_MAX_STEPS 9     /**< adaptive stepping: more than max_steps step attempts */
 #define SR_ERR_ENERGY 10       /**< sr_simulate_guarded: the energy rose without input power beyond the
                                   guard's tolerance (see sr_energy_guard) */
+/** @} */
 
 /** Tolerance on |R^T R - I| (entry-wise) and |det R - 1| accepted by the checks. */
 #ifdef SR_USE_FLOAT
@@ -118,8 +120,9 @@ extern "C" {
  * SR_GUARD_INTERVAL steps and after the last step; finiteness is checked after every step. */
 #define SR_GUARD_INTERVAL 16
 
-/** Time-stepping methods. */
-#define SR_LIE_EULER 0         /**< the paper's eq. (111), first order */
+/** @name Time-stepping methods */
+/** @{ */
+#define SR_LIE_EULER 0         /**< the paper's equation (111), first order */
 /** Fourth-order Lie-group methods (c/sr_steppers.c).  Both advance the state on
  * SO(3) x SO(2)_x x SO(2)_y x R^3 x R^5: R_S by right multiplication with Exp of an so(3)
  * element, R_Y and R_P by exact rotations about x and y, q and nu additively.  The torque u
@@ -131,12 +134,13 @@ extern "C" {
 #define SR_CF4 2               /**< commutator-free method of Celledoni-Marthinsen-Owren (2003):
                                   4 stages, no dexp^-1, the update a product of 2 exponentials;
                                   4 acceleration evaluations and 5 SO(3) exponentials per step */
-#define SR_PROJECT 16          /**< flag, OR-ed into any method (e.g. SR_RKMK4 | SR_PROJECT): after
+#define SR_PROJECT 16          /**< flag, OR-ed into any method (as in SR_RKMK4 | SR_PROJECT): after
                                   every step, one Newton-Schulz step R <- R (3I - R^T R)/2 pulls
                                   R_S (and the cos/sin pairs of R_Y, R_P) back to the rotations.
                                   Off by default: the methods need it only where rounding is
                                   biased, e.g. a robot at rest for ~10^5+ steps, whose tiny
                                   constant increments round the same way every step */
+/** @} */
 
 /** Model: the parameters and the constants derived from them. Fill with sr_model_init.
  * A robot of the paper's geometry (c_Y = 0, J_Y_zz = J_Y_xx + J_Y_yy, J_Y diagonal, c_P on
@@ -155,7 +159,9 @@ typedef struct sr_model {
 /** Human-readable name of a status code (static string, never NULL). */
 const char *sr_status_string(int status);
 
-/** The rules a parameter vector must obey, in the order sr_check_params tests them. */
+/** @name Parameter rules
+ * The rules a parameter vector must obey, in the order sr_check_params tests them. */
+/** @{ */
 #define SR_PARAM_RULE_NONE 0         /**< no rule broken */
 #define SR_PARAM_RULE_FINITE 1       /**< every parameter finite */
 #define SR_PARAM_RULE_POSITIVE 2     /**< general: r, m_S, j_S, m_Y, m_P > 0; paper: r, m_S, b, h, m_b, m_h, l, m_P > 0 */
@@ -164,10 +170,11 @@ const char *sr_status_string(int status);
 #define SR_PARAM_RULE_PENDULUM_FITS 5 /**< paper: l <= r */
 #define SR_PARAM_RULE_NONZERO 6      /**< general: gear ratios n_Y, n_P != 0 */
 #define SR_PARAM_RULE_INERTIA 7      /**< general: J_Y, J_P physical: tr(J)/2 I - J (the second
-                                        moment of the mass) positive semidefinite, i.e. J positive
+                                        moment of the mass) positive semidefinite, that is J positive
                                         semidefinite with the triangle inequalities */
 #define SR_PARAM_RULE_INSIDE 8       /**< general: centres of mass inside the shell, |c_Y|, |c_P| < r */
 #define SR_PARAM_RULE_SLOPE 9        /**< general: |slope| < pi/2 */
+/** @} */
 
 /** The one place that decides whether params are in their physical range (sr_model_init and
  * the Python runtime's Params call it).  Tests the rules above in order and, for the first
@@ -244,7 +251,7 @@ int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU]
 int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy);
 
 /** Generalized gravity torques at rest (f at nu = 0, u = 0) [N m]; zero exactly at the
- * equilibria R_S R_Y R_P e_z = +-e_z of eq. (108). */
+ * equilibria R_S R_Y R_P e_z = +-e_z of equation (108). */
 int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV]);
 
 /** R = Exp([[w]]) by Rodrigues' formula, with a series branch for |w| < 1e-4 rad.
@@ -276,7 +283,7 @@ int sr_step_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[S
 
 /** sr_step on n states of one robot (x n x SR_NX, u n x SR_NU or NULL, x_next n x SR_NX; x_next may
  * equal x, and must not overlap it otherwise), for particle filters, sampling-based controllers
- * and Monte Carlo over initial states (issue 21; c/sr_step_batch.c).  Every row gets exactly the
+ * and Monte Carlo over initial states (c/sr_step_batch.c).  Every row gets exactly the
  * bits and the status code sr_step gives it; the call stops at the first failing row (its index
  * in *failed_row, -1 when all succeed) and writes no row after it.  For SR_LIE_EULER, SR_RKMK4 and
  * SR_CF4 and a robot of the paper's geometry it is vectorised across the states (16 at a time, in
@@ -411,7 +418,7 @@ int sr_simulate_batch(int method, long n, const sr_real *params, long params_str
 #endif
 
 /** @{ */
-/** The error state d[SR_NE] = 12 entries (issue 19; offsets SR_E_* of sr_generated.h), the
+/** The error state d[SR_NE] = 12 entries (offsets SR_E_* of sr_generated.h), the
  * right-trivialised tangent coordinates in which every Jacobian of this library is expressed:
  *   d[SR_E_xi_S + 0..2]  shell rotation vector, R_S <- R_S Exp([[d]])          [rad]
  *   d[SR_E_th_Y]         yoke angle, R_Y <- R_Y Exp(d Sigma_Y)                  [rad]
@@ -507,7 +514,7 @@ int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_r
 
 /* ---- The firmware controller: LQR gain-scheduled on speed and curvature (c/sr_control.c) ----
  *
- * Issue 20.  The controller acts through the two motor torques only.  It measures the state
+ * The controller acts through the two motor torques only.  It measures the state
  * against a reference that rolls at speed v_ref along the heading psi_ref (the heading to hold,
  * or a path's tangent at the point nearest to the robot, with the path's curvature kappa and the
  * signed cross-track error e_y, left positive), in the error coordinates z[SR_LQR_NZ]:
@@ -547,7 +554,7 @@ int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_r
 #define sr_lqr_control sr_lqr_control_f
 #endif
 
-/** A gain schedule (read-only during control; fill it from the design, e.g. the header that
+/** A gain schedule (read-only during control; fill it from the design, such as the header that
  * `python -m runtime.control.lqr --emit-c` writes).  Point (i, j) of the grid, speed i and
  * curvature j, is entry i * n_curvatures + j of z_star, u_star, K_path and K_heading
  * (K row-major 2 x SR_LQR_NZ). */
