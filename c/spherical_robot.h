@@ -512,7 +512,7 @@ int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_r
                            sr_real *F, sr_real *G, long *failed_row);
 /** @} */
 
-/* ---- The firmware controller: LQR gain-scheduled on speed and curvature (c/sr_control.c) ----
+/** @name The firmware controller: LQR gain-scheduled on speed and curvature (c/sr_control.c)
  *
  * The controller acts through the two motor torques only.  It measures the state
  * against a reference that rolls at speed v_ref along the heading psi_ref (the heading to hold,
@@ -536,6 +536,7 @@ int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_r
  * torque was clipped (conditional anti-windup), and the cross-track integral only while
  * |e_y| <= integral_zone (a large initial offset, such as a line's, winds nothing up).  The curvature of the operating point follows
  * the reference's at most kappa_rate per second (a figure eight's switch of turn direction). */
+/** @{ */
 #define SR_LQR_NZ 12               /**< entries of the error coordinates z */
 #ifndef SR_LQR_MAX_SPEEDS
 #define SR_LQR_MAX_SPEEDS 6        /**< capacity of a schedule's speed grid (may be set at build time) */
@@ -613,6 +614,7 @@ int sr_lqr_error(const sr_model *model, const sr_real x[SR_NX], const sr_lqr_tar
 int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_NX],
                    const sr_lqr_target *target, sr_lqr_memory *memory, sr_real u[SR_NU],
                    sr_real u_raw[SR_NU]);
+/** @} */
 
 #ifdef __cplusplus
 }
