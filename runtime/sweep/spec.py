@@ -85,7 +85,8 @@ class SweepSpec:
         return math.prod(len(q.numbers) for q in self.grid)
 
     def with_samples(self, samples):
-        """The same sweep with another number of samples; ValueError unless it is a positive count."""
+        """The same sweep with another number of samples (ValueError unless a whole number from 1 to
+        MAX_SAMPLES)."""
         return dataclasses.replace(self, samples=_count(samples, "--samples"))
 
     def identity(self):
