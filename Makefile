@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 C_SOURCES := $(wildcard generated/*.c generated/*.h c/include/*.h c/src/*.c c/src/*.h)
 
-.PHONY: install test run generate verify bench sweep-bench figures soak fuzz c-lib c-test clean control envelope
+.PHONY: install test run generate verify bench sweep-bench figures soak fuzz c-lib c-test clean control envelope docs
 
 $(STAMP): pyproject.toml setup.py bindings/build_sr.py bindings/fastcall.c $(C_SOURCES)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -52,6 +52,16 @@ control: $(STAMP)
 # The envelope of docs/control.md (prints its numbers, rewrites docs/figures/control-envelope.png).
 envelope: $(STAMP)
 	$(PY) -m runtime envelope
+
+# The API reference (docs/api.md): pdoc over the Python package into out/docs/python/, Doxygen
+# over the public C header into out/docs/c/ (installed from Debian when missing and we are root).
+# A warning of either fails the build.
+docs: $(STAMP)
+	rm -rf out/docs
+	mkdir -p out/docs
+	$(PY) docs/build_python_api.py out/docs/python runtime
+	command -v doxygen >/dev/null || bash .ci/install-doxygen
+	doxygen docs/Doxyfile
 
 soak: $(STAMP)
 	$(PY) -m runtime soak

@@ -39,5 +39,6 @@ def atomic_path(target):
 
 
 def write_text(target, text):
+    """Writes `text` (UTF-8) to `target` atomically: readers see the old file or the whole new one."""
     with atomic_path(target) as tmp:
         tmp.write_text(text, encoding="utf-8")

@@ -79,6 +79,7 @@ class Scenario:
 
     @property
     def duration(self):
+        """The simulated time [s], steps * dt."""
         return self.steps * self.dt
 
     def with_overrides(self, dt=None, steps=None, method=None):

@@ -49,6 +49,8 @@ def equilibrium(params, pendulum="down"):
 
 
 def rolling_state(params, speed, alpha):
+    """The state of steady rolling at `speed` [m/s], the shell spinning about its x axis, the yoke at angle
+    `alpha` [rad]."""
     w = speed / params.r
     return initial_state(theta_Y=alpha, w_S=(w, 0.0, 0.0), w_Y=-w, r=params.r)
 
@@ -77,6 +79,7 @@ def eigenvalues(model, x, u=None):
 
 
 def nontrivial(ev, tol=1e-9):
+    """The eigenvalues `ev` larger in modulus than `tol` (drops the zeros of the symmetries)."""
     return ev[np.abs(ev) > tol]
 
 
@@ -109,6 +112,7 @@ def rolling_table(model, speeds=SPEEDS):
 
 
 def figure(model, out, speeds=SPEEDS):
+    """Draws the Floquet exponents of steady rolling against speed and saves the figure to `out`."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -128,6 +132,7 @@ def figure(model, out, speeds=SPEEDS):
 
 
 def main(argv=()):
+    """Prints the eigenvalues of the equilibria and the Floquet exponents of steady rolling."""
     parser = argparse.ArgumentParser(prog="python -m runtime stability")
     parser.add_argument("figure", nargs="?", default="docs/figures/rolling-stability.png", help="where to write the figure")
     args = parser.parse_args(list(argv))

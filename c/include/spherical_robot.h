@@ -1,4 +1,4 @@
-/*
+/**
  * spherical_robot.h -- public C API of the spherical-robot kernels.
  *
  * Model: S. Fiori (2024), "Lie-group modeling and simulation of a spherical
@@ -43,6 +43,7 @@
  *           x[34]     w_P, pendulum speed (R_P^T dR_P/dt = w_P Sigma_P) [rad/s]
  *   u       [SR_NU] = (yoke motor torque, pendulum motor torque) [N m]
  *   nu      [SR_NV] = (w_S, w_Y, w_P); accelerations are d(nu)/dt [rad/s^2]
+ * @file
  */
 #ifndef SPHERICAL_ROBOT_H
 #define SPHERICAL_ROBOT_H
@@ -84,60 +85,64 @@ extern "C" {
 #define sr_simulate_adaptive sr_simulate_adaptive_f
 #endif
 
-#define SR_NPARAM SR_GEN_NPARAM
-#define SR_NPAPER SR_GEN_NPAPER
-#define SR_NX SR_GEN_NX
-#define SR_NU SR_GEN_NU
-#define SR_NV SR_GEN_NV
-#define SR_NE SR_GEN_NE
+#define SR_NPARAM SR_GEN_NPARAM /**< entries of a parameter vector (params) */
+#define SR_NPAPER SR_GEN_NPAPER /**< the paper's parameters (paper) */
+#define SR_NX SR_GEN_NX         /**< entries of a state (x) */
+#define SR_NU SR_GEN_NU         /**< motor torques (u) */
+#define SR_NV SR_GEN_NV         /**< generalized velocities (nu) and accelerations */
+#define SR_NE SR_GEN_NE         /**< entries of an error state (d): the tangent coordinates */
 
-/* Status codes. */
-#define SR_OK 0
-#define SR_ERR_NULL 1          /* a required pointer is NULL */
-#define SR_ERR_NONFINITE 2     /* an input is NaN or infinite, or a result overflowed (outputs are
+/** @name Status codes */
+/** @{ */
+#define SR_OK 0                /**< success */
+#define SR_ERR_NULL 1          /**< a required pointer is NULL */
+#define SR_ERR_NONFINITE 2     /**< an input is NaN or infinite, or a result overflowed (outputs are
                                   finite whenever a function returns SR_OK) */
-#define SR_ERR_NOT_ROTATION 3  /* a rotation matrix is not orthonormal with det +1, R_Y is not about x or R_P not about y */
-#define SR_ERR_SINGULAR 4      /* the generalized inertia M is not positive definite */
-#define SR_ERR_PARAM 5         /* a parameter is out of its physical range */
-#define SR_ERR_ARG 6           /* another argument is invalid (dt <= 0, steps < 0, unknown method) */
-#define SR_ERR_CONSTRAINT 7    /* q_z differs from r by more than SR_ROTATION_TOL * r */
-#define SR_ERR_STEP_SIZE 8     /* adaptive stepping: the step size fell below the rounding level of t */
-#define SR_ERR_MAX_STEPS 9     /* adaptive stepping: more than max_steps step attempts */
-#define SR_ERR_ENERGY 10       /* sr_simulate_guarded: the energy rose without input power beyond the
+#define SR_ERR_NOT_ROTATION 3  /**< a rotation matrix is not orthonormal with det +1, R_Y is not about x or R_P not about y */
+#define SR_ERR_SINGULAR 4      /**< the generalized inertia M is not positive definite */
+#define SR_ERR_PARAM 5         /**< a parameter is out of its physical range */
+#define SR_ERR_ARG 6           /**< another argument is invalid (dt <= 0, steps < 0, unknown method) */
+#define SR_ERR_CONSTRAINT 7    /**< q_z differs from r by more than SR_ROTATION_TOL * r */
+#define SR_ERR_STEP_SIZE 8     /**< adaptive stepping: the step size fell below the rounding level of t */
+#define SR_ERR_MAX_STEPS 9     /**< adaptive stepping: more than max_steps step attempts */
+#define SR_ERR_ENERGY 10       /**< sr_simulate_guarded: the energy rose without input power beyond the
                                   guard's tolerance (see sr_energy_guard) */
+/** @} */
 
-/* Tolerance on |R^T R - I| (entry-wise) and |det R - 1| accepted by the checks. */
+/** Tolerance on |R^T R - I| (entry-wise) and |det R - 1| accepted by the checks. */
 #ifdef SR_USE_FLOAT
 #define SR_ROTATION_TOL SR_C(1e-3)
 #else
 #define SR_ROTATION_TOL SR_C(1e-6)
 #endif
 
-/* sr_simulate and sr_simulate_guarded check the whole state (sr_check_state) every
+/** sr_simulate and sr_simulate_guarded check the whole state (sr_check_state) every
  * SR_GUARD_INTERVAL steps and after the last step; finiteness is checked after every step. */
 #define SR_GUARD_INTERVAL 16
 
-/* Time-stepping methods. */
-#define SR_LIE_EULER 0         /* the paper's eq. (111), first order */
-/* Fourth-order Lie-group methods (c/src/sr_steppers.c).  Both advance the state on
+/** @name Time-stepping methods */
+/** @{ */
+#define SR_LIE_EULER 0         /**< the paper's equation (111), first order */
+/** Fourth-order Lie-group methods (c/src/sr_steppers.c).  Both advance the state on
  * SO(3) x SO(2)_x x SO(2)_y x R^3 x R^5: R_S by right multiplication with Exp of an so(3)
  * element, R_Y and R_P by exact rotations about x and y, q and nu additively.  The torque u
  * is held constant over the step; q is a stage variable like every other (order 4 overall).
  * Rotations stay orthonormal to rounding (no projection). */
-#define SR_RKMK4 1             /* Runge-Kutta-Munthe-Kaas: classical RK4 tableau in the Lie
+#define SR_RKMK4 1             /**< Runge-Kutta-Munthe-Kaas: classical RK4 tableau in the Lie
                                   algebra with the closed-form dexp^-1 of SO(3); 4 acceleration
                                   evaluations and 4 SO(3) exponentials per step */
-#define SR_CF4 2               /* commutator-free method of Celledoni-Marthinsen-Owren (2003):
+#define SR_CF4 2               /**< commutator-free method of Celledoni-Marthinsen-Owren (2003):
                                   4 stages, no dexp^-1, the update a product of 2 exponentials;
                                   4 acceleration evaluations and 5 SO(3) exponentials per step */
-#define SR_PROJECT 16          /* flag, OR-ed into any method (e.g. SR_RKMK4 | SR_PROJECT): after
+#define SR_PROJECT 16          /**< flag, OR-ed into any method (as in SR_RKMK4 | SR_PROJECT): after
                                   every step, one Newton-Schulz step R <- R (3I - R^T R)/2 pulls
                                   R_S (and the cos/sin pairs of R_Y, R_P) back to the rotations.
                                   Off by default: the methods need it only where rounding is
                                   biased, e.g. a robot at rest for ~10^5+ steps, whose tiny
                                   constant increments round the same way every step */
+/** @} */
 
-/* Model: the parameters and the constants derived from them. Fill with sr_model_init.
+/** Model: the parameters and the constants derived from them. Fill with sr_model_init.
  * A robot of the paper's geometry (c_Y = 0, J_Y_zz = J_Y_xx + J_Y_yy, J_Y diagonal, c_P on
  * the pendulum's z axis, J_P = diag(a, a, 0), no rotors, level floor) is evaluated by the
  * paper-geometry kernels (constants c, general = 0), any other by the general kernels
@@ -145,30 +150,33 @@ extern "C" {
  * has no general kernels (smaller firmware): sr_model_init refuses other robots (SR_ERR_PARAM).  Both give the same numbers for the
  * paper's robot, to rounding (tests/runtime/test_general_robot.py). */
 typedef struct sr_model {
-    sr_real p[SR_NPARAM];
-    int general;
-    sr_real c[SR_GEN_NCONST];
-    sr_real cg[SR_GEN_GENERAL_NCONST];
+    sr_real p[SR_NPARAM];                /**< the parameters, as given to sr_model_init */
+    int general;                         /**< 1: the general kernels (cg), 0: the paper-geometry ones (c) */
+    sr_real c[SR_GEN_NCONST];            /**< derived constants of the paper-geometry kernels */
+    sr_real cg[SR_GEN_GENERAL_NCONST];   /**< derived constants of the general kernels */
 } sr_model;
 
-/* Human-readable name of a status code (static string, never NULL). */
+/** Human-readable name of a status code (static string, never NULL). */
 const char *sr_status_string(int status);
 
-/* The rules a parameter vector must obey, in the order sr_check_params tests them. */
-#define SR_PARAM_RULE_NONE 0         /* no rule broken */
-#define SR_PARAM_RULE_FINITE 1       /* every parameter finite */
-#define SR_PARAM_RULE_POSITIVE 2     /* general: r, m_S, j_S, m_Y, m_P > 0; paper: r, m_S, b, h, m_b, m_h, l, m_P > 0 */
-#define SR_PARAM_RULE_NONNEGATIVE 3  /* k_S, k_Y, k_P, g >= 0; general also j_mY, j_mP >= 0 */
-#define SR_PARAM_RULE_YOKE_FITS 4    /* paper: yoke half-diagonal sqrt(b^2 + h^2)/2 <= r */
-#define SR_PARAM_RULE_PENDULUM_FITS 5 /* paper: l <= r */
-#define SR_PARAM_RULE_NONZERO 6      /* general: gear ratios n_Y, n_P != 0 */
-#define SR_PARAM_RULE_INERTIA 7      /* general: J_Y, J_P physical: tr(J)/2 I - J (the second
-                                        moment of the mass) positive semidefinite, i.e. J positive
+/** @name Parameter rules
+ * The rules a parameter vector must obey, in the order sr_check_params tests them. */
+/** @{ */
+#define SR_PARAM_RULE_NONE 0         /**< no rule broken */
+#define SR_PARAM_RULE_FINITE 1       /**< every parameter finite */
+#define SR_PARAM_RULE_POSITIVE 2     /**< general: r, m_S, j_S, m_Y, m_P > 0; paper: r, m_S, b, h, m_b, m_h, l, m_P > 0 */
+#define SR_PARAM_RULE_NONNEGATIVE 3  /**< k_S, k_Y, k_P, g >= 0; general also j_mY, j_mP >= 0 */
+#define SR_PARAM_RULE_YOKE_FITS 4    /**< paper: yoke half-diagonal sqrt(b^2 + h^2)/2 <= r */
+#define SR_PARAM_RULE_PENDULUM_FITS 5 /**< paper: l <= r */
+#define SR_PARAM_RULE_NONZERO 6      /**< general: gear ratios n_Y, n_P != 0 */
+#define SR_PARAM_RULE_INERTIA 7      /**< general: J_Y, J_P physical: tr(J)/2 I - J (the second
+                                        moment of the mass) positive semidefinite, that is J positive
                                         semidefinite with the triangle inequalities */
-#define SR_PARAM_RULE_INSIDE 8       /* general: centres of mass inside the shell, |c_Y|, |c_P| < r */
-#define SR_PARAM_RULE_SLOPE 9        /* general: |slope| < pi/2 */
+#define SR_PARAM_RULE_INSIDE 8       /**< general: centres of mass inside the shell, |c_Y|, |c_P| < r */
+#define SR_PARAM_RULE_SLOPE 9        /**< general: |slope| < pi/2 */
+/** @} */
 
-/* The one place that decides whether params are in their physical range (sr_model_init and
+/** The one place that decides whether params are in their physical range (sr_model_init and
  * the Python runtime's Params call it).  Tests the rules above in order and, for the first
  * one broken, writes its SR_PARAM_RULE_* code to *rule and the index (SR_P_*) of the first
  * parameter that breaks it to *bad_index (for a tensor, its J_*_xx; for a centre, its c_*_x);
@@ -176,25 +184,25 @@ const char *sr_status_string(int status);
  * Returns SR_OK, SR_ERR_NULL (params), SR_ERR_NONFINITE (rule FINITE) or SR_ERR_PARAM. */
 int sr_check_params(const sr_real params[SR_NPARAM], int *bad_index, int *rule);
 
-/* The same for the paper's twelve parameters (index SR_PAPER_*; the yoke rule reports
+/** The same for the paper's twelve parameters (index SR_PAPER_*; the yoke rule reports
  * SR_PAPER_b, the pendulum rule SR_PAPER_l). */
 int sr_check_paper_params(const sr_real paper[SR_NPAPER], int *bad_index, int *rule);
 
-/* The paper's robot (Section 2.3: a yoke of four uniform rods, a slender pendulum rod, a thin
+/** The paper's robot (Section 2.3: a yoke of four uniform rods, a slender pendulum rod, a thin
  * shell, massless motors, level floor) as params: checks paper (sr_check_paper_params) and
  * writes params.  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_PARAM. */
 int sr_paper_params(const sr_real paper[SR_NPAPER], sr_real params[SR_NPARAM]);
 
-/* The conversion of sr_paper_params without the paper's rules: for batch tools that hand each
+/** The conversion of sr_paper_params without the paper's rules: for batch tools that hand each
  * sample to sr_simulate_batch, whose sr_model_init then judges it (a negative rod mass gives a
  * negative m_Y, SR_ERR_PARAM for that sample alone).  Returns SR_OK, SR_ERR_NULL or
  * SR_ERR_NONFINITE (a result not finite; params untouched). */
 int sr_paper_params_unchecked(const sr_real paper[SR_NPAPER], sr_real params[SR_NPARAM]);
 
-/* The text of a rule of sr_check_params ("must be > 0", ...; static string, never NULL). */
+/** The text of a rule of sr_check_params ("must be > 0", ...; static string, never NULL). */
 const char *sr_param_rule_string(int rule);
 
-/* Validate params (sr_check_params) and fill *model, choosing the kernels (see sr_model).  The derived
+/** Validate params (sr_check_params) and fill *model, choosing the kernels (see sr_model).  The derived
  * constants, M and the energy at the reference state (R_S = R_Y = R_P = I, q = (0, 0, r), at
  * rest) must be finite (else SR_ERR_PARAM: a value so large that it overflows), and M there
  * positive definite (else SR_ERR_SINGULAR: values so small that the inertias underflow).
@@ -202,16 +210,16 @@ const char *sr_param_rule_string(int rule);
  * untouched on error. */
 int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM]);
 
-/* Full state check: finite entries, R_S orthonormal with det +1, R_Y a rotation
+/** Full state check: finite entries, R_S orthonormal with det +1, R_Y a rotation
  * about x, R_P a rotation about y (to SR_ROTATION_TOL), |q_z - r| <= SR_ROTATION_TOL*r.
  * Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION or SR_ERR_CONSTRAINT. */
 int sr_check_state(const sr_model *model, const sr_real x[SR_NX]);
 
-/* sr_check_state over n states (x is n x SR_NX, row-major).  Stops at the first failing row,
+/** sr_check_state over n states (x is n x SR_NX, row-major).  Stops at the first failing row,
  * whose index goes to *failed_row (if not NULL; -1 when all rows pass). */
 int sr_check_state_batch(const sr_model *model, long n, const sr_real *x, long *failed_row);
 
-/* Accelerations a = d(nu)/dt at state x under torques u (u may be NULL: zero torque).
+/** Accelerations a = d(nu)/dt at state x under torques u (u may be NULL: zero torque).
  * Cheap checks only: finiteness of x and u, |gamma| = 1 and the unit columns of R_Y, R_P
  * that the model reads (call sr_check_state once for the full check).  Returns SR_OK or an
  * error code (SR_ERR_NONFINITE also when the result overflows); a is untouched on error.
@@ -219,7 +227,7 @@ int sr_check_state_batch(const sr_model *model, long n, const sr_real *x, long *
  * is either fully written and finite (SR_OK) or untouched. */
 int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV]);
 
-/* sr_accel over n states: x is n x SR_NX, u is n x SR_NU (or NULL), a is n x SR_NV,
+/** sr_accel over n states: x is n x SR_NX, u is n x SR_NU (or NULL), a is n x SR_NV,
  * all row-major.  Stops at the first failing row, whose index goes to *failed_row
  * (if not NULL; -1 when all rows succeed); only the rows before it are written.
  * Each row's result and status are sr_accel's, bit for bit: the rows go through a vectorised
@@ -228,29 +236,29 @@ int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_N
 int sr_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
                    sr_real *a, long *failed_row);
 
-/* sr_check_state, then sr_accel, on each of n states, as sr_accel_batch (what the Python
+/** sr_check_state, then sr_accel, on each of n states, as sr_accel_batch (what the Python
  * Model.accel does for a batch): the full state check at little cost over sr_accel_batch. */
 int sr_checked_accel_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
                            sr_real *a, long *failed_row);
 
-/* Generalized inertia M (row-major 5x5): kinetic energy = 1/2 nu^T M nu [kg m^2]. */
+/** Generalized inertia M (row-major 5x5): kinetic energy = 1/2 nu^T M nu [kg m^2]. */
 int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * SR_NV]);
 
-/* Right-hand side f of M d(nu)/dt = f [N m]. */
+/** Right-hand side f of M d(nu)/dt = f [N m]. */
 int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NV]);
 
-/* Total energy [J]: 1/2 nu^T M nu + m_P g e_z^T (q + R_S R_Y R_P cbar_P). */
+/** Total energy [J]: 1/2 nu^T M nu + m_P g e_z^T (q + R_S R_Y R_P cbar_P). */
 int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy);
 
-/* Generalized gravity torques at rest (f at nu = 0, u = 0) [N m]; zero exactly at the
- * equilibria R_S R_Y R_P e_z = +-e_z of eq. (108). */
+/** Generalized gravity torques at rest (f at nu = 0, u = 0) [N m]; zero exactly at the
+ * equilibria R_S R_Y R_P e_z = +-e_z of equation (108). */
 int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV]);
 
-/* R = Exp([[w]]) by Rodrigues' formula, with a series branch for |w| < 1e-4 rad.
+/** R = Exp([[w]]) by Rodrigues' formula, with a series branch for |w| < 1e-4 rad.
  * SR_ERR_NONFINITE (R untouched) if w is not finite or |w|^2 overflows. */
 int sr_so3_exp(const sr_real w[3], sr_real R[9]);
 
-/* One step of size dt > 0 with constant torques u (NULL: zero) from x to x_next
+/** One step of size dt > 0 with constant torques u (NULL: zero) from x to x_next
  * (x_next may alias x).  method: SR_LIE_EULER, SR_RKMK4 or SR_CF4.  x gets the full check
  * (sr_check_state: SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT), so a loop of
  * single steps stops at a corrupt state instead of carrying it on; the check costs about a
@@ -259,7 +267,8 @@ int sr_so3_exp(const sr_real w[3], sr_real R[9]);
 int sr_step(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
             sr_real dt, sr_real x_next[SR_NX]);
 
-/* sr_step with the method fixed (no projection): the same bits and status codes as
+/** @{ */
+/** sr_step with the method fixed (no projection): the same bits and status codes as
  * sr_step(model, SR_LIE_EULER / SR_RKMK4 / SR_CF4, ...), to which sr_step dispatches.  Each one
  * reaches only its own method's code: a firmware that calls sr_step_lie_euler alone (and
  * neither sr_step nor the drivers), compiled with -ffunction-sections and linked with
@@ -270,8 +279,9 @@ int sr_step_rkmk4(const sr_model *model, const sr_real x[SR_NX], const sr_real u
                   sr_real x_next[SR_NX]);
 int sr_step_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                 sr_real x_next[SR_NX]);
+/** @} */
 
-/* sr_step on n states of one robot (x n x SR_NX, u n x SR_NU or NULL, x_next n x SR_NX; x_next may
+/** sr_step on n states of one robot (x n x SR_NX, u n x SR_NU or NULL, x_next n x SR_NX; x_next may
  * equal x, and must not overlap it otherwise), for particle filters, sampling-based controllers
  * and Monte Carlo over initial states (c/src/sr_step_batch.c).  Every row gets exactly the
  * bits and the status code sr_step gives it; the call stops at the first failing row (its index
@@ -283,7 +293,7 @@ int sr_step_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[S
 int sr_step_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u, sr_real dt,
                   sr_real *x_next, long *failed_row);
 
-/* steps steps of size dt from x0: traj[(steps+1) x SR_NX] receives x0 and every state after;
+/** steps steps of size dt from x0: traj[(steps+1) x SR_NX] receives x0 and every state after;
  * u is steps x SR_NU (torque held over each step) or NULL.  x0 gets the full check
  * (sr_check_state).  Guards: the state is checked for finiteness after every step
  * (SR_ERR_NONFINITE), and fully (SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT: the rotations or
@@ -299,7 +309,7 @@ int sr_step_batch(const sr_model *model, int method, long n, const sr_real *x, c
 int sr_simulate(const sr_model *model, int method, const sr_real x0[SR_NX], sr_real dt, long steps,
                 const sr_real *u, sr_real *traj, long *steps_done);
 
-/* Energy guard of sr_simulate_guarded.  Over a torque-free stretch (steps whose torques are
+/** Energy guard of sr_simulate_guarded.  Over a torque-free stretch (steps whose torques are
  * both exactly 0: no input power) the exact energy cannot rise, since the damping is >= 0.
  * The guard fails the run with SR_ERR_ENERGY when, at a check (the same steps as the state
  * checks), the energy E exceeds
@@ -310,28 +320,28 @@ int sr_simulate(const sr_model *model, int method, const sr_real x0[SR_NX], sr_r
  * Set tol (< 0 disables the guard) and in_stretch = 0 before a run; to continue a run in
  * chunks, pass the same struct again: it carries the stretch across calls. */
 typedef struct sr_energy_guard {
-    sr_real tol;      /* in: allowed rise as a fraction of scale; < 0: no energy guard */
-    int in_stretch;   /* in/out: nonzero inside a torque-free stretch */
-    sr_real e_start;  /* in/out: energy at the start of the stretch [J] */
-    sr_real scale;    /* in/out: kinetic energy at the start of the stretch + m_P g l [J] */
-    sr_real energy;   /* out: energy at the last check [J] (at the failing one on SR_ERR_ENERGY) */
+    sr_real tol;      /**< in: allowed rise as a fraction of scale; < 0: no energy guard */
+    int in_stretch;   /**< in/out: nonzero inside a torque-free stretch */
+    sr_real e_start;  /**< in/out: energy at the start of the stretch [J] */
+    sr_real scale;    /**< in/out: kinetic energy at the start of the stretch + m_P g l [J] */
+    sr_real energy;   /**< out: energy at the last check [J] (at the failing one on SR_ERR_ENERGY) */
 } sr_energy_guard;
 
-/* sr_simulate with the energy guard (guard may be NULL: same as sr_simulate). */
+/** sr_simulate with the energy guard (guard may be NULL: same as sr_simulate). */
 int sr_simulate_guarded(const sr_model *model, int method, const sr_real x0[SR_NX], sr_real dt,
                         long steps, const sr_real *u, sr_energy_guard *guard, sr_real *traj,
                         long *steps_done);
 
-/* Counters of sr_simulate_adaptive. */
+/** Counters of sr_simulate_adaptive. */
 typedef struct sr_adaptive_stats {
-    long accepted;    /* accepted steps */
-    long rejected;    /* rejected step attempts (error estimate above tolerance) */
-    long evaluations; /* calls of the acceleration kernel */
-    long rows_done;   /* output rows written, x0 included: traj rows 0..rows_done-1 are valid */
-    sr_real h_next;   /* step-size proposal at exit: pass it as h_init to continue a run */
+    long accepted;    /**< accepted steps */
+    long rejected;    /**< rejected step attempts (error estimate above tolerance) */
+    long evaluations; /**< calls of the acceleration kernel */
+    long rows_done;   /**< output rows written, x0 included: traj rows 0..rows_done-1 are valid */
+    sr_real h_next;   /**< step-size proposal at exit: pass it as h_init to continue a run */
 } sr_adaptive_stats;
 
-/* Adaptive RKMK4 with output on the fixed grid t_k = k*dt_out, k = 0..n_out:
+/** Adaptive RKMK4 with output on the fixed grid t_k = k*dt_out, k = 0..n_out:
  * traj[(n_out+1) x SR_NX] receives x0 and the state at every t_k.  Steps land exactly on the
  * grid points (no interpolation), so the torque may jump there: u is n_out x SR_NU, row k held
  * over [t_k, t_k+1) (NULL: zero torque).
@@ -360,14 +370,14 @@ int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[SR_
 #define sr_simulate_batch sr_simulate_batch_f
 #endif
 
-/* Summary metrics of one simulated sample, SR_BATCH_NMETRICS numbers in this order. */
+/** Summary metrics of one simulated sample, SR_BATCH_NMETRICS numbers in this order. */
 #define SR_BATCH_NMETRICS 4
-#define SR_BATCH_PATH_LENGTH 0    /* length of the path of the shell centre q, sum of |q_k+1 - q_k| [m] */
-#define SR_BATCH_MAX_DISTANCE 1   /* largest distance |q_k - q_0| from the start [m] */
-#define SR_BATCH_MAX_SHELL_RATE 2 /* largest shell angular speed |w_S| over the rows [rad/s] */
-#define SR_BATCH_FINAL_ENERGY 3   /* total energy of the final state (sr_energy) [J] */
+#define SR_BATCH_PATH_LENGTH 0    /**< length of the path of the shell centre q, sum of |q_k+1 - q_k| [m] */
+#define SR_BATCH_MAX_DISTANCE 1   /**< largest distance |q_k - q_0| from the start [m] */
+#define SR_BATCH_MAX_SHELL_RATE 2 /**< largest shell angular speed |w_S| over the rows [rad/s] */
+#define SR_BATCH_FINAL_ENERGY 3   /**< total energy of the final state (sr_energy) [J] */
 
-/* n independent runs of sr_simulate_guarded, one per sample i, each with its own parameters,
+/** n independent runs of sr_simulate_guarded, one per sample i, each with its own parameters,
  * initial state and torque program:
  *   params + i*params_stride  [SR_NPARAM]       (stride 0: every sample has the same parameters)
  *   x0 + i*x0_stride          [SR_NX]           (stride 0: the same initial state)
@@ -407,7 +417,8 @@ int sr_simulate_batch(int method, long n, const sr_real *params, long params_str
 #define sr_local_batch sr_local_batch_f
 #endif
 
-/* The error state d[SR_NE] = 12 entries (offsets SR_E_* of sr_generated.h), the
+/** @{ */
+/** The error state d[SR_NE] = 12 entries (offsets SR_E_* of sr_generated.h), the
  * right-trivialised tangent coordinates in which every Jacobian of this library is expressed:
  *   d[SR_E_xi_S + 0..2]  shell rotation vector, R_S <- R_S Exp([[d]])          [rad]
  *   d[SR_E_th_Y]         yoke angle, R_Y <- R_Y Exp(d Sigma_Y)                  [rad]
@@ -424,13 +435,16 @@ int sr_simulate_batch(int method, long n, const sr_real *params, long params_str
  * output only on SR_OK (y may alias x in sr_retract). */
 int sr_retract(const sr_model *model, const sr_real x[SR_NX], const sr_real d[SR_NE], sr_real y[SR_NX]);
 int sr_local(const sr_model *model, const sr_real x[SR_NX], const sr_real y[SR_NX], sr_real d[SR_NE]);
+/** @} */
 
-/* The same over n rows (x, y n x SR_NX, d n x SR_NE, row-major); stops at the first failing row,
+/** @{ */
+/** The same over n rows (x, y n x SR_NX, d n x SR_NE, row-major); stops at the first failing row,
  * whose index goes to *failed_row (if not NULL; -1 when all rows succeed).  n < 0: SR_ERR_ARG. */
 int sr_retract_batch(const sr_model *model, long n, const sr_real *x, const sr_real *d, sr_real *y,
                      long *failed_row);
 int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_real *y, sr_real *d,
                    long *failed_row);
+/** @} */
 
 /* ---- Derivatives of the dynamics (c/src/sr_jacobians.c) ------------------------------------------ */
 #ifdef SR_USE_FLOAT
@@ -444,7 +458,7 @@ int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 #define sr_step_jacobian_batch sr_step_jacobian_batch_f
 #endif
 
-/* Jacobians of the accelerations in the error coordinates:
+/** Jacobians of the accelerations in the error coordinates:
  *   nu'(x (+) d, u + w) = nu'(x, u) + Ja d + Jb w + O(|d|^2 + |w|^2),
  * Ja row-major SR_NV x SR_NE, Jb row-major SR_NV x SR_NU.  Derived symbolically from the same
  * derivation as sr_accel (derive/derivatives.py): d(nu') = M^-1 (df - (dM) nu'), one
@@ -456,12 +470,12 @@ int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                       sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU]);
 
-/* The same over n rows (x n x SR_NX, u n x SR_NU or NULL, Ja n x SR_NV x SR_NE, Jb n x SR_NV x
+/** The same over n rows (x n x SR_NX, u n x SR_NU or NULL, Ja n x SR_NV x SR_NE, Jb n x SR_NV x
  * SR_NU); stops at the first failing row, its index in *failed_row (-1 when all succeed). */
 int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u,
                             sr_real *Ja, sr_real *Jb, long *failed_row);
 
-/* Jacobians of one Lie-Euler step (sr_step_lie_euler) in the error coordinates:
+/** Jacobians of one Lie-Euler step (sr_step_lie_euler) in the error coordinates:
  *   step(x (+) d, u + w) (-) step(x, u) = F d + G w + O(|d|^2 + |w|^2),
  * F row-major SR_NE x SR_NE, G row-major SR_NE x SR_NU: the exact derivative of the map as
  * implemented (R_S Exp(h w_S) through the right Jacobian of SO(3), the joint angles, q by the
@@ -471,12 +485,13 @@ int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, con
 int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                                sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU]);
 
-/* The same over n rows (x n x SR_NX, u n x SR_NU or NULL, F n x SR_NE x SR_NE, G n x SR_NE x SR_NU),
+/** The same over n rows (x n x SR_NX, u n x SR_NU or NULL, F n x SR_NE x SR_NE, G n x SR_NE x SR_NU),
  * one dt; stops at the first failing row, its index in *failed_row (-1 when all succeed). */
 int sr_step_jacobian_lie_euler_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real dt,
                                      sr_real *F, sr_real *G, long *failed_row);
 
-/* The same for one RKMK4 and one CF4 step (c/src/sr_step_jacobians.c): the exact derivatives of the
+/** @{ */
+/** The same for one RKMK4 and one CF4 step (c/src/sr_step_jacobians.c): the exact derivatives of the
  * steps of c/src/sr_steppers.c, stage by stage (an accel Jacobian at each of the four stage states,
  * dexp^-1 differentiated for RKMK4); checks, status codes and outputs as
  * sr_step_jacobian_lie_euler.  Built with -DSR_CLONES on x86-64 (GCC, glibc), each is compiled
@@ -485,18 +500,21 @@ int sr_step_jacobian_rkmk4(const sr_model *model, const sr_real x[SR_NX], const 
                            sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU]);
 int sr_step_jacobian_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                          sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU]);
+/** @} */
 
-/* The step Jacobian of any method (SR_LIE_EULER, SR_RKMK4, SR_CF4; no SR_PROJECT): SR_ERR_ARG for
+/** @{ */
+/** The step Jacobian of any method (SR_LIE_EULER, SR_RKMK4, SR_CF4; no SR_PROJECT): SR_ERR_ARG for
  * another; and over n rows (x n x SR_NX, u n x SR_NU or NULL, F n x SR_NE^2, G n x SR_NE*SR_NU),
  * stopping at the first failing row (its index in *failed_row, -1 when all succeed). */
 int sr_step_jacobian(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                      sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU]);
 int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u, sr_real dt,
                            sr_real *F, sr_real *G, long *failed_row);
+/** @} */
 
-/* ---- The firmware controller: LQR gain-scheduled on speed and curvature (c/src/sr_control.c) ----
+/** @name The firmware controller: LQR gain-scheduled on speed and curvature (c/src/sr_control.c)
  *
- * Issue 20.  The controller acts through the two motor torques only.  It measures the state
+ * The controller acts through the two motor torques only.  It measures the state
  * against a reference that rolls at speed v_ref along the heading psi_ref (the heading to hold,
  * or a path's tangent at the point nearest to the robot, with the path's curvature kappa and the
  * signed cross-track error e_y, left positive), in the error coordinates z[SR_LQR_NZ]:
@@ -518,12 +536,13 @@ int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_r
  * torque was clipped (conditional anti-windup), and the cross-track integral only while
  * |e_y| <= integral_zone (a large initial offset, such as a line's, winds nothing up).  The curvature of the operating point follows
  * the reference's at most kappa_rate per second (a figure eight's switch of turn direction). */
-#define SR_LQR_NZ 12
+/** @{ */
+#define SR_LQR_NZ 12               /**< entries of the error coordinates z */
 #ifndef SR_LQR_MAX_SPEEDS
-#define SR_LQR_MAX_SPEEDS 6
+#define SR_LQR_MAX_SPEEDS 6        /**< capacity of a schedule's speed grid (may be set at build time) */
 #endif
 #ifndef SR_LQR_MAX_CURVATURES
-#define SR_LQR_MAX_CURVATURES 5
+#define SR_LQR_MAX_CURVATURES 5    /**< capacity of its curvature grid (may be set at build time) */
 #endif
 
 #ifdef SR_USE_FLOAT
@@ -536,57 +555,57 @@ int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_r
 #define sr_lqr_control sr_lqr_control_f
 #endif
 
-/* A gain schedule (read-only during control; fill it from the design, e.g. the header that
+/** A gain schedule (read-only during control; fill it from the design, such as the header that
  * `python -m runtime.control.lqr --emit-c` writes).  Point (i, j) of the grid, speed i and
  * curvature j, is entry i * n_curvatures + j of z_star, u_star, K_path and K_heading
  * (K row-major 2 x SR_LQR_NZ). */
 typedef struct sr_lqr {
-    int n_speeds;                                   /* 1 .. SR_LQR_MAX_SPEEDS */
-    int n_curvatures;                               /* 1 .. SR_LQR_MAX_CURVATURES */
-    sr_real speeds[SR_LQR_MAX_SPEEDS];              /* strictly increasing [m/s] */
-    sr_real curvatures[SR_LQR_MAX_CURVATURES];      /* strictly increasing [1/m] */
-    sr_real z_star[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_LQR_NZ];
-    sr_real u_star[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_NU];
-    sr_real K_path[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_NU * SR_LQR_NZ];
-    sr_real K_heading[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_NU * SR_LQR_NZ];
-    sr_real period;                                 /* the controller's sampling period [s], > 0 */
-    sr_real u_max;                                  /* torque limit on both motors [N m], > 0 */
-    sr_real kappa_rate;                             /* [1/(m s)], >= 0 */
-    sr_real integral_zone;                          /* [m], > 0 */
+    int n_speeds;                                   /**< 1 .. SR_LQR_MAX_SPEEDS */
+    int n_curvatures;                               /**< 1 .. SR_LQR_MAX_CURVATURES */
+    sr_real speeds[SR_LQR_MAX_SPEEDS];              /**< strictly increasing [m/s] */
+    sr_real curvatures[SR_LQR_MAX_CURVATURES];      /**< strictly increasing [1/m] */
+    sr_real z_star[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_LQR_NZ]; /**< the operating point's z* at each grid point */
+    sr_real u_star[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_NU]; /**< the operating point's torques u* [N m] */
+    sr_real K_path[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_NU * SR_LQR_NZ]; /**< gains for path references */
+    sr_real K_heading[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_NU * SR_LQR_NZ]; /**< gains for speed and heading references */
+    sr_real period;                                 /**< the controller's sampling period [s], > 0 */
+    sr_real u_max;                                  /**< torque limit on both motors [N m], > 0 */
+    sr_real kappa_rate;                             /**< [1/(m s)], >= 0 */
+    sr_real integral_zone;                          /**< [m], > 0 */
 } sr_lqr;
 
-/* What to track at this sample (from the reference). */
+/** What to track at this sample (from the reference). */
 typedef struct sr_lqr_target {
-    sr_real speed;        /* v_ref [m/s] */
-    sr_real heading;      /* psi_ref [rad]: the heading to hold or the path's tangent */
-    sr_real curvature;    /* kappa [1/m], left positive (path references) */
-    sr_real cross_track;  /* e_y [m], positive when the robot is left of the path */
-    int path;             /* nonzero: a path reference (curvature and cross_track are read) */
+    sr_real speed;        /**< v_ref [m/s] */
+    sr_real heading;      /**< psi_ref [rad]: the heading to hold or the path's tangent */
+    sr_real curvature;    /**< kappa [1/m], left positive (path references) */
+    sr_real cross_track;  /**< e_y [m], positive when the robot is left of the path */
+    int path;             /**< nonzero: a path reference (curvature and cross_track are read) */
 } sr_lqr_target;
 
-/* The controller's memory between samples (sr_lqr_reset before the first). */
+/** The controller's memory between samples (sr_lqr_reset before the first). */
 typedef struct sr_lqr_memory {
-    sr_real integrals[2];  /* z[10], z[11] */
-    sr_real kappa;         /* the operating point's curvature [1/m] */
-    int started;           /* 0 until the first sample */
-    int saturated;         /* out: the last sample clipped a torque */
+    sr_real integrals[2];  /**< z[10], z[11] */
+    sr_real kappa;         /**< the operating point's curvature [1/m] */
+    int started;           /**< 0 until the first sample */
+    int saturated;         /**< out: the last sample clipped a torque */
 } sr_lqr_memory;
 
-/* Checks a schedule: sizes in range, grids strictly increasing, every entry finite, period,
+/** Checks a schedule: sizes in range, grids strictly increasing, every entry finite, period,
  * u_max and integral_zone > 0, kappa_rate >= 0.  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
 int sr_lqr_check(const sr_lqr *lqr);
 
-/* Zeroes the memory.  Returns SR_OK or SR_ERR_NULL. */
+/** Zeroes the memory.  Returns SR_OK or SR_ERR_NULL. */
 int sr_lqr_reset(sr_lqr_memory *memory);
 
-/* The error coordinates z of x against the target (integrals: z[10], z[11]; NULL: zeros).
+/** The error coordinates z of x against the target (integrals: z[10], z[11]; NULL: zeros).
  * Checks x in full (sr_check_state) and the target for finiteness.  Returns SR_OK,
  * SR_ERR_NULL, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION or SR_ERR_CONSTRAINT; z is written only
  * on SR_OK. */
 int sr_lqr_error(const sr_model *model, const sr_real x[SR_NX], const sr_lqr_target *target,
                  const sr_real integrals[2], sr_real z[SR_LQR_NZ]);
 
-/* One sample of the controller: the torques u (clipped to +-u_max) for the next period, and
+/** One sample of the controller: the torques u (clipped to +-u_max) for the next period, and
  * (if u_raw is not NULL) the torques before clipping; advances the memory.  Checks x and the
  * target as sr_lqr_error does, the schedule's sizes, period and u_max (SR_ERR_ARG), and that
  * the torques are finite (SR_ERR_NONFINITE: a non-finite entry of the schedule that was used);
@@ -595,6 +614,7 @@ int sr_lqr_error(const sr_model *model, const sr_real x[SR_NX], const sr_lqr_tar
 int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_NX],
                    const sr_lqr_target *target, sr_lqr_memory *memory, sr_real u[SR_NU],
                    sr_real u_raw[SR_NU]);
+/** @} */
 
 #ifdef __cplusplus
 }

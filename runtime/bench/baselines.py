@@ -21,6 +21,7 @@ def _repeat(fn, args, calls):
 
 
 def t_shape_program(steps=10_000):
+    """The torque program of the paper's T-shape manoeuvre over `steps` steps: (steps, 2) [N m]."""
     u = np.zeros((steps, 2))
     for first, last, column, value in [(1, 800, 0, 0.1), (1600, 1900, 1, -0.1), (2500, 3000, 0, -0.1),
                                        (3400, 4500, 1, 0.1)]:
@@ -118,6 +119,8 @@ def compiled_kane_timings(model, calls, progress, min_seconds=0.2, rounds=7):
 
 
 def python_timings(model, X, U, batch_size, progress, with_kane=True, loop_steps=10_000):
+    """Times the Python-level paths (the Model's calls, the cffi calls they wrap, the references and, with
+    `with_kane`, the Kane baselines) on the states X and torques U; returns a dict of timings."""
     from ..verification.paper_formulas import PaperModel
     from ..verification.reference import ReferenceModel
     out = {}

@@ -112,11 +112,13 @@ LQR_RATE, LQR_U_MAX = 50.0, 0.5
 
 
 def lqr_controller(params):
+    """The LQR controller that the C loop's controller timing uses, designed for `params`."""
     from ..control.lqr import Lqr
     return Lqr(params, LQR_RATE, LQR_U_MAX)
 
 
 def lqr_target():
+    """The path target that the controller timings track (a curve with a cross-track error)."""
     from ..control.reference import Target
     return Target(speed=0.3, heading=0.5, curvature=0.2, cross_track=0.05)
 
@@ -139,6 +141,8 @@ def write_input(path, params, X, U, kane_inputs=None):
 
 
 def run_harness(exe, params, X, U, repeats, kane_inputs=None):
+    """Runs the compiled C timing loop `exe` on the states X and torques U, `repeats` sweeps; returns its
+    JSON output as a dict."""
     data = write_input(exe.parent / "input.bin", params, X, U, kane_inputs)
     out = subprocess.run([str(exe), str(data), str(repeats)], check=True, capture_output=True, text=True)
     return json.loads(out.stdout)

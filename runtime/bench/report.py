@@ -197,6 +197,7 @@ def anatomy_section(anatomy):
 
 
 def format_report(res):
+    """The benchmark result `res` as the printed text report (tables, flop rate, targets met or missed)."""
     c = res["c_loop"]
     lines = [f"CPU: {res.get('cpu', '?')}"]
     for title, rows in sections(res):

@@ -143,6 +143,7 @@ def derive(res):
 
 
 def format_report(result):
+    """The sweep benchmark's result as the printed text report."""
     r, d = result["measured"], result["derived"]
     m = d["model_1e6_on_64"]
     lines = [f"sweep benchmark, {result['date']}, CPU: {result['cpu']} ({result['cores']} cores, load average "
@@ -174,6 +175,7 @@ def format_report(result):
 
 
 def main(argv=None):
+    """`python -m runtime.sweep.bench`: time the sweep on Dask and write the result file."""
     p = argparse.ArgumentParser(prog="python -m runtime sweep-bench", description=__doc__.split("\n\n")[0])
     p.add_argument("--samples", type=int, default=4000, help="samples of the shipped sweep (default 4000)")
     p.add_argument("--samples-per-task", type=int, default=250,

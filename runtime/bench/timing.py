@@ -8,6 +8,8 @@ import numpy as np
 
 
 def pin_to_one_core():
+    """Pins this process to the last CPU it may run on and returns its number (None where affinity is
+    unavailable)."""
     try:
         cpus = sorted(os.sched_getaffinity(0))
         os.sched_setaffinity(0, {cpus[-1]})
@@ -17,6 +19,7 @@ def pin_to_one_core():
 
 
 def cpu_name():
+    """The CPU's model name (from /proc/cpuinfo, else what the platform module reports)."""
     try:
         for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):

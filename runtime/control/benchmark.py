@@ -26,6 +26,7 @@ COLUMNS = ("cross_track_rms_m", "cross_track_max_m", "heading_settle_s", "speed_
 
 
 def cpu_name():
+    """The CPU's model name (from lscpu, else what the platform module reports)."""
     try:
         out = subprocess.run(["lscpu"], capture_output=True, text=True, check=True).stdout
         return next(line.split(":", 1)[1].strip() for line in out.splitlines() if line.startswith("Model name"))
@@ -49,6 +50,8 @@ def _fmt(value):
 
 
 def main(argv=()):
+    """`python -m runtime control`: run every controller on the benchmark tasks and write the tables and
+    run folders."""
     parser = argparse.ArgumentParser(prog="python -m runtime control")
     parser.add_argument("--out", default="out/control", help="folder of the table and of one folder per run "
                         "(created as needed)")

@@ -32,6 +32,7 @@ class Controller:
 
     @property
     def period(self):
+        """The sampling period [s], 1 / rate."""
         return 1.0 / self.rate
 
     def reset(self, x0):
@@ -40,6 +41,8 @@ class Controller:
         self.solve_s = []
 
     def compute(self, t, x, target):
+        """The raw torques (2,) [N m] at time t for the measured state x and the reference's target;
+        subclasses implement it."""
         raise NotImplementedError
 
     def update(self, t, x, target):
@@ -62,4 +65,5 @@ class Controller:
 
     @property
     def saturated_fraction(self):
+        """The fraction of the samples so far at which a torque was clipped to u_max."""
         return self.saturated / self.samples if self.samples else 0.0

@@ -119,6 +119,7 @@ def tightest_turn(rows, leans, u_max):
 
 
 def main(argv=()):
+    """Prints the envelope's numbers and rewrites its figure (docs/control.md)."""
     parser = argparse.ArgumentParser(prog="python -m runtime envelope")
     parser.add_argument("figure", nargs="?", default="docs/figures/control-envelope.png", help="where to write the figure")
     args = parser.parse_args(list(argv))

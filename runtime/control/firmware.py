@@ -109,6 +109,7 @@ def write_header(path, name=DEFAULT_TASK, rate=DEFAULT_RATE):
 
 
 def main(argv=()):
+    """Writes the firmware example's gain-table header for a task at a controller rate."""
     parser = argparse.ArgumentParser(prog="python -m runtime firmware-table")
     parser.add_argument("task", nargs="?", default=DEFAULT_TASK)
     parser.add_argument("--rate", type=float, default=DEFAULT_RATE, help="controller rate [Hz]")

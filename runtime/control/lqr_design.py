@@ -209,6 +209,7 @@ class Weights:
     torque_n_m: float = 0.5
 
     def q_diagonal(self):
+        """The state weights of the Riccati equation: one over the square of each bound."""
         return 1.0 / np.square(np.array([*self.attitude_rad, self.pendulum_rad, *self.rate_rad_s,
                                           self.yoke_rate_rad_s, self.pendulum_rate_rad_s,
                                           self.cross_track_m, self.cross_track_integral_m_s,

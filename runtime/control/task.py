@@ -55,6 +55,8 @@ class ControllerSpec:
 
 @dataclasses.dataclass(frozen=True)
 class Task:
+    """A control task: the scenario, the reference, the controllers to run, the plant and its measurement
+    noise."""
     name: str
     source: str
     scenario: object            # runtime.scenario.Scenario: the controller's model and x0
@@ -66,16 +68,18 @@ class Task:
 
     @property
     def duration(self):
+        """The task's length [s]."""
         return self.scenario.duration
 
     # The first controller's settings (a task run with one controller: `with_controller`).
-    controller_kind = property(lambda self: self.controllers[0].kind)
-    rate = property(lambda self: self.controllers[0].rate)
-    u_max = property(lambda self: self.controllers[0].u_max)
-    gains = property(lambda self: self.controllers[0].gains)
+    controller_kind = property(lambda self: self.controllers[0].kind, doc="The first controller's kind.")
+    rate = property(lambda self: self.controllers[0].rate, doc="The first controller's rate [Hz].")
+    u_max = property(lambda self: self.controllers[0].u_max, doc="The first controller's torque limit [N m].")
+    gains = property(lambda self: self.controllers[0].gains, doc="The first controller's gains.")
 
     @property
     def controller_kinds(self):
+        """The kinds of controller the task names, its default first."""
         return tuple(c.kind for c in self.controllers)
 
     def with_controller(self, kind):
@@ -86,6 +90,8 @@ class Task:
         raise ValueError(f"{self.source}: no controller of kind {kind!r} (it has {', '.join(self.controller_kinds)})")
 
     def controller(self):
+        """A new controller of the task's kind, rate, torque limit and gains, designed for the scenario's
+        robot."""
         cls = AVAILABLE_CONTROLLERS[self.controller_kind][0]
         return cls(self.scenario.params, rate=self.rate, u_max=self.u_max, gains=self.gains)
 
@@ -114,14 +120,17 @@ class Task:
 
 
 def task_dir():
+    """The folder of the shipped task files."""
     return importlib.resources.files("runtime") / "control" / "tasks"
 
 
 def shipped_tasks():
+    """The names of the shipped tasks."""
     return sorted(p.name[:-5] for p in task_dir().iterdir() if p.name.endswith(".toml"))
 
 
 def load_task(name_or_path):
+    """The task of a shipped name or a path to a .toml file; ValueError naming the problem otherwise."""
     candidate = task_dir() / f"{name_or_path}.toml"
     path = pathlib.Path(str(candidate)) if "/" not in str(name_or_path) and candidate.is_file() \
         else pathlib.Path(name_or_path)
@@ -136,6 +145,8 @@ def load_task(name_or_path):
 
 
 def parse_task(data, source="<task>", name="task"):
+    """The Task described by the table `data` (from the file `source`); ValueError naming the field and the
+    problem."""
     check_table(data, _SCENARIO_KEYS | {"reference", "controller", "plant", "estimator"}, source)
     scenario = parse_scenario({k: v for k, v in data.items() if k in _SCENARIO_KEYS}, source, name)
     reference = _parse_reference(data.get("reference"), source)

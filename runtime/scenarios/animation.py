@@ -135,6 +135,7 @@ class RobotScene:
         return picture
 
     def close(self):
+        """Closes the scene's figure."""
         plt.close(self.fig)
 
 

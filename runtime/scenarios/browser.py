@@ -91,6 +91,7 @@ def screenshot(page, target, width=1280, height=1560):
 
 
 def have_apt_as_root():
+    """True when this process is root and apt-get is on the PATH."""
     import os
 
     return hasattr(os, "geteuid") and os.geteuid() == 0 and shutil.which("apt-get") is not None

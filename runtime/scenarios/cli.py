@@ -31,6 +31,7 @@ from ..scenario import PAPER_SCENARIOS, load_scenario, run_scenario, scenario_pa
 
 
 def build_parser():
+    """The argument parser of `python -m runtime run`."""
     shipped = ", ".join(shipped_scenarios())
     parser = argparse.ArgumentParser(
         prog="python -m runtime run",
@@ -113,6 +114,7 @@ def check_output_folder(folder, force):
 
 
 def main(argv):
+    """`python -m runtime run`: simulate the scenarios named in argv and write their output folders."""
     args = build_parser().parse_args(argv)
     names = list(PAPER_SCENARIOS) if args.scenario == "all" else [args.scenario]
     try:

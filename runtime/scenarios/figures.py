@@ -23,6 +23,7 @@ COMMITTED.append(("t-shape", plots.inclinations_figure, "inclinations"))
 
 
 def main(argv):
+    """`python -m runtime figures`: run the paper's scenarios and rewrite the committed figures."""
     parser = argparse.ArgumentParser(prog="python -m runtime figures", description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=pathlib.Path, default=DEFAULT_OUT, help=f"folder (default: {DEFAULT_OUT})")
     args = parser.parse_args(argv)

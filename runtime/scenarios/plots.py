@@ -98,6 +98,7 @@ def absolute_inclinations_figure(result, size=(6.0, 3.6)):
 
 
 def energy_figure(result, size=(6.0, 3.6)):
+    """The total energy of a result against time, as a matplotlib figure."""
     fig, ax = _time_figure(result, size)
     ax.plot(result.time, result.energy, color="k")
     _finish_time_axes(ax, result, "E [J]", "kinetic + potential energy", legend=False)

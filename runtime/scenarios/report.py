@@ -107,6 +107,7 @@ def write_csv(result, target):
 
 
 def write_summary(summary_dict, target):
+    """Writes the summary dict as indented JSON to `target`, atomically."""
     write_text(target, json.dumps(summary_dict, indent=2) + "\n")
 
 

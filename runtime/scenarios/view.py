@@ -25,6 +25,7 @@ def replay_page(path):
 
 
 def main(argv):
+    """`python -m runtime view`: open a run's replay page in the browser."""
     parser = argparse.ArgumentParser(prog="python -m runtime view",
                                      description="Open the interactive replay of a run in the browser.")
     parser.add_argument("folder", metavar="FOLDER", help="a run's output folder (e.g. out/t-shape) or its replay.html")

@@ -69,6 +69,7 @@ def _scheduler(text):
 
 
 def build_parser():
+    """The argument parser of `python -m runtime sweep`."""
     p = _Parser(prog="python -m runtime sweep", description=__doc__.split("\n\n")[1])
     cores = os.cpu_count() or 1
     p.add_argument("sweep", help=f"a shipped sweep ({', '.join(shipped_sweeps())}) or a sweep file")
@@ -97,6 +98,7 @@ def nominal_end_point(spec):
 
 
 def main(argv):
+    """`python -m runtime sweep`: run (or resume) a sweep and write its store and summary."""
     try:
         args = build_parser().parse_args(argv)
         spec = load_sweep(args.sweep)

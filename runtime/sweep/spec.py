@@ -81,13 +81,17 @@ class SweepSpec:
 
     @property
     def grid(self):
+        """The quantities given as lists of values (the grid's axes)."""
         return tuple(q for q in self.quantities if q.kind == "values")
 
     @property
     def grid_size(self):
+        """The number of points of the grid (1 without grid axes)."""
         return math.prod(len(q.numbers) for q in self.grid)
 
     def with_samples(self, samples):
+        """The same sweep with another number of samples (ValueError unless a whole number from 1 to
+        MAX_SAMPLES)."""
         return dataclasses.replace(self, samples=_count(samples, "--samples"))
 
     def identity(self):
@@ -106,6 +110,7 @@ def _sweep_dir():
 
 
 def shipped_sweeps():
+    """The names of the shipped sweep files."""
     return sorted(p.name[:-5] for p in _sweep_dir().iterdir() if p.name.endswith(".toml"))
 
 

@@ -137,6 +137,7 @@ class SweepStore:
         return [(a, min(a + k, n)) for a in range(0, n, k)]
 
     def chunk_path(self, start, stop):
+        """The Parquet file of the samples start .. stop-1."""
         return self.folder / CHUNKS / f"part-{start:010d}-{stop:010d}.parquet"
 
     def verify(self):

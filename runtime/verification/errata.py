@@ -19,19 +19,23 @@ from .sampling import random_inputs, random_state
 
 
 def relative_error(a, b):
+    """max |a - b| / max |b|."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     return float(np.abs(a - b).max() / max(np.abs(b).max(), 1e-300))
 
 
 def worst(pairs):
+    """The largest relative_error over the pairs (a, b)."""
     return max(relative_error(a, b) for a, b in pairs)
 
 
 def accel_errors(model, paper, states):
+    """The worst relative error of the paper formulas' accelerations against the model's over the states."""
     return worst((paper.accel(x, u), model.accel(x, u)) for x, u in states)
 
 
 def energy_errors(model, paper, states):
+    """The worst relative error of the paper formulas' energy against the model's over the states."""
     return worst((paper.energy(x), model.energy(x)) for x, _ in states)
 
 
@@ -80,6 +84,7 @@ def evidence(n_states=200, seed=0):
 
 
 def main(argv=None):
+    """Prints the errata's evidence as a Markdown table."""
     parser = argparse.ArgumentParser(prog="python -m runtime errata", description=__doc__.splitlines()[0])
     parser.add_argument("--states", type=int, default=200)
     parser.add_argument("--seed", type=int, default=0)

@@ -16,10 +16,12 @@ def random_state(rng, params=None, max_speed=10.0):
 
 
 def random_states(rng, n, params=None, max_speed=10.0):
+    """n random valid states (n, 35), speeds up to `max_speed`."""
     return np.array([random_state(rng, params, max_speed) for _ in range(n)])
 
 
 def random_inputs(rng, n, max_torque=1.0):
+    """n random torque pairs (n, 2), uniform in +-max_torque [N m]."""
     return rng.uniform(-max_torque, max_torque, size=(n, NU))
 
 
