@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 C_SOURCES := $(wildcard generated/*.c generated/*.h c/*.c c/*.h)
 
-.PHONY: install test run generate verify bench sweep-bench figures soak fuzz c-lib c-test clean control envelope
+.PHONY: install test run generate verify bench sweep-bench figures soak fuzz c-lib c-test clean control envelope fmu
 
 $(STAMP): pyproject.toml setup.py bindings/build_sr.py bindings/fastcall.c $(C_SOURCES)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -48,6 +48,11 @@ control: $(STAMP)
 # The envelope of docs/control.md (prints its numbers, rewrites docs/figures/control-envelope.png).
 envelope: $(STAMP)
 	$(PY) -m runtime.control.envelope
+
+# The robot as FMI 2.0 and FMI 3.0 co-simulation FMUs: out/fmu/SphericalRobot.fmu and
+# out/fmu/fmi3/SphericalRobot.fmu (docs/interop.md).
+fmu: $(STAMP)
+	$(PY) -m runtime export-fmu --out out/fmu
 
 soak: $(STAMP)
 	$(PY) -m runtime soak
