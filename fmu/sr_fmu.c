@@ -72,9 +72,19 @@ int sr_fmu_prepare(sr_fmu *fmu, double start_time)
     if (!isfinite(start_time))
         return fail(fmu, "%s: %s, got %g", "start time", "must be finite", start_time);
     status = sr_check_params(fmu->params, &bad, &rule);
-    if (status != SR_OK && bad >= 0)
+    if (status != SR_OK && bad >= 0) {
+        /* A tensor or centre breaks its rule as a whole: C reports its first entry. */
+        int last = rule == SR_PARAM_RULE_INERTIA ? bad + 5 : rule == SR_PARAM_RULE_INSIDE ? bad + 2 : bad;
+        if (last != bad) {
+            const char *name = name_of(SR_FMU_PARAM, bad);
+            size_t suffix = rule == SR_PARAM_RULE_INERTIA ? 3 : 2;  /* _xx of a tensor, _x of a centre */
+            snprintf(fmu->message, sizeof fmu->message, "%.*s (%s .. %s): %s", (int)(strlen(name) - suffix), name,
+                     name, name_of(SR_FMU_PARAM, last), sr_param_rule_string(rule));
+            return SR_FMU_ERROR;
+        }
         return fail(fmu, "%s: %s, got %g", name_of(SR_FMU_PARAM, bad), sr_param_rule_string(rule),
                     fmu->params[bad]);
+    }
     status = sr_model_init(&fmu->model, fmu->params);
     if (status != SR_OK) {
         snprintf(fmu->message, sizeof fmu->message, "the parameters give no model: %s",
@@ -253,7 +263,8 @@ int sr_fmu_get_real(sr_fmu *fmu, unsigned int vr, double *value)
         case SR_FMU_ENERGY:
             status = sr_energy(&fmu->model, fmu->x, &energy);
             if (status != SR_OK) {
-                snprintf(fmu->message, sizeof fmu->message, "%s: %s", NAMES[vr], sr_status_string(status));
+                snprintf(fmu->message, sizeof fmu->message, "%s at t = %.17g: %s", NAMES[vr], fmu->time,
+                         sr_status_string(status));
                 return SR_FMU_ERROR;
             }
             *value = energy;
