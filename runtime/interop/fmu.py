@@ -142,7 +142,7 @@ def token(table=None):
     so that an XML and a binary of different tables refuse each other."""
     table = variables() if table is None else table
     digest = hashlib.sha256(repr(table).encode() + (GLUE / "sr_fmu.h").read_bytes()).hexdigest()
-    return "{" + str(uuid.UUID(digest[:32])) + "}"
+    return "{" + str(uuid.uuid5(uuid.NAMESPACE_URL, f"spherical-robot-fmu:{digest}")) + "}"
 
 
 def variables_header(table=None):
