@@ -200,8 +200,10 @@ def _method_items():
     return [{"name": name, "value": str(code)} for name, code in METHODS.items()]
 
 
-def model_description(version, table=None):
-    """modelDescription.xml (text) of the FMI `version` (2 or 3)."""
+def model_description(version, table=None, sources=()):
+    """modelDescription.xml (text) of the FMI `version` (2 or 3); `sources`: the names of the C
+    files under sources/ that build the binary (FMI 2 lists them here, FMI 3 in
+    sources/buildDescription.xml)."""
     if version not in (2, 3):
         raise ValueError(f"version: FMI 2 or 3, got {version!r}")
     table = variables() if table is None else table
@@ -213,9 +215,13 @@ def model_description(version, table=None):
     if version == 2:
         root = ET.Element("fmiModelDescription", fmiVersion="2.0", guid=token(table), numberOfEventIndicators="0",
                           **common)
-        ET.SubElement(root, "CoSimulation", modelIdentifier=MODEL_IDENTIFIER,
-                      canHandleVariableCommunicationStepSize="true", canGetAndSetFMUstate="false",
-                      canSerializeFMUstate="false", canNotUseMemoryManagementFunctions="false")
+        cosimulation = ET.SubElement(root, "CoSimulation", modelIdentifier=MODEL_IDENTIFIER,
+                                     canHandleVariableCommunicationStepSize="true", canGetAndSetFMUstate="false",
+                                     canSerializeFMUstate="false", canNotUseMemoryManagementFunctions="false")
+        if sources:
+            files = ET.SubElement(cosimulation, "SourceFiles")
+            for name in sources:
+                ET.SubElement(files, "File", name=name)
     else:
         root = ET.Element("fmiModelDescription", fmiVersion="3.0", instantiationToken=token(table), **common)
         ET.SubElement(root, "CoSimulation", modelIdentifier=MODEL_IDENTIFIER,
@@ -270,6 +276,30 @@ def model_description(version, table=None):
             ET.SubElement(structure, "InitialUnknown", valueReference=str(vr))
     ET.indent(root)
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def build_description(sources):
+    """sources/buildDescription.xml of the FMI 3 FMU: one C99 file set."""
+    root = ET.Element("fmiBuildDescription", fmiVersion="3.0")
+    files = ET.SubElement(ET.SubElement(root, "BuildConfiguration", modelIdentifier=MODEL_IDENTIFIER),
+                          "SourceFileSet", language="C99")
+    for name in sources:
+        ET.SubElement(files, "SourceFile", name=name)
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def source_files(version, build_dir):
+    """(C sources, headers) of the FMI `version` binary, as paths; every base name once (the FMU's
+    sources/ folder is flat)."""
+    sources = [*library_sources(), GLUE / "sr_fmu.c", GLUE / f"fmi{version}.c"]
+    headers = sorted(p for d in LIBRARY_INCLUDES for p in (ROOT / d).glob("*.h"))
+    headers += [GLUE / "sr_fmu.h", pathlib.Path(build_dir) / "sr_fmu_variables.h"]
+    names = [p.name for p in sources + headers]
+    repeated = sorted({n for n in names if names.count(n) > 1})
+    if repeated:
+        raise ValueError(f"sources: the base names {repeated} occur twice; the FMU's sources/ folder is flat")
+    return sources, headers
 
 
 def platform_folder(version):
@@ -335,9 +365,17 @@ def build(versions, out_dir, cc=None):
             out_path = paths[version]
             out_path.parent.mkdir(parents=True, exist_ok=True)
             partial = out_path.with_name(out_path.name + ".partial")
+            sources, headers = source_files(version, tmp)
+            names = [p.name for p in sources]
             with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as fmu:
-                fmu.writestr("modelDescription.xml", model_description(version))
+                fmu.writestr("modelDescription.xml", model_description(version, sources=names))
                 fmu.write(binary, f"binaries/{platform_folder(version)}/{binary.name}")
+                # The sources, so that a tool on another platform (Windows for Simulink) can build
+                # its own binary, e.g. with FMPy's build_platform_binary.
+                for path in sources + headers:
+                    fmu.write(path, f"sources/{path.name}")
+                if version == 3:
+                    fmu.writestr("sources/buildDescription.xml", build_description(names))
             os.replace(partial, out_path)
     return {v: paths[v] for v in versions}
 

@@ -1,6 +1,7 @@
 """The FMUs of `make fmu` (runtime/interop/fmu.py, fmu/): valid by FMPy, the same numbers as the
 runtime, the parameters where their names say, errors that name what is wrong."""
 import dataclasses
+import shutil
 import xml.etree.ElementTree as ET
 import zipfile
 
@@ -231,3 +232,20 @@ def test_the_cli_reports_an_unsupported_fmi_version_without_a_traceback(capsys):
         main(["export-fmu", "--fmi", "4"])
     assert exit_.value.code == 2
     assert "invalid choice: 4" in capsys.readouterr().err
+
+
+def test_the_fmus_sources_build_a_binary_that_computes_the_same(fmus, tmp_path):
+    """What a tool on another platform does (e.g. for Simulink on Windows): FMPy's CMake build of
+    the FMU's sources/ (FMI 3: sources/buildDescription.xml) in place of the shipped binary."""
+    if shutil.which("cmake") is None:
+        pytest.skip("cmake is not installed")
+    from fmpy.build import build_platform_binary
+    unzipped = tmp_path / "unzipped"
+    fmpy.extract(str(fmus[3]), str(unzipped))
+    shutil.rmtree(unzipped / "binaries")
+    (tmp_path / "build").mkdir()
+    build_platform_binary(unzipped, build_dir=tmp_path / "build")
+    start = {"theta_P_0": 0.5, "method": 2}
+    rebuilt = fmpy.simulate_fmu(str(unzipped), stop_time=1.0, output_interval=0.01, start_values=start)
+    shipped = fmpy.simulate_fmu(str(fmus[3]), stop_time=1.0, output_interval=0.01, start_values=start)
+    assert max(np.max(np.abs(rebuilt[n] - shipped[n])) for n in shipped.dtype.names) <= 1e-12
