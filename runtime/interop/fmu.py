@@ -27,9 +27,6 @@ import zipfile
 
 import numpy as np
 
-from derive import parameters as derive_parameters
-from derive import state as derive_state
-
 from bindings._sr import lib
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -84,6 +81,16 @@ class Variable:
     enumeration: bool = False
 
 
+def _derive():
+    """derive's parameters and state modules (SymPy: the dev extra, as `make fmu` installs it)."""
+    try:
+        from derive import parameters, state
+    except ImportError as exc:
+        raise ValueError(f"the FMU's tables come from derive/, which needs the dev extra "
+                         f"(pip install -e '.[dev]'): {exc}") from None
+    return parameters, state
+
+
 def _state_names(block, length):
     if length == 9:
         return [f"{block}_{i + 1}{j + 1}" for i in range(3) for j in range(3)]
@@ -97,6 +104,7 @@ def variables():
     from runtime.model import METHODS
     from runtime.params import Params
 
+    derive_parameters, derive_state = _derive()
     out = [Variable("time", "SR_FMU_TIME", "0", "independent", "continuous", "s", "simulation time")]
     for name, _ in sorted(derive_state.INPUT_NAMES, key=lambda item: getattr(lib, f"SR_U_{item[0]}")):
         unit, text = derive_state.INPUT_MEANINGS[name]
@@ -317,7 +325,10 @@ def platform_folder(version):
 
 def fmi_headers():
     """The folder of the FMI 2 and 3 C headers that ship with FMPy."""
-    import fmpy
+    try:
+        import fmpy
+    except ImportError:
+        raise ValueError("fmpy: not installed; it brings the FMI headers (pip install -e '.[dev]')") from None
     folder = pathlib.Path(fmpy.__file__).parent / "c-code"
     if not (folder / "fmi2Functions.h").is_file() or not (folder / "fmi3Functions.h").is_file():
         raise ValueError(f"fmpy: no FMI 2 and 3 headers under {folder} (install fmpy from PyPI)")
@@ -342,6 +353,12 @@ def _compile(cc, source, obj, includes):
     _run([cc, *CFLAGS, *(f"-I{d}" for d in includes), "-c", source, "-o", obj], f"compiling {source}")
 
 
+def include_dirs(build_dir):
+    """The include folders of the build: build_dir (the variable header), the FMI headers, the glue
+    and the library."""
+    return [pathlib.Path(build_dir), fmi_headers(), GLUE, *(ROOT / d for d in LIBRARY_INCLUDES)]
+
+
 def build(versions, out_dir, cc=None):
     """Writes the FMUs of the FMI `versions` (2, 3) under out_dir (`fmu_paths`); returns their paths.
     The library is compiled once for all of them."""
@@ -350,7 +367,7 @@ def build(versions, out_dir, cc=None):
     with tempfile.TemporaryDirectory() as tmp:
         tmp = pathlib.Path(tmp)
         (tmp / "sr_fmu_variables.h").write_text(variables_header())
-        includes = [tmp, fmi_headers(), GLUE, *(ROOT / d for d in LIBRARY_INCLUDES)]
+        includes = include_dirs(tmp)
         objects = []
         for k, source in enumerate([*library_sources(), GLUE / "sr_fmu.c"]):
             objects.append(tmp / f"{k}_{source.stem}.o")
@@ -400,18 +417,15 @@ def start_values(params, x0, method, step):
     if not np.allclose(R_S, [[c, -s, 0], [s, c, 0], [0, 0, 1]], rtol=0, atol=1e-12):
         raise ValueError(f"x0: R_S = {R_S.tolist()} is not a rotation about the vertical; the FMU starts "
                          f"from R_S = rot_z(yaw_S_0)")
-    values = {str(p): float(v) for p, v in zip(derive_parameters.PARAMETERS, _ordered(params.as_array()))}
+    names = [v.name for v in variables() if v.kind == "SR_FMU_PARAM"]
+    array = params.as_array()
+    values = {name: float(array[getattr(lib, f"SR_P_{name}")]) for name in names}
     values.update({"theta_Y_0": float(yoke_angle(x0)), "theta_P_0": float(pendulum_angle(x0)), "yaw_S_0": yaw,
                    "q_x_0": float(x0[IDX_Q][0]), "q_y_0": float(x0[IDX_Q][1]),
                    "w_S_x_0": float(x0[IDX_WS][0]), "w_S_y_0": float(x0[IDX_WS][1]),
                    "w_S_z_0": float(x0[IDX_WS][2]), "w_Y_0": float(x0[IDX_WY]), "w_P_0": float(x0[IDX_WP]),
                    "method": METHODS[method], "internal_step": float(step)})
     return values
-
-
-def _ordered(array):
-    """The parameter vector (SR_P_* order) in the order of derive's PARAMETERS."""
-    return [array[getattr(lib, f"SR_P_{p}")] for p in derive_parameters.PARAMETERS]
 
 
 def torque_signal(torques, dt):

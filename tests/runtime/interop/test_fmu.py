@@ -249,3 +249,43 @@ def test_the_fmus_sources_build_a_binary_that_computes_the_same(fmus, tmp_path):
     rebuilt = fmpy.simulate_fmu(str(unzipped), stop_time=1.0, output_interval=0.01, start_values=start)
     shipped = fmpy.simulate_fmu(str(fmus[3]), stop_time=1.0, output_interval=0.01, start_values=start)
     assert max(np.max(np.abs(rebuilt[n] - shipped[n])) for n in shipped.dtype.names) <= 1e-12
+
+
+def writable_objects(obj):
+    """The objects of a compiled file in writable sections: .data or .bss (not the relocated
+    read-only .data.rel.ro of position-independent constants)."""
+    import subprocess
+    table = subprocess.run(["objdump", "-t", str(obj)], check=True, capture_output=True, text=True).stdout
+    found = []
+    for line in table.splitlines():
+        fields = line.split()
+        if len(fields) >= 5 and "O" in fields[1:-3]:
+            section = fields[-3]
+            if section in ("*COM*", ".bss", ".data") or section.startswith((".bss.", ".data.")) and \
+                    not section.startswith(".data.rel.ro"):
+                found.append(f"{section} {fields[-1]}")
+    return found
+
+
+@pytest.mark.parametrize("glue", ["sr_fmu.c", "fmi2.c", "fmi3.c"])
+def test_the_glue_has_no_mutable_global(glue, tmp_path):
+    """Instances share nothing: no object of the glue lands in a writable section."""
+    if shutil.which("objdump") is None:
+        pytest.skip("objdump is not installed")
+    import subprocess
+    (tmp_path / "sr_fmu_variables.h").write_text(fmu.variables_header())
+    obj = tmp_path / "glue.o"
+    subprocess.run([shutil.which("cc") or "gcc", *fmu.CFLAGS, *(f"-I{d}" for d in fmu.include_dirs(tmp_path)),
+                    "-c", str(fmu.GLUE / glue), "-o", str(obj)], check=True)
+    assert writable_objects(obj) == []
+
+
+def test_the_scan_finds_a_mutable_global(tmp_path):
+    import subprocess
+    source = tmp_path / "globals.c"
+    source.write_text("int counter;\nint seeded = 3;\nstatic int hidden;\nint *touch(void) { return &hidden; }\n"
+                      "const char *const names[] = {\"a\"};\n")
+    subprocess.run([shutil.which("cc") or "gcc", "-fPIC", "-fno-common", "-c", str(source), "-o",
+                    str(tmp_path / "globals.o")], check=True)
+    assert sorted(name.split()[-1] for name in writable_objects(tmp_path / "globals.o")) == [
+        "counter", "hidden", "seeded"]
