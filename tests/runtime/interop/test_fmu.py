@@ -244,7 +244,7 @@ def test_the_fmus_sources_build_a_binary_that_computes_the_same(fmus, tmp_path):
     fmpy.extract(str(fmus[3]), str(unzipped))
     shutil.rmtree(unzipped / "binaries")
     (tmp_path / "build").mkdir()
-    build_platform_binary(unzipped, build_dir=tmp_path / "build")
+    build_platform_binary(unzipped, build_dir=tmp_path / "build", configuration="Debug")   # -O0: quicker
     start = {"theta_P_0": 0.5, "method": 2}
     rebuilt = fmpy.simulate_fmu(str(unzipped), stop_time=1.0, output_interval=0.01, start_values=start)
     shipped = fmpy.simulate_fmu(str(fmus[3]), stop_time=1.0, output_interval=0.01, start_values=start)
