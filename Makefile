@@ -6,7 +6,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 C_SOURCES := $(wildcard generated/*.c generated/*.h c/include/*.h c/src/*.c c/src/*.h)
 
-.PHONY: install test run generate verify bench sweep-bench figures soak fuzz c-lib c-test clean control envelope docs
+.PHONY: install test run generate verify bench sweep-bench figures soak fuzz c-lib c-test clean control envelope docs fmu
 
 $(STAMP): pyproject.toml setup.py bindings/build_sr.py bindings/fastcall.c $(C_SOURCES)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -62,6 +62,11 @@ docs: $(STAMP)
 	$(PY) docs/build_python_api.py out/docs/python runtime
 	command -v doxygen >/dev/null || bash .ci/install-doxygen
 	doxygen docs/Doxyfile
+
+# The robot as FMI 2.0 and FMI 3.0 co-simulation FMUs: out/fmu/SphericalRobot.fmu and
+# out/fmu/fmi3/SphericalRobot.fmu (docs/interop.md).
+fmu: $(STAMP)
+	$(PY) -m runtime export-fmu --out out/fmu
 
 soak: $(STAMP)
 	$(PY) -m runtime soak

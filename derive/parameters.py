@@ -74,6 +74,42 @@ PARAMETERS = (r, m_S, j_S, k_S, m_Y, *vector("c_Y"), *_tensor_symbols("J_Y"), k_
               m_P, *vector("c_P"), *_tensor_symbols("J_P"), k_P, j_mY, n_Y, j_mP, n_P, g, slope)
 
 
+#: What each parameter is and its unit (SI; FMI unit syntax: "kg.m2", "N.m.s/rad", "1" for a pure
+#: number), by name: a centre's (_x, _y, _z) and a tensor's (_xx .. _yz) entries share their
+#: parameter's.  Read by the FMU's model description (runtime/interop/fmu.py).
+PARAMETER_MEANINGS = {
+    "r": ("m", "shell radius"),
+    "m_S": ("kg", "shell mass"),
+    "j_S": ("kg.m2", "shell inertia about its centre (isotropic)"),
+    "k_S": ("N.m.s/rad", "shell damping (torque -k_S w_S)"),
+    "m_Y": ("kg", "yoke mass"),
+    "c_Y": ("m", "yoke centre of mass, yoke frame, from the shell centre"),
+    "J_Y": ("kg.m2", "yoke inertia tensor about its centre of mass, yoke frame"),
+    "k_Y": ("N.m.s/rad", "yoke joint damping"),
+    "m_P": ("kg", "pendulum mass"),
+    "c_P": ("m", "pendulum centre of mass, pendulum frame, from its hinge at the shell centre"),
+    "J_P": ("kg.m2", "pendulum inertia tensor about its centre of mass, pendulum frame"),
+    "k_P": ("N.m.s/rad", "pendulum joint damping"),
+    "j_mY": ("kg.m2", "yoke motor rotor inertia about its axis"),
+    "n_Y": ("1", "yoke motor gear ratio (rotor speed relative to the shell / joint speed)"),
+    "j_mP": ("kg.m2", "pendulum motor rotor inertia about its axis"),
+    "n_P": ("1", "pendulum motor gear ratio (rotor speed relative to the yoke / joint speed)"),
+    "g": ("m/s2", "gravitational acceleration"),
+    "slope": ("rad", "inclination of the floor (the plane's x axis points up the slope)"),
+}
+
+
+def meaning(name):
+    """(unit, description) of a parameter of PARAMETERS by its name, e.g. "J_Y_xy"."""
+    if name in PARAMETER_MEANINGS:
+        return PARAMETER_MEANINGS[name]
+    base, _, entry = name.rpartition("_")
+    if base in PARAMETER_MEANINGS and entry in ("x", "y", "z", *_TENSOR_ENTRIES):
+        unit, text = PARAMETER_MEANINGS[base]
+        return unit, f"{text}: entry {entry}"
+    raise KeyError(f"{name}: no unit in PARAMETER_MEANINGS")
+
+
 def derived_constants():
     """Section 2.3 and eq. (35): derived constant -> expression in the paper's parameters."""
     return {

@@ -27,7 +27,20 @@ STATE_BLOCKS = (
 #: The entries of u: (name, index), emitted as SR_U_<name>.
 INPUT_NAMES = (("u_Y", 0), ("u_P", 1))
 
-#: The error (tangent) state d, right-trivialised: x ⊕ d is R_S Exp(⟦d_xi_S⟧),
+#: What each block of x and each input is, with its unit (SI, FMI unit syntax; "1" for the
+#: entries of a rotation matrix).  Read by the FMU's model description (runtime/interop/fmu.py).
+STATE_MEANINGS = {
+    "R_S": ("1", "shell attitude, shell frame to plane frame (row-major)"),
+    "R_Y": ("1", "yoke attitude relative to the shell, a rotation about x (row-major)"),
+    "R_P": ("1", "pendulum attitude relative to the yoke, a rotation about y (row-major)"),
+    "q": ("m", "shell centre in the plane frame (q_z = r)"),
+    "w_S": ("rad/s", "shell angular velocity in the shell frame"),
+    "w_Y": ("rad/s", "yoke speed relative to the shell"),
+    "w_P": ("rad/s", "pendulum speed relative to the yoke"),
+}
+INPUT_MEANINGS = {"u_Y": ("N.m", "yoke motor torque"), "u_P": ("N.m", "pendulum motor torque")}
+
+#: The error (tangent) state d right-trivialised: x ⊕ d is R_S Exp(⟦d_xi_S⟧),
 #: R_Y Exp(d_th_Y Σ_Y), R_P Exp(d_th_P Σ_P), q + (d_q, 0), ν + d_nu.  (name, offset, length),
 #: emitted as SR_E_<name> and SR_GEN_NE; the Jacobians of the dynamics and the steps use it.
 ERROR_BLOCKS = (("xi_S", 0, 3), ("th_Y", 3, 1), ("th_P", 4, 1), ("q", 5, 2), ("nu", 7, 5))

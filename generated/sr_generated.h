@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 6c4982832c7ecffc], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 957fd9ca5d555706], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/include/spherical_robot.h.

@@ -13,6 +13,7 @@ COMMANDS = {
     "figures": ("runtime.scenarios.figures", "regenerate the committed figures under docs/figures/"),
     "sweep": ("runtime.sweep.cli", "many runs of a scenario with varied inputs, on Dask (results in Parquet)"),
     "control": ("runtime.control.benchmark", "closed-loop benchmark: every controller on every task (make control)"),
+    "export-fmu": ("runtime.interop.fmu", "build the robot as FMI 2.0 and 3.0 co-simulation FMUs (make fmu)"),
     "soak": ("runtime.verification.soak", "10^7 steps from random states: constraint and energy drift (not a unit test)"),
     "errata": ("runtime.verification.errata", "the paper's printed formulas against the kernels (docs/errata.md)"),
     "stability": ("runtime.stability", "eigenvalues and Floquet exponents; writes docs/figures/rolling-stability.png"),
