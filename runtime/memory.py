@@ -64,14 +64,14 @@ def check(where, parts, budget=None):
     """The total of `parts` ({what: bytes}) if it fits `budget` (default `budget_bytes()`);
     otherwise MemoryBudgetExceeded("<where>: ...") naming the total, the largest parts and the budget."""
     needed = int(sum(parts.values()))
+    source = f" (SR_MEMORY_FRACTION = {fraction():g} of the memory available)" if budget is None else ""
     budget = budget_bytes() if budget is None else int(budget)
     if needed > budget:
         largest = sorted(parts.items(), key=lambda item: -item[1])[:3]
         detail = ", ".join(f"{what} {gib(n)}" for what, n in largest if n > 0)
         raise MemoryBudgetExceeded(
             f"{where}: the run needs about {gib(needed)} ({detail}), more than the memory budget of "
-            f"{gib(budget)} (SR_MEMORY_FRACTION = {fraction():g} of the memory available); "
-            f"shorten the run or raise SR_MEMORY_FRACTION", needed, budget)
+            f"{gib(budget)}{source}; shorten the run or raise SR_MEMORY_FRACTION", needed, budget)
     return needed
 
 
