@@ -56,7 +56,8 @@ def memory_estimate(spec, samples_per_task, at_once=1):
     chunks read back, their concatenation and the Parquet file's buffers: three copies of one
     float64 per sample and column) and the arrays of `at_once` tasks of `samples_per_task`
     samples running at once (parameters, initial and final states, a torque program per sample
-    when a torque factor varies, the result columns)."""
+    when a torque factor varies, the result columns), and the unvaried scenario's run that the
+    summary's figure marks."""
     columns = len(column_names(spec))
     steps = spec.scenario.steps
     per_sample = 8 * (lib.SR_NPARAM + 2 * NX + columns + 2 * (len(spec.quantities) + 1))
@@ -64,7 +65,8 @@ def memory_estimate(spec, samples_per_task, at_once=1):
         per_sample += 8 * NU * steps
     return {"result table": 3 * 8 * spec.samples * columns,
             "tasks": at_once * min(samples_per_task, spec.samples) * per_sample,
-            "torque program": 8 * NU * (steps + 1)}
+            "torque program": 8 * NU * (steps + 1),
+            "nominal run": memory.trajectory_bytes(steps)}
 
 
 def check_memory(spec, samples_per_task, at_once=1, budget=None):

@@ -268,9 +268,10 @@ def _check_grid_values(spec, source):
 
 
 def _count(value, where):
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= MAX_SAMPLES:
-        raise ValueError(f"{where}: expected a whole number from 1 to {MAX_SAMPLES}, got {value!r}")
-    return int(value)
+    rng = SWEEP_RANGES[""]["samples"]
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise ValueError(f"{where}: expected {rng}, got {value!r}")
+    return int(check_range(int(value), rng, where))
 
 
 # -- the inputs of samples start..stop-1 ----------------------------------------------------------
