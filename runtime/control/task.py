@@ -258,11 +258,12 @@ def parse_task(data, source="<task>", name="task"):
 def _parse_estimator(table, source):
     where = f"{source}: estimator"
     check_table(table, {"kind", *ESTIMATOR_SETTINGS}, where)
-    check_ranges(table, TASK_RANGES["estimator"], where)
     if table.get("kind") != "ekf":
         raise ValueError(f"{where}.kind: expected \"ekf\", got {table.get('kind')!r}")
-    return EkfSettings(**{k: _real(v, f"{where}.{k}", positive=k != "rate", nonnegative=k == "rate")
-                          for k, v in table.items() if k != "kind"})
+    settings = EkfSettings(**{k: _real(v, f"{where}.{k}", positive=k != "rate", nonnegative=k == "rate")
+                              for k, v in table.items() if k != "kind"})
+    check_ranges(table, TASK_RANGES["estimator"], where)
+    return settings
 
 
 def _real(value, where, positive=False, nonnegative=False):
