@@ -22,6 +22,7 @@ import tomllib
 
 import numpy as np
 
+from . import memory
 from . import model as _model_module
 from .errors import SimulationStopped
 from .model import Model
@@ -29,7 +30,7 @@ from .params import NAMES as PARAM_NAMES
 from .params import PAPER_NAMES, SHAPES, Params
 from .so3 import rot_x, rot_y
 from .state import IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NU, NX
-from .schema import check_table, show
+from .schema import Range, check_ranges, check_table, show
 from .validation import ROTATION_TOL, describe_state
 
 #: The paper's simulations in the order of Section 5.3 (`run all` runs them in this order).
@@ -41,6 +42,40 @@ PRESETS = {"paper": Params.paper, "paper_simulation": Params.paper_simulation}
 #: Largest number of steps of a run (runtime.model.MAX_STEPS, the one limit): a larger `steps`
 #: (or duration / dt) is an error, not a MemoryError.
 MAX_STEPS = _model_module.MAX_STEPS
+
+_ANGLE = Range(-1e3, 1e3, "rad", "an angle: further out its rotation keeps too few digits")
+_RATE = Range(-1e3, 1e3, "rad/s", "a rate: 10,000 turns a minute, far past any motor")
+_TORQUE = Range(-1e3, 1e3, "N m", "a motor torque: the paper's motors give 0.5-2 N m")
+_TIME = Range(0, 1e6, "s", "a time within a run: at most MAX_STEPS steps of at most 1 s, in practice far less")
+#: The ranges of a robot's parameters (robot files, `[params]` of scenario and `[plant]` of task
+#: files), by the general names and the paper's, each entry of a vector or tensor alike.  Which
+#: values make a robot at all is C's parameter check; these bound what is computable.
+ROBOT_RANGES = {
+    **{name: Range(0, 100, "m", "a length: a robot of up to 100 m") for name in ("r", "b", "h", "l")},
+    **{name: Range(0, 1e6, "kg", "a mass: up to 1000 t") for name in ("m_S", "m_Y", "m_P", "m_b", "m_h")},
+    **{name: Range(0, 1e6, "kg m^2", "an inertia") for name in ("j_S", "j_mY", "j_mP")},
+    **{name: Range(-1e6, 1e6, "kg m^2", "an inertia tensor's entry") for name in ("J_Y", "J_P")},
+    **{name: Range(-100, 100, "m", "a centre of mass, inside a robot of up to 100 m") for name in ("c_Y", "c_P")},
+    **{name: Range(0, 1e6, "N m s/rad", "a damping coefficient") for name in ("k_S", "k_Y", "k_P")},
+    **{name: Range(-1e4, 1e4, "", "a gear ratio") for name in ("n_Y", "n_P")},
+    "g": Range(0, 1e3, "m/s^2", "gravity: 100 g at most"),
+    "slope": Range(-1.5707963267948966, 1.5707963267948966, "rad", "a floor's slope"),
+}
+#: The ranges of the numbers of a scenario file, by table ("" the top level).
+SCENARIO_RANGES = {
+    "": {"dt": Range(1e-9, 1.0, "s", "below 1 ns a step moves the state by less than its rounding; "
+                                     "above 1 s no integrator follows the robot"),
+         "steps": Range(1, MAX_STEPS, "", "the trajectory is kept in memory (MAX_STEPS)", whole=True),
+         "duration": Range(0, 1e6, "s", "at most MAX_STEPS steps of at most 1 s", open_low=True)},
+    "params": ROBOT_RANGES,
+    "initial": {"theta_Y": _ANGLE, "theta_P": _ANGLE, "R_S": Range(-1, 1, "", "a rotation's entry"),
+                "R_Y": Range(-1, 1, "", "a rotation's entry"), "R_P": Range(-1, 1, "", "a rotation's entry"),
+                "q": Range(-1e6, 1e6, "m", "a position: 1000 km from the origin at most"),
+                "w_S": _RATE, "w_Y": _RATE, "w_P": _RATE},
+    "torque": {"from_step": Range(1, MAX_STEPS, "", "a step of the run", whole=True),
+               "to_step": Range(1, MAX_STEPS, "", "a step of the run", whole=True),
+               "from_time": _TIME, "to_time": _TIME, "u_Y": _TORQUE, "u_P": _TORQUE},
+}
 
 _TOP_KEYS = {"description", "dt", "steps", "duration", "method", "params", "initial", "torque"}
 _INITIAL_KEYS = {"theta_Y", "theta_P", "R_S", "R_Y", "R_P", "q", "w_S", "w_Y", "w_P"}
@@ -186,8 +221,19 @@ def parse_scenario(data, source="<scenario>", name="scenario"):
     if problem is not None:
         raise ValueError(f"{source}: initial: {problem}")
     torques = _parse_torques(data.get("torque", []), dt, steps, source)
+    check_scenario_ranges(data, source)
     return Scenario(name=name, source=source, params=params, x0=x0, dt=dt, steps=steps,
                     method=method, torques=torques, description=description)
+
+
+def check_scenario_ranges(data, source):
+    """Every number of the scenario table `data` inside its range of `SCENARIO_RANGES`."""
+    check_ranges(data, SCENARIO_RANGES[""], source, sep=": ")
+    check_ranges(data.get("params"), ROBOT_RANGES, f"{source}: params")
+    check_ranges(data.get("initial"), SCENARIO_RANGES["initial"], f"{source}: initial")
+    windows = data.get("torque", [])
+    for i, window in enumerate(windows if isinstance(windows, list) else [], start=1):
+        check_ranges(window, SCENARIO_RANGES["torque"], f"{source}: torque[{i}]")
 
 
 def _scenario_dir():
@@ -224,6 +270,7 @@ def _load_robot(path, source):
         table = tomllib.loads(full.read_text())
     except (OSError, tomllib.TOMLDecodeError) as exc:
         raise ValueError(f"robot: cannot read {full}: {exc}") from None
+    check_ranges(table, ROBOT_RANGES, str(full), sep=": ")
     unknown = sorted(set(table) - set(PARAM_NAMES))
     if unknown:
         raise ValueError(f"robot: {full}: unknown key(s) {', '.join(map(repr, unknown))}; allowed: "
@@ -378,13 +425,26 @@ def _rotation(table, key, where, axis):
 
 
 # -- running ------------------------------------------------------------------------------
+def memory_estimate(scenario):
+    """{what: bytes} of the arrays a run of `scenario` holds (runtime/memory.py)."""
+    return {"trajectory": memory.trajectory_bytes(scenario.steps)}
+
+
+def check_memory(scenario, budget=None):
+    """The bytes a run of `scenario` needs, or memory.MemoryBudgetExceeded naming the file when they
+    exceed `budget` (default: the memory budget)."""
+    return memory.check(scenario.source, memory_estimate(scenario), budget)
+
+
 def run_scenario(scenario, progress=None):
     """Simulate `scenario`; `progress(done_steps, total_steps)` is called every few thousand steps.
 
     The loop stays in C (`Model.simulate`, with its guards).  If a guard stops the
     run, the `SimulationStopped` exception propagates with `.result`: a `Result`
-    holding the rows computed before the failing step (see docs/robustness.md).
+    holding the rows computed before the failing step (see docs/robustness.md).  A run whose
+    arrays would not fit the memory budget is refused first (`check_memory`).
     """
+    check_memory(scenario)
     started = time.perf_counter()
     model = Model(scenario.params)
     steps = scenario.steps

@@ -12,6 +12,7 @@ import json
 import platform
 import subprocess
 import pathlib
+import sys
 
 from tqdm.auto import tqdm
 
@@ -35,7 +36,9 @@ def cpu_name():
 
 
 def run_task(task, progress=False):
-    """(ClosedLoopResult, reference, tracking metrics) of one task."""
+    """(ClosedLoopResult, reference, tracking metrics) of one task; memory.MemoryBudgetExceeded
+    before anything is built if the run would not fit the memory budget."""
+    task.check_memory()
     reference = task.reference()
     result = simulate_closed_loop(task.plant_params, task.controller(), reference, task.scenario.x0,
                                   task.duration, task.scenario.dt, task.scenario.method, task.noise, progress,
@@ -65,7 +68,8 @@ def main(argv=()):
     try:
         tasks = [load_task(name) for name in args.tasks.split(",")]
     except ValueError as exc:
-        parser.error(str(exc))
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     # A run's folder is named after its task's name (a task file's stem), never its path: every run
     # lands under --out, whichever folder the task file is in.
     names = [task.name for task in tasks]
@@ -78,10 +82,17 @@ def main(argv=()):
         parser.error(f"--out: cannot create the folder {out} ({exc.strerror})")
     rows = []
     runs = [(task.name, task.with_controller(kind)) for task in tasks for kind in task.controller_kinds]
+    if args.duration is not None:
+        runs = [(name, dataclasses.replace(task, scenario=dataclasses.replace(
+            task.scenario, steps=max(1, round(min(args.duration, task.duration) / task.scenario.dt)))))
+            for name, task in runs]
+    try:                                # every run is sized before the first starts
+        for _, task in runs:
+            task.check_memory()
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
     for name, task in tqdm(runs, unit="run"):
-        if args.duration is not None:
-            steps = max(1, round(min(args.duration, task.duration) / task.scenario.dt))
-            task = dataclasses.replace(task, scenario=dataclasses.replace(task.scenario, steps=steps))
         result, reference, metrics = run_task(task)
         folder = out / f"{name}-{task.controller_kind}"
         folder.mkdir(exist_ok=True)

@@ -98,6 +98,25 @@ class Path:
         return out
 
 
+def path_points(kind, length, radius=None, size=None, start=None, points=None, ds=PATH_DS):
+    """How many samples the path of `kind` covering `length` m has (as the functions below build
+    it; None for a speed or heading reference): what a task's memory estimate reads before
+    anything is built."""
+    if kind == "line":
+        return (length + 1.0) / ds + 1
+    if kind == "circle":
+        laps = math.ceil(length / (2 * math.pi * radius)) + 1
+        return 2 * math.pi * radius * laps / ds + 2
+    if kind == "figure8":
+        laps = math.ceil(length / (4 * math.pi * size)) + 1
+        return 2 * laps * (2 * math.pi * size / ds + 2)
+    if kind == "waypoints":
+        corners = np.vstack([np.asarray(start, dtype=np.float64)[None, :2], np.asarray(points, dtype=np.float64)])
+        legs = np.hypot(*np.diff(corners, axis=0).T)
+        return float(np.sum(np.maximum(legs / ds, 1.0))) + 2.0 / ds + 1
+    return None
+
+
 def _arc(center, radius, start_angle, sweep, ds=PATH_DS):
     n = max(int(abs(sweep) * radius / ds), 2)
     a = start_angle + np.linspace(0.0, sweep, n + 1)

@@ -15,21 +15,25 @@ import tomllib
 
 import numpy as np
 
+from bindings._sr import lib
+
+from .. import memory
 from ..params import NAMES as PARAM_NAMES
 from ..params import PAPER_NAMES, SHAPES
-from ..scenario import parse_scenario
-from ..schema import check_table
+from ..scenario import ROBOT_RANGES, parse_scenario
+from ..schema import Range, check_ranges, check_table
 from .closed_loop import Noise
 from .controller import DEFAULT_U_MAX
 from .geometry import heading
 from .lqr import GAIN_NAMES as LQR_GAIN_NAMES
 from .lqr import Lqr, LqrGains
 from .nmpc import GAIN_NAMES as NMPC_GAIN_NAMES
+from .nmpc import NZ_N as NMPC_NZ
 from .nmpc import Nmpc, NmpcGains
 from .estimator import SETTING_NAMES as ESTIMATOR_SETTINGS
 from .estimator import Ekf, EkfSettings
 from .pid import GAIN_NAMES, Pid, PidGains
-from .reference import KINDS, SpeedHeading, circle_path, figure8_path, line_path, waypoints_path
+from .reference import KINDS, SpeedHeading, path_points, circle_path, figure8_path, line_path, waypoints_path
 from ..state import IDX_Q
 
 #: Controller kinds: (class, its settings, the settings' names).
@@ -40,6 +44,60 @@ _SCENARIO_KEYS = {"description", "dt", "duration", "steps", "method", "params", 
 _REFERENCE_KEYS = {"kind", "speed", "heading", "offset", "radius", "size", "points"}
 _NEEDS = {"speed": ("speed",), "heading": ("speed", "heading"), "line": ("speed", "offset"),
           "circle": ("speed", "radius"), "figure8": ("speed", "size"), "waypoints": ("speed", "points")}
+_ERROR_SIZE = Range(1e-6, 1e6, "", "a Bryson error size (its unit: the key's); 0 or a huge one makes the Riccati "
+                    "weights singular")
+_PID_GAIN = Range(0, 1e6, "", "a gain (its unit: docs/control.md)")
+_LQR_RANGES = {
+    **{name: _ERROR_SIZE for name in ("tilt_rad", "attitude_rad", "pendulum_rad", "rolling_rate_rad_s", "rate_rad_s",
+                                      "joint_rate_rad_s", "cross_track_m", "cross_track_integral_m_s",
+                                      "speed_integral_rad", "integral_zone_m")},
+    "v_min": Range(0, 10, "m/s", "the design grid's speeds"), "v_max": Range(0, 10, "m/s", "the design grid's speeds"),
+    "n_speeds": Range(1, lib.SR_LQR_MAX_SPEEDS, "", "the C controller's grid holds SR_LQR_MAX_SPEEDS", whole=True),
+    "kappa_max": Range(0, 100, "1/m", "a turn of 1 cm radius at most"),
+    "n_curvatures": Range(1, lib.SR_LQR_MAX_CURVATURES, "", "the C controller's grid holds SR_LQR_MAX_CURVATURES",
+                          whole=True),
+    "kappa_rate": Range(0, 1e4, "1/(m s)", "how fast the operating point may follow the path"),
+    "preview_m": Range(0, 100, "m", "a preview along the path"),
+    "smoothing_m": Range(0, 100, "m", "a smoothing window along the path"),
+}
+#: The ranges of the numbers of a task file beyond its scenario's (runtime/scenario.py's
+#: SCENARIO_RANGES): by table, the controllers' settings by kind ("controller.<kind>").
+TASK_RANGES = {
+    "reference": {"speed": Range(-10, 10, "m/s", "the robot's speed: 10 m/s is 5 turns a second of a 0.3 m shell"),
+                  "heading": Range(-1e3, 1e3, "rad", "an angle: further out it keeps too few digits"),
+                  "offset": Range(-1e3, 1e3, "m", "a line's offset from the start"),
+                  "radius": Range(0.05, 1e3, "m", "a circle: tighter than 5 cm no robot turns; its path table "
+                                                  "holds a point every 5 mm"),
+                  "size": Range(0.05, 1e3, "m", "a figure eight's lobe radius, as a circle's"),
+                  "points": Range(-1e4, 1e4, "m", "a waypoint: its legs are tabled every 5 mm")},
+    "controller": {"rate": Range(0.01, 1e4, "Hz", "a sampling rate: its period is a whole number of steps dt"),
+                   "u_max": Range(1e-6, 100, "N m", "a torque limit: the paper's motors give 0.5-2 N m")},
+    "controller.pid": {**{name: _PID_GAIN for name in ("k_v", "k_vi", "k_y", "k_psi", "k_r", "k_ri", "k_phi",
+                                                      "k_phii", "k_phid")},
+                       "phi_max": Range(0, 1.5, "rad", "a lean short of lying on the side")},
+    "controller.lqr": _LQR_RANGES,
+    "controller.nmpc": {**_LQR_RANGES,
+                        "torque_step_n_m": Range(1e-6, 1e6, "N m", "a torque change worth the full cost"),
+                        "horizon": Range(1, 200, "", "nodes of the horizon: the QP has 2N unknowns and a dense "
+                                                     "(2N)^2 Hessian", whole=True),
+                        "node_periods": Range(1, 100, "", "controller periods per node", whole=True),
+                        "iterations": Range(1, 100, "", "real-time iterations per sample: each solves a QP",
+                                            whole=True)},
+    "estimator": {"position_m": Range(1e-9, 1e3, "m", "a standard deviation"),
+                  "attitude_rad": Range(1e-9, 10, "rad", "a standard deviation"),
+                  "joint_rad": Range(1e-9, 10, "rad", "a standard deviation"),
+                  "rate_rad_s": Range(1e-9, 1e3, "rad/s", "a standard deviation"),
+                  "accel_rad_s2": Range(1e-9, 1e4, "rad/s^2/sqrt(Hz)", "a process noise"),
+                  "rate": Range(0, 1e5, "Hz", "the sensors' rate (0: the controller's)")},
+    "plant": {**ROBOT_RANGES,
+              "noise_position_m": Range(0, 1e3, "m", "a standard deviation"),
+              "noise_attitude_rad": Range(0, 10, "rad", "a standard deviation"),
+              "noise_rate_rad_s": Range(0, 1e3, "rad/s", "a standard deviation"),
+              "noise_seed": Range(0, 2**63 - 1, "", "a seed of NumPy's generator", whole=True)},
+}
+#: Bytes per sample of a path table: points (2), arc length, tangent, curvature, and the
+#: differences, segment lengths and turns that build them.
+PATH_ROW_BYTES = 12 * 8
 _NOISE_KEYS = {"noise_position_m": "position_m", "noise_attitude_rad": "attitude_rad",
                "noise_rate_rad_s": "rate_rad_s", "noise_seed": "seed"}
 
@@ -99,12 +157,41 @@ class Task:
         """The `[estimator]` on the controller's model (never the plant's), or None."""
         return None if self.estimator is None else Ekf(self.scenario.params, self.estimator)
 
+    def path_length(self):
+        """The length [m] of path a run needs: the distance at the reference speed and 2 m more."""
+        return abs(self.reference_spec["speed"]) * self.duration + 2.0
+
+    def memory_estimate(self):
+        """{what: bytes} of the largest arrays a run of the task holds (runtime/memory.py): the
+        plant's trajectory and torques, the estimates, the path table (its points, arc lengths,
+        tangents, curvatures and the temporaries that build them), the NMPC's condensed problem."""
+        steps = self.scenario.steps
+        parts = {"trajectory": memory.trajectory_bytes(steps)}
+        spec, x0 = self.reference_spec, self.scenario.x0
+        points = path_points(spec["kind"], self.path_length(), spec.get("radius"), spec.get("size"),
+                             x0[IDX_Q][:2], spec.get("points"))
+        if points is not None:
+            parts["path table"] = points * PATH_ROW_BYTES
+        if self.estimator is not None:
+            parts["estimates"] = (steps + 1) * memory.STATE_ROW_BYTES
+        nmpc = [c for c in self.controllers if c.kind == "nmpc"]
+        if nmpc:
+            n = max(int(c.gains.horizon) for c in nmpc)
+            nz, nu = NMPC_NZ, 2 * n
+            parts["NMPC problem"] = 8 * (3 * (n + 1) * nz * nu + 4 * nu * nu + 3 * n * nz * (nz + 2))
+        return parts
+
+    def check_memory(self, budget=None):
+        """The bytes a run needs, or memory.MemoryBudgetExceeded naming the file when they exceed
+        `budget` (default: the memory budget)."""
+        return memory.check(self.source, self.memory_estimate(), budget)
+
     def reference(self):
         """The reference, built from the start pose (paths start at the robot, tangent to its heading)."""
         spec, x0 = self.reference_spec, self.scenario.x0
         start, psi0 = x0[IDX_Q][:2], float(heading(x0))
         speed = spec["speed"]
-        length = abs(speed) * self.duration + 2.0
+        length = self.path_length()
         kind = spec["kind"]
         if kind == "speed":
             return SpeedHeading(speed, spec.get("heading", psi0))
@@ -173,8 +260,10 @@ def _parse_estimator(table, source):
     check_table(table, {"kind", *ESTIMATOR_SETTINGS}, where)
     if table.get("kind") != "ekf":
         raise ValueError(f"{where}.kind: expected \"ekf\", got {table.get('kind')!r}")
-    return EkfSettings(**{k: _real(v, f"{where}.{k}", positive=k != "rate", nonnegative=k == "rate")
-                          for k, v in table.items() if k != "kind"})
+    settings = EkfSettings(**{k: _real(v, f"{where}.{k}", positive=k != "rate", nonnegative=k == "rate")
+                              for k, v in table.items() if k != "kind"})
+    check_ranges(table, TASK_RANGES["estimator"], where)
+    return settings
 
 
 def _real(value, where, positive=False, nonnegative=False):
@@ -194,6 +283,7 @@ def _parse_reference(table, source):
     if table is None:
         raise ValueError(f"{where}: missing (required): give kind = one of {', '.join(KINDS)}")
     check_table(table, _REFERENCE_KEYS, where)
+    check_ranges(table, TASK_RANGES["reference"], where)
     kind = table.get("kind")
     if kind not in KINDS:
         raise ValueError(f"{where}.kind: expected one of {', '.join(KINDS)}, got {kind!r}")
@@ -229,6 +319,7 @@ def _parse_controller(table, source, name="controller"):
         raise ValueError(f"{where}.kind: expected one of {', '.join(CONTROLLER_KINDS)}, got {kind!r}")
     _, gains_cls, gain_names = AVAILABLE_CONTROLLERS[kind]
     check_table(table, {"kind", "rate", "u_max", *gain_names}, where)
+    check_ranges(table, TASK_RANGES["controller"] | TASK_RANGES[f"controller.{kind}"], where)
     rate = _real(table.get("rate", 50.0), f"{where}.rate", positive=True)
     u_max = _real(table.get("u_max", DEFAULT_U_MAX), f"{where}.u_max", positive=True)
     try:
@@ -244,6 +335,7 @@ def _parse_controller(table, source, name="controller"):
 def _parse_plant(table, params, source):
     where = f"{source}: plant"
     check_table(table, set(PARAM_NAMES) | set(PAPER_NAMES) | set(_NOISE_KEYS), where)
+    check_ranges(table, TASK_RANGES["plant"], where)
     overrides = {k: (_real(v, f"{where}.{k}") if SHAPES.get(k, ()) == () else v)
                  for k, v in table.items() if k not in _NOISE_KEYS}
     try:

@@ -27,7 +27,7 @@ import sys
 from . import report
 from ..errors import KernelError, SimulationStopped
 from .parallel import RunBar, write_runs
-from ..scenario import PAPER_SCENARIOS, load_scenario, run_scenario, scenario_path, shipped_scenarios
+from ..scenario import PAPER_SCENARIOS, check_memory, load_scenario, run_scenario, scenario_path, shipped_scenarios
 
 
 def build_parser():
@@ -80,6 +80,8 @@ def run_many(names, args):
     is raised (the runs after it are not simulated)."""
     scenarios = [load_scenario(name).with_overrides(dt=args.dt, steps=args.steps, method=args.method)
                  for name in names]
+    for scenario in scenarios:          # before the first run: `all` does not stop half-way
+        check_memory(scenario)
     results, failure = [], None
     for scenario in scenarios:
         check_output_folder(args.out / scenario.name, args.force)

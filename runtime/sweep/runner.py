@@ -15,8 +15,12 @@ import time
 
 from tqdm.auto import tqdm
 
+from bindings._sr import lib
+
+from .. import memory
+from ..state import NU, NX
 from .store import BadRows, SweepStore
-from .task import run_chunk
+from .task import column_names, run_chunk
 
 #: Default wall time of one task: long against Dask's per-task cost (about a millisecond, see
 #: docs/sweeps.md), short enough that a lost worker or an interrupt costs little.
@@ -45,6 +49,30 @@ def scheduler_address(text):
     if not port.isdigit() or not 1 <= int(port) <= 65535:
         raise ValueError(f"{text!r}: the port {port!r} is not a number from 1 to 65535 ({expected})")
     return text
+
+
+def memory_estimate(spec, samples_per_task, at_once=1):
+    """{what: bytes} of a sweep's largest arrays here (runtime/memory.py): the result table (the
+    chunks read back, their concatenation and the Parquet file's buffers: three copies of one
+    float64 per sample and column) and the arrays of `at_once` tasks of `samples_per_task`
+    samples running at once (parameters, initial and final states, a torque program per sample
+    when a torque factor varies, the result columns), and the unvaried scenario's run that the
+    summary's figure marks."""
+    columns = len(column_names(spec))
+    steps = spec.scenario.steps
+    per_sample = 8 * (lib.SR_NPARAM + 2 * NX + columns + 2 * (len(spec.quantities) + 1))
+    if any(q.name.startswith("torque.") for q in spec.quantities):
+        per_sample += 8 * NU * steps
+    return {"result table": 3 * 8 * spec.samples * columns,
+            "tasks": at_once * min(samples_per_task, spec.samples) * per_sample,
+            "torque program": 8 * NU * (steps + 1),
+            "nominal run": memory.trajectory_bytes(steps)}
+
+
+def check_memory(spec, samples_per_task, at_once=1, budget=None):
+    """The bytes a sweep needs here, or memory.MemoryBudgetExceeded naming the sweep file when they
+    exceed `budget` (default: the memory budget)."""
+    return memory.check(spec.source, memory_estimate(spec, samples_per_task, at_once), budget)
 
 
 def warn(message):
@@ -124,7 +152,10 @@ def run_sweep(spec, out, scheduler=None, workers=None, samples_per_task=None, pr
         except ValueError as exc:
             raise ValueError(f"--scheduler: {exc}") from None
     per_task = samples_per_task or spec.samples_per_task
+    at_once = 1 if scheduler == SERIAL else (workers or os.cpu_count() or 1) if scheduler is None else 1
+    check_memory(spec, per_task or 1, at_once)
     store = SweepStore.open(out, spec, lambda: per_task or measure_samples_per_task(spec))
+    check_memory(spec, store.samples_per_task, at_once)
     todo, bad = store.verify()
     for path, why in bad:
         notify(f"{path}: {why}; recomputing it")

@@ -36,8 +36,8 @@ import numpy as np
 from bindings._sr import lib
 
 from ..params import PAPER_NAMES, Params, paper_rows_to_params
-from ..schema import check_table
-from ..scenario import Scenario, load_scenario
+from ..schema import Range, check_range, check_ranges, check_table
+from ..scenario import ROBOT_RANGES, SCENARIO_RANGES, Scenario, load_scenario
 from ..state import IDX_QZ, IDX_RP, IDX_RY, IDX_WP, IDX_WY, IDX_UP, IDX_UY, pendulum_angle, rot_x, rot_y, yoke_angle
 
 #: A sweep varies parameters by the paper's names (r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P,
@@ -56,6 +56,33 @@ MAX_SAMPLES = 10**9
 #: A normal draw is mean + sd z with |z| < 14 (NumPy's ziggurat: its tail ends near 3.65 + 36.7/3.65),
 #: so |mean| + NORMAL_REACH sd finite keeps every draw finite.
 NORMAL_REACH = 100.0
+
+#: A factor (`relative = true`) on a scenario's value.
+FACTOR = Range(-1e3, 1e3, "", "a factor on the scenario's value")
+#: The ranges of the numbers of a sweep file: its top level, and what a quantity's numbers may be
+#: (a value of `values`, `uniform` or a `normal`'s mean: the range of what it varies, a parameter's
+#: that of robot files (ROBOT_RANGES), FACTOR when `relative`; a normal's sd: at most that range's width).
+SWEEP_RANGES = {
+    "": {"samples": Range(1, MAX_SAMPLES, "", "the sample index is part of every seed; one result row each",
+                          whole=True),
+         "seed": Range(0, 2**63 - 1, "", "a seed of NumPy's generator", whole=True),
+         "samples_per_task": Range(1, MAX_SAMPLES, "", "a task's samples (its arrays are sized before the run)",
+                                   whole=True)},
+    "initial": {key: SCENARIO_RANGES["initial"][key] for key in INITIAL_KEYS},
+    "torque": {key: Range(-1e3, 1e3, "", "a factor on the scenario's torques") for key in TORQUE_KEYS},
+}
+
+
+def quantity_range(name, relative):
+    """The Range of the values of the quantity `name` ("params.m_P", "initial.w_Y", ...)."""
+    group, key = name.split(".", 1)
+    if relative:
+        return FACTOR
+    if group == "params":
+        base = key if key in ROBOT_RANGES else next(n for n in sorted(ROBOT_RANGES, key=len, reverse=True)
+                                                    if key.startswith(n + "_"))
+        return ROBOT_RANGES[base]
+    return SWEEP_RANGES[group][key]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -152,6 +179,7 @@ def parse_sweep(data, source="<sweep>", name="sweep", folder=None):
     per_task = data.get("samples_per_task")
     if per_task is not None:
         per_task = _count(per_task, f"{source}: samples_per_task")
+    check_ranges(data, SWEEP_RANGES[""], source, sep=": ")
     quantities = []
     groups = {"params": PARAM_KEYS, "initial": INITIAL_KEYS, "torque": TORQUE_KEYS}
     for group, allowed in groups.items():
@@ -209,6 +237,13 @@ def _quantity(name, table, where):
     relative = table.get("relative", False)
     if not isinstance(relative, bool):
         raise ValueError(f"{where}.relative: expected true or false, got {relative!r}")
+    rng = quantity_range(name, relative)
+    checked = numbers[:1] if kind == "normal" else numbers
+    for i, v in enumerate(checked):
+        check_range(v, rng, f"{where}.{kind}[{i}]")
+    if kind == "normal":
+        check_range(numbers[1], Range(0, rng.high - rng.low, rng.unit, "a spread within the range's width"),
+                    f"{where}.normal[1]")
     return Quantity(name=name, kind=kind, numbers=numbers, relative=relative)
 
 
@@ -233,9 +268,10 @@ def _check_grid_values(spec, source):
 
 
 def _count(value, where):
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= value <= MAX_SAMPLES:
-        raise ValueError(f"{where}: expected a whole number from 1 to {MAX_SAMPLES}, got {value!r}")
-    return int(value)
+    rng = SWEEP_RANGES[""]["samples"]
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise ValueError(f"{where}: expected {rng}, got {value!r}")
+    return int(check_range(int(value), rng, where))
 
 
 # -- the inputs of samples start..stop-1 ----------------------------------------------------------

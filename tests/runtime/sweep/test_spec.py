@@ -69,8 +69,8 @@ def test_bad_sweep_files_raise_value_errors_naming_the_key(tmp_path, change, mes
 
 
 def test_grid_values_must_make_valid_robots(tmp_path):
-    path = write_sweep(tmp_path, SWEEP + "\n[params.r]\nvalues = [0.3, -1.0]\n")
-    with pytest.raises(ValueError, match="params.r.values: -1 gives invalid parameters"):
+    path = write_sweep(tmp_path, SWEEP + "\n[params.r]\nvalues = [0.3, 0.0]\n")
+    with pytest.raises(ValueError, match="params.r.values: 0 gives invalid parameters"):
         load_sweep(path)
 
 
