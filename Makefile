@@ -4,9 +4,9 @@ PYTHON ?= python3
 VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
-C_SOURCES := $(wildcard generated/*.c generated/*.h c/*.c c/*.h)
+C_SOURCES := $(wildcard generated/*.c generated/*.h c/include/*.h c/src/*.c c/src/*.h)
 
-.PHONY: install test run generate verify bench sweep-bench figures soak fuzz c-lib c-test clean control envelope
+.PHONY: install test run generate verify bench sweep-bench figures soak fuzz c-lib c-test clean control envelope docs
 
 $(STAMP): pyproject.toml setup.py bindings/build_sr.py bindings/fastcall.c $(C_SOURCES)
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -22,9 +22,13 @@ test: $(STAMP)
 run: $(STAMP)
 	$(PY) -m runtime run all --out out --force
 
+# The SymPy-emitted kernels (byte-reproducible), the extension rebuilt on them, then the firmware
+# example's gain table (generated/lqr_task.h: an LQR design through LAPACK, whose last bits vary
+# with the CPU; tests/runtime/control/test_firmware.py holds it to a fresh design within 1e-7).
 generate: $(STAMP)
 	$(PY) -m derive
 	$(PY) -m pip install --quiet --no-deps -e .
+	$(PY) -m runtime firmware-table --out generated/lqr_task.h
 
 verify: $(STAMP)
 	$(PY) -m runtime verify
@@ -36,7 +40,7 @@ bench: $(STAMP)
 # Sweep throughput on Dask (1 and 2 workers), overhead against the C batch, per-task cost, bytes
 # per result: bench/results/sweep/<date>.json (docs/sweeps.md).
 sweep-bench: $(STAMP)
-	$(PY) -m runtime.sweep.bench
+	$(PY) -m runtime sweep-bench
 
 figures: $(STAMP)
 	$(PY) -m runtime figures
@@ -47,7 +51,17 @@ control: $(STAMP)
 
 # The envelope of docs/control.md (prints its numbers, rewrites docs/figures/control-envelope.png).
 envelope: $(STAMP)
-	$(PY) -m runtime.control.envelope
+	$(PY) -m runtime envelope
+
+# The API reference (docs/api.md): pdoc over the Python package into out/docs/python/, Doxygen
+# over the public C header into out/docs/c/ (installed from Debian when missing and we are root).
+# A warning of either fails the build.
+docs: $(STAMP)
+	rm -rf out/docs
+	mkdir -p out/docs
+	$(PY) docs/build_python_api.py out/docs/python runtime
+	command -v doxygen >/dev/null || bash .ci/install-doxygen
+	doxygen docs/Doxyfile
 
 soak: $(STAMP)
 	$(PY) -m runtime soak

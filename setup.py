@@ -7,7 +7,7 @@ from setuptools import Extension, setup
 fastcall = Extension(
     "bindings._fastcall",
     sources=["bindings/fastcall.c"],
-    include_dirs=["c", "generated", numpy.get_include()],
+    include_dirs=["c/include", "generated", numpy.get_include()],
     extra_compile_args=["-std=c99", "-O2"],
 )
 

@@ -44,7 +44,7 @@ static double now_ns(void)
 
 typedef int (*kernel_fn)(const sr_model *, int, int);
 static sr_model model;
-/* A robot of none of the paper's special geometry (issue 18): the general kernels, same states. */
+/* A robot of none of the paper's special geometry: the general kernels, same states. */
 static sr_model general_model;
 
 static int k_accel(const sr_model *m, int i, int arg) { (void)arg; return sr_accel(m, X[i], U[i], OUT[i]); }

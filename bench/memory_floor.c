@@ -1,4 +1,4 @@
-/* memory_floor.c -- the memory traffic of the batch accel on n states and nothing else (issue 21):
+/* memory_floor.c -- the memory traffic of the batch accel on n states and nothing else:
  * read the 35 entries of every state and its 2 torques, write 5 numbers per state, with no
  * arithmetic beyond the sums that keep the reads alive.  What a checked batch accel on states
  * that do not fit in the caches cannot beat on this core (docs/sweeps.md, "The memory floor").

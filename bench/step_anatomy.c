@@ -1,4 +1,4 @@
-/* step_anatomy.c -- where the time of a fourth-order step goes (issue 17, item 9), in a C loop
+/* step_anatomy.c -- where the time of a fourth-order step goes, in a C loop
  * over the benchmark's states (the input file of bench_kernels.c; only n, the parameters, the
  * states and the torques are read).  Prints one JSON object, ns per call, best of 11 rounds:
  *
@@ -11,7 +11,7 @@
  *   step_rkmk4, step_cf4        sr_step
  *
  * Built a second time with -DANATOMY_GLUE_ONLY (runtime/bench/harness.py): the library's steppers
- * (c/sr_steppers.c, included below) then call a stub in place of the dynamics, two flops per
+ * (c/src/sr_steppers.c, included below) then call a stub in place of the dynamics, two flops per
  * acceleration that keep the stages' dependence on the stage state, so step_rkmk4 and step_cf4
  * time everything a step does but the four accelerations: the state check, the group action
  * x . exp(th) (Rodrigues' and the one-axis exponentials), the kinematics, dexp^-1 and the tableau.

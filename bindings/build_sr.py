@@ -1,4 +1,4 @@
-"""cffi builder for `bindings._sr`: compiles generated/ and c/ into one extension module."""
+"""cffi builder for `bindings._sr`: compiles generated/ and c/src/ into one extension module."""
 import os
 import pathlib
 import re
@@ -9,11 +9,11 @@ import sysconfig
 import cffi
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-# Every C file of generated/ and the top level of c/ (examples and C tests live in subfolders).
-SOURCES = sorted(str(p.relative_to(ROOT)) for d in ("generated", "c") for p in (ROOT / d).glob("*.c"))
-INCLUDE_DIRS = ["generated", "c"]
+# Every C file of generated/ and c/src/ (the library; its public headers are in c/include/).
+SOURCES = sorted(str(p.relative_to(ROOT)) for d in ("generated", "c/src") for p in (ROOT / d).glob("*.c"))
+INCLUDE_DIRS = ["generated", "c/include"]
 
-HEADER = ROOT / "c" / "spherical_robot.h"
+HEADER = ROOT / "c" / "include" / "spherical_robot.h"
 
 
 def compiler():
@@ -22,9 +22,9 @@ def compiler():
 
 
 def preprocessed_header():
-    """(file, line) pairs of the double build of c/spherical_robot.h after the C preprocessor,
+    """(file, line) pairs of the double build of c/include/spherical_robot.h after the C preprocessor,
     the #define lines kept in place (-dD); file is the header each line comes from."""
-    out = subprocess.run([*compiler(), "-E", "-dD", "-std=c99", f"-I{ROOT / 'c'}", f"-I{ROOT / 'generated'}",
+    out = subprocess.run([*compiler(), "-E", "-dD", "-std=c99", f"-I{ROOT / 'c' / 'include'}", f"-I{ROOT / 'generated'}",
                           "-x", "c", str(HEADER)], check=True, capture_output=True, text=True).stdout
     current, lines = None, []
     for line in out.splitlines():
@@ -42,11 +42,11 @@ _FLOAT = re.compile(r"^\(?\s*(?:SR_C\()?\s*[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+
 
 def header_cdef():
     """The cdef cffi needs, read from the checked-in headers (no hand copy): the declarations
-    of c/ and generated/ as the preprocessor leaves them, every object-like SR_* macro whose
+    of c/include/ and generated/ as the preprocessor leaves them, every object-like SR_* macro whose
     value is an integer (directly or through other macros: SR_NX -> SR_GEN_NX -> 35) as a
     #define, and every one whose value is a floating literal (SR_ROTATION_TOL) as a
     `static const double` that cffi reads from the compiled module."""
-    ours = {str(d) for d in (ROOT / "c", ROOT / "generated")}
+    ours = {str(d) for d in (ROOT / "c" / "include", ROOT / "generated")}
     macros, declarations = {}, []
     for path, line in preprocessed_header():
         if not path or not any(os.path.abspath(path).startswith(d) for d in ours):
@@ -118,7 +118,7 @@ ffibuilder.set_source(
     # No FMA contraction: the firmware example (c/examples) must reproduce the Python runs bit for bit.
     # -O3: GCC vectorises the batch calls' lanes loops (sr_gen_accel_lanes) only with its full cost
     # model; without -ffast-math it changes no result (tests/bindings: batch == single, bit for bit).
-    # -DSR_CLONES: the batch loops also for AVX2, picked at load time (c/sr_real.h, SR_LANES_CLONES).
+    # -DSR_CLONES: the batch loops also for AVX2, picked at load time (c/include/sr_real.h, SR_LANES_CLONES).
     extra_compile_args=["-std=c99", "-O3", "-ffp-contract=off", "-DSR_CLONES", *NATIVE],
 )
 

@@ -1,4 +1,4 @@
-/* bindings._fastcall: the one-state fast path of Model.accel and Model.step (issue 17, item 8).
+/* bindings._fastcall: the one-state fast path of Model.accel and Model.step.
  *
  * Through cffi, each NumPy array passed to C costs an ffi.from_buffer (a buffer export and a
  * cdata object), and the output array an np.empty: together about three times the call of

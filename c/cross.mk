@@ -25,7 +25,7 @@ cross-test:
 	$(CROSS_ENV) sh cross/cross_test.sh $(BUILD)/cross
 
 cross-report:
-	python3 cross/m4_report.py --build $(BUILD)/cross/report --cross-prefix '$(CROSS_PREFIX)' --qemu '$(QEMU)' \
+	python3 ../tools/m4_report.py --build $(BUILD)/cross/report --cross-prefix '$(CROSS_PREFIX)' --qemu '$(QEMU)' \
 	    --update ../docs/embedding.md
 
 .PHONY: cross-clean

@@ -1,8 +1,8 @@
-"""The model as CasADi Functions (issue 19): accel and one step of each method on the group.
+"""The model as CasADi Functions: accel and one step of each method on the group.
 
 For CasADi and acados users: the same derivation as the C kernels (M and f of
 derive/dynamics.py, converted expression by expression to CasADi SX, ν̇ = M⁻¹ f), and
-the steppers of c/sr_steppers.c written in SX (Lie–Euler, RKMK4, CF4 on
+the steppers of c/src/sr_steppers.c written in SX (Lie–Euler, RKMK4, CF4 on
 SO(3) × SO(2) × SO(2) × ℝ³ × ℝ⁵, with the same Rodrigues coefficients, one-axis
 rotations, dexp⁻¹ and tableaux).  Every Function takes the parameters as an input
 vector p in SR_P_* order (derive.parameters.PARAMETERS), so one file serves any robot:
@@ -24,7 +24,7 @@ from . import parameters as P
 from . import robot as R
 from . import state as S
 
-# The series thresholds of c/sr_internal.h (SR_SERIES_T2) and of sr_internal_dexpinv.
+# The series thresholds of c/src/sr_so3.h (SR_SERIES_T2) and of sr_internal_dexpinv.
 SERIES_T2 = 0.0625
 
 
@@ -90,7 +90,7 @@ def accel_function():
 
 def cholesky_solve(M, f):
     """M⁻¹ f for the symmetric positive definite M by Cholesky, M = L Lᵀ: the factorisation the C
-    uses (c/sr_jacobians.c), better conditioned here than the symbolic QR of ca.solve."""
+    uses (c/src/sr_jacobians.c), better conditioned here than the symbolic QR of ca.solve."""
     n = M.shape[0]
     L = [[None] * n for _ in range(n)]
     for j in range(n):
@@ -107,14 +107,14 @@ def cholesky_solve(M, f):
     return ca.vertcat(*z)
 
 
-# ---- the group and its steppers (c/sr_steppers.c, same names) ----------------------------------
+# ---- the group and its steppers (c/src/sr_steppers.c, same names) ----------------------------------
 
 def _hat(w):
     return ca.vertcat(ca.horzcat(0, -w[2], w[1]), ca.horzcat(w[2], 0, -w[0]), ca.horzcat(-w[1], w[0], 0))
 
 
 def _series(t2, ratios, lead):
-    """lead (1 - t2/ratios[0] (1 - t2/ratios[1] (...))): the Horner form of sr_internal.h."""
+    """lead (1 - t2/ratios[0] (1 - t2/ratios[1] (...))): the Horner form of c/src/sr_so3.h."""
     out = 1
     for d in reversed(ratios):
         out = 1 - t2 * (1.0 / d) * out
@@ -170,7 +170,7 @@ def dexpinv(th, k):
     half = 0.5 * ca.sqrt(safe)
     t4 = t2 * t2
     series = ((1.0 / 12 + t2 * (1.0 / 720)) + t4 * (1.0 / 30240 + t2 * (1.0 / 1209600))
-              + (t4 * t4) * (1.0 / 47900160 + t2 * (691.0 / 1307674368000.0)))   # dexpinv_series of c/sr_internal.h
+              + (t4 * t4) * (1.0 / 47900160 + t2 * (691.0 / 1307674368000.0)))   # dexpinv_series of c/src/sr_so3.h
     c = ca.if_else(small, series, (1 - half * ca.cos(half) / ca.sin(half)) / safe)
     a = ca.cross(t, w)
     return ca.vertcat(w + 0.5 * a + c * ca.cross(t, a), k[3:])
@@ -202,7 +202,7 @@ STEPPERS = {"lie_euler": lie_euler, "rkmk4": rkmk4, "cf4": cf4}
 
 
 def step_function(accel, method):
-    """sr_step_<method>(x, u, dt, p) -> x_next, one step of c/sr_steppers.c's method."""
+    """sr_step_<method>(x, u, dt, p) -> x_next, one step of c/src/sr_steppers.c's method."""
     x, u, p = ca.SX.sym("x", S.NX), ca.SX.sym("u", S.NU), ca.SX.sym("p", len(P.PARAMETERS))
     dt = ca.SX.sym("dt")
     return ca.Function(f"sr_step_{method}", [x, u, dt, p], [STEPPERS[method](accel, x, u, dt, p)],

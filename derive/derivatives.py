@@ -1,13 +1,13 @@
-"""Derivatives of the dynamics in the error coordinates of issue 19 (derive/state.py ERROR_BLOCKS).
+"""Derivatives of the dynamics in the error coordinates (derive/state.py ERROR_BLOCKS).
 
 The accelerations solve M ν̇ = f (`derive.dynamics`: M of eqs. 97-99, f from eqs. 71/85, 78, 84).
 Along x ⊕ d the configuration moves on its group, right-trivialised:
     γ = R_Sᵀ e_z  →  Exp(−⟦δξ⟧) γ,   so  ∂γ/∂δξ_k = −e_k × γ       (eq. 85's advection, with δξ for Ω_S dt)
-    χ = R_Sᵀ e_x  likewise (the general robot on a slope, issue 18)
+    χ = R_Sᵀ e_x  likewise (the general robot on a slope)
     R_Y → R_Y Exp(δθ_Y Σ_Y),  R_P → R_P Exp(δθ_P Σ_P)              (eqs. 39)
 q enters neither M nor f, and ν, u enter additively.  Differentiating M ν̇ = f gives
     ∂ν̇ = M⁻¹ (∂f − (∂M) ν̇),
-so one factorisation of M serves ν̇ and every column (c/sr_jacobians.c does the solves).
+so one factorisation of M serves ν̇ and every column (c/src/sr_jacobians.c does the solves).
 `derive.dynamics` reduced M and f modulo |γ| = 1 and cos² + sin² = 1; those forms agree with
 the derivation on the manifold, so their derivatives along its tangent directions (the only ones
 taken here) agree too.
@@ -82,7 +82,7 @@ def accel_jacobian(M=None, f=None):
     return M.LUsolve(rhs_jacobian() - dM_a)
 
 
-# ---- The paper's robot in the yoke frame (derive.yoke_frame): what c/sr_jacobians.c evaluates ----
+# ---- The paper's robot in the yoke frame (derive.yoke_frame): what c/src/sr_jacobians.c evaluates ----
 # ν̇ = Tᵀ g with T = diag(R_Yᵀ, 1, 1) and g = M'⁻¹ f'(γ', R_P, ν'), γ' = R_Yᵀ γ, ν' = T ν, where M'
 # and f' are M and f at R_Y = I (a third of the operations of the shell-frame forms, and none of
 # their dependence on R_Y).  The shell frame's error coordinates move the yoke frame's variables as

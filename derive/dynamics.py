@@ -7,7 +7,7 @@ from the printed formulas of Section 4.
 
 Shell (eq. 85, first line, with γ̇ and not γ in the last term; eq. 71 has γ):
     d/dt ∂ℓ_c/∂ω_S = ∂ℓ_c/∂ω_S × ω_S + ∂ℓ/∂γ × γ + r γ̇ × ∂ℓ/∂v − k_S ω_S
-                     [+ ∂ℓ/∂χ × χ + r γ × m_R R_Sᵀg⃗   on a slope, issue 18]
+                     [+ ∂ℓ/∂χ × χ + r γ × m_R R_Sᵀg⃗   on a slope]
   the vector form of  d/dt ∂ℓ_c/∂Ω_S − ad*_{Ω_S} ∂ℓ_c/∂Ω_S = −γ◇∂ℓ/∂γ + r γ̇◇∂ℓ/∂v − k_S Ω_S.
 Yoke and pendulum (eqs. 78, 84):
     d/dt ∂ℓ_c/∂ω_Y = ⟨∂ℓ_c/∂R_Y, R_Y Σ_Y⟩ + u_Y − k_Y ω_Y

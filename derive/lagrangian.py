@@ -6,7 +6,7 @@ eq. (34) writes ‖Ṙ_Sᵀ q̇‖ for ‖R_Sᵀ q̇‖.  The Lagrangian below i
 that eqs. (19)-(32) define, term by term.
 
 Every function takes the `robot` (derive/robot.py): the paper's (Section 2.3,
-the default) or the general one of issue 18, whose bodies have arbitrary
+the default) or the general one, whose bodies have arbitrary
 centres of mass and tensors, whose motors have rotors and whose floor is
 inclined.  The paper's robot gives the paper's terms exactly.
 """
@@ -37,7 +37,7 @@ def pendulum_moment(robot):
 
 
 def rotor_energy(robot):
-    """The motors' rotors, axial inertia only (issue 18): ½ j_mY (e_xᵀω_S + n_Y ω_Y)² for the yoke
+    """The motors' rotors, axial inertia only: ½ j_mY (e_xᵀω_S + n_Y ω_Y)² for the yoke
     motor's rotor on the shell, ½ j_mP ((R_Y e_y)ᵀω_S + n_P ω_P)² for the pendulum motor's on the yoke."""
     yoke_rotor = S.w_S[0] + robot.n_Y * S.w_Y
     pendulum_rotor = (S.R_Y * sp.Matrix([0, 1, 0])).dot(S.w_S) + robot.n_P * S.w_P

@@ -125,7 +125,7 @@ def check_equal_to_rhs():
 
 
 def general_program():
-    """f of the general robot (issue 18, derive.robot.GENERAL) body by body, in the shell frame:
+    """f of the general robot (derive.robot.GENERAL) body by body, in the shell frame:
     (program, f).  The same d'Alembert principle about O as `program`, with what the general robot
     adds: first moments h = R c m and tensors about O of any shape (I = R J_O Rᵀ with
     J_O = tr(Ĵ_O) I − Ĵ_O), gravity G = R_Sᵀg⃗ = −(g_x χ + g_z γ) on a slope (as an acceleration −G

@@ -10,7 +10,7 @@ Glossary (paper symbol -> Python name):
     m_P    pendulum mass [kg]                    k_P   pendulum damping [N m s/rad]
     g      gravitational acceleration [m/s^2]
 
-The general robot (issue 18, the C API's parameter vector, PARAMETERS):
+The general robot (the C API's parameter vector, PARAMETERS):
 
     j_S    shell's isotropic inertia about its centre [kg m^2]
     m_Y, c_Y, J_Y   yoke mass, centre of mass (yoke frame, from the shell centre), inertia about it
@@ -47,7 +47,7 @@ PAPER_PARAMETERS = (r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P, g)
 # per parameter set (by the generated `sr_gen_constants`).
 j_S, j_xx, j_yy, j_P, m_Y, m_R = sp.symbols("j_S j_xx j_yy j_P m_Y m_R", positive=True)
 
-# The general robot of issue 18 (derive/robot.py): every body by its mass, centre of mass and
+# The general robot (derive/robot.py): every body by its mass, centre of mass and
 # standard inertia tensor about that centre, plus the motors' rotors and the slope.
 j_mY, n_Y, j_mP, n_P, slope = sp.symbols("j_mY n_Y j_mP n_P slope", real=True)
 _TENSOR_ENTRIES = ("xx", "yy", "zz", "xy", "xz", "yz")
@@ -69,7 +69,7 @@ def _tensor_symbols(name):
     return (T[0, 0], T[1, 1], T[2, 2], T[0, 1], T[0, 2], T[1, 2])
 
 
-#: The parameters of the C API (SR_P_*), in order: the general robot of issue 18.
+#: The parameters of the C API (SR_P_*), in order: the general robot.
 PARAMETERS = (r, m_S, j_S, k_S, m_Y, *vector("c_Y"), *_tensor_symbols("J_Y"), k_Y,
               m_P, *vector("c_P"), *_tensor_symbols("J_P"), k_P, j_mY, n_Y, j_mP, n_P, g, slope)
 

@@ -1,4 +1,4 @@
-"""The bodies of the robot as the Lagrangian sees them: the paper's robot and the general one (issue 18).
+"""The bodies of the robot as the Lagrangian sees them: the paper's robot and the general one.
 
 Both hinges sit at the shell centre O, so every body enters the kinetic and
 potential energies through its mass, its first moment about O and its
@@ -14,7 +14,7 @@ evaluate them: `PAPER` in the paper's derived constants (j_xx, j_P, l, ...),
 `GENERAL` in the per-model constants that `general_constants` computes from
 the parameters of `derive.parameters.PARAMETERS`.
 
-Glossary of the general robot (issue 18; `derive.parameters` for the symbols):
+Glossary of the general robot (`derive.parameters` for the symbols):
 
     j_S          shell's isotropic inertia about O          g_x, g_z   g sin(slope), g cos(slope)
     h_Y, Ĵ_Y     yoke's first moment and tensor about O     j_mY, n_Y  yoke motor rotor (on the shell)

@@ -27,7 +27,7 @@ STATE_BLOCKS = (
 #: The entries of u: (name, index), emitted as SR_U_<name>.
 INPUT_NAMES = (("u_Y", 0), ("u_P", 1))
 
-#: The error (tangent) state d of issue 19, right-trivialised: x ⊕ d is R_S Exp(⟦d_xi_S⟧),
+#: The error (tangent) state d, right-trivialised: x ⊕ d is R_S Exp(⟦d_xi_S⟧),
 #: R_Y Exp(d_th_Y Σ_Y), R_P Exp(d_th_P Σ_P), q + (d_q, 0), ν + d_nu.  (name, offset, length),
 #: emitted as SR_E_<name> and SR_GEN_NE; the Jacobians of the dynamics and the steps use it.
 ERROR_BLOCKS = (("xi_S", 0, 3), ("th_Y", 3, 1), ("th_P", 4, 1), ("q", 5, 2), ("nu", 7, 5))
@@ -52,7 +52,7 @@ Sigma_C = hat([0, 0, 1])
 # γ = R_Sᵀ e_z is the third row of R_S.
 gamma = sp.Matrix(sp.symbols("gamma_x gamma_y gamma_z", real=True))
 # χ = R_Sᵀ e_x, the first row of R_S: the up-slope direction in the shell frame.  On a slope
-# gravity has a component along e_x, so the potential depends on χ as well as γ (issue 18).
+# gravity has a component along e_x, so the potential depends on χ as well as γ.
 chi = sp.Matrix(sp.symbols("chi_x chi_y chi_z", real=True))
 # Entries of R_Y (rotation about x) and R_P (rotation about y).
 RY_c, RY_s = sp.symbols("RY_11 RY_21", real=True)

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources d521d32981a365f8], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 6c4982832c7ecffc], SymPy 1.14.0. */
 #include "sr_generated.h"
 
 #include <math.h>
@@ -538,7 +538,7 @@ int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], con
     return SR_GEN_OK;
 }
 
-/* The yoke frame's M' (upper triangle, row by row), f', ∂f'/∂(δξ', δθ_P, δν') (5 x 9, row-major), ∂f'/∂u (5 x 2) and ∂M'/∂(δξ', δθ_P) (4 upper triangles), at γ' = R_Y^T γ, ν' = diag(R_Y^T, 1, 1) ν, for the paper robot's accel Jacobian (c/sr_jacobians.c: g = M'⁻¹ f', ∂g = M'⁻¹(∂f' − (∂M') g), and the chain rule to the error coordinates). */
+/* The yoke frame's M' (upper triangle, row by row), f', ∂f'/∂(δξ', δθ_P, δν') (5 x 9, row-major), ∂f'/∂u (5 x 2) and ∂M'/∂(δξ', δθ_P) (4 upper triangles), at γ' = R_Y^T γ, ν' = diag(R_Y^T, 1, 1) ν, for the paper robot's accel Jacobian (c/src/sr_jacobians.c: g = M'⁻¹ f', ∂g = M'⁻¹(∂f' − (∂M') g), and the chain rule to the error coordinates). */
 int sr_gen_accel_jacobian_yoke_terms(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real M[15], sr_real f[5], sr_real df[45], sr_real dfdu[10], sr_real dM[60])
 {
     const sr_real j_xx = c[6];

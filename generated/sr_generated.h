@@ -1,7 +1,7 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources d521d32981a365f8], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 6c4982832c7ecffc], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
- * Internal to the library: use the checked API of c/spherical_robot.h.
+ * Internal to the library: use the checked API of c/include/spherical_robot.h.
  * Every function returns SR_GEN_OK, SR_GEN_NONFINITE (a result is not finite) or, for accel,
  * SR_GEN_SINGULAR; outputs are caller-provided and written only on SR_GEN_OK (sr_gen_constants:
  * always, the caller checks them).
@@ -9,7 +9,7 @@
 #ifndef SR_GENERATED_H
 #define SR_GENERATED_H
 
-/* sr_real, SR_C, SR_GEN_PIVOT_TOL and the SR_GEN_ status codes: hand-written, in c/. */
+/* sr_real, SR_C, SR_GEN_PIVOT_TOL and the SR_GEN_ status codes: hand-written, in c/include/. */
 #include "sr_real.h"
 
 #define SR_GEN_NPARAM 32
@@ -161,7 +161,7 @@ int sr_gen_energy(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr
 int sr_gen_equilibrium_residual(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr_real res[5]);
 /* ν̇ = (ω̇_S, ω̇_Y, ω̇_P) solving M ν̇ = f, joints first; SR_GEN_SINGULAR if M is not positive definite. */
 int sr_gen_accel(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real a[SR_GEN_NV]);
-/* The yoke frame's M' (upper triangle, row by row), f', ∂f'/∂(δξ', δθ_P, δν') (5 x 9, row-major), ∂f'/∂u (5 x 2) and ∂M'/∂(δξ', δθ_P) (4 upper triangles), at γ' = R_Y^T γ, ν' = diag(R_Y^T, 1, 1) ν, for the paper robot's accel Jacobian (c/sr_jacobians.c: g = M'⁻¹ f', ∂g = M'⁻¹(∂f' − (∂M') g), and the chain rule to the error coordinates). */
+/* The yoke frame's M' (upper triangle, row by row), f', ∂f'/∂(δξ', δθ_P, δν') (5 x 9, row-major), ∂f'/∂u (5 x 2) and ∂M'/∂(δξ', δθ_P) (4 upper triangles), at γ' = R_Y^T γ, ν' = diag(R_Y^T, 1, 1) ν, for the paper robot's accel Jacobian (c/src/sr_jacobians.c: g = M'⁻¹ f', ∂g = M'⁻¹(∂f' − (∂M') g), and the chain rule to the error coordinates). */
 int sr_gen_accel_jacobian_yoke_terms(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real M[15], sr_real f[5], sr_real df[45], sr_real dfdu[10], sr_real dM[60]);
 /* The paper's robot (Section 2.3) as a general one: p[SR_P_*] from the paper's twelve parameters (derive.parameters.from_paper). */
 int sr_gen_paper_params(const sr_real pp[SR_GEN_NPAPER], sr_real p[SR_GEN_NPARAM]);

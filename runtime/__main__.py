@@ -1,4 +1,5 @@
-"""`python -m runtime COMMAND [options]`: one module per command, each with its own `main(argv) -> int`."""
+"""`python -m runtime COMMAND [options]`: the one command-line entry of runtime/; one module per command,
+each with its own `main(argv) -> int` (no module of runtime/ runs as a script of its own)."""
 import importlib
 import sys
 
@@ -8,16 +9,23 @@ COMMANDS = {
     "verify": ("runtime.verification.verify", "cross-check the kernels against the reference and the invariants"),
     "convergence": ("runtime.verification.convergence", "convergence and energy study of the integrators"),
     "bench": ("runtime.bench.cli", "benchmarks against the alternatives"),
+    "bench-table": ("runtime.bench.headline", "the benchmark tables of README.md and docs/performance.md, from the pinned run"),
     "figures": ("runtime.scenarios.figures", "regenerate the committed figures under docs/figures/"),
     "sweep": ("runtime.sweep.cli", "many runs of a scenario with varied inputs, on Dask (results in Parquet)"),
     "control": ("runtime.control.benchmark", "closed-loop benchmark: every controller on every task (make control)"),
     "soak": ("runtime.verification.soak", "10^7 steps from random states: constraint and energy drift (not a unit test)"),
+    "errata": ("runtime.verification.errata", "the paper's printed formulas against the kernels (docs/errata.md)"),
+    "stability": ("runtime.stability", "eigenvalues and Floquet exponents; writes docs/figures/rolling-stability.png"),
+    "envelope": ("runtime.control.envelope", "what the torque limits allow (make envelope)"),
+    "climbing": ("runtime.control.climbing", "the climbing limit on a slope; writes docs/figures/climbing-limit.png"),
+    "firmware-table": ("runtime.control.firmware", "the firmware example's LQR gain table, generated/lqr_task.h (make generate)"),
+    "sweep-bench": ("runtime.bench.sweep", "what a sweep costs (make sweep-bench)"),
 }
 
 
 def usage():
     lines = ["usage: python -m runtime COMMAND [options]", "", "commands:"]
-    lines += [f"  {name:<12} {doc}" for name, (_, doc) in COMMANDS.items()]
+    lines += [f"  {name:<15} {doc}" for name, (_, doc) in COMMANDS.items()]
     return "\n".join(lines)
 
 

@@ -22,13 +22,13 @@ from .params import Params
 from .state import NU, NX
 from .validation import real_array
 
-#: Summary metrics of every sample, by the index C writes them at (c/spherical_robot.h, SR_BATCH_*).
 METRIC_NAMES = tuple(name for _, name in sorted({
     lib.SR_BATCH_PATH_LENGTH: "path_length",          # length of the path of the shell centre [m]
     lib.SR_BATCH_MAX_DISTANCE: "max_distance",        # largest |q_k − q_0| [m]
     lib.SR_BATCH_MAX_SHELL_RATE: "max_shell_rate",    # largest |ω_S| [rad/s]
     lib.SR_BATCH_FINAL_ENERGY: "final_energy",        # energy of the final state [J]
 }.items()))
+"""Summary metrics of every sample, by the index C writes them at (c/spherical_robot.h, SR_BATCH_*)."""
 assert len(METRIC_NAMES) == lib.SR_BATCH_NMETRICS
 
 

@@ -1,4 +1,4 @@
-"""The model as CasADi Functions, as `make generate` wrote them into generated/casadi/ (issue 19).
+"""The model as CasADi Functions, as `make generate` wrote them into generated/casadi/.
 
     from runtime import casadi_model
     accel = casadi_model.load("sr_accel")            # accel(x[35], u[2], p) -> nu_dot[5]

@@ -1,4 +1,4 @@
-"""Derivatives of the dynamics in the error coordinates of `runtime.group` (issue 19).
+"""Derivatives of the dynamics in the error coordinates of `runtime.group`.
 
 `accel_jacobian` is C (c/sr_jacobians.c, from the symbolic derivatives of derive/derivatives.py);
 `linearize` assembles the continuous-time error dynamics from it and the kinematics of the

@@ -1,4 +1,4 @@
-"""The state as a point of SO(3) × SO(2) × SO(2) × ℝ² × ℝ⁵ and its error coordinates (issue 19).
+"""The state as a point of SO(3) × SO(2) × SO(2) × ℝ² × ℝ⁵ and its error coordinates.
 
 `x ⊕ d` (retract) and `y ⊖ x` (local) in the right-trivialised coordinates of
 `runtime.state.NE` (c/spherical_robot.h, c/sr_group.c): the contract in which the Jacobians of

@@ -12,32 +12,32 @@ from .params import Params
 from .state import NU, NV, NX
 from .validation import ROTATION_TOL, check_finite, check_states, describe_state, project_state, real_array
 
-#: Integrator names accepted by `Model.step`, `Model.simulate` and scenario files.
-#: lie-euler: eq. (111), order 1.  rkmk4: Runge–Kutta–Munthe-Kaas (RK4 tableau in the Lie
-#: algebra, dexp⁻¹ correction), order 4.  cf4: commutator-free method of Celledoni–Marthinsen–
-#: Owren, order 4.  All keep R_S, R_Y, R_P on SO(3) by construction (c/spherical_robot.h);
-#: the "-projected" variants add one Newton–Schulz correction per step (SR_PROJECT), for very
-#: long runs at rest, where rounding drifts the same way every step.
 METHODS = {"lie-euler": lib.SR_LIE_EULER, "rkmk4": lib.SR_RKMK4, "cf4": lib.SR_CF4,
            "rkmk4-projected": lib.SR_RKMK4 | lib.SR_PROJECT, "cf4-projected": lib.SR_CF4 | lib.SR_PROJECT}
+"""Integrator names accepted by `Model.step`, `Model.simulate` and scenario files.
+lie-euler: eq. (111), order 1.  rkmk4: Runge–Kutta–Munthe-Kaas (RK4 tableau in the Lie
+algebra, dexp⁻¹ correction), order 4.  cf4: commutator-free method of Celledoni–Marthinsen–
+Owren, order 4.  All keep R_S, R_Y, R_P on SO(3) by construction (c/spherical_robot.h);
+the "-projected" variants add one Newton–Schulz correction per step (SR_PROJECT), for very
+long runs at rest, where rounding drifts the same way every step."""
 
-#: Default of `Model.simulate(energy_tol=...)`: the energy may rise over a torque-free stretch
-#: by at most this fraction of the stretch's energy scale (kinetic energy at its start + m_P g l)
-#: before the run is stopped (SR_ERR_ENERGY).  The exact flow never gains energy without input
-#: (damping >= 0).  Measured (docs/robustness.md): the shipped scenarios gain at most 0.0018 of
-#: the scale with Lie–Euler at dt = 0.01 s, 0.25 at dt = 0.05 s, RKMK4 nothing; frictionless
-#: Lie–Euler gains 0.14 in 100 s at dt = 0.001 s, 2.0 at dt = 0.01 s, 19 at dt = 0.1 s.
-#: Half the scale gained from nowhere (the pendulum could swing up half its range by itself)
-#: means the results are no longer physics: stop there.
 ENERGY_TOL = 0.5
+"""Default of `Model.simulate(energy_tol=...)`: the energy may rise over a torque-free stretch
+by at most this fraction of the stretch's energy scale (kinetic energy at its start + m_P g l)
+before the run is stopped (SR_ERR_ENERGY).  The exact flow never gains energy without input
+(damping >= 0).  Measured (docs/robustness.md): the shipped scenarios gain at most 0.0018 of
+the scale with Lie–Euler at dt = 0.01 s, 0.25 at dt = 0.05 s, RKMK4 nothing; frictionless
+Lie–Euler gains 0.14 in 100 s at dt = 0.001 s, 2.0 at dt = 0.01 s, 19 at dt = 0.1 s.
+Half the scale gained from nowhere (the pendulum could swing up half its range by itself)
+means the results are no longer physics: stop there."""
 
-#: Steps per C call of `Model.simulate` (between calls the progress callback runs).
 CHUNK_STEPS = 2000
+"""Steps per C call of `Model.simulate` (between calls the progress callback runs)."""
 
-#: Largest number of steps of one run (`Model.simulate`, `simulate_many`, scenario files, the
-#: CLI): the trajectory is held in memory (35 float64 a row, so 10^7 steps take 2.8 GB).  A
-#: larger count is a ValueError naming `steps`, not a MemoryError.
 MAX_STEPS = 10_000_000
+"""Largest number of steps of one run (`Model.simulate`, `simulate_many`, scenario files, the
+CLI): the trajectory is held in memory (35 float64 a row, so 10^7 steps take 2.8 GB).  A
+larger count is a ValueError naming `steps`, not a MemoryError."""
 
 
 def step_count(steps, name="steps"):

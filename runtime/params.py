@@ -1,4 +1,4 @@
-"""Robot parameters, physical SI units: the general robot (issue 18) and the paper's twelve.
+"""Robot parameters, physical SI units: the general robot and the paper's twelve.
 
 `Params` describes any robot of the yoke–pendulum architecture: each body by its
 mass, centre of mass and inertia tensor about that centre, the motors' rotors
@@ -20,10 +20,10 @@ import numpy as np
 
 from bindings._sr import ffi, lib
 
-#: The general parameters: name -> shape (() scalar, (3,) a centre of mass, (3, 3) a tensor).
 SHAPES = {"r": (), "m_S": (), "j_S": (), "k_S": (), "m_Y": (), "c_Y": (3,), "J_Y": (3, 3), "k_Y": (),
           "m_P": (), "c_P": (3,), "J_P": (3, 3), "k_P": (), "j_mY": (), "n_Y": (), "j_mP": (), "n_P": (),
           "g": (), "slope": ()}
+"""The general parameters: name -> shape (() scalar, (3,) a centre of mass, (3, 3) a tensor)."""
 _TENSOR_ENTRIES = (("xx", 0, 0), ("yy", 1, 1), ("zz", 2, 2), ("xy", 0, 1), ("xz", 0, 2), ("yz", 1, 2))
 
 
@@ -103,6 +103,7 @@ class PaperParams:
         return np.array([getattr(self, n) for n in PAPER_NAMES], dtype=np.float64)
 
     def as_dict(self):
+        """The twelve parameters as a dict, name -> value, in the paper's order."""
         return {n: getattr(self, n) for n in PAPER_NAMES}
 
     def robot(self):
@@ -115,9 +116,9 @@ class PaperParams:
         return Params.from_array(np.frombuffer(ffi.buffer(out), dtype=np.float64), paper_params=self)
 
 
-#: Paper parameter order of the C API: every field at its index SR_PAPER_<name> (checked at import).
 PAPER_NAMES = parameter_order(tuple(f.name for f in dataclasses.fields(PaperParams)),
                               prefix="SR_PAPER_", size="SR_NPAPER")
+"""Paper parameter order of the C API: every field at its index SR_PAPER_<name> (checked at import)."""
 
 
 def _as_shape(name, value, shape):
@@ -131,17 +132,33 @@ def _as_shape(name, value, shape):
     if array.shape != shape:
         raise ValueError(f"Params.{name}: expected an array of shape {shape}, got shape {array.shape}")
     if len(shape) == 2 and not np.array_equal(array, array.T, equal_nan=True):
-        raise ValueError(f"Params.{name}: an inertia tensor must be symmetric, got {array.tolist()}")
+        array = _symmetric(name, array)
     return tuple(map(tuple, array.tolist())) if len(shape) == 2 else tuple(array.tolist())
 
 
-#: The default of every Params field: the paper's robot's value.
+SYMMETRY_TOL = 1e-12
+"""Largest asymmetry of an inertia tensor, relative to its largest entry, that is taken as rounding:
+a tensor computed as R D Rᵀ is symmetric only to a few ulps."""
+
+
+def _symmetric(name, array):
+    """The symmetric part of a tensor whose asymmetry is rounding; ValueError with the asymmetry otherwise."""
+    scale = np.abs(array).max()
+    asymmetry = np.abs(array - array.T).max()
+    if not asymmetry <= SYMMETRY_TOL * scale:       # also refuses NaN and inf off the diagonal
+        raise ValueError(f"Params.{name}: an inertia tensor must be symmetric, got {array.tolist()} "
+                         f"(largest |J - Jᵀ| = {asymmetry:.3g}, relative to its largest entry "
+                         f"{asymmetry / scale if scale > 0 else float('inf'):.3g} > {SYMMETRY_TOL:g})")
+    return 0.5 * array + 0.5 * array.T
+
+
 DEFAULT = type("PaperDefault", (), {"__repr__": lambda self: "<the paper's value>"})()
+"""The default of every Params field: the paper's robot's value."""
 
 
 @dataclasses.dataclass(frozen=True)
 class Params:
-    """A robot of the yoke–pendulum architecture (issue 18); defaults: the paper's robot, Section 5.2.
+    """A robot of the yoke–pendulum architecture; defaults: the paper's robot, Section 5.2.
 
     Shell: radius r, mass m_S, isotropic inertia j_S about its centre, damping k_S.  Yoke (rotates
     about the shell's x axis, hinge at the shell centre): mass m_Y, centre of mass c_Y (yoke frame,
@@ -325,10 +342,10 @@ def _flat_fields():
     return tuple(entries[n] for n in order)
 
 
-#: For each index of the C parameter vector: the Params field and the entry in it.
 FLAT_FIELDS = _flat_fields()
-#: The general fields, in declaration order.
+"""For each index of the C parameter vector: the Params field and the entry in it."""
 NAMES = tuple(SHAPES)
+"""The general fields, in declaration order."""
 
 _DEFAULTS = []
 

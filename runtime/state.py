@@ -15,27 +15,27 @@ from .so3 import orthonormality, rot_x, rot_y, rot_z  # noqa: F401  (rot_z re-ex
 
 NX, NU, NV = lib.SR_NX, lib.SR_NU, lib.SR_NV
 
-#: Index ranges of the blocks of x (matrices row-major).  IDX_WY and IDX_WP are single entries.
 IDX_RS = slice(lib.SR_X_R_S, lib.SR_X_R_S + 9)
+"""Index ranges of the blocks of x (matrices row-major).  IDX_WY and IDX_WP are single entries."""
 IDX_RY = slice(lib.SR_X_R_Y, lib.SR_X_R_Y + 9)
 IDX_RP = slice(lib.SR_X_R_P, lib.SR_X_R_P + 9)
 IDX_Q = slice(lib.SR_X_q, lib.SR_X_q + 3)
 IDX_WS = slice(lib.SR_X_w_S, lib.SR_X_w_S + 3)
 IDX_WY, IDX_WP = lib.SR_X_w_Y, lib.SR_X_w_P
-#: ν = (ω_S, ω_Y, ω_P), contiguous from ω_S (the generated header promises it).
 IDX_NU = slice(lib.SR_X_w_S, lib.SR_X_w_S + NV)
-#: q_z (= r on every valid state).
+"""ν = (ω_S, ω_Y, ω_P), contiguous from ω_S (the generated header promises it)."""
 IDX_QZ = lib.SR_X_q + 2
+"""q_z (= r on every valid state)."""
 
-#: The rotation blocks by name, in state order.
 ROTATION_BLOCKS = {"R_S": IDX_RS, "R_Y": IDX_RY, "R_P": IDX_RP}
-#: Indices of the inputs u = (u_Y, u_P).
+"""The rotation blocks by name, in state order."""
 IDX_UY, IDX_UP = lib.SR_U_u_Y, lib.SR_U_u_P
+"""Indices of the inputs u = (u_Y, u_P)."""
 
-#: The error state d (12,) of `Model.retract` / `Model.local` and of every Jacobian (issue 19,
-#: right-trivialised; generated SR_E_* offsets): shell rotation vector, yoke and pendulum
-#: angles, in-plane shift of q, change of ν.
 NE = lib.SR_NE
+"""The error state d (12,) of `Model.retract` / `Model.local` and of every Jacobian
+(right-trivialised; generated SR_E_* offsets): shell rotation vector, yoke and pendulum
+angles, in-plane shift of q, change of ν."""
 IDX_E_XI_S = slice(lib.SR_E_xi_S, lib.SR_E_xi_S + 3)
 IDX_E_TH_Y, IDX_E_TH_P = lib.SR_E_th_Y, lib.SR_E_th_P
 IDX_E_Q = slice(lib.SR_E_q, lib.SR_E_q + 2)

@@ -1,4 +1,4 @@
-"""Jacobians of one step of each method in the error coordinates (issue 19), by CasADi's AD of the
+"""Jacobians of one step of each method in the error coordinates, by CasADi's AD of the
 exported steps (runtime.casadi_model, generated/casadi/):
 
     step(x ⊕ d, u + w) ⊖ step(x, u) = F d + G w + O(|d|² + |w|²),  F (12, 12), G (12, 2).

@@ -33,12 +33,12 @@ from .errors import KernelError
 from .so3 import nearest_rotation, orthonormality, rot_x, rot_y
 from .state import IDX_Q, IDX_QZ, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NX, ROTATION_BLOCKS
 
-#: Tolerance of the state checks, exported from C (SR_ROTATION_TOL): entries of RᵀR − I,
-#: det R − 1, and |q_z − r| / r.
 ROTATION_TOL = float(lib.SR_ROTATION_TOL)
+"""Tolerance of the state checks, exported from C (SR_ROTATION_TOL): entries of RᵀR − I,
+det R − 1, and |q_z − r| / r."""
 
-#: dtype kinds accepted for real arrays: signed and unsigned integers, floats.
 _REAL_KINDS = "iuf"
+"""dtype kinds accepted for real arrays: signed and unsigned integers, floats."""
 _KIND_NAMES = {"b": "bool", "c": "complex", "O": "object", "U": "string", "S": "bytes",
                "M": "datetime", "m": "timedelta", "V": "structured"}
 
@@ -56,10 +56,10 @@ def _entry_names():
     return tuple(names)
 
 
-#: Name of every entry of the state: STATE_ENTRY_NAMES[12] == "R_Y[1,0]".
 STATE_ENTRY_NAMES = _entry_names()
-#: The rotation about a fixed axis of each joint block (row and column `axis` equal e_axis).
+"""Name of every entry of the state: STATE_ENTRY_NAMES[12] == "R_Y[1,0]"."""
 _JOINT_AXIS = {"R_Y": 0, "R_P": 1}
+"""The rotation about a fixed axis of each joint block (row and column `axis` equal e_axis)."""
 
 
 # -- arrays ------------------------------------------------------------------------------------

@@ -1,4 +1,4 @@
-"""The embeddable C library on its own (issue 6), built with c/Makefile and c/CMakeLists.txt.
+"""The embeddable C library on its own, built with c/Makefile and c/CMakeLists.txt.
 
 * the C tests (c/tests/) pass in the double and the float build, and under
   AddressSanitizer + UndefinedBehaviorSanitizer;
@@ -25,6 +25,7 @@ import pytest
 from conftest import ROOT
 
 C_DIR = ROOT / "c"
+INCLUDE = C_DIR / "include"   # the public headers: the one include path of a user (with generated/)
 MAKE = shutil.which("make")
 CC = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
 DT, STEPS = 0.01, 10_000
@@ -135,7 +136,7 @@ def test_library_has_no_mutable_globals(build, lib):
 
 
 def test_every_public_function_returns_a_status_code():
-    text = re.sub(r"/\*.*?\*/", "", (C_DIR / "spherical_robot.h").read_text(), flags=re.S)
+    text = re.sub(r"/\*.*?\*/", "", (INCLUDE / "spherical_robot.h").read_text(), flags=re.S)
     prototypes = re.findall(r"^([A-Za-z_][\w \t\*]*?)\b(sr_\w+)\s*\(", text, flags=re.M)
     assert len(prototypes) >= 12
     for ret, name in prototypes:
@@ -270,7 +271,7 @@ def test_a_program_calling_a_fourth_order_step_links_it(build, tmp_path):
     probe.write_text('#include "spherical_robot.h"\n'
                      "int main(void) { sr_model m; sr_real x[SR_NX] = {0};\n"
                      "    return sr_step_rkmk4(&m, x, 0, SR_C(0.01), x) == SR_OK; }\n")
-    run([CC, "-std=c99", "-O2", f"-I{C_DIR}", f"-I{ROOT / 'generated'}", str(probe), str(build / "libsphericalrobot.a"),
+    run([CC, "-std=c99", "-O2", f"-I{INCLUDE}", f"-I{ROOT / 'generated'}", str(probe), str(build / "libsphericalrobot.a"),
          "-lm", "-Wl,--gc-sections", "-o", str(tmp_path / "probe")])
     assert "sr_step_rkmk4" in defined_functions(tmp_path / "probe")
 
@@ -283,8 +284,8 @@ def test_size_report_covers_every_public_function(tmp_path):
     if run([CC, "-fcallgraph-info=su", "-c", str(probe), "-o", str(tmp_path / "probe.o")],
            check=False, cwd=tmp_path).returncode != 0:
         pytest.skip("the C compiler has no -fcallgraph-info (GCC >= 10 needed)")
-    out = run([sys.executable, "tools/size_report.py", "--cc", CC]).stdout
-    header = re.sub(r"/\*.*?\*/", "", (C_DIR / "spherical_robot.h").read_text(), flags=re.S)
+    out = run([sys.executable, str(ROOT / "tools" / "size_report.py"), "--cc", CC]).stdout
+    header = re.sub(r"/\*.*?\*/", "", (INCLUDE / "spherical_robot.h").read_text(), flags=re.S)
     for name in re.findall(r"^[A-Za-z_][\w \t\*]*?\b(sr_\w+)\s*\(", header, flags=re.M):
         assert out.count(f"| `{name}` |") == 2, name  # one row per scalar type
 
@@ -293,7 +294,7 @@ def test_size_report_covers_every_public_function(tmp_path):
 def test_a_float_double_mismatch_fails_at_link_time(build, tmp_path, app_scalar, lib_name):
     """The float build's symbols carry _f: mixing the builds cannot link (and misread buffers)."""
     flags = ["-DSR_USE_FLOAT"] if app_scalar == "float" else []
-    out = run([CC, "-std=c99", *flags, f"-I{C_DIR}", f"-I{ROOT / 'generated'}",
+    out = run([CC, "-std=c99", *flags, f"-I{INCLUDE}", f"-I{ROOT / 'generated'}",
                str(C_DIR / "examples" / "firmware_tshape.c"), str(build / lib_name), "-lm",
                "-o", str(tmp_path / "mixed")], check=False)
     assert out.returncode != 0
@@ -323,10 +324,10 @@ def test_a_paper_only_build_refuses_other_robots_and_links_no_general_kernel(tmp
     """-DSR_PAPER_ONLY leaves the general kernels out (firmware flash); the full build is the control."""
     probe = tmp_path / "probe.c"
     probe.write_text(PAPER_ONLY_PROBE)
-    sources = [str(p) for p in sorted(C_DIR.glob("sr_*.c"))] + [str(ROOT / "generated" / "sr_generated.c")]
+    sources = [str(p) for p in sorted((C_DIR / "src").glob("sr_*.c"))] + [str(ROOT / "generated" / "sr_generated.c")]
     flags = ["-DSR_PAPER_ONLY"] if paper_only else []
     run([CC, "-std=c99", "-O1", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-ffunction-sections", *flags,
-         f"-I{C_DIR}", f"-I{ROOT / 'generated'}", str(probe), *sources, "-lm", "-Wl,--gc-sections",
+         f"-I{INCLUDE}", f"-I{ROOT / 'generated'}", str(probe), *sources, "-lm", "-Wl,--gc-sections",
          "-o", str(tmp_path / "probe")])
     out = run([tmp_path / "probe"]).stdout.split()
     linked = {name for _, name in nm_symbols(tmp_path / "probe")}

@@ -112,7 +112,7 @@ def test_driver_finds_a_contract_violation(fuzz_build, tmp_path):
         '{ (void)m; (void)x; *e = (sr_real)NAN; return SR_OK; }\n'
         '#define sr_energy bad_energy', 1))
     exe = tmp_path / "bad_driver"
-    compile_ = subprocess.run([CC, "-std=c99", "-O1", "-I", str(C_DIR), "-I", str(ROOT / "generated"), str(bad),
+    compile_ = subprocess.run([CC, "-std=c99", "-O1", "-I", str(C_DIR / "include"), "-I", str(ROOT / "generated"), str(bad),
                                str(C_DIR / "fuzz" / "driver.c"), str(build / "libsphericalrobot_asan.a"),
                                "-fsanitize=address,undefined", "-lm", "-o", str(exe)], capture_output=True, text=True)
     assert compile_.returncode == 0, compile_.stderr

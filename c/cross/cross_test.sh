@@ -11,12 +11,12 @@
 #     and its objects checked for software double routines (__aeabi_d*);
 #  5. the C tests under QEMU (mps2-an386, mps2-an500): the same "N passed, 0 failed" as the host;
 #  6. the firmware examples under QEMU against the host build of the same precision
-#     (compare_runs.py: double identical; float within 1e-4 m at 10 s): the open-loop t-shape and
+#     (tools/compare_runs.py: double identical; float within 1e-4 m at 10 s): the open-loop t-shape and
 #     the closed loop (the LQR at 100 Hz, c/examples/firmware_lqr.c); the double t-shape again
 #     with -ffp-contract=fast must be caught, and its difference is printed (also the float one);
 #  7. the CMake toolchain file (c/cmake/arm-none-eabi.cmake): both libraries configured and built
 #     for the two CPUs, and checked like the Makefile's;
-#  8. the M4 sizes and stacks (m4_report.py): a Lie-Euler-only firmware linked and run under QEMU,
+#  8. the M4 sizes and stacks (tools/m4_report.py): a Lie-Euler-only firmware linked and run under QEMU,
 #     checked for __aeabi_d*.
 # Every step runs even if an earlier one failed; the exit status is 1 if any failed.
 set -u
@@ -128,8 +128,8 @@ step "firmware example (t-shape, 10,000 Lie-Euler steps) under QEMU against the 
 "$HOST_DIR/firmware_tshape_f" >"$OUT/tshape_f.host.csv" || fail "host float example"
 run_qemu mps2-an500 "$M7_DIR/firmware_tshape" "$OUT/tshape.m7.csv" || fail "Cortex-M7 example exited with $?"
 run_qemu mps2-an386 "$M4_DIR/firmware_tshape_f" "$OUT/tshape_f.m4.csv" || fail "Cortex-M4F example exited with $?"
-python3 cross/compare_runs.py double "$OUT/tshape.host.csv" "$OUT/tshape.m7.csv" || fail "Cortex-M7 example"
-python3 cross/compare_runs.py float "$OUT/tshape_f.host.csv" "$OUT/tshape_f.m4.csv" "$OUT/tshape.host.csv" ||
+python3 ../tools/compare_runs.py double "$OUT/tshape.host.csv" "$OUT/tshape.m7.csv" || fail "Cortex-M7 example"
+python3 ../tools/compare_runs.py float "$OUT/tshape_f.host.csv" "$OUT/tshape_f.m4.csv" "$OUT/tshape.host.csv" ||
     fail "Cortex-M4F example"
 
 step "closed-loop firmware example (the LQR at 100 Hz, heading step, 30 s) under QEMU against the host"
@@ -140,8 +140,8 @@ run_qemu mps2-an386 "$M4_DIR/firmware_lqr_f" "$OUT/lqr_f.m4.csv" || fail "Cortex
 # Not bit for bit: the controller's atan2 (Log, pendulum angle) and sin/cos of the heading come
 # from newlib on the target and glibc on the host, which round a few arguments differently (the
 # open-loop t-shape, through sin, cos and sqrt only, is identical).  Within 1e-12 relative.
-python3 cross/compare_runs.py double-libm "$OUT/lqr.host.csv" "$OUT/lqr.m7.csv" || fail "Cortex-M7 closed loop"
-python3 cross/compare_runs.py float "$OUT/lqr_f.host.csv" "$OUT/lqr_f.m4.csv" "$OUT/lqr.host.csv" ||
+python3 ../tools/compare_runs.py double-libm "$OUT/lqr.host.csv" "$OUT/lqr.m7.csv" || fail "Cortex-M7 closed loop"
+python3 ../tools/compare_runs.py float "$OUT/lqr_f.host.csv" "$OUT/lqr_f.m4.csv" "$OUT/lqr.host.csv" ||
     fail "Cortex-M4F closed loop"
 
 # A slightly different kernel must be caught: the same double build with fused multiply-adds
@@ -151,13 +151,13 @@ step "the Cortex-M7 double build with -ffp-contract=fast must differ from the ho
 cross_make "$OUT/m7-contract" "$M7_CPU_FLAGS -ffp-contract=fast" mps2-an500.ld "$OUT/m7-contract/firmware_tshape" &&
     run_qemu mps2-an500 "$OUT/m7-contract/firmware_tshape" "$OUT/tshape.m7-contract.csv" ||
     fail "Cortex-M7 build or run with -ffp-contract=fast"
-if python3 cross/compare_runs.py double "$OUT/tshape.host.csv" "$OUT/tshape.m7-contract.csv"; then
+if python3 ../tools/compare_runs.py double "$OUT/tshape.host.csv" "$OUT/tshape.m7-contract.csv"; then
     fail "the double comparison did not see fused multiply-adds"
 fi
 step "for information: the Cortex-M4F float build with -ffp-contract=fast"
 cross_make "$OUT/m4-contract" "$M4_CPU_FLAGS -ffp-contract=fast" mps2-an386.ld "$OUT/m4-contract/firmware_tshape_f" &&
     run_qemu mps2-an386 "$OUT/m4-contract/firmware_tshape_f" "$OUT/tshape_f.m4-contract.csv" &&
-    python3 cross/compare_runs.py float "$OUT/tshape_f.host.csv" "$OUT/tshape_f.m4-contract.csv" "$OUT/tshape.host.csv" ||
+    python3 ../tools/compare_runs.py float "$OUT/tshape_f.host.csv" "$OUT/tshape_f.m4-contract.csv" "$OUT/tshape.host.csv" ||
     echo "  (not a failure: contraction is off in the builds above)"
 
 # ---- 7. CMake -------------------------------------------------------------------------------------
@@ -183,8 +183,8 @@ cmake_build cortex-m4 ON
 cmake_build cortex-m7 OFF
 
 # ---- 8. sizes and stacks ---------------------------------------------------------------------------
-step "Cortex-M4F sizes and stacks (m4_report.py)"
-python3 cross/m4_report.py --build "$OUT/report" --cross-prefix "$CROSS_PREFIX" --qemu "$QEMU" ||
+step "Cortex-M4F sizes and stacks (tools/m4_report.py)"
+python3 ../tools/m4_report.py --build "$OUT/report" --cross-prefix "$CROSS_PREFIX" --qemu "$QEMU" ||
     fail "m4_report"
 
 echo

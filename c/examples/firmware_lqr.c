@@ -2,8 +2,8 @@
  * firmware_lqr.c -- a closed-loop firmware example: the LQR controller (sr_lqr_control) at a
  * fixed rate, driving the simulated robot; no Python, no heap.
  *
- * The scenario comes from lqr_task.h, written by `python -m runtime.control.firmware` (by
- * default: the heading-step task, a heading step of pi/2 while rolling at 0.3 m/s, with the LQR
+ * The scenario comes from generated/lqr_task.h, written by `make generate` (python -m runtime
+ * firmware-table; by default: the heading-step task, a heading step of pi/2 while rolling at 0.3 m/s, with the LQR
  * at 100 Hz; its gain schedule designed for the task's model).  Every controller sample reads
  * the state, computes the torques, and holds them for LQR_TASK_STEPS_PER_SAMPLE plant steps of
  * LQR_TASK_DT (sr_simulate: on a robot, the plant is the robot and the state comes from the
@@ -19,7 +19,8 @@
  */
 #include <stdio.h>
 
-/* -DLQR_TASK_FROM_INCLUDE_PATH -I<dir>: another task's header from <dir> (the tests do this). */
+/* -DLQR_TASK_FROM_INCLUDE_PATH -I<dir>: another task's header from <dir> (the tests do this, through
+ * c/Makefile's CPPFLAGS, which come before the library's include directories). */
 #ifdef LQR_TASK_FROM_INCLUDE_PATH
 #include <lqr_task.h>
 #else

@@ -595,7 +595,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
     }
 
-    /* The group, the derivatives and the batch steps (issues 19, 21); read last, so that the
+    /* The group, the derivatives and the batch steps; read last, so that the
      * inputs kept in fuzz/regressions/ still mean what they meant. */
     {
         static guarded g2;   /* a second output (G of a step Jacobian, Jb) */
@@ -670,7 +670,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         expect("sr_checked_accel_batch", status, &g, status == SR_OK ? 2 * SR_NV : (row > 0 ? (int)row * SR_NV : 0), 1);
     }
 
-    /* The controller (issue 20); read last, for the same reason. */
+    /* The controller; read last, for the same reason. */
     fuzz_controller(&rd, &model, x);
 
     /* NULL pointers */

@@ -1,5 +1,5 @@
 /*
- * test_accel_batch.c -- sr_accel_batch and sr_checked_accel_batch (c/sr_kernels.c), which run
+ * test_accel_batch.c -- sr_accel_batch and sr_checked_accel_batch (c/src/sr_kernels.c), which run
  * the vectorised lanes form of the checks and the kernel (sr_internal_check_lanes,
  * sr_gen_accel_lanes) and hand every row that form does not clear to the scalar functions: each
  * row's result is sr_accel's bit for bit, and every bad entry of every row is reported with the

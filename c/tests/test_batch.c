@@ -1,5 +1,5 @@
 /*
- * test_batch.c -- sr_simulate_batch (c/sr_batch.c): each sample is the chunked guarded run a
+ * test_batch.c -- sr_simulate_batch (c/src/sr_batch.c): each sample is the chunked guarded run a
  * caller would make alone, bit for bit; a failing sample fails alone and leaves its rows
  * untouched; malformed arguments are refused before any sample runs.
  */

@@ -1,5 +1,5 @@
 /*
- * test_control.c -- the LQR controller (c/sr_control.c) on hand-made schedules: the error
+ * test_control.c -- the LQR controller (c/src/sr_control.c) on hand-made schedules: the error
  * coordinates at and near the reference, the law at a grid point and between points, clipping
  * with anti-windup, the curvature's rate limit, and status codes with untouched outputs.
  */

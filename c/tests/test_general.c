@@ -1,4 +1,4 @@
-/* The general robot (issue 18) in C: sr_model_init chooses the kernels, the general kernels agree
+/* The general robot in C: sr_model_init chooses the kernels, the general kernels agree
  * with the paper-geometry ones where both apply, and a general robot conserves energy on its slope.
  * (Against the independent references: tests/runtime/verification, make verify.) */
 #include "sr_test.h"

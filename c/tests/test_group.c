@@ -1,5 +1,5 @@
 /*
- * test_group.c -- sr_retract and sr_local (c/sr_group.c): inverse of each other for every angle,
+ * test_group.c -- sr_retract and sr_local (c/src/sr_group.c): inverse of each other for every angle,
  * the shell's Log accurate near pi, status codes and untouched outputs on error.
  */
 #include "sr_test.h"

@@ -1,5 +1,5 @@
 /*
- * test_guards.c -- what issue 8 added to the C API: sr_model_init rejects parameters
+ * test_guards.c -- the C API's guards: sr_model_init rejects parameters
  * that overflow or make M singular; kernel results are finite whenever SR_OK; the
  * batch state check names its failing row; sr_simulate / sr_simulate_guarded stop
  * when the state drifts off the constraints or gains energy without input power.

@@ -1,10 +1,10 @@
 /*
- * test_jacobians.c -- sr_accel_jacobian (c/sr_jacobians.c): each column is the central difference
+ * test_jacobians.c -- sr_accel_jacobian (c/src/sr_jacobians.c): each column is the central difference
  * of sr_accel along sr_retract (or along u); status codes and untouched outputs on error; the
  * accelerations its internal form gives the step Jacobians are sr_accel's.
  */
 #include "sr_test.h"
-#include "sr_internal.h" /* sr_internal_accel_jacobian: the step Jacobians' stage values, tested directly */
+#include "../src/sr_jacobians.h" /* sr_internal_accel_jacobian: the step Jacobians' stage values, tested directly */
 
 #include <math.h>
 #include <string.h>

@@ -5,7 +5,7 @@
  * determinism (aliasing, re-entrancy: no hidden state between calls).
  */
 #include "sr_test.h"
-#include "sr_internal.h" /* dexpinv_series: internal, tested directly */
+#include "../src/sr_so3.h" /* dexpinv_series: internal, tested directly */
 
 #include <math.h>
 #include <string.h>
@@ -71,7 +71,7 @@ static void test_so3_exp_matches_taylor_series(void)
 }
 
 /* sin t and cos t - 1 from sr_so3_exp about one axis, where the series of sin(t)/t and
- * (1 - cos t)/t^2 serve (|t| < 1/4, sr_internal.h) and just above, against libm, to a few ulp
+ * (1 - cos t)/t^2 serve (|t| < 1/4, src/sr_so3.h) and just above, against libm, to a few ulp
  * of each entry (not of 1: cos t - 1 is read as E - I).  The control: the same series without
  * its last two terms misses that bound near t = 1/4, so the check can see a wrong series. */
 static void test_so3_exp_small_angle_series_match_libm_to_a_few_ulp(void)
@@ -109,9 +109,9 @@ static double dexpinv_reference(double s, int derivative)
     return sum;
 }
 
-/* The series of dexp^-1's coefficient and of its derivative (sr_internal.h; the fourth-order steps
+/* The series of dexp^-1's coefficient and of its derivative (src/sr_so3.h; the fourth-order steps
  * and their Jacobians use them below s = 1/16) equal the Bernoulli form to a few ulp.  The control:
- * the four-term series used below s = 1e-2 before 2026-11-25 misses the bound near 1/16. */
+ * a four-term series (enough below s = 1e-2) misses the bound near 1/16. */
 static void test_dexpinv_series_match_the_bernoulli_form_to_a_few_ulp(void)
 {
     int n, truncated_ok = 1;

@@ -1,5 +1,5 @@
 /*
- * test_step_batch.c -- sr_step_batch (c/sr_step_batch.c, c/sr_step_lanes.c): every method's step
+ * test_step_batch.c -- sr_step_batch (c/src/sr_step_batch.c, c/src/sr_step_lanes.c): every method's step
  * vectorised across the states, every row not cleared by the lanes through sr_step.  Each row's
  * result is sr_step's bit for bit, whichever path it took (the lanes, or sr_step for a step angle
  * past the series' range), and every bad entry of every row is reported with sr_step's status, at

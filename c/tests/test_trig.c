@@ -1,5 +1,5 @@
 /*
- * test_trig.c -- the float build's own sine and cosine (c/sr_trig.c) against double libm: within
+ * test_trig.c -- the float build's own sine and cosine (c/src/sr_trig.c) against double libm: within
  * 2^-23 on a dense grid of |x| <= 8192 rad, within |x| 2^-23 up to 2^24 rad, NaN beyond.  In
  * the double build (and with -DSR_LIBM_TRIG) the library uses libm and there is nothing to test.
  */

@@ -8,6 +8,6 @@
 - `emit`: kernel -> C text, the header and source texts, and `write`, the one place that writes files.
 
 The hand-written part of the generated header (the scalar type `sr_real`,
-SR_C, SR_GEN_PIVOT_TOL, the SR_GEN_ status codes) is c/sr_real.h, not a
+SR_C, SR_GEN_PIVOT_TOL, the SR_GEN_ status codes) is c/include/sr_real.h, not a
 Python string.
 """

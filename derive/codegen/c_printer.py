@@ -1,7 +1,7 @@
 """Generic C printing of SymPy expressions: literals, common factors, a latency scheduler, flop counts.
 
 Nothing here is specific to the model.  The scalar type is `sr_real`
-(double, or float with -DSR_USE_FLOAT; c/sr_real.h), and numeric literals
+(double, or float with -DSR_USE_FLOAT; c/include/sr_real.h), and numeric literals
 go through SR_C() so both builds are clean under -Wall -Wextra -Wpedantic
 -Werror.
 """

@@ -1,6 +1,6 @@
 """Emission: each kernel as C text, the header and source texts, and `write`, the one place that writes files.
 
-The generated header includes the hand-written c/sr_real.h (the scalar type
+The generated header includes the hand-written c/include/sr_real.h (the scalar type
 `sr_real`, SR_C, SR_GEN_PIVOT_TOL and the SR_GEN_ status codes) and adds only
 what is derived: sizes, layout macros, flop counts and prototypes.
 """
@@ -20,7 +20,7 @@ from .kernels import INPUT_DOCS, array_layouts, input_symbols, kernels
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 HEADER_NAME = "sr_generated.h"
 SOURCE_NAME = "sr_generated.c"
-HAND_WRITTEN_HEADER = "sr_real.h"   # in c/: what is chosen, not derived
+HAND_WRITTEN_HEADER = "sr_real.h"   # in c/include/: what is chosen, not derived
 PREFIX = "sr_gen_"
 
 
@@ -201,7 +201,7 @@ def header_text(ks, flops, n_constants, n_general_constants):
     float_names += "".join(f"\n#define {PREFIX}{k.name}_lanes {PREFIX}{k.name}_lanes_f" for k in ks if k.lanes)
     return f"""{banner()}/*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
- * Internal to the library: use the checked API of c/spherical_robot.h.
+ * Internal to the library: use the checked API of c/include/spherical_robot.h.
  * Every function returns SR_GEN_OK, SR_GEN_NONFINITE (a result is not finite) or, for accel,
  * SR_GEN_SINGULAR; outputs are caller-provided and written only on SR_GEN_OK (sr_gen_constants:
  * always, the caller checks them).
@@ -209,7 +209,7 @@ def header_text(ks, flops, n_constants, n_general_constants):
 #ifndef {guard}
 #define {guard}
 
-/* sr_real, SR_C, SR_GEN_PIVOT_TOL and the SR_GEN_ status codes: hand-written, in c/. */
+/* sr_real, SR_C, SR_GEN_PIVOT_TOL and the SR_GEN_ status codes: hand-written, in c/include/. */
 #include "{HAND_WRITTEN_HEADER}"
 
 #define SR_GEN_NPARAM {len(P.PARAMETERS)}

@@ -107,9 +107,9 @@ UPPER = tuple((i, j) for i in range(S.NV) for j in range(i, S.NV))
 
 
 def general_kernels():
-    """The general robot of issue 18 (derive.robot.GENERAL): M of derive.dynamics with CSE, f body
+    """The general robot (derive.robot.GENERAL): M of derive.dynamics with CSE, f body
     by body (derive.newton_euler.general_program, proven equal to dynamics.rhs first); the solve of
-    M ν̇ = f is hand-written (c/sr_kernels.c), since with rotors and general tensors every entry of
+    M ν̇ = f is hand-written (c/src/sr_kernels.c), since with rotors and general tensors every entry of
     M may be non-zero."""
     robot = R.GENERAL
     M = D.inertia(robot)
@@ -139,7 +139,7 @@ def general_kernels():
 
 
 def accel_jacobian_yoke_terms():
-    """What the paper robot's sr_accel_jacobian (c/sr_jacobians.c) needs, in the yoke frame
+    """What the paper robot's sr_accel_jacobian (c/src/sr_jacobians.c) needs, in the yoke frame
     (derive.derivatives, "the paper's robot in the yoke frame"), at the shell-frame state: one
     kernel, so that CSE shares M', f' and their derivatives."""
     sub = YF.from_shell_frame()
@@ -149,7 +149,7 @@ def accel_jacobian_yoke_terms():
         "accel_jacobian_yoke_terms",
         "The yoke frame's M' (upper triangle, row by row), f', ∂f'/∂(δξ', δθ_P, δν') (5 x 9, row-major),"
         " ∂f'/∂u (5 x 2) and ∂M'/∂(δξ', δθ_P) (4 upper triangles), at γ' = R_Y^T γ, ν' = diag(R_Y^T, 1, 1) ν,"
-        " for the paper robot's accel Jacobian (c/sr_jacobians.c: g = M'⁻¹ f', ∂g = M'⁻¹(∂f' − (∂M') g),"
+        " for the paper robot's accel Jacobian (c/src/sr_jacobians.c: g = M'⁻¹ f', ∂g = M'⁻¹(∂f' − (∂M') g),"
         " and the chain rule to the error coordinates).",
         ("c", "x", "u"),
         (Output("M", tuple(M[i, j].xreplace(sub) for i, j in UPPER), "M', upper triangle row by row"),
@@ -160,7 +160,7 @@ def accel_jacobian_yoke_terms():
 
 
 def accel_jacobian_terms(robot, name, inputs):
-    """What the solves of the general robot's sr_accel_jacobian (c/sr_jacobians.c) need, in one
+    """What the solves of the general robot's sr_accel_jacobian (c/src/sr_jacobians.c) need, in one
     kernel so that CSE shares M, f and their derivatives (derive.derivatives): ∂ν̇ = M⁻¹(∂f − (∂M) ν̇)."""
     upper = UPPER
     M, f = D.inertia(robot), D.rhs(robot)

@@ -1,16 +1,16 @@
 """Benchmarks, `python -m runtime bench` (`make bench`): our kernels against the alternatives, like
-against like (issue 17, item 5), every alternative's numbers checked against ours before its time counts.
+against like, every alternative's numbers checked against ours before its time counts.
 
 C against C (bench/bench_kernels.c, no Python in the timed region, one pinned core): our checked
   accel, the raw generated kernel, inertia, one step of every integrator; the Kane model
   (sympy.physics.mechanics) compiled the ways its users ship it: CasADi's C of M and F with
   ca.solve, SymPy's C printer with a generic LU, PyDy's C with the same LU
   (`kane_compiled`); and the CasADi C of our own 9x9 KKT reference, a verification model.
-The anatomy of a fourth-order step (bench/step_anatomy.c, item 9): the checked accel, four accels
+The anatomy of a fourth-order step (bench/step_anatomy.c): the checked accel, four accels
   chained as a step's stages chain them, the RKMK4 and CF4 steps, and the same steps with the
   dynamics replaced by a stub (everything but the four accelerations).
 Python call against Python call: Model.accel and Model.step against the raw cffi call of the
-  checked C function with prepared buffers (item 8), PyDy's Cython ODE function, the lambdified
+  checked C function with prepared buffers, PyDy's Cython ODE function, the lambdified
   Kane model (three ways), a CasADi Function call of the Kane model, the CasADi reference and the
   NumPy transcription of the paper's formulas.
 Batches (Model.accel over 10⁶ states, CasADi's Function.map, the lambdified Kane model on
@@ -24,5 +24,5 @@ Modules: `cli` (the command), `harness` (the C loop: build, run, check), `kane_c
 Kane model as C and as compiled Python calls), `baselines` (the Python-side timings of ours and
 of the alternatives, and the Lie–Euler loop a user of an alternative would write), `timing` (how
 a time is taken), `checks` (numbers compared before a time counts), `report` (the table, the
-targets and the result file).
+targets and the result file), `sweep` (`python -m runtime sweep-bench`: what a sweep costs on Dask).
 """

@@ -15,12 +15,13 @@ from .timing import best_seconds, per_call_ns, per_call_ns_interleaved
 def _repeat(fn, args, calls):
     """fn(*args) `calls` times, each result dropped before the next call: kept in a list, every
     call's fresh output (2.8 MB for 10⁴ states) was first touched page by page, which cost the
-    batch step 150 ns per state of page faults on top of its 58 (AMD EPYC, 2026-11-25)."""
+    batch step 150 ns per state of page faults on top of its 58 on an AMD EPYC."""
     for _ in range(calls):
         fn(*args)
 
 
 def t_shape_program(steps=10_000):
+    """The torque program of the paper's T-shape manoeuvre over `steps` steps: (steps, 2) [N m]."""
     u = np.zeros((steps, 2))
     for first, last, column, value in [(1, 800, 0, 0.1), (1600, 1900, 1, -0.1), (2500, 3000, 0, -0.1),
                                        (3400, 4500, 1, 0.1)]:
@@ -59,7 +60,7 @@ def lie_euler_loop(accel, x0, dt, u_prog, r):
 
 # -- Python-side timings -------------------------------------------------------------------------
 def call_overhead_timings(model, calls, min_seconds=0.02, rounds=25):
-    """One call from Python (issue 17, item 8): Model.accel and Model.step against the raw cffi call of
+    """One call from Python: Model.accel and Model.step against the raw cffi call of
     the checked C function (sr_accel, sr_step) on buffers prepared beforehand, over the same states,
     their rounds interleaved (per_call_ns_interleaved), in ns.  The raw calls' outputs are checked first."""
     from bindings._sr import ffi, lib
@@ -92,7 +93,7 @@ def call_overhead_timings(model, calls, min_seconds=0.02, rounds=25):
 
 
 def compiled_kane_timings(model, calls, progress, min_seconds=0.2, rounds=7):
-    """The compiled Kane model called from Python (issue 17, item 5): PyDy's Cython ODE function and
+    """The compiled Kane model called from Python: PyDy's Cython ODE function and
     the CasADi Function (ca.solve of M and F), each on its own coordinates prepared beforehand
     (the conversion from our states is not timed), each checked against Model.accel first; ns."""
     import tempfile
@@ -118,6 +119,8 @@ def compiled_kane_timings(model, calls, progress, min_seconds=0.2, rounds=7):
 
 
 def python_timings(model, X, U, batch_size, progress, with_kane=True, loop_steps=10_000):
+    """Times the Python-level paths (the Model's calls, the cffi calls they wrap, the references and, with
+    `with_kane`, the Kane baselines) on the states X and torques U; returns a dict of timings."""
     from ..verification.paper_formulas import PaperModel
     from ..verification.reference import ReferenceModel
     out = {}

@@ -3,10 +3,12 @@ import numpy as np
 
 
 class WrongNumbers(RuntimeError):
+    """A benchmarked path gave numbers that differ from the reference's: its timing would mean nothing."""
     pass
 
 
 def check_close(name, ours, theirs, rtol):
+    """The relative max-difference of `ours` from `theirs`; raises WrongNumbers when it exceeds `rtol`."""
     ours, theirs = np.asarray(ours, dtype=float), np.asarray(theirs, dtype=float)
     err = np.abs(ours - theirs).max() / max(np.abs(theirs).max(), 1e-300)
     if not err <= rtol:

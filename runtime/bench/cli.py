@@ -24,6 +24,8 @@ RESULTS = ROOT / "bench" / "results"
 
 
 def main(argv=None):
+    """`python -m runtime bench`: the benchmarks on one pinned core (or, with --markdown, a stored
+    result rendered as Markdown); returns the exit status."""
     parser = argparse.ArgumentParser(prog="python -m runtime bench", description="Benchmarks against the alternatives.")
     parser.add_argument("--states", type=int, default=1024, help="states in the C loop (<= 4096)")
     parser.add_argument("--repeats", type=int, default=200, help="sweeps over the states per timing")
@@ -60,6 +62,8 @@ def main(argv=None):
 
 
 def run(args, core, progress):
+    """Runs every benchmark of `args` (pinned to `core`, reporting through `progress`), prints the
+    report and writes the result file; returns 0, or 1 when a path gives wrong numbers."""
     rng = np.random.default_rng(0)
     params = Params.paper_simulation()
     model = Model(params)

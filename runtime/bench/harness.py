@@ -42,12 +42,12 @@ def _compiler():
 
 
 #: How the timed programs build the library (portable: no -march; the AVX2 clones as the extension has them).
-LIBRARY_FLAGS = ["-std=c99", "-O3", "-DSR_CLONES", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c'}"]
+LIBRARY_FLAGS = ["-std=c99", "-O3", "-DSR_CLONES", f"-I{ROOT / 'generated'}", f"-I{ROOT / 'c' / 'include'}"]
 
 
 def _library_sources():
     """The generated and the hand-written C of the library."""
-    return [p for d in ("generated", "c") for p in sorted((ROOT / d).glob("*.c"))]
+    return [p for d in ("generated", "c/src") for p in sorted((ROOT / d).glob("*.c"))]
 
 
 def build_harness(build, native, with_casadi, kane=None):
@@ -71,16 +71,16 @@ def build_harness(build, native, with_casadi, kane=None):
 
 
 def step_anatomy(build, input_file, repeats):
-    """Where a fourth-order step's time goes (bench/step_anatomy.c; issue 17, item 9): the checked
+    """Where a fourth-order step's time goes (bench/step_anatomy.c): the checked
     accel, four accels chained as a step's stages chain them, and the steps; then the same steps
-    with the dynamics replaced by a two-flop stub (the library's c/sr_steppers.c compiled into the
+    with the dynamics replaced by a two-flop stub (the library's c/src/sr_steppers.c compiled into the
     program with -DANATOMY_GLUE_ONLY), i.e. everything a step does but its four accelerations.
     Built with the C loop's LIBRARY_FLAGS; `input_file` is the C loop's input."""
     library = _library_sources()
     out = {}
     for name, extra, sources in (
             ("full", [], library),
-            ("glue_only", ["-DANATOMY_GLUE_ONLY"], [p for p in library if p.name != "sr_steppers.c"])):
+            ("glue_only", ["-DANATOMY_GLUE_ONLY", f"-I{ROOT / 'c' / 'src'}"], [p for p in library if p.name != "sr_steppers.c"])):
         exe = build / f"step_anatomy_{name}"
         subprocess.run([_compiler(), *LIBRARY_FLAGS, *extra, str(ROOT / "bench" / "step_anatomy.c"),
                         *map(str, sources), "-lm", "-o", str(exe)], check=True)
@@ -100,10 +100,10 @@ def memory_floor(build, states, rounds=7):
 
 
 def general_robot(params):
-    """The general robot the C loop times beside `params` (issue 18): the same radius, so the same
+    """The general robot the C loop times beside `params`: the same radius, so the same
     states are valid, with an off-centre battery, full tensors, geared rotors and a slope (its
     kernels are the general ones)."""
-    from ..scenarios.scenario import load_scenario
+    from ..scenario import load_scenario
     return load_scenario("battery-geared").params.replace(r=params.r, slope=0.05)
 
 
@@ -112,11 +112,13 @@ LQR_RATE, LQR_U_MAX = 50.0, 0.5
 
 
 def lqr_controller(params):
+    """The LQR controller that the C loop's controller timing uses, designed for `params`."""
     from ..control.lqr import Lqr
     return Lqr(params, LQR_RATE, LQR_U_MAX)
 
 
 def lqr_target():
+    """The path target that the controller timings track (a curve with a cross-track error)."""
     from ..control.reference import Target
     return Target(speed=0.3, heading=0.5, curvature=0.2, cross_track=0.05)
 
@@ -139,6 +141,8 @@ def write_input(path, params, X, U, kane_inputs=None):
 
 
 def run_harness(exe, params, X, U, repeats, kane_inputs=None):
+    """Runs the compiled C timing loop `exe` on the states X and torques U, `repeats` sweeps; returns its
+    JSON output as a dict."""
     data = write_input(exe.parent / "input.bin", params, X, U, kane_inputs)
     out = subprocess.run([str(exe), str(data), str(repeats)], check=True, capture_output=True, text=True)
     return json.loads(out.stdout)
@@ -221,10 +225,10 @@ def check_harness(result, model, X, U, step_dt=0.01):
         check("C RKMK4 step of a general robot vs NumPy tableau on the reference", "step_rkmk4_general_robot",
               lambda i: STEPPERS["rkmk4"](general.accel, general.params["r"], X[i], U[i], step_dt), 1e-10)
     if "lqr_control" in result:
-        from ..verification.lqr_law import numpy_law
+        from ..control.lqr_law import numpy_law
         controller, target = lqr_controller(model.params), lqr_target()
         g = controller.gains
-        check("C lqr_control vs the NumPy law (runtime.verification.lqr_law)", "lqr_control",
+        check("C lqr_control vs the NumPy law (runtime.control.lqr_law)", "lqr_control",
               lambda i: numpy_law(controller.schedule, model.params.r, X[i], target, np.zeros(2), None,
                                   controller.period, controller.u_max, g.kappa_rate, g.integral_zone_m)[1], 1e-10)
     if "casadi_generated_reference_accel" in result:

@@ -1,4 +1,4 @@
-"""The benchmark's report: the table on stdout, in families of like against like (issue 17, item 5),
+"""The benchmark's report: the table on stdout, in families of like against like,
 with the targets, and the result file of the run."""
 import json
 import os
@@ -97,7 +97,7 @@ def sections(res):
         rows.append(("our LQR controller, one sample (sr_lqr_control, state checked)", f"{c['lqr_control']['ns']:,.1f} ns",
                      f"{c['lqr_control']['ns'] / ours:.1f}x"))
     if "accel_general_robot" in c:
-        rows.append(("our accel of a general robot (issue 18: general kernels)", f"{c['accel_general_robot']['ns']:,.1f} ns",
+        rows.append(("our accel of a general robot (general kernels)", f"{c['accel_general_robot']['ns']:,.1f} ns",
                      f"{c['accel_general_robot']['ns'] / ours:.1f}x"))
         rows.append(("our rkmk4 step of a general robot", f"{c['step_rkmk4_general_robot']['ns']:,.1f} ns",
                      f"{c['step_rkmk4_general_robot']['ns'] / c['step_rkmk4']['ns']:.1f}x our rkmk4 step"))
@@ -176,7 +176,7 @@ def sections(res):
 
 def anatomy_section(anatomy):
     """Where a fourth-order step's time goes (runtime.bench.harness.step_anatomy), against the checked
-    accel of the same program: what 6x (issue 17, item 9) would leave for the step's work besides
+    accel of the same program: what 6x (the target for a fourth-order step) would leave for the step's work besides
     its four accelerations, and what that work takes alone."""
     full, glue = anatomy["full"], anatomy["glue_only"]
     one = full["accel"]
@@ -193,10 +193,11 @@ def anatomy_section(anatomy):
     budget = 6 * one - full["accels_chained_through_nu"]
     rows.append(("6x one accel minus four chained accels: left for all but the accelerations",
                  f"{budget:,.1f} ns", f"{budget / one:.2f}x"))
-    return ("Anatomy of a fourth-order step (C loop; issue 17, item 9)", rows)
+    return ("Anatomy of a fourth-order step (C loop)", rows)
 
 
 def format_report(res):
+    """The benchmark result `res` as the printed text report (tables, flop rate, targets met or missed)."""
     c = res["c_loop"]
     lines = [f"CPU: {res.get('cpu', '?')}"]
     for title, rows in sections(res):
@@ -224,7 +225,7 @@ def result_file_name(date):
 
 
 def write_results(result, folder):
-    """The run as JSON in its own file, `<date and time>.json` (issue 17, item 7: every run is kept,
+    """The run as JSON in its own file, `<date and time>.json` (every run is kept,
     so every figure the README quotes is in a stored file).  Never overwrites: a second run within
     the same second gets `-2`, `-3`, ...  Written to a temporary file first, then linked under its
     name (os.link fails rather than replace an existing file).  Returns the path written."""

@@ -8,6 +8,8 @@ import numpy as np
 
 
 def pin_to_one_core():
+    """Pins this process to the last CPU it may run on and returns its number (None where affinity is
+    unavailable)."""
     try:
         cpus = sorted(os.sched_getaffinity(0))
         os.sched_setaffinity(0, {cpus[-1]})
@@ -17,6 +19,7 @@ def pin_to_one_core():
 
 
 def cpu_name():
+    """The CPU's model name (from /proc/cpuinfo, else what the platform module reports)."""
     try:
         for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):
@@ -74,7 +77,7 @@ def per_call_ns(fn, calls, min_seconds=0.1, rounds=7):
     """Best of `rounds` timings of a Python loop over `calls` (list of argument tuples), each
     lasting at least `min_seconds`.  Many short rounds, like the C loop's 11, so that a host
     busy for a moment slows some rounds and not the best one; a host busy for seconds still
-    shows (2026-11-23: the Kane call read 66 us with three 0.5 s rounds, 71 us with seven
+    shows (the Kane call read 66 us with three 0.5 s rounds, 71 us with seven
     0.2 s rounds, against 47-49 us when quiet), which flatters our ratios, never theirs."""
     return min(_round_ns(fn, calls, min_seconds) for _ in range(rounds))
 

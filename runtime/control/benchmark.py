@@ -11,12 +11,11 @@ import dataclasses
 import json
 import platform
 import subprocess
-import sys
 import pathlib
 
 from tqdm.auto import tqdm
 
-from ..scenarios.atomic import atomic_path, write_text
+from ..atomic import atomic_path, write_text
 from .closed_loop import simulate_closed_loop
 from .metrics import tracking_metrics
 from .plots import plot_run
@@ -27,6 +26,7 @@ COLUMNS = ("cross_track_rms_m", "cross_track_max_m", "heading_settle_s", "speed_
 
 
 def cpu_name():
+    """The CPU's model name (from lscpu, else what the platform module reports)."""
     try:
         out = subprocess.run(["lscpu"], capture_output=True, text=True, check=True).stdout
         return next(line.split(":", 1)[1].strip() for line in out.splitlines() if line.startswith("Model name"))
@@ -50,26 +50,41 @@ def _fmt(value):
 
 
 def main(argv=()):
-    parser = argparse.ArgumentParser(prog="python -m runtime.control.benchmark")
-    parser.add_argument("--out", default="out/control")
-    parser.add_argument("--tasks", default=",".join(shipped_tasks()))
+    """`python -m runtime control`: run every controller on the benchmark tasks and write the tables and
+    run folders."""
+    parser = argparse.ArgumentParser(prog="python -m runtime control")
+    parser.add_argument("--out", default="out/control", help="folder of the table and of one folder per run "
+                        "(created as needed)")
+    parser.add_argument("--tasks", default=",".join(shipped_tasks()),
+                        help="comma-separated tasks: each a shipped name, or a path to a task file")
     parser.add_argument("--duration", type=float, default=None, help="cut every task to this many seconds")
     args = parser.parse_args(list(argv))
     if args.duration is not None and not args.duration > 0:
         parser.error(f"--duration: must be > 0 s, got {args.duration:g}")
     out = pathlib.Path(args.out)
+    try:
+        tasks = [load_task(name) for name in args.tasks.split(",")]
+    except ValueError as exc:
+        parser.error(str(exc))
+    # A run's folder is named after its task's name (a task file's stem), never its path: every run
+    # lands under --out, whichever folder the task file is in.
+    names = [task.name for task in tasks]
+    twice = sorted({name for name in names if names.count(name) > 1})
+    if twice:
+        parser.error(f"--tasks: two tasks named {', '.join(map(repr, twice))} would write the same run folders")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        parser.error(f"--out: cannot create the folder {out} ({exc.strerror})")
     rows = []
-    runs = []
-    for name in args.tasks.split(","):
-        task = load_task(name)
-        runs += [(name, task.with_controller(kind)) for kind in task.controller_kinds]
+    runs = [(task.name, task.with_controller(kind)) for task in tasks for kind in task.controller_kinds]
     for name, task in tqdm(runs, unit="run"):
         if args.duration is not None:
             steps = max(1, round(min(args.duration, task.duration) / task.scenario.dt))
             task = dataclasses.replace(task, scenario=dataclasses.replace(task.scenario, steps=steps))
         result, reference, metrics = run_task(task)
         folder = out / f"{name}-{task.controller_kind}"
-        folder.mkdir(parents=True, exist_ok=True)
+        folder.mkdir(exist_ok=True)
         summary = {"task": name, "controller": task.controller_kind, "rate_hz": task.rate, "u_max": task.u_max,
                    "duration_s": task.duration, "cpu": cpu_name(), "tracking": metrics}
         write_text(folder / "summary.json", json.dumps(summary, indent=2) + "\n")
@@ -87,7 +102,3 @@ def main(argv=()):
         writer.writerows(rows)
     print(table)
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

@@ -1,4 +1,4 @@
-"""Climbing a slope under a constant yoke torque (issue 18): the limit, and the speed either side of it.
+"""Climbing a slope under a constant yoke torque: the limit, and the speed either side of it.
 
 In steady climbing the yoke and the pendulum hang still in the world while the shell rolls up the
 slope at ω, so the yoke motor turns at ω relative to the shell and the rotors at constant speeds
@@ -13,10 +13,10 @@ yoke and the pendulum (m_P g l/2 for the paper's robot); a larger torque flips t
 Both follow from the physics alone, not from the kernels; `simulate_climb` runs the kernels, and
 tests/runtime/control/test_climbing.py holds one against the other on both sides of the limit.
 
-    python -m runtime.control.climbing      # prints the limit, writes docs/figures/climbing-limit.png
+    python -m runtime climbing      # prints the limit, writes docs/figures/climbing-limit.png
 """
+import argparse
 import math
-import sys
 
 import numpy as np
 
@@ -59,14 +59,17 @@ def simulate_climb(params, u_Y, duration=60.0, window=5.0):
 
 
 def main(argv=()):
-    """Prints the limit and both sides for the paper's robot; writes the figure (argv[0], default
+    """Prints the limit and both sides for the paper's robot; writes the figure (FIGURE, default
     docs/figures/climbing-limit.png): simulated against predicted speed over slopes for the paper's
     robot and the battery robot of runtime/scenarios/robots/battery-geared.toml."""
+    parser = argparse.ArgumentParser(prog="python -m runtime climbing")
+    parser.add_argument("figure", nargs="?", default="docs/figures/climbing-limit.png", help="where to write the figure")
+    args = parser.parse_args(list(argv))
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..scenarios.scenario import load_scenario
+    from ..scenario import load_scenario
     base = Params.paper_simulation()
     u_Y = 0.5
     limit = climbing_limit(base, u_Y)
@@ -89,11 +92,7 @@ def main(argv=()):
     ax.set_xlabel("slope [deg]"), ax.set_ylabel("steady speed up the slope [m/s]")
     ax.set_title(f"climbing under a held yoke torque of {u_Y} N m"), ax.legend(fontsize=7)
     fig.tight_layout()
-    out = argv[0] if argv else "docs/figures/climbing-limit.png"
+    out = args.figure
     fig.savefig(out, dpi=100)
     print(f"wrote {out}")
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

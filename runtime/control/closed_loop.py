@@ -28,6 +28,7 @@ class Noise:
 
     @property
     def active(self):
+        """True when any of the measurement noises is non-zero."""
         return self.position_m > 0 or self.attitude_rad > 0 or self.rate_rad_s > 0
 
 

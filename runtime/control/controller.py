@@ -9,7 +9,7 @@ import time
 
 import numpy as np
 
-#: Default torque limit [N m]: the low end of the paper's 0.5–2 N m (issue #20).
+#: Default torque limit [N m]: the low end of the paper's 0.5–2 N m.
 DEFAULT_U_MAX = 0.5
 #: A torque within this fraction of u_max counts as saturated: clipped (PID, LQR) or held at its
 #: bound by the optimiser (NMPC, whose QP returns the bound to rounding).
@@ -32,6 +32,7 @@ class Controller:
 
     @property
     def period(self):
+        """The sampling period [s], 1 / rate."""
         return 1.0 / self.rate
 
     def reset(self, x0):
@@ -40,6 +41,8 @@ class Controller:
         self.solve_s = []
 
     def compute(self, t, x, target):
+        """The raw torques (2,) [N m] at time t for the measured state x and the reference's target;
+        subclasses implement it."""
         raise NotImplementedError
 
     def update(self, t, x, target):
@@ -62,4 +65,5 @@ class Controller:
 
     @property
     def saturated_fraction(self):
+        """The fraction of the samples so far at which a torque was clipped to u_max."""
         return self.saturated / self.samples if self.samples else 0.0

@@ -1,4 +1,4 @@
-"""The envelope: what the torque limits allow (issue #20, item 1; docs/control.md).
+"""The envelope: what the torque limits allow (docs/control.md).
 
 Computed by simulation with the verified kernels (RKMK4, dt = 0.005 s), Params.paper_simulation():
 * steady rolling speed against a constant yoke torque from rest: "steady" = the speed of the
@@ -9,9 +9,10 @@ Computed by simulation with the verified kernels (RKMK4, dt = 0.005 s), Params.p
   the PID's inner lean loop; the steady turn radius is v / mean yaw rate over the last 10 s of a
   40 s run, and the largest |u_P| over those 10 s says whether |u| ≤ u_max holds the turn.
 
-    python -m runtime.control.envelope      # prints the numbers, writes docs/figures/control-envelope.png
+    python -m runtime envelope      # prints the numbers, writes docs/figures/control-envelope.png
 """
-import sys
+
+import argparse
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -118,6 +119,10 @@ def tightest_turn(rows, leans, u_max):
 
 
 def main(argv=()):
+    """Prints the envelope's numbers and rewrites its figure (docs/control.md)."""
+    parser = argparse.ArgumentParser(prog="python -m runtime envelope")
+    parser.add_argument("figure", nargs="?", default="docs/figures/control-envelope.png", help="where to write the figure")
+    args = parser.parse_args(list(argv))
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -146,11 +151,7 @@ def main(argv=()):
     b.set_xlabel("lean of the rolling axis φ [deg]"), b.set_ylabel("steady turn radius [m]"), b.legend()
     b.set_yscale("log"), b.set_title(f"turns (o: held with |u_P| < {env['u_max']} N m, x: saturated)")
     fig.tight_layout()
-    out = argv[0] if argv else "docs/figures/control-envelope.png"
+    out = args.figure
     fig.savefig(out, dpi=100)
     print(f"wrote {out}")
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

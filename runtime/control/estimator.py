@@ -1,12 +1,12 @@
 """An extended Kalman filter on the group: the controller's view of a robot measured with noise.
 
 The state is a point x of SO(3) × SO(2) × SO(2) × ℝ² × ℝ⁵ and the filter's uncertainty lives in
-its tangent space, in the right-trivialised error coordinates δ ∈ ℝ¹² of issue #19 (x ⊕ δ,
+its tangent space, in the right-trivialised error coordinates δ ∈ ℝ¹² of runtime/group.py (x ⊕ δ,
 y ⊖ x: runtime/group.py), as in the invariant / error-state filters of the estimation literature
 (and manif's and SymForce's examples).  One sample of period T, torques u held:
 
     predict   x⁻ = step(x̂, u, T)                 one RKMK4 step (c/sr_steppers.c)
-              P⁻ = F P Fᵀ + G_w Σ_w G_wᵀ T        F = ∂step/∂δ, the exact step Jacobian (issue #19)
+              P⁻ = F P Fᵀ + G_w Σ_w G_wᵀ T        F = ∂step/∂δ, the exact step Jacobian
     correct   e  = y ⊖ x⁻                          the measurement's error coordinates
               K  = P⁻ (P⁻ + R)⁻¹,  x̂ = x⁻ ⊕ K e,  P = (I − K) P⁻
 

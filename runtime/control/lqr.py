@@ -60,6 +60,7 @@ class LqrGains:
             raise ValueError(f"kappa_max: must be > 0 when n_curvatures > 1, got {self.kappa_max!r}")
 
     def weights(self, u_max):
+        """These bounds as the design's Riccati weights, with the torque bound `u_max` [N m]."""
         return design.Weights(attitude_rad=(self.tilt_rad, self.attitude_rad, self.attitude_rad), pendulum_rad=self.pendulum_rad,
                               rate_rad_s=(self.rolling_rate_rad_s, self.rate_rad_s, self.rate_rad_s),
                               yoke_rate_rad_s=self.joint_rate_rad_s, pendulum_rate_rad_s=self.joint_rate_rad_s, cross_track_m=self.cross_track_m,
@@ -160,6 +161,7 @@ def to_c(schedule, period, u_max, kappa_rate, integral_zone):
 
 
 def c_target(target):
+    """The target as the C library's sr_lqr_target (a path target when it has a cross-track error)."""
     t = ffi.new("sr_lqr_target *")
     t.speed, t.heading = target.speed, target.heading
     t.path = target.cross_track is not None
@@ -182,6 +184,7 @@ class Lqr(Controller):
         self._u, self._raw = np.zeros(2), np.zeros(2)
 
     def reset(self, x0):
+        """Starts a run at x0: zeroes the controller's memory (integrals, operating curvature)."""
         super().reset(x0)
         lib.sr_lqr_reset(self._memory)
 
@@ -203,9 +206,11 @@ class Lqr(Controller):
 
     @property
     def integrals(self):
+        """The controller's two integrals, z[10] and z[11] of the C controller's error coordinates."""
         return np.array(list(self._memory.integrals))
 
     def compute(self, t, x, target):
+        """The torques of one sample of the C controller (sr_lqr_control) for state x and the target."""
         x = np.ascontiguousarray(x, dtype=np.float64)
         if target.cross_track is not None:
             target = dataclasses.replace(target, curvature=self.operating_curvature(target))

@@ -1,4 +1,4 @@
-"""LQR design on the reduced error coordinates of a rolling robot (issue #20: the firmware controller).
+"""LQR design on the reduced error coordinates of a rolling robot: the firmware's controller.
 
 Why reduced coordinates.  Steady straight rolling is periodic in the full state (the shell turns,
 and γ and R_Y with it), so `linearize` at one instant of it does not give a time-invariant
@@ -31,7 +31,7 @@ the controller's rate, and K from the discrete Riccati equation (`gains`).  The 
 bilinearly in (v_ref, κ) over a grid of operating points.
 
 The reduced field's eigenvalues at straight rolling equal the Floquet exponents of the full
-model's periodic motion (runtime/control/stability.py): an independent check of this chart
+model's periodic motion (runtime/stability.py): an independent check of this chart
 (tests/runtime/control/test_lqr_design.py, and a row of make verify).
 """
 import dataclasses
@@ -209,6 +209,7 @@ class Weights:
     torque_n_m: float = 0.5
 
     def q_diagonal(self):
+        """The state weights of the Riccati equation: one over the square of each bound."""
         return 1.0 / np.square(np.array([*self.attitude_rad, self.pendulum_rad, *self.rate_rad_s,
                                           self.yoke_rate_rad_s, self.pendulum_rate_rad_s,
                                           self.cross_track_m, self.cross_track_integral_m_s,

@@ -1,4 +1,4 @@
-"""The `tracking` metrics of a closed-loop run (issue #20, item 4), each a pure function of arrays.
+"""The `tracking` metrics of a closed-loop run, each a pure function of arrays.
 
 Definitions (docs/control.md, "Metrics"):
 * cross_track_rms_m, cross_track_max_m: RMS and largest |e_y| of the samples at t ≥ T/2

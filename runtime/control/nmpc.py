@@ -1,4 +1,4 @@
-"""NMPC on the full non-linear model, built on the model as CasADi (issue #20).
+"""NMPC on the full non-linear model, built on the model as CasADi.
 
 The model.  The reduced error coordinates of runtime/control/lqr_design.py (the yoke's attitude
 error E = Log(Q_refᵀ Q) on SO(3), the pendulum, the rates in the yoke's frame, the cross-track
@@ -232,6 +232,7 @@ class Nmpc(Controller):
         return P_path, P_heading
 
     def reset(self, x0):
+        """Starts a run at x0: forgets the warm start, the heading and the integral."""
         super().reset(x0)
         self._guess, self._heading, self._u_last = None, 0.0, None
         self.integral = 0.0                     # ∫e_y dt [m s], the controller's own state
@@ -262,6 +263,8 @@ class Nmpc(Controller):
         return mix(s.z_star)[:, :NZ_N], mix(s.u_star)[:-1]
 
     def compute(self, t, x, target):
+        """The torques of one sample: solves the horizon's optimal control problem from state x for the
+        target."""
         n, path = self.n, target.cross_track is not None
         v = float(target.speed)
         if path and target.curvature_ahead is not None and len(target.curvature_ahead) == n + 1:

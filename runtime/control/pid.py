@@ -42,6 +42,7 @@ GAIN_NAMES = tuple(f.name for f in dataclasses.fields(PidGains))
 
 
 class Pid(Controller):
+    """Two PID loops: the yoke torque holds the speed, the pendulum torque steers by leaning the robot."""
     kind = "pid"
 
     def __init__(self, params, rate=50.0, u_max=DEFAULT_U_MAX, gains=PidGains()):
@@ -49,12 +50,14 @@ class Pid(Controller):
         self.gains = gains
 
     def reset(self, x0):
+        """Starts a run at x0: zeroes the integrals and takes the lean and heading of x0 as the last ones."""
         super().reset(x0)
         self.int_v = self.int_r = self.int_phi = 0.0
         self.last_phi, self.last_psi = float(lean(x0)), float(heading(x0))
         self._clipped = (False, False)
 
     def compute(self, t, x, target):
+        """The torques of one sample for state x and the target."""
         g, p, dt = self.gains, self.params, self.period
         e_v = target.speed - float(forward_speed(x, p.r))
         u_ff = target.speed * (p.k_S + p.k_Y) / p.r
@@ -81,4 +84,5 @@ class Pid(Controller):
         return u_Y, u_P
 
     def after_limits(self, raw, u):
+        """Records which torques were clipped (anti-windup: their integrals stop at the next sample)."""
         self._clipped = (bool(raw[0] != u[0]), bool(raw[1] != u[1]))

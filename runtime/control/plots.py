@@ -6,6 +6,8 @@ from .geometry import forward_speed, heading, wrap_angle
 
 
 def plot_run(result, reference, task, path):
+    """Draws a closed-loop run (path, speed and heading, torques) against its reference and saves it to
+    `path`."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

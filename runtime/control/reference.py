@@ -23,6 +23,8 @@ SEARCH_BACK_M, SEARCH_AHEAD_M = 0.5, 1.5
 
 @dataclasses.dataclass(frozen=True)
 class Target:
+    """What a controller tracks at one sample: speed, heading and, for paths, curvature and cross-track
+    error."""
     speed: float                      # m/s
     heading: float                    # rad: the heading to hold, or the path's tangent heading
     curvature: float = 0.0            # 1/m, left positive (path tasks)
@@ -38,6 +40,7 @@ class SpeedHeading:
         self.speed, self.heading = float(speed), float(heading)
 
     def target(self, t, position, heading):
+        """The constant speed and heading, whatever the time and position."""
         return Target(self.speed, self.heading)
 
 
@@ -62,6 +65,7 @@ class Path:
         self._hint = 0
 
     def reset(self):
+        """Starts the nearest-point search from the path's beginning again."""
         self._hint = 0
 
     def nearest(self, position, hint=None):
@@ -76,6 +80,8 @@ class Path:
         return i, float(-math.sin(psi) * rel[0] + math.cos(psi) * rel[1])
 
     def target(self, t, position, heading):
+        """The target at the point of the path nearest to `position`: its tangent, curvature and the cross-
+        track error."""
         i, e = self.nearest(position)
         self._hint = i
         return Target(self.speed, float(self.tangent[i]), float(self.curvature[i]), e)

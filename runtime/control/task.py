@@ -4,7 +4,7 @@
     task = load_task("circle")            # a shipped name (runtime/control/tasks/), or a path
     controller, reference = task.controller(), task.reference()
 
-The scenario part is validated by runtime/scenarios/scenario.py (`parse_scenario`); every bad
+The scenario part is validated by runtime/scenario.py (`parse_scenario`); every bad
 value here raises ValueError("<file>: <section>.<key>: <what is wrong>").
 """
 import dataclasses
@@ -17,7 +17,8 @@ import numpy as np
 
 from ..params import NAMES as PARAM_NAMES
 from ..params import PAPER_NAMES, SHAPES
-from ..scenarios.scenario import parse_scenario
+from ..scenario import parse_scenario
+from ..schema import check_table
 from .closed_loop import Noise
 from .controller import DEFAULT_U_MAX
 from .geometry import heading
@@ -31,7 +32,7 @@ from .pid import GAIN_NAMES, Pid, PidGains
 from .reference import KINDS, SpeedHeading, circle_path, figure8_path, line_path, waypoints_path
 from ..state import IDX_Q
 
-#: Controller kinds of issue #20: (class, its settings, the settings' names).
+#: Controller kinds: (class, its settings, the settings' names).
 AVAILABLE_CONTROLLERS = {"pid": (Pid, PidGains, GAIN_NAMES), "lqr": (Lqr, LqrGains, LQR_GAIN_NAMES),
                          "nmpc": (Nmpc, NmpcGains, NMPC_GAIN_NAMES)}
 CONTROLLER_KINDS = tuple(AVAILABLE_CONTROLLERS)
@@ -54,9 +55,11 @@ class ControllerSpec:
 
 @dataclasses.dataclass(frozen=True)
 class Task:
+    """A control task: the scenario, the reference, the controllers to run, the plant and its measurement
+    noise."""
     name: str
     source: str
-    scenario: object            # runtime.scenarios.scenario.Scenario: the controller's model and x0
+    scenario: object            # runtime.scenario.Scenario: the controller's model and x0
     reference_spec: dict
     controllers: tuple          # ControllerSpec, one per kind; the first is the task's default
     plant_params: object        # runtime.Params of the simulated robot
@@ -65,16 +68,18 @@ class Task:
 
     @property
     def duration(self):
+        """The task's length [s]."""
         return self.scenario.duration
 
     # The first controller's settings (a task run with one controller: `with_controller`).
-    controller_kind = property(lambda self: self.controllers[0].kind)
-    rate = property(lambda self: self.controllers[0].rate)
-    u_max = property(lambda self: self.controllers[0].u_max)
-    gains = property(lambda self: self.controllers[0].gains)
+    controller_kind = property(lambda self: self.controllers[0].kind, doc="The first controller's kind.")
+    rate = property(lambda self: self.controllers[0].rate, doc="The first controller's rate [Hz].")
+    u_max = property(lambda self: self.controllers[0].u_max, doc="The first controller's torque limit [N m].")
+    gains = property(lambda self: self.controllers[0].gains, doc="The first controller's gains.")
 
     @property
     def controller_kinds(self):
+        """The kinds of controller the task names, its default first."""
         return tuple(c.kind for c in self.controllers)
 
     def with_controller(self, kind):
@@ -85,6 +90,8 @@ class Task:
         raise ValueError(f"{self.source}: no controller of kind {kind!r} (it has {', '.join(self.controller_kinds)})")
 
     def controller(self):
+        """A new controller of the task's kind, rate, torque limit and gains, designed for the scenario's
+        robot."""
         cls = AVAILABLE_CONTROLLERS[self.controller_kind][0]
         return cls(self.scenario.params, rate=self.rate, u_max=self.u_max, gains=self.gains)
 
@@ -113,14 +120,17 @@ class Task:
 
 
 def task_dir():
+    """The folder of the shipped task files."""
     return importlib.resources.files("runtime") / "control" / "tasks"
 
 
 def shipped_tasks():
+    """The names of the shipped tasks."""
     return sorted(p.name[:-5] for p in task_dir().iterdir() if p.name.endswith(".toml"))
 
 
 def load_task(name_or_path):
+    """The task of a shipped name or a path to a .toml file; ValueError naming the problem otherwise."""
     candidate = task_dir() / f"{name_or_path}.toml"
     path = pathlib.Path(str(candidate)) if "/" not in str(name_or_path) and candidate.is_file() \
         else pathlib.Path(name_or_path)
@@ -135,13 +145,9 @@ def load_task(name_or_path):
 
 
 def parse_task(data, source="<task>", name="task"):
-    if not isinstance(data, dict):
-        raise ValueError(f"{source}: expected a table")
-    sections = {"reference", "controller", "plant", "estimator"}
-    unknown = sorted(set(data) - _SCENARIO_KEYS - sections)
-    if unknown:
-        raise ValueError(f"{source}: unknown key(s) {', '.join(map(repr, unknown))}; allowed: "
-                         f"{', '.join(sorted(_SCENARIO_KEYS | sections))}")
+    """The Task described by the table `data` (from the file `source`); ValueError naming the field and the
+    problem."""
+    check_table(data, _SCENARIO_KEYS | {"reference", "controller", "plant", "estimator"}, source)
     scenario = parse_scenario({k: v for k, v in data.items() if k in _SCENARIO_KEYS}, source, name)
     reference = _parse_reference(data.get("reference"), source)
     tables = data.get("controller")
@@ -164,21 +170,11 @@ def parse_task(data, source="<task>", name="task"):
 
 def _parse_estimator(table, source):
     where = f"{source}: estimator"
-    _table(table, where, {"kind", *ESTIMATOR_SETTINGS})
+    check_table(table, {"kind", *ESTIMATOR_SETTINGS}, where)
     if table.get("kind") != "ekf":
         raise ValueError(f"{where}.kind: expected \"ekf\", got {table.get('kind')!r}")
     return EkfSettings(**{k: _real(v, f"{where}.{k}", positive=k != "rate", nonnegative=k == "rate")
                           for k, v in table.items() if k != "kind"})
-
-
-def _table(value, where, allowed):
-    if not isinstance(value, dict):
-        raise ValueError(f"{where}: expected a table, got {type(value).__name__} {value!r}")
-    unknown = sorted(set(value) - set(allowed))
-    if unknown:
-        raise ValueError(f"{where}: unknown key(s) {', '.join(map(repr, unknown))}; allowed: "
-                         f"{', '.join(sorted(allowed))}")
-    return value
 
 
 def _real(value, where, positive=False, nonnegative=False):
@@ -197,7 +193,7 @@ def _parse_reference(table, source):
     where = f"{source}: reference"
     if table is None:
         raise ValueError(f"{where}: missing (required): give kind = one of {', '.join(KINDS)}")
-    _table(table, where, _REFERENCE_KEYS)
+    check_table(table, _REFERENCE_KEYS, where)
     kind = table.get("kind")
     if kind not in KINDS:
         raise ValueError(f"{where}.kind: expected one of {', '.join(KINDS)}, got {kind!r}")
@@ -232,7 +228,7 @@ def _parse_controller(table, source, name="controller"):
     if kind not in CONTROLLER_KINDS:
         raise ValueError(f"{where}.kind: expected one of {', '.join(CONTROLLER_KINDS)}, got {kind!r}")
     _, gains_cls, gain_names = AVAILABLE_CONTROLLERS[kind]
-    _table(table, where, {"kind", "rate", "u_max", *gain_names})
+    check_table(table, {"kind", "rate", "u_max", *gain_names}, where)
     rate = _real(table.get("rate", 50.0), f"{where}.rate", positive=True)
     u_max = _real(table.get("u_max", DEFAULT_U_MAX), f"{where}.u_max", positive=True)
     try:
@@ -247,7 +243,7 @@ def _parse_controller(table, source, name="controller"):
 
 def _parse_plant(table, params, source):
     where = f"{source}: plant"
-    _table(table, where, set(PARAM_NAMES) | set(PAPER_NAMES) | set(_NOISE_KEYS))
+    check_table(table, set(PARAM_NAMES) | set(PAPER_NAMES) | set(_NOISE_KEYS), where)
     overrides = {k: (_real(v, f"{where}.{k}") if SHAPES.get(k, ()) == () else v)
                  for k, v in table.items() if k not in _NOISE_KEYS}
     try:

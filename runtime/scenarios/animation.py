@@ -19,7 +19,7 @@ from matplotlib import font_manager  # noqa: E402
 from PIL import Image, ImageDraw, ImageFont  # noqa: E402
 
 from ..state import IDX_Q, rotations  # noqa: E402
-from .atomic import atomic_path  # noqa: E402
+from ..atomic import atomic_path  # noqa: E402
 from .outline import rod_tip, yoke_outline  # noqa: E402
 
 GIF_SECONDS = 10.0
@@ -135,6 +135,7 @@ class RobotScene:
         return picture
 
     def close(self):
+        """Closes the scene's figure."""
         plt.close(self.fig)
 
 

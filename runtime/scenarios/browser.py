@@ -79,7 +79,7 @@ def console_errors(driver):
 
 def screenshot(page, target, width=1280, height=1560):
     """Save a PNG of `page` as a user first sees it, one moment into the run (frame at a third of it)."""
-    from .atomic import atomic_path
+    from ..atomic import atomic_path
 
     with open_replay(page, width, height) as driver:
         driver.execute_script("const s = document.getElementById('time');"
@@ -91,6 +91,7 @@ def screenshot(page, target, width=1280, height=1560):
 
 
 def have_apt_as_root():
+    """True when this process is root and apt-get is on the PATH."""
     import os
 
     return hasattr(os, "geteuid") and os.geteuid() == 0 and shutil.which("apt-get") is not None

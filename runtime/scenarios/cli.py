@@ -27,10 +27,11 @@ import sys
 from . import report
 from ..errors import KernelError, SimulationStopped
 from .parallel import RunBar, write_runs
-from .scenario import PAPER_SCENARIOS, load_scenario, run_scenario, scenario_path, shipped_scenarios
+from ..scenario import PAPER_SCENARIOS, load_scenario, run_scenario, scenario_path, shipped_scenarios
 
 
 def build_parser():
+    """The argument parser of `python -m runtime run`."""
     shipped = ", ".join(shipped_scenarios())
     parser = argparse.ArgumentParser(
         prog="python -m runtime run",
@@ -113,6 +114,7 @@ def check_output_folder(folder, force):
 
 
 def main(argv):
+    """`python -m runtime run`: simulate the scenarios named in argv and write their output folders."""
     args = build_parser().parse_args(argv)
     names = list(PAPER_SCENARIOS) if args.scenario == "all" else [args.scenario]
     try:
@@ -131,7 +133,3 @@ def main(argv):
               file=sys.stderr)
         return 2
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

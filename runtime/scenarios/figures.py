@@ -13,7 +13,7 @@ import tempfile
 
 from . import browser, plots
 from .replay import write_replay
-from .scenario import PAPER_SCENARIOS, load_scenario, run_scenario
+from ..scenario import PAPER_SCENARIOS, load_scenario, run_scenario
 
 DEFAULT_OUT = pathlib.Path(__file__).resolve().parents[2] / "docs" / "figures"
 
@@ -23,6 +23,7 @@ COMMITTED.append(("t-shape", plots.inclinations_figure, "inclinations"))
 
 
 def main(argv):
+    """`python -m runtime figures`: run the paper's scenarios and rewrite the committed figures."""
     parser = argparse.ArgumentParser(prog="python -m runtime figures", description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=pathlib.Path, default=DEFAULT_OUT, help=f"folder (default: {DEFAULT_OUT})")
     args = parser.parse_args(argv)
@@ -43,7 +44,3 @@ def main(argv):
         browser.screenshot(page, target)
     print(target)
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

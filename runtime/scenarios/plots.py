@@ -4,7 +4,7 @@ The centre's path on the plane (start marked with an open circle), the
 relative inclinations θ_Y (yoke relative to the shell) and θ_P (pendulum
 relative to the yoke), the absolute inclinations (yoke plane normal and
 pendulum shaft against the vertical) and the energy.  Each function takes a
-`ScenarioResult` (runtime/scenarios/scenario.py) and returns a figure;
+`ScenarioResult` (runtime/scenario.py) and returns a figure;
 `save_figure` writes it atomically.
 """
 import matplotlib
@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
 
 from ..state import IDX_Q, absolute_inclinations, pendulum_angle, yoke_angle  # noqa: E402
-from .atomic import atomic_path  # noqa: E402
+from ..atomic import atomic_path  # noqa: E402
 
 FIGURE_DPI = 100
 
@@ -98,6 +98,7 @@ def absolute_inclinations_figure(result, size=(6.0, 3.6)):
 
 
 def energy_figure(result, size=(6.0, 3.6)):
+    """The total energy of a result against time, as a matplotlib figure."""
     fig, ax = _time_figure(result, size)
     ax.plot(result.time, result.energy, color="k")
     _finish_time_axes(ax, result, "E [J]", "kinetic + potential energy", legend=False)

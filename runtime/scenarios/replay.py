@@ -27,7 +27,7 @@ import numpy as np
 from ..state import IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, absolute_inclinations, pendulum_angle, \
     yoke_angle
 from .animation import _sphere_wireframe
-from .atomic import write_text
+from ..atomic import write_text
 from .outline import rod_tip, yoke_outline
 
 #: At most this many samples go into the page (a 100 s run at dt = 0.01 s: every 5th step).

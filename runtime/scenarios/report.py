@@ -1,13 +1,13 @@
 """Outputs of a scenario run: trajectory.csv, summary.json, and the whole set of files of a run.
 
-Every file is written atomically (runtime/scenarios/atomic.py).
+Every file is written atomically (runtime/atomic.py).
 
     files = write_outputs(result, pathlib.Path("out/t-shape"), gif=True)
 
 writes the CSV, the figures (runtime/scenarios/plots.py), the animation
 (runtime/scenarios/animation.py), the interactive replay (runtime/scenarios/replay.py)
 and the summary.  Nothing here simulates:
-see runtime/scenarios/scenario.py.
+see runtime/scenario.py.
 """
 import contextlib
 import json
@@ -19,7 +19,7 @@ import numpy as np
 from ..state import (IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, absolute_inclinations,
                      pendulum_angle, yoke_angle)
 from .animation import frame_samples, write_gif
-from .atomic import write_text
+from ..atomic import write_text
 from .plots import FIGURES, save_figure
 from .replay import write_replay
 
@@ -107,6 +107,7 @@ def write_csv(result, target):
 
 
 def write_summary(summary_dict, target):
+    """Writes the summary dict as indented JSON to `target`, atomically."""
     write_text(target, json.dumps(summary_dict, indent=2) + "\n")
 
 

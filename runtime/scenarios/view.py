@@ -25,6 +25,7 @@ def replay_page(path):
 
 
 def main(argv):
+    """`python -m runtime view`: open a run's replay page in the browser."""
     parser = argparse.ArgumentParser(prog="python -m runtime view",
                                      description="Open the interactive replay of a run in the browser.")
     parser.add_argument("folder", metavar="FOLDER", help="a run's output folder (e.g. out/t-shape) or its replay.html")
@@ -39,7 +40,3 @@ def main(argv):
         print("error: no browser could be started; open the page above by hand", file=sys.stderr)
         return 2
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

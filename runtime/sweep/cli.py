@@ -8,28 +8,81 @@ process, no Dask).  Writes OUT/results.parquet (one row per sample: inputs, stat
 OUT/summary.png and OUT/percentiles.md; rerun the same command to resume an interrupted sweep.
 
 Exit status: 0 when every sample ran; 1 when some samples failed (their rows carry the
-status); 2 on a bad argument, sweep file or output folder.
+status), or when the results are incomplete (chunk files that fail verification, rows refused)
+or the environment fails (an unreachable scheduler, a lost cluster, a file that cannot be
+written); 2 on a bad argument, sweep file or output folder.  Every error is one line on stderr.
 """
 import argparse
+import math
+import os
 import sys
 
 from ..errors import SimulationStopped
 from ..model import Model
-from ..scenarios.atomic import write_text
+from ..atomic import write_text
 from ..state import IDX_Q
-from .runner import SERIAL, run_sweep
-from .spec import load_sweep, shipped_sweeps
+from .runner import CONNECT_TIMEOUT, SERIAL, run_sweep, scheduler_address
+from .spec import MAX_SAMPLES, load_sweep, shipped_sweeps
+from .store import SweepIncomplete
 from .summary import percentile_table, write_summary_figure
+
+#: Most worker processes of the embedded LocalCluster, per core (more only share the cores).
+WORKERS_PER_CORE = 4
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse whose errors are a ValueError (one line, exit status 2, from `main`)."""
+
+    def error(self, message):
+        raise ValueError(message)
+
+
+def _whole(low, high):
+    def whole(text):
+        try:
+            value = int(text)
+        except ValueError:
+            value = None
+        if value is None or not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"expected a whole number from {low} to {high}, got {text!r}")
+        return value
+    return whole
+
+
+def _seconds(text):
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {text!r}")
+    return value
+
+
+def _scheduler(text):
+    if text == SERIAL:
+        return text
+    try:
+        return scheduler_address(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def build_parser():
-    p = argparse.ArgumentParser(prog="python -m runtime sweep", description=__doc__.split("\n\n")[1])
+    """The argument parser of `python -m runtime sweep`."""
+    p = _Parser(prog="python -m runtime sweep", description=__doc__.split("\n\n")[1])
+    cores = os.cpu_count() or 1
     p.add_argument("sweep", help=f"a shipped sweep ({', '.join(shipped_sweeps())}) or a sweep file")
     p.add_argument("--out", required=True, help="output folder (resumed if it holds this sweep)")
-    p.add_argument("--samples", type=int, help="number of samples (default: the file's)")
-    p.add_argument("--scheduler", help=f"Dask scheduler address, or '{SERIAL}' (default: an embedded LocalCluster)")
-    p.add_argument("--workers", type=int, help="worker processes of the embedded LocalCluster (default: cores)")
-    p.add_argument("--samples-per-task", type=int, help="task size (default: the file's, else ~2 s of work)")
+    p.add_argument("--samples", type=_whole(1, MAX_SAMPLES), help="number of samples (default: the file's)")
+    p.add_argument("--scheduler", type=_scheduler,
+                   help=f"Dask scheduler address, or '{SERIAL}' (default: an embedded LocalCluster)")
+    p.add_argument("--connect-timeout", type=_seconds, default=CONNECT_TIMEOUT, metavar="SECONDS",
+                   help=f"how long to wait for the --scheduler to answer (default: {CONNECT_TIMEOUT:g})")
+    p.add_argument("--workers", type=_whole(1, WORKERS_PER_CORE * cores),
+                   help="worker processes of the embedded LocalCluster (default: cores)")
+    p.add_argument("--samples-per-task", type=_whole(1, MAX_SAMPLES),
+                   help="task size (default: the file's, else ~2 s of work)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
 
@@ -45,26 +98,30 @@ def nominal_end_point(spec):
 
 
 def main(argv):
-    args = build_parser().parse_args(argv)
+    """`python -m runtime sweep`: run (or resume) a sweep and write its store and summary."""
     try:
+        args = build_parser().parse_args(argv)
         spec = load_sweep(args.sweep)
         if args.samples is not None:
             spec = spec.with_samples(args.samples)
-        for name in ("workers", "samples_per_task"):
-            value = getattr(args, name)
-            if value is not None and value < 1:
-                raise ValueError(f"--{name.replace('_', '-')}: expected a positive integer, got {value}")
         table = run_sweep(spec, args.out, scheduler=args.scheduler, workers=args.workers,
-                          samples_per_task=args.samples_per_task, progress=not args.no_progress)
+                          samples_per_task=args.samples_per_task, progress=not args.no_progress,
+                          connect_timeout=args.connect_timeout)
+        first = spec.quantities[0] if spec.quantities else None
+        write_summary_figure(table, f"{args.out}/summary.png", spec.name, colour_by=first and first.name,
+                             colour_label=first and (f"{first.name} (factor)" if first.relative else first.name),
+                             nominal=nominal_end_point(spec))
+        summary = percentile_table(table)
+        write_text(f"{args.out}/percentiles.md", summary + "\n")
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    first = spec.quantities[0] if spec.quantities else None
-    write_summary_figure(table, f"{args.out}/summary.png", spec.name, colour_by=first and first.name,
-                         colour_label=first and (f"{first.name} (factor)" if first.relative else first.name),
-                         nominal=nominal_end_point(spec))
-    summary = percentile_table(table)
-    write_text(f"{args.out}/percentiles.md", summary + "\n")
+    except (SweepIncomplete, OSError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("error: interrupted; the finished tasks are kept, rerun the same command to resume", file=sys.stderr)
+        return 130
     print(summary)
     failed = sum(1 for s in table.column("status").to_pylist() if s != 0)
     return 1 if failed else 0

@@ -5,14 +5,17 @@ The client process submits every missing task, writes the rows of each as it com
 shows a progress bar; the workers only compute (they need this package installed, not the
 output folder).
 """
+import concurrent.futures
 import contextlib
 import logging
 import os
+import re
+import sys
 import time
 
 from tqdm.auto import tqdm
 
-from .store import SweepStore
+from .store import BadRows, SweepStore
 from .task import run_chunk
 
 #: Default wall time of one task: long against Dask's per-task cost (about a millisecond, see
@@ -20,6 +23,33 @@ from .task import run_chunk
 TASK_SECONDS = 2.0
 #: `scheduler` value that runs the tasks in this process, without Dask.
 SERIAL = "serial"
+#: Seconds to wait for a scheduler given by address to answer (Dask's own default is 30 s).
+CONNECT_TIMEOUT = 10.0
+#: Protocols of Dask scheduler addresses (distributed.comm); inproc:// is local to a process.
+PROTOCOLS = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
+_HOST_PORT = re.compile(r"(?P<host>\[[0-9A-Fa-f:.]+\]|[^\[\]:/\s]+):(?P<port>[^:]*)")
+
+
+def scheduler_address(text):
+    """`text` if it is a Dask scheduler address (HOST:PORT or PROTOCOL://HOST:PORT), else ValueError."""
+    expected = f"expected HOST:PORT, tcp://HOST:PORT or '{SERIAL}'"
+    protocol, sep, location = text.rpartition("://")
+    if sep and protocol not in PROTOCOLS:
+        raise ValueError(f"{text!r}: unknown protocol {protocol!r} (Dask's: {', '.join(PROTOCOLS)}); {expected}")
+    if protocol == "inproc":
+        return text
+    match = _HOST_PORT.fullmatch(location)
+    if not match:
+        raise ValueError(f"{text!r} is not a scheduler address ({expected})")
+    port = match["port"]
+    if not port.isdigit() or not 1 <= int(port) <= 65535:
+        raise ValueError(f"{text!r}: the port {port!r} is not a number from 1 to 65535 ({expected})")
+    return text
+
+
+def warn(message):
+    """The default `notify` of run_sweep: one line on stderr."""
+    print(f"warning: {message}", file=sys.stderr, flush=True)
 
 
 def measure_samples_per_task(spec, seconds=TASK_SECONDS):
@@ -41,12 +71,18 @@ EMBEDDED_CLUSTER_CONFIG = {
 
 
 @contextlib.contextmanager
-def dask_client(scheduler=None, workers=None):
-    """A distributed.Client: on `scheduler` (an address), or on a new LocalCluster of `workers`
-    single-threaded worker processes (default: one per core)."""
+def dask_client(scheduler=None, workers=None, connect_timeout=CONNECT_TIMEOUT):
+    """A distributed.Client: on `scheduler` (an address; ConnectionError if it does not answer
+    within `connect_timeout` seconds), or on a new LocalCluster of `workers` single-threaded
+    worker processes (default: one per core)."""
     from distributed import Client, LocalCluster
     if scheduler is not None:
-        with Client(scheduler) as client:
+        try:
+            client = Client(scheduler, timeout=connect_timeout)
+        except OSError as exc:
+            raise ConnectionError(f"--scheduler: no Dask scheduler answered at {scheduler} within "
+                                  f"{connect_timeout:g} s ({exc})".replace("\n", " ")) from None
+        with client:
             yield client
         return
     import dask
@@ -66,32 +102,58 @@ def dask_client(scheduler=None, workers=None):
         yield client
 
 
-def run_sweep(spec, out, scheduler=None, workers=None, samples_per_task=None, progress=True, client=None):
+def run_sweep(spec, out, scheduler=None, workers=None, samples_per_task=None, progress=True, client=None,
+              connect_timeout=CONNECT_TIMEOUT, notify=warn):
     """Run `spec` into the folder `out` (resuming what is there); returns the results table.
 
     scheduler: None (an embedded LocalCluster of `workers` processes), SERIAL (this process,
-    no Dask), or the address of a running Dask scheduler ("tcp://host:8786").
+    no Dask), or the address of a running Dask scheduler ("tcp://host:8786"), which must answer
+    within `connect_timeout` seconds (else ConnectionError).
     samples_per_task: None for the sweep file's, else measured for TASK_SECONDS.
     client: a distributed.Client to use instead (the benchmark reuses one cluster).
+    notify(message): called with each chunk file that fails verification (it is recomputed)
+    and each task whose rows are refused (they are not written).
+
+    Raises store.SweepIncomplete, writing no results file, unless every sample has verified
+    rows; ValueError for a bad argument or output folder; ConnectionError when the scheduler
+    cannot be reached or the cluster fails (the finished tasks are kept for a rerun).
     """
+    if scheduler is not None and scheduler != SERIAL:
+        try:
+            scheduler_address(scheduler)
+        except ValueError as exc:
+            raise ValueError(f"--scheduler: {exc}") from None
     per_task = samples_per_task or spec.samples_per_task
     store = SweepStore.open(out, spec, lambda: per_task or measure_samples_per_task(spec))
-    todo = store.missing()
+    todo, bad = store.verify()
+    for path, why in bad:
+        notify(f"{path}: {why}; recomputing it")
+
+    def keep(a, b, columns):
+        try:
+            store.write_chunk(a, b, columns)
+        except BadRows as exc:
+            notify(str(exc))
+
     done = spec.samples - sum(b - a for a, b in todo)
     with tqdm(total=spec.samples, initial=done, unit="sample", desc=spec.name, disable=not progress or None,
               smoothing=0.1) as bar:
         if todo and scheduler == SERIAL:
             for a, b in todo:
-                store.write_chunk(a, b, run_chunk(spec, a, b))
+                keep(a, b, run_chunk(spec, a, b))
                 bar.update(b - a)
         elif todo:
-            from distributed import as_completed
-            with (contextlib.nullcontext(client) if client is not None
-                  else dask_client(scheduler, workers)) as client:
-                futures = {client.submit(run_chunk, spec, a, b, pure=False): (a, b) for a, b in todo}
-                for future in as_completed(futures):
-                    a, b = futures.pop(future)
-                    store.write_chunk(a, b, future.result())
-                    future.release()
-                    bar.update(b - a)
+            from distributed import KilledWorker, as_completed
+            try:
+                with (contextlib.nullcontext(client) if client is not None
+                      else dask_client(scheduler, workers, connect_timeout)) as client:
+                    futures = {client.submit(run_chunk, spec, a, b, pure=False): (a, b) for a, b in todo}
+                    for future in as_completed(futures):
+                        a, b = futures.pop(future)
+                        keep(a, b, future.result())
+                        future.release()
+                        bar.update(b - a)
+            except (KilledWorker, concurrent.futures.CancelledError) as exc:
+                raise ConnectionError(f"the Dask cluster failed ({type(exc).__name__}: {exc}); the finished "
+                                      "tasks are kept, rerun the same command to resume".replace("\n", " ")) from None
     return store.combine()

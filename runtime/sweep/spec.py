@@ -28,6 +28,7 @@ import dataclasses
 import importlib.resources
 import math
 import pathlib
+import sys
 import tomllib
 
 import numpy as np
@@ -35,7 +36,8 @@ import numpy as np
 from bindings._sr import lib
 
 from ..params import PAPER_NAMES, Params, paper_rows_to_params
-from ..scenarios.scenario import Scenario, load_scenario
+from ..schema import check_table
+from ..scenario import Scenario, load_scenario
 from ..state import IDX_QZ, IDX_RP, IDX_RY, IDX_WP, IDX_WY, IDX_UP, IDX_UY, pendulum_angle, rot_x, rot_y, yoke_angle
 
 #: A sweep varies parameters by the paper's names (r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P,
@@ -51,6 +53,9 @@ INITIAL_KEYS = ("theta_Y", "theta_P", "w_Y", "w_P")
 TORQUE_KEYS = ("u_Y_scale", "u_P_scale")
 #: Largest sample count (the sample index is part of every seed; results are one row each).
 MAX_SAMPLES = 10**9
+#: A normal draw is mean + sd z with |z| < 14 (NumPy's ziggurat: its tail ends near 3.65 + 36.7/3.65),
+#: so |mean| + NORMAL_REACH sd finite keeps every draw finite.
+NORMAL_REACH = 100.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -76,13 +81,17 @@ class SweepSpec:
 
     @property
     def grid(self):
+        """The quantities given as lists of values (the grid's axes)."""
         return tuple(q for q in self.quantities if q.kind == "values")
 
     @property
     def grid_size(self):
+        """The number of points of the grid (1 without grid axes)."""
         return math.prod(len(q.numbers) for q in self.grid)
 
     def with_samples(self, samples):
+        """The same sweep with another number of samples (ValueError unless a whole number from 1 to
+        MAX_SAMPLES)."""
         return dataclasses.replace(self, samples=_count(samples, "--samples"))
 
     def identity(self):
@@ -101,6 +110,7 @@ def _sweep_dir():
 
 
 def shipped_sweeps():
+    """The names of the shipped sweep files."""
     return sorted(p.name[:-5] for p in _sweep_dir().iterdir() if p.name.endswith(".toml"))
 
 
@@ -115,12 +125,14 @@ def load_sweep(name_or_path):
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ValueError(f"{path}: not valid TOML ({exc})") from None
+    except OSError as exc:
+        raise ValueError(f"{path}: cannot be read ({exc.strerror})") from None
     return parse_sweep(data, source=str(path), name=path.stem, folder=path.parent)
 
 
 def parse_sweep(data, source="<sweep>", name="sweep", folder=None):
     """Validate the table `data` (as read by tomllib) into a `SweepSpec`."""
-    _check_keys(data, _TOP_KEYS, source)
+    check_table(data, _TOP_KEYS, source)
     description = data.get("description", "")
     if not isinstance(description, str):
         raise ValueError(f"{source}: description: expected a string, got {description!r}")
@@ -144,7 +156,7 @@ def parse_sweep(data, source="<sweep>", name="sweep", folder=None):
     groups = {"params": PARAM_KEYS, "initial": INITIAL_KEYS, "torque": TORQUE_KEYS}
     for group, allowed in groups.items():
         table = data.get(group, {})
-        _check_keys(table, set(allowed), f"{source}: {group}")
+        check_table(table, set(allowed), f"{source}: {group}")
         for key, spec in table.items():
             quantities.append(_quantity(f"{group}.{key}", spec, f"{source}: {group}.{key}"))
     _check_param_names(data.get("params", {}), scenario, f"{source}: params")
@@ -172,7 +184,7 @@ def _check_param_names(table, scenario, where):
 def _quantity(name, table, where):
     if not isinstance(table, dict):
         raise ValueError(f"{where}: expected a table with one of {', '.join(_KINDS)}, got {table!r}")
-    _check_keys(table, set(_KINDS) | {"relative"}, where)
+    check_table(table, set(_KINDS) | {"relative"}, where)
     kinds = [k for k in _KINDS if k in table]
     if len(kinds) != 1:
         raise ValueError(f"{where}: give exactly one of {', '.join(_KINDS)}, got {kinds or 'none'}")
@@ -186,8 +198,14 @@ def _quantity(name, table, where):
         raise ValueError(f"{where}.values: the grid is empty")
     if kind == "uniform" and (len(numbers) != 2 or not numbers[0] <= numbers[1]):
         raise ValueError(f"{where}.uniform: expected [low, high] with low <= high, got {list(numbers)}")
+    if kind == "uniform" and not math.isfinite(numbers[1] - numbers[0]):
+        raise ValueError(f"{where}.uniform: the width high - low of {list(numbers)} overflows; "
+                         f"expected a width below {sys.float_info.max:.4g}")
     if kind == "normal" and (len(numbers) != 2 or not numbers[1] >= 0):
         raise ValueError(f"{where}.normal: expected [mean, sd] with sd >= 0, got {list(numbers)}")
+    if kind == "normal" and not math.isfinite(abs(numbers[0]) + NORMAL_REACH * numbers[1]):
+        raise ValueError(f"{where}.normal: |mean| + {NORMAL_REACH:g} sd of {list(numbers)} overflows; "
+                         f"expected it below {sys.float_info.max:.4g} (every draw must be finite)")
     relative = table.get("relative", False)
     if not isinstance(relative, bool):
         raise ValueError(f"{where}.relative: expected true or false, got {relative!r}")
@@ -212,15 +230,6 @@ def _check_grid_values(spec, source):
                         Params.from_array(values)
                 except ValueError as exc:
                     raise ValueError(f"{source}: {q.name}.values: {v:g} gives invalid parameters ({exc})") from None
-
-
-def _check_keys(table, allowed, where):
-    if not isinstance(table, dict):
-        raise ValueError(f"{where}: expected a table, got {table!r}")
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise ValueError(f"{where}: unknown key{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))}; "
-                         f"allowed: {', '.join(sorted(allowed))}")
 
 
 def _count(value, where):

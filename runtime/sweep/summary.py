@@ -43,6 +43,7 @@ def summary_figure(table, title, colour_by=None, colour_label=None, nominal=None
 
 
 def write_summary_figure(table, target, title, colour_by=None, colour_label=None, nominal=None):
+    """Draws the sweep's summary figure of `table` and saves it to `target`."""
     save_figure(summary_figure(table, title, colour_by, colour_label, nominal), target)
 
 

@@ -21,7 +21,6 @@ ODE, with the rotations projected before every call of Model.accel).
 import argparse
 import json
 import pathlib
-import sys
 import time
 
 import numpy as np
@@ -79,6 +78,8 @@ def scipy_reference(model, x0, u, t_end, rtol=1e-13):
 
 
 def error_table(model, log):
+    """The error at the end of each scenario against an adaptive reference, per method and dt, with fitted
+    orders."""
     out = {}
     for name, (x0, u) in scenarios().items():
         ref = model.simulate_adaptive(x0, T_END, T_END, rtol=1e-13, atol=1e-15, u=u.reshape(1, 2))[-1]
@@ -149,6 +150,7 @@ def orthogonality(log, steps=1_000_000, dt=0.001, chunk=50_000):
 
 
 def adaptive_cost(log):
+    """The accel evaluations and error of the adaptive stepper at several tolerances on one scenario."""
     model = Model(Params.paper_simulation())
     x0, u = scenarios()["spinning-3d"]
     ref = model.simulate_adaptive(x0, T_END, T_END, rtol=1e-13, atol=1e-15, u=u.reshape(1, 2))[-1]
@@ -165,6 +167,7 @@ def adaptive_cost(log):
 
 
 def figure(errors, path):
+    """Draws the error against dt of every method and scenario and saves the figure to `path`."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -188,6 +191,7 @@ def figure(errors, path):
 
 
 def markdown(res):
+    """The study's result `res` as the page docs/convergence.md."""
     lines = ["# Convergence and energy study of the integrators", "",
              "Written by `python -m runtime convergence` (runtime/verification/convergence.py); every number "
              "below is measured.  Parameters: `Params.paper_simulation()`.", "",
@@ -233,6 +237,8 @@ def markdown(res):
 
 
 def main(argv):
+    """`python -m runtime convergence`: run the study and write its results (and, with --docs, the docs
+    page)."""
     parser = argparse.ArgumentParser(prog="python -m runtime convergence", description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="out/convergence", help="output folder (default out/convergence)")
     parser.add_argument("--docs", action="store_true", help="also write docs/convergence.md and docs/figures/")
@@ -265,7 +271,3 @@ def main(argv):
         (root / "docs" / "convergence.md").write_text(md)
     log(f"wrote {out}/convergence.png, convergence.md, convergence.json")
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

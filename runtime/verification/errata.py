@@ -1,6 +1,6 @@
 """Evidence for docs/errata.md: each printed formula against its corrected form, at random states.
 
-`python -m runtime.verification.errata [--states N] [--seed S]` prints a markdown table: for
+`python -m runtime errata [--states N] [--seed S]` prints a markdown table: for
 every erratum, the worst relative error against the kernel (and, where it
 exists, the independent CasADi reference) with the printed form and with the
 corrected one.
@@ -19,19 +19,23 @@ from .sampling import random_inputs, random_state
 
 
 def relative_error(a, b):
+    """max |a - b| / max |b|."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     return float(np.abs(a - b).max() / max(np.abs(b).max(), 1e-300))
 
 
 def worst(pairs):
+    """The largest relative_error over the pairs (a, b)."""
     return max(relative_error(a, b) for a, b in pairs)
 
 
 def accel_errors(model, paper, states):
+    """The worst relative error of the paper formulas' accelerations against the model's over the states."""
     return worst((paper.accel(x, u), model.accel(x, u)) for x, u in states)
 
 
 def energy_errors(model, paper, states):
+    """The worst relative error of the paper formulas' energy against the model's over the states."""
     return worst((paper.energy(x), model.energy(x)) for x, _ in states)
 
 
@@ -80,7 +84,8 @@ def evidence(n_states=200, seed=0):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m runtime.verification.errata", description=__doc__.splitlines()[0])
+    """Prints the errata's evidence as a Markdown table."""
+    parser = argparse.ArgumentParser(prog="python -m runtime errata", description=__doc__.splitlines()[0])
     parser.add_argument("--states", type=int, default=200)
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
@@ -90,7 +95,3 @@ def main(argv=None):
         cells = ["—" if v is None else f"{v:.2e}" for v in (printed, corrected)]
         print(f"| {equation} | {quantity} | {cells[0]} | {cells[1]} |")
     return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

@@ -1,4 +1,4 @@
-"""Checks of the Jacobians (issue 19) against two independent sources.
+"""Checks of the Jacobians against two independent sources.
 
 * CasADi AD of the independent reference (`runtime.verification.reference`, a Lagrange–d'Alembert
   model in coordinates that imports neither derive/ nor the kernels): its accelerations at the
@@ -25,7 +25,7 @@ def _rowmajor(R):
 
 def reference_accel_jacobian(ref):
     """CasADi Function (x, u) -> (Ja 5x12, Jb 5x2) by AD of the reference's accelerations at
-    x ⊕ d, u + w; ⊕ as issue 19 defines it (R_S Exp(⟦δξ⟧), R_Y rot_x(δθ_Y), R_P rot_y(δθ_P),
+    x ⊕ d, u + w; ⊕ as runtime/group.py defines it (R_S Exp(⟦δξ⟧), R_Y rot_x(δθ_Y), R_P rot_y(δθ_P),
     q + (δq, 0), ν + δν)."""
     x0, u0 = ca.SX.sym("x", STATE_DIM), ca.SX.sym("u", 2)
     d, w = ca.SX.sym("d", 12), ca.SX.sym("w", 2)
@@ -108,7 +108,7 @@ STEP_METHODS = ("lie-euler", "rkmk4", "cf4")
 
 
 def step_jacobian_checks(n_states=20, seed=7, jacobian=None, params=None, dt=0.01):
-    """Rows of `make verify` for step_jacobian (issue 19), per method:
+    """Rows of `make verify` for step_jacobian, per method:
 
     * against Richardson central differences of the C step through retract/local (≤ 1e-8
       relative; the Jacobian under test is the C kernel of every method, the differences are

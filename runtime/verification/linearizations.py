@@ -1,4 +1,4 @@
-"""Rows of `make verify` for the linearisations of runtime/control/stability.py (issue 19).
+"""Rows of `make verify` for the linearisations of runtime/stability.py.
 
 * Eigenvalues at the equilibria (pendulum down and up): `linearize` against the same error
   dynamics with the accel Jacobian replaced by CasADi AD of the independent reference.
@@ -11,7 +11,7 @@ Each check takes the function under test as an argument, so a test can perturb i
 """
 import numpy as np
 
-from ..control import stability
+from .. import stability
 from ..model import Model
 from ..params import Params
 from ..state import IDX_E_NU
@@ -25,6 +25,8 @@ def _spectrum_distance(ours, theirs):
 
 
 def equilibrium_checks(params=None, linearize=None):
+    """Check rows: the eigenvalues of the linearisation at the two equilibria against those of the
+    independent reference's Jacobian."""
     params = Params.paper_simulation() if params is None else params
     model = Model(params)
     linearize = linearize or (lambda m, x, u: m.linearize(x, u))
@@ -43,6 +45,7 @@ def equilibrium_checks(params=None, linearize=None):
 
 
 def steady_rolling_checks(params=None, speeds=(0.3, 1.0, 1.5)):
+    """Check rows: steady rolling at each speed holds with the predicted torque and accelerations."""
     params = Params.paper_simulation() if params is None else params
     model = Model(params)
     worst = 0.0
@@ -73,6 +76,8 @@ def rolling_growth_rate(model, speed, duration=12.0, dt=0.001, seed=0):
 
 
 def rolling_stability_checks(params=None, speed=1.0, floquet=None):
+    """Check rows: the largest Floquet exponent of steady rolling against the growth rate of a perturbed
+    simulation."""
     params = Params.paper_simulation() if params is None else params
     model = Model(params)
     floquet = floquet or stability.floquet_exponents

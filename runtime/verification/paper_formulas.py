@@ -100,6 +100,7 @@ class PaperModel:
     # -- configuration ---------------------------------------------------------
     @staticmethod
     def unpack(x):
+        """The state's rotations, position and the angular-velocity matrices of the paper's formulas."""
         x = np.asarray(x)
         R_S, R_Y, R_P = rotations(x)
         return R_S, R_Y, R_P, x[IDX_Q], hat(x[IDX_WS]), x[IDX_WY] * SIGMA_Y, x[IDX_WP] * SIGMA_P
@@ -144,6 +145,7 @@ class PaperModel:
         return np.column_stack([self.coefficients(*self.momenta(gamma, R_Y, R_P, *b)) for b in basis])
 
     def inertia(self, x):
+        """The generalized inertia matrix of the paper's Appendix C at state x."""
         R_S, R_Y, R_P, *_ = self.unpack(x)
         return self.appendix_c_matrix(R_S[2], R_Y, R_P)
 

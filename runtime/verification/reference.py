@@ -111,7 +111,7 @@ from ..so3 import hat as _hat_np
 from ..so3 import rot_x as _rot_x_np
 from ..so3 import rot_y as _rot_y_np
 
-#: The general robot (issue 18): scalars, c_* 3-vectors, J_* 3x3 tensors about the centre of mass.
+#: The general robot: scalars, c_* 3-vectors, J_* 3x3 tensors about the centre of mass.
 PARAM_NAMES = ("r", "m_S", "j_S", "k_S", "m_Y", "c_Y", "J_Y", "k_Y", "m_P", "c_P", "J_P", "k_P",
                "j_mY", "n_Y", "j_mP", "n_P", "g", "slope")
 #: The paper's robot (Section 5.2), built here from its rods (`paper_robot`).

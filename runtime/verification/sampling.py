@@ -16,10 +16,12 @@ def random_state(rng, params=None, max_speed=10.0):
 
 
 def random_states(rng, n, params=None, max_speed=10.0):
+    """n random valid states (n, 35), speeds up to `max_speed`."""
     return np.array([random_state(rng, params, max_speed) for _ in range(n)])
 
 
 def random_inputs(rng, n, max_torque=1.0):
+    """n random torque pairs (n, 2), uniform in +-max_torque [N m]."""
     return rng.uniform(-max_torque, max_torque, size=(n, NU))
 
 
@@ -52,7 +54,7 @@ def random_centre(rng, radius):
 
 
 def random_general_params(rng):
-    """A robot of issue 18 with every feature: off-centre masses, full tensors, geared rotors, a slope."""
+    """A general robot with every feature: off-centre masses, full tensors, geared rotors, a slope."""
     r = rng.uniform(0.1, 0.6)
     m_S, m_Y, m_P = rng.uniform(0.5, 5, size=3)
     return Params(r=r, m_S=m_S, j_S=rng.uniform(0.3, 0.7) * m_S * r**2, k_S=rng.uniform(0, 0.3),

@@ -16,7 +16,6 @@ Exit status 0, or 1 if a guard stopped a run.
 """
 import argparse
 import json
-import sys
 import time
 
 import numpy as np
@@ -35,6 +34,7 @@ def defects(x, r):
 
 
 def energy_scale(model, x):
+    """The energy scale of state x: its kinetic energy plus the range of the potential energy."""
     rest = x.copy()
     rest[IDX_NU] = 0
     p = model.params
@@ -42,6 +42,8 @@ def energy_scale(model, x):
 
 
 def soak_one(model, x0, steps, dt, method, chunk):
+    """Simulates `steps` steps from x0 in chunks and returns the worst rotation defect, q_z error and
+    energy drift, and the time per step."""
     e0, scale = model.energy(x0), energy_scale(model, x0)
     worst_rot, worst_qz, worst_e, x, done = 0.0, 0.0, 0.0, x0, 0
     started = time.perf_counter()
@@ -59,6 +61,7 @@ def soak_one(model, x0, steps, dt, method, chunk):
 
 
 def main(argv):
+    """`python -m runtime soak`: long runs from random states, reporting the drift of the invariants."""
     parser = argparse.ArgumentParser(prog="python -m runtime soak", description=__doc__.split("\n\n")[0])
     parser.add_argument("--steps", type=int, default=10_000_000, help="total steps (default 1e7)")
     parser.add_argument("--states", type=int, default=10, help="random initial states (default 10)")
@@ -103,7 +106,3 @@ def main(argv):
         with open(args.json, "w", encoding="utf-8") as f:
             json.dump(total, f, indent=2)
     return 1 if failed else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

@@ -19,6 +19,7 @@ BERNOULLI = {0: 1.0, 1: -0.5, 2: 1 / 6, 4: -1 / 30, 6: 1 / 42, 8: -1 / 30, 10: 5
 
 
 def hat(w):
+    """The skew-symmetric matrix [[w]] of a 3-vector w."""
     return np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
 
 
@@ -57,6 +58,7 @@ def lie_euler(accel, r, x, u, h):
 
 
 def rkmk4(accel, r, x, u, h):
+    """One RKMK4 step of size h from x under torque u (the reference implementation)."""
     K = [field(accel, r, x, u)]
     for a in (0.5, 0.5, 1.0):
         th = a * h * K[-1]
@@ -65,6 +67,7 @@ def rkmk4(accel, r, x, u, h):
 
 
 def cf4(accel, r, x, u, h):
+    """One commutator-free CF4 step of size h from x under torque u (the reference implementation)."""
     F1 = field(accel, r, x, u)
     Y2 = act(x, h / 2 * F1)
     F2 = field(accel, r, Y2, u)

@@ -40,6 +40,7 @@ from .sampling import random_general_params, random_inputs, random_params, rando
 
 @dataclasses.dataclass
 class CheckResult:
+    """One row of the verification table: a check's worst errors, its tolerance, and what it would catch."""
     name: str
     abs_error: float
     rel_error: float
@@ -50,6 +51,7 @@ class CheckResult:
 
     @property
     def passed(self):
+        """True when the error is within the tolerance (or above the bound, for a lower-bound row)."""
         if self.at_least:
             return bool(self.abs_error >= self.tolerance)
         return bool(self.rel_error <= self.tolerance)
@@ -64,6 +66,7 @@ def integrate(model, x0, t_end, u=None, rtol=1e-12, atol=1e-12, dense=False):
 
 # -- cross-check against the independent reference --------------------------------------
 def parameter_sets(rng, n_random=5):
+    """The paper's simulation parameters and `n_random` random ones."""
     return [Params.paper_simulation()] + [random_params(rng) for _ in range(n_random)]
 
 
@@ -97,7 +100,7 @@ def cross_check(n_states=1000, seed=0, n_param_sets=6):
 
 
 def general_cross_check(n_states=200, seed=6, n_robots=5):
-    """The general kernels (issue 18) on random general robots against both independent models:
+    """The general kernels on random general robots against both independent models:
     the CasADi reference (accel, inertia, energy) and the Kane model (accel)."""
     from .alternatives.kane import KaneModel
     from .reference import ReferenceModel
@@ -130,7 +133,7 @@ def general_cross_check(n_states=200, seed=6, n_robots=5):
 # -- physics invariants ------------------------------------------------------------------
 def energy_conservation(n_runs=3, seed=1, t_end=20.0, general=False):
     """Energy along motions without damping or torque: the paper's robot, or (general=True) random
-    general robots of issue 18 on their slopes (the climb's potential m_R g_x q_x included)."""
+    general robots on their slopes (the climb's potential m_R g_x q_x included)."""
     rng = np.random.default_rng(seed)
     worst = (0.0, 0.0)
     for _ in range(n_runs):
@@ -182,6 +185,7 @@ def energy_rate(model, x, u):
 
 
 def power_balance(n_states=200, seed=2):
+    """Check row: the rate of change of the energy equals the power of the torques minus the damping's."""
     rng = np.random.default_rng(seed)
     worst = (0.0, 0.0)
     for params in parameter_sets(rng, 2) + [random_general_params(rng) for _ in range(2)]:
@@ -239,6 +243,8 @@ def rolling_contact(n_runs=3, seed=3, t_end=1.0, dt=2.5e-4, samples=20):
 
 
 def equilibrium_state(theta_Y, theta_P, up, alpha=0.0):
+    """The rest state with joint angles theta_Y, theta_P and the pendulum below (or above, `up`) the
+    centre."""
     R_YP = rot_x(theta_Y) @ rot_y(theta_P)
     flip = rot_x(np.pi) if up else np.eye(3)
     return initial_state(theta_Y, theta_P, R_S=rot_z(alpha) @ flip @ R_YP.T)
@@ -260,6 +266,7 @@ def linearization(model, x):
 
 
 def equilibria(seed=4):
+    """Check rows: no acceleration at the equilibria; the pendulum down is stable, up unstable."""
     rng = np.random.default_rng(seed)
     model = Model(Params.paper_simulation())
     worst_accel = 0.0
@@ -302,6 +309,7 @@ def planar_symmetry(steps=2000):
 
 
 def jacobian_rows(n_states=1000, seed=5):
+    """Check rows of the accel and step Jacobians against finite differences and the variational equations."""
     from .jacobians import accel_jacobian_checks, step_jacobian_checks, variational_checks
     general = random_general_params(np.random.default_rng(seed + 2))
     general_rows = [(f"{name} on a general robot", *rest)
@@ -318,6 +326,7 @@ def jacobian_rows(n_states=1000, seed=5):
 
 
 def linearization_rows():
+    """Check rows of the linearisations (equilibria, steady rolling, its stability)."""
     from .linearizations import equilibrium_checks, rolling_stability_checks, steady_rolling_checks
     return ([CheckResult(*row, catches="the pendulum's stiffness in A off by 1e-6") for row in equilibrium_checks()]
             + [CheckResult(*row, catches="an acceleration off by 1e-6 rad/s²") for row in steady_rolling_checks()]
@@ -326,6 +335,7 @@ def linearization_rows():
 
 
 def run_all(n_states=1000, seed=0, progress=None):
+    """Runs every check and returns the CheckResult rows."""
     steps = [
         ("cross-check", lambda: cross_check(n_states, seed)),
         ("general robots", lambda: general_cross_check(max(n_states // 5, 20), seed + 6)),
@@ -346,6 +356,7 @@ def run_all(n_states=1000, seed=0, progress=None):
 
 
 def format_table(results):
+    """The CheckResult rows as the printed table."""
     rows = [("check", "worst abs", "worst rel", "tolerance", "result", "would catch")]
     rows += [(r.name, f"{r.abs_error:.2e}", "-" if np.isnan(r.rel_error) else f"{r.rel_error:.2e}",
               (">= " if r.at_least else "") + f"{r.tolerance:.0e}",
@@ -357,6 +368,7 @@ def format_table(results):
 
 
 def main(argv=None):
+    """`python -m runtime verify`: run every check and print the table; returns 1 when one fails, else 0."""
     parser = argparse.ArgumentParser(prog="python -m runtime verify", description="Verify the generated kernels.")
     parser.add_argument("--states", type=int, default=1000, help="random states per parameter set (default 1000)")
     parser.add_argument("--seed", type=int, default=0)

@@ -1,4 +1,4 @@
-"""Issue 17 item 4: every public Python entry point refuses each kind of wrong input by name.
+"""Every public Python entry point refuses each kind of wrong input by name.
 
 For each entry point, at least one input of every kind it can receive wrong: shape, type,
 non-finite, out of range, inconsistent with the model.  Each case names the field the

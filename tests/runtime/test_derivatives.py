@@ -1,4 +1,4 @@
-"""Model.accel_jacobian and Model.linearize (runtime/derivatives.py, c/sr_jacobians.c): the
+"""Model.accel_jacobian and Model.linearize (runtime/derivatives.py, c/src/sr_jacobians.c): the
 first-order terms of ν̇ and of the error dynamics in the coordinates of retract/local."""
 import numpy as np
 import pytest

@@ -1,5 +1,5 @@
-"""x ⊕ d and y ⊖ x (runtime/group.py, c/sr_group.c): inverse of each other for every angle, with
-the meaning of each block as issue 19 defines it, and bad input named."""
+"""x ⊕ d and y ⊖ x (runtime/group.py, c/src/sr_group.c): inverse of each other for every angle, with
+the meaning of each block as runtime/group.py defines it, and bad input named."""
 import math
 
 import numpy as np

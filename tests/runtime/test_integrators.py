@@ -1,4 +1,4 @@
-"""Fourth-order Lie-group integrators (c/sr_lie_integrators.c): agreement with an independent
+"""Fourth-order Lie-group integrators (c/src/sr_steppers.c): agreement with an independent
 NumPy transcription of the tableaux, measured orders, orthogonality, and adaptive stepping."""
 import numpy as np
 import pytest

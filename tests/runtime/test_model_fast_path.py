@@ -1,4 +1,4 @@
-"""The one-state fast path of Model.accel and Model.step (bindings/fastcall.c, issue 17 item 8).
+"""The one-state fast path of Model.accel and Model.step (bindings/fastcall.c).
 
 It must give the full path's numbers bit for bit, apply the full C state check, leave every
 input it does not take (other dtypes, shapes, layouts, lists) to the full path, and let the

@@ -148,9 +148,36 @@ def test_a_slender_rod_and_a_planar_body_are_physical():
     Params(J_P=np.diag([0.01, 0.01, 0.0]), J_Y=np.diag([0.1, 0.3, 0.4]))
 
 
-def test_an_asymmetric_tensor_is_refused():
-    with pytest.raises(ValueError, match=r"^Params\.J_Y: an inertia tensor must be symmetric"):
+def test_an_asymmetric_tensor_is_refused_with_the_size_of_its_asymmetry():
+    with pytest.raises(ValueError, match=r"^Params\.J_Y: an inertia tensor must be symmetric.*\|J - Jᵀ\| = 0\.01,"):
         Params(J_Y=[[0.2, 0.01, 0], [0.0, 0.3, 0], [0, 0, 0.4]])
+
+
+def rotated_tensor():
+    """R D Rᵀ for a rotation about a skew axis: symmetric only to rounding."""
+    from runtime.so3 import exp
+    R = exp(np.array([0.3, -0.7, 1.1]))
+    return R @ np.diag([0.2, 0.3, 0.4]) @ R.T
+
+
+def test_a_rotated_tensor_is_not_exactly_symmetric():
+    """The premise of the next test: without it, that test could not fail."""
+    J = rotated_tensor()
+    assert not np.array_equal(J, J.T)
+
+
+def test_a_tensor_symmetric_to_rounding_is_accepted_and_symmetrised():
+    J = rotated_tensor()
+    stored = np.array(Params(J_Y=J).J_Y)
+    assert np.array_equal(stored, stored.T)
+    assert np.abs(stored - J).max() <= 1e-15
+
+
+def test_an_asymmetry_just_above_the_rounding_tolerance_is_refused():
+    J = np.diag([0.2, 0.3, 0.4])
+    J[0, 1] = 1e-11
+    with pytest.raises(ValueError, match=r"^Params\.J_Y: an inertia tensor must be symmetric"):
+        Params(J_Y=J)
 
 
 @pytest.mark.parametrize("value", [[0.1, 0.2], "abc", [[0.1], [0.2], [0.3]]])

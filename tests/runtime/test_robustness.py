@@ -1,4 +1,4 @@
-"""Bad input to the Python API, simulation guards and the CLI's output folders (issue 8, docs/robustness.md).
+"""Bad input to the Python API, simulation guards and the CLI's output folders (docs/robustness.md).
 
 Every bad input raises a ValueError naming the argument, the entry and the rule; a simulation
 that leaves the model's domain stops with SimulationStopped naming the step and keeping the rows

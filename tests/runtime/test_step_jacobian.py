@@ -74,7 +74,7 @@ def general_model():
 def test_c_step_jacobian_equals_casadi_ad_of_the_exported_step(model, samples, dt, method, robot):
     """Two derivations: the C kernels by hand (right Jacobian of SO(3), rolling kinematics, accel_jacobian,
     for RKMK4 and CF4 stage by stage with dexp^-1 differentiated) and CasADi's AD of the SX step;
-    dt = 0.5 s takes the closed forms rather than the series.  The general robot's too (issue 18)."""
+    dt = 0.5 s takes the closed forms rather than the series.  The general robot's too."""
     m = model if robot == "paper" else general_model()
     X, U = samples
     for x, u in zip(X, U):

@@ -1,6 +1,6 @@
 """The robot written the way a PyDy user would: sympy.physics.mechanics + lambdify.
 
-A baseline for the benchmark (issue 7, alternative (c)).  Nothing here is
+A baseline for the benchmark.  Nothing here is
 shared with ``derive/``, ``generated/``, ``c/`` or ``runtime/verification/reference.py``:
 the model is rebuilt from the bodies of Section 2.3 with
 ``sympy.physics.mechanics.KanesMethod`` and turned into NumPy code with
@@ -83,7 +83,7 @@ import numpy as np
 # with derive/ or the kernels); tests/runtime/verification/test_tables.py checks them against
 # the generated SR_P_* and SR_X_* macros.
 PARAM_NAMES = ("r", "m_S", "k_S", "b", "h", "m_b", "m_h", "k_Y", "l", "m_P", "k_P", "g")
-#: The general robot of issue 18, flattened (centres x, y, z; tensors xx, yy, zz, xy, xz, yz).
+#: The general robot, flattened (centres x, y, z; tensors xx, yy, zz, xy, xz, yz).
 _TENSOR = ("xx", "yy", "zz", "xy", "xz", "yz")
 GENERAL_PARAM_NAMES = ("r", "m_S", "j_S", "k_S", "m_Y", "c_Y_x", "c_Y_y", "c_Y_z", *(f"J_Y_{k}" for k in _TENSOR),
                        "k_Y", "m_P", "c_P_x", "c_P_y", "c_P_z", *(f"J_P_{k}" for k in _TENSOR), "k_P",
@@ -100,7 +100,7 @@ def _derive(general=False):
     """Symbolic derivation with sympy.physics.mechanics; returns a dict of the expressions to lambdify.
 
     general=False: the paper's robot by its twelve parameters (rods); True: the general robot of
-    issue 18 (bodies by mass, centre and tensor, motor rotors, a slope)."""
+    the general robot (bodies by mass, centre and tensor, motor rotors, a slope)."""
     import sympy as sm
     import sympy.physics.mechanics as me
 

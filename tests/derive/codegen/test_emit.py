@@ -48,16 +48,16 @@ def test_generated_files_say_they_are_generated():
 
 @pytest.mark.parametrize("scalar", ["double", "float"])
 @pytest.mark.parametrize("source", ["generated/sr_generated.c"] + sorted(
-    p.relative_to(ROOT).as_posix() for p in (ROOT / "c").glob("*.c")))
+    p.relative_to(ROOT).as_posix() for p in (ROOT / "c" / "src").glob("*.c")))
 def test_c_compiles_cleanly_as_c99(scalar, source, tmp_path):
     cc = shutil.which("cc") or shutil.which("gcc")
-    flags = WARNINGS + ["-O2", "-Igenerated", "-Ic"] + (["-DSR_USE_FLOAT"] if scalar == "float" else [])
+    flags = WARNINGS + ["-O2", "-Igenerated", "-Ic/include"] + (["-DSR_USE_FLOAT"] if scalar == "float" else [])
     subprocess.run([cc, *flags, "-c", source, "-o", str(tmp_path / "out.o")], cwd=ROOT, check=True)
 
 
-def test_generated_header_takes_the_hand_written_types_from_c():
+def test_generated_header_takes_the_hand_written_types_from_c_include():
     header = (ROOT / "generated" / "sr_generated.h").read_text()
-    hand_written = (ROOT / "c" / emit.HAND_WRITTEN_HEADER).read_text()
+    hand_written = (ROOT / "c" / "include" / emit.HAND_WRITTEN_HEADER).read_text()
     assert f'#include "{emit.HAND_WRITTEN_HEADER}"' in header
     for chosen in ("typedef", "#define SR_C(", "#define SR_GEN_PIVOT_TOL", "#define SR_GEN_OK", "#define SR_GEN_SINGULAR"):
         assert chosen not in header and chosen in hand_written

@@ -1,4 +1,4 @@
-"""The C loop's outputs are checked state by state against independent numbers (issue 17, item 6)."""
+"""The C loop's outputs are checked state by state against independent numbers."""
 import numpy as np
 import pytest
 

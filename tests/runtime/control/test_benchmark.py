@@ -2,6 +2,8 @@
 import csv
 import json
 
+import pytest
+
 from runtime.__main__ import main
 from runtime.control.benchmark import COLUMNS
 
@@ -18,3 +20,55 @@ def test_the_benchmark_writes_one_table_row_and_one_summary_per_task_and_control
         summary = json.loads((tmp_path / run / "summary.json").read_text())
         assert set(summary["tracking"]) == set(COLUMNS)
         assert (tmp_path / run / "tracking.png").stat().st_size > 0
+
+
+PID_ONLY_TASK = """
+dt = 0.005
+duration = 1.0
+[params]
+preset = "paper_simulation"
+[initial]
+R_S = [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+[reference]
+kind = "speed"
+speed = 0.3
+[[controller]]
+kind = "pid"
+rate = 50.0
+"""
+
+
+def test_a_task_given_by_path_runs_under_out_which_is_created_as_needed(tmp_path):
+    task = tmp_path / "tasks" / "my-task.toml"
+    task.parent.mkdir()
+    task.write_text(PID_ONLY_TASK)
+    out = tmp_path / "not" / "yet"
+    assert main(["control", "--out", str(out), "--tasks", str(task), "--duration", "0.1"]) == 0
+    assert [r["task"] for r in csv.DictReader(open(out / "table.csv"))] == ["my-task"]
+    assert json.loads((out / "my-task-pid" / "summary.json").read_text())["task"] == "my-task"
+    assert sorted(p.name for p in task.parent.iterdir()) == ["my-task.toml"]
+
+
+def test_a_missing_task_is_a_named_error(tmp_path, capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["control", "--out", str(tmp_path), "--tasks", str(tmp_path / "absent.toml")])
+    assert stop.value.code == 2
+    assert "absent.toml: no such task file" in capsys.readouterr().err
+
+
+def test_two_tasks_of_one_name_are_a_named_error(tmp_path, capsys):
+    for folder in ("a", "b"):
+        (tmp_path / folder).mkdir()
+        (tmp_path / folder / "same.toml").write_text(PID_ONLY_TASK)
+    with pytest.raises(SystemExit) as stop:
+        main(["control", "--out", str(tmp_path / "out"), "--tasks", f"{tmp_path}/a/same.toml,{tmp_path}/b/same.toml"])
+    assert stop.value.code == 2
+    assert "two tasks named 'same'" in capsys.readouterr().err
+
+
+def test_an_out_that_cannot_be_created_is_a_named_error(tmp_path, capsys):
+    (tmp_path / "file").write_text("")
+    with pytest.raises(SystemExit) as stop:
+        main(["control", "--out", str(tmp_path / "file" / "out"), "--tasks", "speed-step"])
+    assert stop.value.code == 2
+    assert "--out: cannot create the folder" in capsys.readouterr().err

@@ -5,7 +5,7 @@ import pytest
 
 from runtime import Params
 from runtime.control.climbing import climbing_limit, holding_limit, simulate_climb, steady_climb_speed
-from runtime.scenarios.scenario import load_scenario
+from runtime.scenario import load_scenario
 
 U_Y = 0.5
 
@@ -41,7 +41,7 @@ def test_the_papers_limits():
 
 @pytest.mark.parametrize("name, climbs", [("ramp-climb", True), ("ramp-too-steep", False)])
 def test_the_shipped_ramps_climb_or_roll_back_as_the_limit_predicts(name, climbs):
-    from runtime.scenarios.scenario import run_scenario
+    from runtime.scenario import run_scenario
     scenario = load_scenario(name)
     params, u_Y = scenario.params, scenario.torque_at_step_starts()[0][0]
     assert (params.slope < climbing_limit(params, u_Y)) == climbs
@@ -53,7 +53,7 @@ def test_the_shipped_ramps_climb_or_roll_back_as_the_limit_predicts(name, climbs
 
 def test_the_battery_robot_is_general_and_runs_its_scenario():
     from runtime import Model
-    from runtime.scenarios.scenario import run_scenario
+    from runtime.scenario import run_scenario
     scenario = load_scenario("battery-geared").with_overrides(steps=500)
     assert Model(scenario.params)._model.general == 1 and scenario.params.paper_params is None
     assert run_scenario(scenario).trajectory.shape == (501, 35)

@@ -1,5 +1,6 @@
 """The closed-loop firmware example (c/examples/firmware_lqr.c) equals the Python closed loop of the
-same task bit for bit (double build, host), and its checked-in header is the current design."""
+same task bit for bit (double build, host), and its gain table, generated/lqr_task.h (written by
+`make generate`), is the current design within the spread of LAPACK builds."""
 import re
 import shutil
 import subprocess
@@ -13,6 +14,10 @@ from runtime.control.firmware import header, write_header
 from runtime.control.firmware import firmware_task
 
 C_DIR = ROOT / "c"
+SHIPPED = ROOT / "generated" / "lqr_task.h"
+#: How far the checked-in table may be from a fresh design: LAPACK builds differ in the last bits
+#: of the Riccati solution (about 1e-8 relative across CPUs); a change of the design moves it by far more.
+RTOL, ATOL = 1e-7, 1e-10
 MAKE = shutil.which("make")
 pytestmark = pytest.mark.skipif(not (MAKE and shutil.which("cc")), reason="needs make and a C compiler")
 
@@ -20,7 +25,7 @@ pytestmark = pytest.mark.skipif(not (MAKE and shutil.which("cc")), reason="needs
 def build_and_run(header_dir, build_dir):
     exe = build_dir / "firmware_lqr"
     subprocess.run([MAKE, "-s", "-C", str(C_DIR), f"BUILD={build_dir}",
-                    f"CFLAGS=-O2 -DLQR_TASK_FROM_INCLUDE_PATH -I{header_dir}", str(exe)],
+                    f"CPPFLAGS=-DLQR_TASK_FROM_INCLUDE_PATH -I{header_dir}", str(exe)],
                    check=True, capture_output=True, text=True)
     out = subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout
     return np.loadtxt(out.splitlines()[1:], delimiter=",")
@@ -67,16 +72,40 @@ def test_the_bit_for_bit_check_fails_for_one_gain_changed_in_its_last_digits(run
     assert not np.array_equal(perturbed[:, 1:36], rows[:, 1:36])
 
 
-def test_the_checked_in_header_is_the_current_design():
-    # Not byte for byte: the Riccati solution's last bits depend on the machine's LAPACK (an AMD
-    # EPYC with AVX-512 gave 2 of the 1634 numbers 1.1e-8 and 1.6e-8 relative from the checked-in
-    # ones, written on a Zen 3 VM; a change of the design moves them by far more).
+NUMBER = re.compile(r"SR_C\(([-0-9.e]+)\)")
+
+
+def same_table(shipped, fresh):
+    """The two headers' text equal but for their numbers, and every number within RTOL, ATOL."""
+    a = np.array([float(v) for v in NUMBER.findall(shipped)])
+    b = np.array([float(v) for v in NUMBER.findall(fresh)])
+    return (a.shape == b.shape and bool(np.allclose(a, b, rtol=RTOL, atol=ATOL))
+            and NUMBER.sub("", shipped) == NUMBER.sub("", fresh))
+
+
+@pytest.fixture(scope="module")
+def fresh_table():
     task = firmware_task()
-    fresh = header(task, task.controller())
-    shipped = (C_DIR / "examples" / "lqr_task.h").read_text()
-    number = re.compile(r"SR_C\(([-0-9.e]+)\)")
-    a = np.array([float(v) for v in number.findall(shipped)])
-    b = np.array([float(v) for v in number.findall(fresh)])
-    assert a.shape == b.shape
-    assert np.allclose(a, b, rtol=1e-7, atol=1e-10)
-    assert number.sub("", shipped) == number.sub("", fresh)
+    return header(task, task.controller())
+
+
+def test_the_checked_in_table_is_the_current_design(fresh_table):
+    # Not byte for byte: the Riccati solution's last bits depend on the machine's LAPACK (an AMD
+    # EPYC with AVX-512 gave 2 of the 1634 numbers 1.1e-8 and 1.6e-8 relative from a table
+    # written on a Zen 3 VM).
+    assert same_table(SHIPPED.read_text(), fresh_table)
+
+
+def test_the_table_comparison_fails_for_a_gain_changed_beyond_the_tolerance(fresh_table):
+    at = fresh_table.index("SR_C(", fresh_table.index("/* K_heading */"))
+    end = fresh_table.index(")", at)
+    value = float(fresh_table[at + 5:end])
+    changed = fresh_table[:at] + f"SR_C({value * (1 + 10 * RTOL) + 10 * ATOL!r})" + fresh_table[end + 1:]
+    assert not same_table(changed, fresh_table)
+
+
+def test_the_dispatcher_command_writes_the_table(fresh_table, tmp_path, capsys):
+    from runtime.__main__ import main
+    out = tmp_path / "lqr_task.h"
+    assert main(["firmware-table", "--out", str(out)]) == 0
+    assert out.read_text() == fresh_table

@@ -1,4 +1,4 @@
-"""The C controller `sr_lqr_control` (c/sr_control.c) against the law written out here in NumPy:
+"""The C controller `sr_lqr_control` (c/src/sr_control.c) against the law written out here in NumPy:
 error coordinates, interpolation of the schedule, clipping, anti-windup, the curvature's rate limit."""
 import dataclasses
 
@@ -13,7 +13,7 @@ from runtime.control.reference import Target
 from runtime.model import Model
 from runtime.params import Params
 from runtime.state import initial_state
-from runtime.verification.lqr_law import numpy_law
+from runtime.control.lqr_law import numpy_law
 
 PARAMS = Params.paper_simulation()
 RATE, U_MAX = 50.0, 0.5

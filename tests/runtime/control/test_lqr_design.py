@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from runtime.control import lqr_design as design
-from runtime.control import stability
+from runtime import stability
 from runtime.model import Model
 from runtime.params import Params
 from runtime.state import IDX_Q

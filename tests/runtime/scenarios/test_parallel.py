@@ -2,7 +2,7 @@
 import pytest
 
 from runtime.scenarios import parallel, report
-from runtime.scenarios.scenario import load_scenario, run_scenario
+from runtime.scenario import load_scenario, run_scenario
 
 
 @pytest.fixture(scope="module")

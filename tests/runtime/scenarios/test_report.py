@@ -6,7 +6,7 @@ import pytest
 
 from runtime import Params
 from runtime.scenarios import report
-from runtime.scenarios.scenario import load_scenario, run_scenario
+from runtime.scenario import load_scenario, run_scenario
 
 
 def test_summary_energy_balance_for_the_tilted_pendulum(results):

@@ -1,4 +1,6 @@
 """Sweep files (runtime/sweep/spec.py): validation, and the inputs of sample i."""
+import re
+
 import numpy as np
 import pytest
 
@@ -57,10 +59,12 @@ def test_inputs_apply_relative_factors_angles_and_torque_scales(spec):
     (("relative = true", "relative = 1"), "params.k_S.relative"),
     (('scenario = "base.toml"', 'scenario = "nowhere.toml"'), "scenario"),
     (("[initial.theta_P]", "[initial.R_S]"), "initial: unknown key 'R_S'"),
+    (("uniform = [0.9, 1.1]", "uniform = [-1e308, 1e308]"), "params.k_S.uniform: the width high - low"),
+    (("normal = [1.0, 0.6]", "normal = [1.0, 1e307]"), "params.m_P.normal: |mean| + 100 sd"),
 ])
 def test_bad_sweep_files_raise_value_errors_naming_the_key(tmp_path, change, message):
     path = write_sweep(tmp_path, SWEEP.replace(*change))
-    with pytest.raises(ValueError, match=message):
+    with pytest.raises(ValueError, match=re.escape(message)):
         load_sweep(path)
 
 

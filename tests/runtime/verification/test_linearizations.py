@@ -3,7 +3,7 @@ for a slightly perturbed kernel."""
 import numpy as np
 import pytest
 
-from runtime.control import stability
+from runtime import stability
 from runtime.model import Model
 from runtime.state import IDX_E_NU, IDX_E_TH_P
 from runtime.verification import linearizations as L

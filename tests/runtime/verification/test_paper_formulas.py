@@ -45,7 +45,7 @@ def test_each_printed_form_disagrees_with_the_kernel(setup, erratum, quantity):
     assert err > 1e-2
 
 
-# -- the factor 2 between the paper's τ, k and physical torque and damping (issue 17, item 2) ----
+# -- the factor 2 between the paper's τ, k and physical torque and damping ----------------------
 def test_eq_42_pairs_a_unit_rotation_axis_with_itself_to_two():
     """⟨Σ, Σ⟩ = tr(ΣᵀΣ) = 2 for Σ_Y, Σ_P, Σ_C and any unit ⟦e⟧: the origin of the factor."""
     from runtime.so3 import hat

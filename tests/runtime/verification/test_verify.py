@@ -1,6 +1,6 @@
-"""Issue 3: the kernels against the independent CasADi reference, and against the physics.
+"""The kernels against the independent CasADi reference, and against the physics.
 
-Issue 17: every row of `make verify` has a test that it FAILS for a slightly perturbed kernel: a
+Every row of `make verify` has a test that it FAILS for a slightly perturbed kernel: a
 parameter off by 1e-6 relative in the kernel only (the reference keeps the true one), or the
 kernel's output wrapped with a small error of the kind the row is there to catch.
 """

@@ -1,0 +1,170 @@
+/*
+ * sr_control.c -- the firmware controller: LQR gain-scheduled on speed and curvature.
+ * The law, its coordinates and its design are described in spherical_robot.h and
+ * docs/control.md; the schedule comes from runtime/control/lqr_design.py.
+ */
+#include "sr_checks.h"
+#include "sr_so3.h"
+#include "sr_argcheck.h"
+
+#include <string.h>
+
+static int valid_sizes(const sr_lqr *lqr)
+{
+    return lqr->n_speeds >= 1 && lqr->n_speeds <= SR_LQR_MAX_SPEEDS && lqr->n_curvatures >= 1
+        && lqr->n_curvatures <= SR_LQR_MAX_CURVATURES && lqr->period > 0 && lqr->u_max > 0
+        && lqr->kappa_rate >= 0 && lqr->integral_zone > 0;
+}
+
+int sr_lqr_check(const sr_lqr *lqr)
+{
+    int i, n;
+    if (!lqr) return SR_ERR_NULL;
+    if (!all_finite(&lqr->period, 1) || !all_finite(&lqr->u_max, 1) || !all_finite(&lqr->kappa_rate, 1)
+        || !all_finite(&lqr->integral_zone, 1))
+        return SR_ERR_NONFINITE;
+    if (!valid_sizes(lqr)) return SR_ERR_ARG;
+    n = lqr->n_speeds * lqr->n_curvatures;
+    if (!all_finite(lqr->speeds, lqr->n_speeds) || !all_finite(lqr->curvatures, lqr->n_curvatures))
+        return SR_ERR_NONFINITE;
+    for (i = 0; i < n; ++i)
+        if (!all_finite(lqr->z_star[i], SR_LQR_NZ) || !all_finite(lqr->u_star[i], SR_NU)
+            || !all_finite(lqr->K_path[i], SR_NU * SR_LQR_NZ) || !all_finite(lqr->K_heading[i], SR_NU * SR_LQR_NZ))
+            return SR_ERR_NONFINITE;
+    for (i = 1; i < lqr->n_speeds; ++i)
+        if (!(lqr->speeds[i] > lqr->speeds[i - 1])) return SR_ERR_ARG;
+    for (i = 1; i < lqr->n_curvatures; ++i)
+        if (!(lqr->curvatures[i] > lqr->curvatures[i - 1])) return SR_ERR_ARG;
+    return SR_OK;
+}
+
+int sr_lqr_reset(sr_lqr_memory *memory)
+{
+    if (!memory) return SR_ERR_NULL;
+    memset(memory, 0, sizeof *memory);
+    return SR_OK;
+}
+
+static int valid_target(const sr_lqr_target *target)
+{
+    return all_finite(&target->speed, 1) && all_finite(&target->heading, 1)
+        && (!target->path || (all_finite(&target->curvature, 1) && all_finite(&target->cross_track, 1)));
+}
+
+/* z without checks (see sr_lqr_error). */
+static void error_coordinates(const sr_model *model, const sr_real x[SR_NX], const sr_lqr_target *target,
+                              const sr_real integrals[2], sr_real z[SR_LQR_NZ])
+{
+    const sr_real *R_Y = x + SR_X_R_Y, *R_P = x + SR_X_R_P, *w_S = x + SR_X_w_S;
+    const sr_real rate = target->speed / model->p[SR_P_r];
+    /* Q_ref = rot_z(psi - pi/2) = [[sin psi, cos psi, 0], [-cos psi, sin psi, 0], [0, 0, 1]]. */
+    const sr_real s = SR_SIN(target->heading), c = SR_COS(target->heading);
+    sr_real Q[9], M[9];
+    int j;
+    matmul3(x + SR_X_R_S, R_Y, Q);
+    for (j = 0; j < 3; ++j) { /* M = Q_ref^T Q */
+        M[j] = s * Q[j] - c * Q[3 + j];
+        M[3 + j] = c * Q[j] + s * Q[3 + j];
+        M[6 + j] = Q[6 + j];
+    }
+    so3_log(M, z);
+    z[3] = SR_ATAN2(R_P[2], R_P[0]); /* R_P = rot_y(theta_P): R_P[0][2] = sin, R_P[0][0] = cos */
+    for (j = 0; j < 3; ++j) /* R_Y^T w_S */
+        z[4 + j] = R_Y[j] * w_S[0] + R_Y[3 + j] * w_S[1] + R_Y[6 + j] * w_S[2];
+    z[4] += rate;
+    z[7] = x[SR_X_w_Y] - rate;
+    z[8] = x[SR_X_w_P];
+    z[9] = target->path ? target->cross_track : 0;
+    z[10] = integrals ? integrals[0] : 0;
+    z[11] = integrals ? integrals[1] : 0;
+}
+
+int sr_lqr_error(const sr_model *model, const sr_real x[SR_NX], const sr_lqr_target *target,
+                 const sr_real integrals[2], sr_real z[SR_LQR_NZ])
+{
+    sr_real tmp[SR_LQR_NZ];
+    int status = arg_model(model);
+    if (status != SR_OK) return status;
+    if (!x || !target || !z) return SR_ERR_NULL;
+    status = sr_internal_check_state(model, x);
+    if (status != SR_OK) return status;
+    if (!valid_target(target) || (integrals && !all_finite(integrals, 2))) return SR_ERR_NONFINITE;
+    error_coordinates(model, x, target, integrals, tmp);
+    return deliver(SR_OK, tmp, SR_LQR_NZ, z);
+}
+
+/* The grid interval [*lo, *hi] around value and its weight in it, clamped to the grid. */
+static void bracket(const sr_real *grid, int n, sr_real value, int *lo, int *hi, sr_real *w)
+{
+    int i = 0;
+    if (n == 1) {
+        *lo = *hi = 0;
+        *w = 0;
+        return;
+    }
+    while (i < n - 2 && value > grid[i + 1]) ++i;
+    *lo = i;
+    *hi = i + 1;
+    *w = (value - grid[i]) / (grid[i + 1] - grid[i]);
+    *w = *w < 0 ? 0 : (*w > 1 ? 1 : *w);
+}
+
+int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_NX],
+                   const sr_lqr_target *target, sr_lqr_memory *memory, sr_real u[SR_NU],
+                   sr_real u_raw[SR_NU])
+{
+    sr_real z[SR_LQR_NZ], dz[SR_LQR_NZ], out[SR_NU], raw[SR_NU], kappa, step, wv, wk;
+    sr_real weight[4];
+    int status = arg_model(model), i0, i1, j0, j1, k, j, n, point[4], clipped = 0;
+    if (status != SR_OK) return status;
+    if (!lqr || !x || !target || !memory || !u) return SR_ERR_NULL;
+    if (!valid_sizes(lqr)) return SR_ERR_ARG;
+    status = sr_internal_check_state(model, x);
+    if (status != SR_OK) return status;
+    if (!valid_target(target) || !all_finite(memory->integrals, 2) || !all_finite(&memory->kappa, 1))
+        return SR_ERR_NONFINITE;
+
+    /* The operating point's curvature follows the reference's at a bounded rate. */
+    kappa = target->path ? target->curvature : 0;
+    if (memory->started) {
+        step = lqr->kappa_rate * lqr->period;
+        kappa = kappa - memory->kappa > step ? memory->kappa + step
+              : (kappa - memory->kappa < -step ? memory->kappa - step : kappa);
+    }
+    bracket(lqr->speeds, lqr->n_speeds, target->speed, &i0, &i1, &wv);
+    bracket(lqr->curvatures, lqr->n_curvatures, kappa, &j0, &j1, &wk);
+    n = lqr->n_curvatures;
+    point[0] = i0 * n + j0; weight[0] = (1 - wv) * (1 - wk);
+    point[1] = i0 * n + j1; weight[1] = (1 - wv) * wk;
+    point[2] = i1 * n + j0; weight[2] = wv * (1 - wk);
+    point[3] = i1 * n + j1; weight[3] = wv * wk;
+
+    error_coordinates(model, x, target, memory->integrals, z);
+    for (j = 0; j < SR_LQR_NZ; ++j)
+        dz[j] = z[j] - (weight[0] * lqr->z_star[point[0]][j] + weight[1] * lqr->z_star[point[1]][j]
+                        + weight[2] * lqr->z_star[point[2]][j] + weight[3] * lqr->z_star[point[3]][j]);
+    for (k = 0; k < SR_NU; ++k) {
+        sr_real acc = 0;
+        for (i0 = 0; i0 < 4; ++i0) {
+            const sr_real *K = (target->path ? lqr->K_path : lqr->K_heading)[point[i0]] + k * SR_LQR_NZ;
+            sr_real kdz = 0;
+            for (j = 0; j < SR_LQR_NZ; ++j) kdz += K[j] * dz[j];
+            acc += weight[i0] * (lqr->u_star[point[i0]][k] - kdz);
+        }
+        raw[k] = acc;
+        out[k] = acc > lqr->u_max ? lqr->u_max : (acc < -lqr->u_max ? -lqr->u_max : acc);
+        clipped |= out[k] != acc;
+    }
+    if (!all_finite(raw, SR_NU)) return SR_ERR_NONFINITE;
+
+    if (!clipped) {
+        if (target->path && SR_FABS(dz[9]) <= lqr->integral_zone) memory->integrals[0] += lqr->period * dz[9];
+        memory->integrals[1] += lqr->period * dz[4];
+    }
+    memory->kappa = kappa;
+    memory->started = 1;
+    memory->saturated = clipped;
+    memcpy(u, out, sizeof out);
+    if (u_raw) memcpy(u_raw, raw, sizeof raw);
+    return SR_OK;
+}

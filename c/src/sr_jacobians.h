@@ -1,0 +1,33 @@
+/*
+ * sr_jacobians.h -- the accelerations' derivatives without the checks
+ * (sr_jacobians.c), for the step Jacobians.
+ * Internal to the library: not part of the public API of spherical_robot.h, and not seen by the
+ * cffi bindings.
+ */
+#ifndef SR_JACOBIANS_H
+#define SR_JACOBIANS_H
+
+#include "sr_math.h"
+
+#ifdef SR_USE_FLOAT /* float symbols carry _f, as in spherical_robot.h */
+#define sr_internal_accel_jacobian sr_internal_accel_jacobian_f
+#define sr_internal_accel_jacobian_along sr_internal_accel_jacobian_along_f
+#endif
+
+/* sr_accel_jacobian without the checks (x valid, u not NULL): Ja, Jb and the accelerations a
+ * (to rounding those of sr_accel) at once, for the step Jacobians; outputs not tested for
+ * finiteness.  c/src/sr_jacobians.c. */
+int sr_internal_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                               sr_real a[SR_NV], sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU]);
+
+/* The accelerations' derivative along given directions, for the step Jacobians' stages: out = Ja V
+ * (5 x SR_J_NC) for V the derivatives of the error's rows that the dynamics reads (SR_J_READ rows:
+ * xi_S, th_Y, th_P, nu; nothing depends on q) along SR_J_NC directions; also Jb and the
+ * accelerations a, as sr_internal_accel_jacobian.  For the paper's robot Ja is never formed: the
+ * yoke frame's chain rule acts on V (c/src/sr_jacobians.c). */
+enum { SR_J_XI = 0, SR_J_TH_Y = 3, SR_J_TH_P = 4, SR_J_NU = 5, SR_J_READ = 10, SR_J_NC = 12 };
+int sr_internal_accel_jacobian_along(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                     const sr_real V[SR_J_READ][SR_J_NC], sr_real a[SR_NV],
+                                     sr_real out[SR_NV][SR_J_NC], sr_real Jb[SR_NV * SR_NU]);
+
+#endif /* SR_JACOBIANS_H */

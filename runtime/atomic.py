@@ -1,0 +1,44 @@
+"""Atomic file writing: a reader (or a crash half-way through rendering) never sees a partial file.
+
+Every output is written first to a temporary file in the target's folder,
+then moved over the target with os.replace.
+"""
+import contextlib
+import os
+import pathlib
+import tempfile
+
+
+def _current_umask():
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+_UMASK = _current_umask()
+
+
+@contextlib.contextmanager
+def atomic_path(target):
+    """Yield a temporary path next to `target`; on success move it onto `target`, on error delete it.
+
+    The temporary name keeps the target's extension (writers such as Pillow
+    choose the format from it) and starts with a dot.
+    """
+    target = pathlib.Path(target)
+    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.stem}.", suffix=f".tmp{target.suffix}")
+    os.close(fd)
+    try:
+        yield pathlib.Path(tmp)
+        os.chmod(tmp, 0o666 & ~_UMASK)       # mkstemp makes 0600; give the file the usual permissions
+        os.replace(tmp, target)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+
+
+def write_text(target, text):
+    """Writes `text` (UTF-8) to `target` atomically: readers see the old file or the whole new one."""
+    with atomic_path(target) as tmp:
+        tmp.write_text(text, encoding="utf-8")
