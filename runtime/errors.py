@@ -11,6 +11,8 @@ _STATUS_HINTS = {
                              "(R_S orthonormal with det +1, R_Y about x, R_P about y)",
     lib.SR_ERR_SINGULAR: "gives a singular generalized inertia",
     lib.SR_ERR_CONSTRAINT: "violates q_z = r",
+    lib.SR_ERR_MODEL: "is not a valid sr_model: not filled by sr_model_init, or a parameter or constant "
+                      "changed since (its checksum differs); build a new Model",
 }
 
 
@@ -18,10 +20,13 @@ class KernelError(ValueError):
     """A C kernel returned an error status (`.status`, one of the SR_* codes of c/spherical_robot.h).
 
     The message names the argument (`field`) and the rule; `message`, when given, replaces the
-    generic text built from the status.
+    generic text built from the status.  SR_ERR_MODEL is the model's fault whatever the call was
+    given, so it names the model (field "model").
     """
 
     def __init__(self, field, status, detail="", message=None):
+        if status == lib.SR_ERR_MODEL:
+            field = "model"
         self.status = status
         self.field = field
         if message is None:

@@ -155,7 +155,8 @@ def check_states(model_ptr, x, r, name="x"):
         state = x[row] if row >= 0 else None
     if status == lib.SR_OK:
         return
-    message = describe_state(state, r, row_name) if state is not None else None
+    # A model that is not valid is refused before any state is looked at: nothing to describe.
+    message = describe_state(state, r, row_name) if state is not None and status != lib.SR_ERR_MODEL else None
     raise KernelError(row_name, status, message=message)
 
 

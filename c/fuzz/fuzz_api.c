@@ -272,6 +272,130 @@ static void fuzz_controller(reader *r, const sr_model *model, const sr_real x[SR
                   SR_ERR_NULL);
 }
 
+/* ---- the validity stamp: every entry point on a model whose bytes the input changed ------------
+ * The model is zeroed, filled with input bytes, has one parameter or constant replaced by a picked
+ * value, has one byte flipped, or stays as it is.  Contract: where the bytes the kernels read
+ * (stamp, checksum, p, general, the constants of its kind) differ from the valid model's, every
+ * function that takes the model returns SR_ERR_MODEL and leaves its outputs untouched; where they
+ * do not, no function returns SR_ERR_MODEL; SR_OK always comes with finite outputs. */
+static int model_changed(const sr_model *a, const sr_model *b)
+{
+    if (a->stamp != b->stamp || a->checksum != b->checksum || a->general != b->general) return 1;
+    if (memcmp(a->p, b->p, sizeof a->p) != 0) return 1;
+    return a->general ? memcmp(a->cg, b->cg, sizeof a->cg) != 0 : memcmp(a->c, b->c, sizeof a->c) != 0;
+}
+
+static void expect_model_verdict(const char *fn, int status, int changed, const guarded *g, int n_out)
+{
+    if (changed && status != SR_ERR_MODEL) fail(fn, status, "accepted a changed or uninitialised model");
+    if (!changed && status == SR_ERR_MODEL) fail(fn, status, "refused a valid model");
+    if (changed) expect(fn, status, g, 0, 1);
+    else if (status == SR_OK) expect(fn, status, g, n_out, 1);
+}
+
+static void fuzz_model_validity(reader *r, const sr_model *valid, const sr_real x[SR_NX], const sr_real *u,
+                                sr_real dt, int method)
+{
+    static sr_model m;
+    static guarded g, g2;
+    static sr_lqr lqr;
+    static const sr_lqr_target target = {SR_C(0.3), SR_C(0.5), SR_C(0.2), SR_C(0.05), 1};
+    static const sr_real d[SR_NE];
+    sr_real x2[2 * SR_NX];
+    sr_lqr_memory memory = {{0, 0}, 0, 0, 0};
+    sr_energy_guard guard = {SR_C(0.5), 0, 0, 0, 0};
+    sr_adaptive_stats st;
+    const unsigned mode = read_u8(r) % 5;
+    long row, done;
+    int changed, status;
+    size_t i;
+    m = *valid;
+    if (mode == 0) {
+        memset(&m, 0, sizeof m);
+    } else if (mode == 1) {
+        unsigned char *b = (unsigned char *)&m;
+        for (i = 0; i < sizeof m; ++i) b[i] = (unsigned char)read_u8(r);
+    } else if (mode == 2) {
+        const unsigned k = read_u8(r) % (SR_NPARAM + SR_GEN_NCONST + SR_GEN_GENERAL_NCONST);
+        sr_real *field = k < SR_NPARAM ? &m.p[k] : k < SR_NPARAM + SR_GEN_NCONST ? &m.c[k - SR_NPARAM]
+                                                                                : &m.cg[k - SR_NPARAM - SR_GEN_NCONST];
+        *field = pick(r, (double)*field);
+    } else if (mode == 3) {
+        const size_t at = ((size_t)read_u8(r) << 8 | read_u8(r)) % sizeof m;
+        ((unsigned char *)&m)[at] ^= (unsigned char)(1u << (read_u8(r) % 8));
+    }
+    changed = model_changed(&m, valid);
+    memcpy(x2, x, sizeof(sr_real) * SR_NX);
+    memcpy(x2 + SR_NX, x, sizeof(sr_real) * SR_NX);
+    memset(&lqr, 0, sizeof lqr);
+    lqr.n_speeds = lqr.n_curvatures = 1;
+    lqr.period = SR_C(0.02);
+    lqr.u_max = SR_C(0.5);
+    lqr.integral_zone = SR_C(0.2);
+
+    arm(&g, 0);
+    expect_model_verdict("sr_check_state (model)", sr_check_state(&m, x), changed, &g, 0);
+    expect_model_verdict("sr_check_state_batch (model)", sr_check_state_batch(&m, 2, x2, &row), changed, &g, 0);
+    status = sr_accel(&m, x, u, arm(&g, SR_NV));
+    expect_model_verdict("sr_accel (model)", status, changed, &g, SR_NV);
+    status = sr_accel_batch(&m, 2, x2, NULL, arm(&g, 2 * SR_NV), &row);
+    expect_model_verdict("sr_accel_batch (model)", status, changed, &g, 2 * SR_NV);
+    status = sr_checked_accel_batch(&m, 2, x2, NULL, arm(&g, 2 * SR_NV), &row);
+    expect_model_verdict("sr_checked_accel_batch (model)", status, changed, &g, 2 * SR_NV);
+    status = sr_inertia(&m, x, arm(&g, SR_NV * SR_NV));
+    expect_model_verdict("sr_inertia (model)", status, changed, &g, SR_NV * SR_NV);
+    status = sr_rhs(&m, x, u, arm(&g, SR_NV));
+    expect_model_verdict("sr_rhs (model)", status, changed, &g, SR_NV);
+    status = sr_energy(&m, x, arm(&g, 1));
+    expect_model_verdict("sr_energy (model)", status, changed, &g, 1);
+    status = sr_equilibrium_residual(&m, x, arm(&g, SR_NV));
+    expect_model_verdict("sr_equilibrium_residual (model)", status, changed, &g, SR_NV);
+    status = sr_step(&m, method, x, u, dt, arm(&g, SR_NX));
+    expect_model_verdict("sr_step (model)", status, changed, &g, SR_NX);
+    status = sr_step_lie_euler(&m, x, u, dt, arm(&g, SR_NX));
+    expect_model_verdict("sr_step_lie_euler (model)", status, changed, &g, SR_NX);
+    status = sr_step_rkmk4(&m, x, u, dt, arm(&g, SR_NX));
+    expect_model_verdict("sr_step_rkmk4 (model)", status, changed, &g, SR_NX);
+    status = sr_step_cf4(&m, x, u, dt, arm(&g, SR_NX));
+    expect_model_verdict("sr_step_cf4 (model)", status, changed, &g, SR_NX);
+    status = sr_step_batch(&m, method, 2, x2, NULL, dt, arm(&g, 2 * SR_NX), &row);
+    expect_model_verdict("sr_step_batch (model)", status, changed, &g, 2 * SR_NX);
+    status = sr_simulate(&m, method, x, dt, 1, u, arm(&g, 2 * SR_NX), &done);
+    expect_model_verdict("sr_simulate (model)", status, changed, &g, 2 * SR_NX);
+    status = sr_simulate_guarded(&m, method, x, dt, 1, u, &guard, arm(&g, 2 * SR_NX), &done);
+    expect_model_verdict("sr_simulate_guarded (model)", status, changed, &g, 2 * SR_NX);
+    status = sr_simulate_adaptive(&m, SR_RKMK4, x, dt, 1, u, SR_C(1e-6), SR_C(1e-9), 0, 40, arm(&g, 2 * SR_NX), &st);
+    expect_model_verdict("sr_simulate_adaptive (model)", status, changed, &g, 2 * SR_NX);
+    status = sr_retract(&m, x, d, arm(&g, SR_NX));
+    expect_model_verdict("sr_retract (model)", status, changed, &g, SR_NX);
+    status = sr_local(&m, x, x, arm(&g, SR_NE));
+    expect_model_verdict("sr_local (model)", status, changed, &g, SR_NE);
+    status = sr_retract_batch(&m, 1, x, d, arm(&g, SR_NX), &row);
+    expect_model_verdict("sr_retract_batch (model)", status, changed, &g, SR_NX);
+    status = sr_local_batch(&m, 1, x, x, arm(&g, SR_NE), &row);
+    expect_model_verdict("sr_local_batch (model)", status, changed, &g, SR_NE);
+    status = sr_accel_jacobian(&m, x, u, arm(&g, SR_NV * SR_NE), arm(&g2, SR_NV * SR_NU));
+    expect_model_verdict("sr_accel_jacobian (model)", status, changed, &g, SR_NV * SR_NE);
+    status = sr_accel_jacobian_batch(&m, 1, x, u, arm(&g, SR_NV * SR_NE), arm(&g2, SR_NV * SR_NU), &row);
+    expect_model_verdict("sr_accel_jacobian_batch (model)", status, changed, &g, SR_NV * SR_NE);
+    status = sr_step_jacobian_lie_euler(&m, x, u, dt, arm(&g, SR_NE * SR_NE), arm(&g2, SR_NE * SR_NU));
+    expect_model_verdict("sr_step_jacobian_lie_euler (model)", status, changed, &g, SR_NE * SR_NE);
+    status = sr_step_jacobian_lie_euler_batch(&m, 1, x, u, dt, arm(&g, SR_NE * SR_NE), arm(&g2, SR_NE * SR_NU), &row);
+    expect_model_verdict("sr_step_jacobian_lie_euler_batch (model)", status, changed, &g, SR_NE * SR_NE);
+    status = sr_step_jacobian_rkmk4(&m, x, u, dt, arm(&g, SR_NE * SR_NE), arm(&g2, SR_NE * SR_NU));
+    expect_model_verdict("sr_step_jacobian_rkmk4 (model)", status, changed, &g, SR_NE * SR_NE);
+    status = sr_step_jacobian_cf4(&m, x, u, dt, arm(&g, SR_NE * SR_NE), arm(&g2, SR_NE * SR_NU));
+    expect_model_verdict("sr_step_jacobian_cf4 (model)", status, changed, &g, SR_NE * SR_NE);
+    status = sr_step_jacobian(&m, method, x, u, dt, arm(&g, SR_NE * SR_NE), arm(&g2, SR_NE * SR_NU));
+    expect_model_verdict("sr_step_jacobian (model)", status, changed, &g, SR_NE * SR_NE);
+    status = sr_step_jacobian_batch(&m, method, 1, x, u, dt, arm(&g, SR_NE * SR_NE), arm(&g2, SR_NE * SR_NU), &row);
+    expect_model_verdict("sr_step_jacobian_batch (model)", status, changed, &g, SR_NE * SR_NE);
+    status = sr_lqr_error(&m, x, &target, NULL, arm(&g, SR_LQR_NZ));
+    expect_model_verdict("sr_lqr_error (model)", status, changed, &g, SR_LQR_NZ);
+    status = sr_lqr_control(&lqr, &m, x, &target, &memory, arm(&g, SR_NU), NULL);
+    expect_model_verdict("sr_lqr_control (model)", status, changed, &g, SR_NU);
+}
+
 /* ---- the target ------------------------------------------------------------------------------ */
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -502,7 +626,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         status = sr_step_batch(&model, method, 2, x2, u_or_null, dt, arm(&g, 2 * SR_NX), &row);
         EXPECT_STATUS("sr_step_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT,
                       SR_ERR_SINGULAR, SR_ERR_ARG);
-        if ((status == SR_OK) != (row == -1) || row < -1 || row > 1) fail("sr_step_batch", status, "bad failed_row");
+        /* SR_ERR_ARG (a bad method or dt) is refused before any row: failed_row -1 */
+        if (status == SR_ERR_ARG ? row != -1 : ((status == SR_OK) != (row == -1) || row < -1 || row > 1))
+            fail("sr_step_batch", status, "bad failed_row");
         expect("sr_step_batch", status, &g, status == SR_OK ? 2 * SR_NX : (row > 0 ? (int)row * SR_NX : 0), 1);
         if (status == SR_OK || row == 1) { /* each written row is sr_step's, bit for bit */
             sr_real one[SR_NX];
@@ -519,8 +645,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                                         arm(&g2, 2 * SR_NE * SR_NU), &row);
         EXPECT_STATUS("sr_step_jacobian_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT,
                       SR_ERR_SINGULAR, SR_ERR_ARG);
-        /* SR_ERR_ARG: an unknown method is refused before any row (-1), a bad dt at row 0 */
-        if (status == SR_ERR_ARG ? row != -1 && row != 0 : ((status == SR_OK) != (row == -1) || row < -1 || row > 1))
+        /* SR_ERR_ARG: an unknown method or a bad dt is refused before any row (-1) */
+        if (status == SR_ERR_ARG ? row != -1 : ((status == SR_OK) != (row == -1) || row < -1 || row > 1))
             fail("sr_step_jacobian_batch", status, "bad failed_row");
         expect("sr_step_jacobian_batch", status, &g, status == SR_OK ? 2 * SR_NE * SR_NE : (row > 0 ? (int)row * SR_NE * SR_NE : 0), 1);
         expect("sr_step_jacobian_batch", status, &g2, status == SR_OK ? 2 * SR_NE * SR_NU : (row > 0 ? (int)row * SR_NE * SR_NU : 0), 1);
@@ -550,5 +676,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* NULL pointers */
     EXPECT_STATUS("sr_accel(NULL)", sr_accel(&model, x, u, NULL), SR_ERR_NULL);
     EXPECT_STATUS("sr_check_state(NULL)", sr_check_state(NULL, x), SR_ERR_NULL);
+
+    /* The validity stamp (read last, for the same reason). */
+    fuzz_model_validity(&rd, &model, x, u_or_null, dt, method);
     return 0;
 }

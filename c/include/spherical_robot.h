@@ -50,6 +50,8 @@
 
 #include "sr_generated.h"
 
+#include <stdint.h>
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -107,6 +109,9 @@ extern "C" {
 #define SR_ERR_MAX_STEPS 9     /**< adaptive stepping: more than max_steps step attempts */
 #define SR_ERR_ENERGY 10       /**< sr_simulate_guarded: the energy rose without input power beyond the
                                   guard's tolerance (see sr_energy_guard) */
+#define SR_ERR_MODEL 11        /**< the model is not one that sr_model_init filled: never initialised
+                                  (zeroed or garbage memory), or a parameter or constant changed
+                                  since (see sr_model) */
 /** @} */
 
 /** Tolerance on |R^T R - I| (entry-wise) and |det R - 1| accepted by the checks. */
@@ -148,12 +153,20 @@ extern "C" {
  * paper-geometry kernels (constants c, general = 0), any other by the general kernels
  * (constants cg, general = 1); sr_model_init chooses.  A library compiled with -DSR_PAPER_ONLY
  * has no general kernels (smaller firmware): sr_model_init refuses other robots (SR_ERR_PARAM).  Both give the same numbers for the
- * paper's robot, to rounding (tests/runtime/test_general_robot.py). */
+ * paper's robot, to rounding (tests/runtime/test_general_robot.py).
+ * A model is a value: copy it whole (assignment, memcpy), never change a field.  Every function
+ * that takes a model first checks that it is valid, and returns SR_ERR_MODEL for one that is not:
+ * its stamp missing (memory that sr_model_init never filled: zeroed, uninitialised, or left
+ * untouched by a failed sr_model_init), or its checksum not that of what the kernels read (p,
+ * general and the constants of that kind: any one entry changed since, to NaN or to any other
+ * value).  The check costs about 8 ns a call (docs/robustness.md). */
 typedef struct sr_model {
     sr_real p[SR_NPARAM];                /**< the parameters, as given to sr_model_init */
     int general;                         /**< 1: the general kernels (cg), 0: the paper-geometry ones (c) */
     sr_real c[SR_GEN_NCONST];            /**< derived constants of the paper-geometry kernels */
     sr_real cg[SR_GEN_GENERAL_NCONST];   /**< derived constants of the general kernels */
+    uint64_t stamp;                      /**< set by sr_model_init: a model never initialised lacks it */
+    uint64_t checksum;                   /**< of p, general and the constants of that kind, set by sr_model_init */
 } sr_model;
 
 /** Human-readable name of a status code (static string, never NULL). */

@@ -2,6 +2,7 @@
  * Built on the public API only (sr_model_init, sr_simulate_guarded, sr_energy), so that each
  * sample is exactly the run a caller would make alone, chunk for chunk. */
 #include "sr_math.h"
+#include "sr_argcheck.h"
 
 #include <stddef.h>
 
@@ -103,12 +104,6 @@ static int run_sample(int method, const sr_real params[SR_NPARAM], const sr_real
     return SR_OK;
 }
 
-static int valid_batch_method(int method)
-{
-    const int base = method & ~SR_PROJECT;
-    return (method & ~(SR_PROJECT | 3)) == 0 && (base == SR_LIE_EULER || base == SR_RKMK4 || base == SR_CF4);
-}
-
 int sr_simulate_batch(int method, long n, const sr_real *params, long params_stride, const sr_real *x0,
                       long x0_stride, sr_real dt, long steps, const sr_real *u, long u_stride,
                       sr_real energy_tol, long chunk_steps, sr_real *work, sr_real *traj,
@@ -117,7 +112,7 @@ int sr_simulate_batch(int method, long n, const sr_real *params, long params_str
     long i;
     if (!params || !x0 || !status || !steps_done || (!traj && !work)) return SR_ERR_NULL;
     if (n < 0 || steps < 0 || chunk_steps < 1 || params_stride < 0 || x0_stride < 0 || u_stride < 0
-        || !(dt > 0) || !isfinite(dt) || !valid_batch_method(method)
+        || arg_dt(dt) != SR_OK || arg_method(method) != SR_OK
         || (energy_tol == energy_tol && !isfinite(energy_tol)))
         return SR_ERR_ARG;
     for (i = 0; i < n; ++i) {

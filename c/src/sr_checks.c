@@ -1,6 +1,7 @@
 /* sr_checks.c -- the full state check (the cheap per-call checks are inline in sr_checks.h).
  * Hand-written; see spherical_robot.h for the contract of every function. */
 #include "sr_checks.h"
+#include "sr_argcheck.h"
 
 #include <stddef.h>
 
@@ -33,10 +34,9 @@ static int is_axis_rotation(const sr_real *R, int k)
         && near(R[3 * p + p] * R[3 * q + q] - R[3 * p + q] * R[3 * q + p], 1);
 }
 
-int sr_check_state(const sr_model *model, const sr_real x[SR_NX])
+int sr_internal_check_state(const sr_model *model, const sr_real x[SR_NX])
 {
-    const sr_real r = model ? model->p[SR_P_r] : 0;
-    if (!model || !x) return SR_ERR_NULL;
+    const sr_real r = model->p[SR_P_r];
     if (!all_finite(x, SR_NX)) return SR_ERR_NONFINITE;
     if (!is_rotation(x + SR_X_R_S) || !is_axis_rotation(x + SR_X_R_Y, 0) || !is_axis_rotation(x + SR_X_R_P, 1))
         return SR_ERR_NOT_ROTATION;
@@ -44,14 +44,23 @@ int sr_check_state(const sr_model *model, const sr_real x[SR_NX])
     return SR_OK;
 }
 
+int sr_check_state(const sr_model *model, const sr_real x[SR_NX])
+{
+    const int status = arg_model(model);
+    if (status != SR_OK) return status;
+    if (!x) return SR_ERR_NULL;
+    return sr_internal_check_state(model, x);
+}
+
 int sr_check_state_batch(const sr_model *model, long n, const sr_real *x, long *failed_row)
 {
     long i;
+    int status = arg_model(model);
     if (failed_row) *failed_row = -1;
-    if (!model || !x) return SR_ERR_NULL;
-    if (n < 0) return SR_ERR_ARG;
+    if (status == SR_OK) status = arg_rows(n, x != NULL);
+    if (status != SR_OK) return status;
     for (i = 0; i < n; ++i) {
-        const int status = sr_check_state(model, x + i * SR_NX);
+        status = sr_internal_check_state(model, x + i * SR_NX);
         if (status != SR_OK) {
             if (failed_row) *failed_row = i;
             return status;

@@ -5,6 +5,7 @@
  */
 #include "sr_checks.h"
 #include "sr_so3.h"
+#include "sr_argcheck.h"
 
 #include <string.h>
 
@@ -82,9 +83,10 @@ int sr_lqr_error(const sr_model *model, const sr_real x[SR_NX], const sr_lqr_tar
                  const sr_real integrals[2], sr_real z[SR_LQR_NZ])
 {
     sr_real tmp[SR_LQR_NZ];
-    int status;
-    if (!model || !x || !target || !z) return SR_ERR_NULL;
-    status = sr_check_state(model, x);
+    int status = arg_model(model);
+    if (status != SR_OK) return status;
+    if (!x || !target || !z) return SR_ERR_NULL;
+    status = sr_internal_check_state(model, x);
     if (status != SR_OK) return status;
     if (!valid_target(target) || (integrals && !all_finite(integrals, 2))) return SR_ERR_NONFINITE;
     error_coordinates(model, x, target, integrals, tmp);
@@ -113,10 +115,11 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
 {
     sr_real z[SR_LQR_NZ], dz[SR_LQR_NZ], out[SR_NU], raw[SR_NU], kappa, step, wv, wk;
     sr_real weight[4];
-    int status, i0, i1, j0, j1, k, j, n, point[4], clipped = 0;
-    if (!lqr || !model || !x || !target || !memory || !u) return SR_ERR_NULL;
+    int status = arg_model(model), i0, i1, j0, j1, k, j, n, point[4], clipped = 0;
+    if (status != SR_OK) return status;
+    if (!lqr || !x || !target || !memory || !u) return SR_ERR_NULL;
     if (!valid_sizes(lqr)) return SR_ERR_ARG;
-    status = sr_check_state(model, x);
+    status = sr_internal_check_state(model, x);
     if (status != SR_OK) return status;
     if (!valid_target(target) || !all_finite(memory->integrals, 2) || !all_finite(&memory->kappa, 1))
         return SR_ERR_NONFINITE;

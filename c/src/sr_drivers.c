@@ -6,6 +6,7 @@
 #include "sr_checks.h"
 #include "sr_kernels.h"
 #include "sr_steppers.h"
+#include "sr_argcheck.h"
 
 #include <stddef.h>
 
@@ -72,11 +73,13 @@ int sr_simulate_guarded(const sr_model *model, int method, const sr_real x0[SR_N
     int i, status;
     sr_real comp[SR_NX] = {0}; /* Kahan compensation carried across the steps of this call */
     if (steps_done) *steps_done = 0;
-    status = sr_check_state(model, x0);
+    status = arg_model(model);
     if (status != SR_OK) return status;
-    if (!traj) return SR_ERR_NULL;
-    if (steps < 0 || !(dt > 0) || !isfinite(dt) || !sr_internal_valid_method(method)) return SR_ERR_ARG;
+    if (!x0 || !traj) return SR_ERR_NULL;
+    if (steps < 0 || arg_dt(dt) != SR_OK || arg_method(method) != SR_OK) return SR_ERR_ARG;
     if (guard && guard->tol == guard->tol && !isfinite(guard->tol)) return SR_ERR_ARG; /* +-inf */
+    status = sr_internal_check_state(model, x0);
+    if (status != SR_OK) return status;
     for (i = 0; i < SR_NX; ++i) traj[i] = x0[i];
     for (n = 0; n < steps; ++n) {
         const sr_real *x = traj + n * SR_NX;
@@ -90,7 +93,7 @@ int sr_simulate_guarded(const sr_model *model, int method, const sr_real x0[SR_N
         }
         status = sr_internal_advance(model, method, x, un, dt, comp, next);
         if (status == SR_OK && !all_finite(next, SR_NX)) status = SR_ERR_NONFINITE;
-        if (status == SR_OK && check_row) status = sr_check_state(model, next);
+        if (status == SR_OK && check_row) status = sr_internal_check_state(model, next);
         if (status == SR_OK) {
             const sr_real *u_next = n + 1 < steps ? (u ? u + (n + 1) * SR_NU : sr_zero_u) : NULL;
             if (u_next && !all_finite(u_next, SR_NU)) u_next = NULL; /* reported at step n + 2 */
@@ -175,14 +178,16 @@ int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[SR_
     int i, base, status;
     if (!stats) stats = &local;
     *stats = local;
-    status = sr_check_state(model, x0); /* in full, like sr_simulate */
+    status = arg_model(model);
     if (status != SR_OK) return status;
-    if (!traj) return SR_ERR_NULL;
+    if (!x0 || !traj) return SR_ERR_NULL;
     base = method & ~SR_PROJECT;
-    if (base != SR_RKMK4 || !(dt_out > 0) || !isfinite(dt_out) || n_out < 0
+    if (arg_method(method) != SR_OK || base != SR_RKMK4 || arg_dt(dt_out) != SR_OK || n_out < 0
         || !(rtol >= 0) || !(atol >= 0) || !(rtol + atol > 0) || !isfinite(rtol) || !isfinite(atol)
         || !(max_steps > 0) || h_init != h_init || !isfinite(h_init))
         return SR_ERR_ARG;
+    status = sr_internal_check_state(model, x0); /* in full, like sr_simulate */
+    if (status != SR_OK) return status;
 
     cx.model = model;
     cx.rtol = rtol;

@@ -6,6 +6,7 @@
  */
 #include "sr_checks.h"
 #include "sr_so3.h"
+#include "sr_argcheck.h"
 
 #include <string.h>
 
@@ -57,9 +58,10 @@ static void local(const sr_real x[SR_NX], const sr_real y[SR_NX], sr_real d[SR_N
 int sr_retract(const sr_model *model, const sr_real x[SR_NX], const sr_real d[SR_NE], sr_real y[SR_NX])
 {
     sr_real out[SR_NX];
-    int status;
-    if (!model || !x || !d || !y) return SR_ERR_NULL;
-    status = sr_check_state(model, x);
+    int status = arg_model(model);
+    if (status != SR_OK) return status;
+    if (!x || !d || !y) return SR_ERR_NULL;
+    status = sr_internal_check_state(model, x);
     if (status != SR_OK) return status;
     if (!all_finite(d, SR_NE)) return SR_ERR_NONFINITE;
     retract(x, d, out);
@@ -71,10 +73,11 @@ int sr_retract(const sr_model *model, const sr_real x[SR_NX], const sr_real d[SR
 int sr_local(const sr_model *model, const sr_real x[SR_NX], const sr_real y[SR_NX], sr_real d[SR_NE])
 {
     sr_real out[SR_NE];
-    int status;
-    if (!model || !x || !y || !d) return SR_ERR_NULL;
-    status = sr_check_state(model, x);
-    if (status == SR_OK) status = sr_check_state(model, y);
+    int status = arg_model(model);
+    if (status != SR_OK) return status;
+    if (!x || !y || !d) return SR_ERR_NULL;
+    status = sr_internal_check_state(model, x);
+    if (status == SR_OK) status = sr_internal_check_state(model, y);
     if (status != SR_OK) return status;
     local(x, y, out);
     if (!all_finite(out, SR_NE)) return SR_ERR_NONFINITE;
@@ -86,11 +89,12 @@ int sr_retract_batch(const sr_model *model, long n, const sr_real *x, const sr_r
                      long *failed_row)
 {
     long i;
+    int status = arg_model(model);
     if (failed_row) *failed_row = -1;
-    if (!model || (n > 0 && (!x || !d || !y))) return SR_ERR_NULL;
-    if (n < 0) return SR_ERR_ARG;
+    if (status == SR_OK) status = arg_rows(n, x && d && y);
+    if (status != SR_OK) return status;
     for (i = 0; i < n; ++i) {
-        const int status = sr_retract(model, x + i * SR_NX, d + i * SR_NE, y + i * SR_NX);
+        status = sr_retract(model, x + i * SR_NX, d + i * SR_NE, y + i * SR_NX);
         if (status != SR_OK) {
             if (failed_row) *failed_row = i;
             return status;
@@ -103,11 +107,12 @@ int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
                    long *failed_row)
 {
     long i;
+    int status = arg_model(model);
     if (failed_row) *failed_row = -1;
-    if (!model || (n > 0 && (!x || !y || !d))) return SR_ERR_NULL;
-    if (n < 0) return SR_ERR_ARG;
+    if (status == SR_OK) status = arg_rows(n, x && y && d);
+    if (status != SR_OK) return status;
     for (i = 0; i < n; ++i) {
-        const int status = sr_local(model, x + i * SR_NX, y + i * SR_NX, d + i * SR_NE);
+        status = sr_local(model, x + i * SR_NX, y + i * SR_NX, d + i * SR_NE);
         if (status != SR_OK) {
             if (failed_row) *failed_row = i;
             return status;

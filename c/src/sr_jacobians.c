@@ -9,6 +9,7 @@
 #include "sr_jacobians.h"
 #include "sr_kernels.h"
 #include "sr_so3.h"
+#include "sr_argcheck.h"
 
 #include <string.h>
 
@@ -306,7 +307,8 @@ int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_re
                       sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU])
 {
     sr_real a[SR_NV], ja[SR_NV * SR_NE], jb[SR_NV * SR_NU];
-    int status;
+    int status = arg_model(model);
+    if (status != SR_OK) return status;
     if (!Ja || !Jb) return SR_ERR_NULL;
     status = checks(model, x, u);
     if (status != SR_OK) return status;
@@ -322,11 +324,12 @@ int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, con
                             sr_real *Ja, sr_real *Jb, long *failed_row)
 {
     long i;
+    int status = arg_model(model);
     if (failed_row) *failed_row = -1;
-    if (!model || (n > 0 && (!x || !Ja || !Jb))) return SR_ERR_NULL;
-    if (n < 0) return SR_ERR_ARG;
+    if (status == SR_OK) status = arg_rows(n, x && Ja && Jb);
+    if (status != SR_OK) return status;
     for (i = 0; i < n; ++i) {
-        const int status = sr_accel_jacobian(model, x + i * SR_NX, u ? u + i * SR_NU : NULL,
+        status = sr_accel_jacobian(model, x + i * SR_NX, u ? u + i * SR_NU : NULL,
                                              Ja + i * SR_NV * SR_NE, Jb + i * SR_NV * SR_NU);
         if (status != SR_OK) {
             if (failed_row) *failed_row = i;
@@ -339,17 +342,20 @@ int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, con
 int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                                sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
 {
-    const sr_real *w = x + SR_X_w_S, *R = x + SR_X_R_S;
+    const sr_real *w, *R;
     sr_real a[SR_NV], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], phi[3], D[9], Jr[9], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
     sr_real v[2][3], r;
-    int status, i, j;
-    if (!F || !G) return SR_ERR_NULL;
-    status = sr_check_state(model, x);
+    int status = arg_model(model), i, j;
+    if (status != SR_OK) return status;
+    if (!x || !F || !G) return SR_ERR_NULL;
+    if (arg_dt(dt) != SR_OK) return SR_ERR_ARG;
+    status = sr_internal_check_state(model, x);
     if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
     if (status != SR_OK) return status;
-    if (!(dt > 0) || !isfinite(dt)) return SR_ERR_ARG;
     status = sr_internal_accel_jacobian(model, x, u ? u : sr_zero_u, a, Ja, Jb);   /* checked above */
     if (status != SR_OK) return status;
+    w = x + SR_X_w_S;
+    R = x + SR_X_R_S;
     r = model->p[SR_P_r];
     memset(f, 0, sizeof f);
     memset(g, 0, sizeof g);
@@ -398,11 +404,13 @@ int sr_step_jacobian_lie_euler_batch(const sr_model *model, long n, const sr_rea
                                      sr_real *F, sr_real *G, long *failed_row)
 {
     long i;
+    int status = arg_model(model);
     if (failed_row) *failed_row = -1;
-    if (!model || (n > 0 && (!x || !F || !G))) return SR_ERR_NULL;
-    if (n < 0) return SR_ERR_ARG;
+    if (status == SR_OK) status = arg_rows(n, x && F && G);
+    if (status == SR_OK) status = arg_dt(dt);
+    if (status != SR_OK) return status;
     for (i = 0; i < n; ++i) {
-        const int status = sr_step_jacobian_lie_euler(model, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt,
+        status = sr_step_jacobian_lie_euler(model, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt,
                                                       F + i * SR_NE * SR_NE, G + i * SR_NE * SR_NU);
         if (status != SR_OK) {
             if (failed_row) *failed_row = i;

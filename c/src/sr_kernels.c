@@ -3,6 +3,7 @@
 #include "sr_checks.h"
 #include "sr_kernels.h"
 #include "sr_so3.h"
+#include "sr_argcheck.h"
 
 #include <stddef.h>
 #include <string.h>
@@ -104,7 +105,8 @@ int sr_internal_general_accel_jacobian_terms(const sr_model *model, const sr_rea
 
 int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV])
 {
-    int status;
+    int status = arg_model(model);
+    if (status != SR_OK) return status;
     if (!a) return SR_ERR_NULL;
     status = checks(model, x, u);
     if (status != SR_OK) return status;
@@ -122,10 +124,10 @@ static int accel_rows(const sr_model *model, long n, const sr_real *x, const sr_
     enum { BLOCK = 64 };
     sr_real ok_state[BLOCK], ok_accel[BLOCK], block[BLOCK * SR_NV];
     long start, i;
-    int k;
+    int k, status = arg_model(model);
     if (failed_row) *failed_row = -1;
-    if (!model || !x || !a) return SR_ERR_NULL;
-    if (n < 0) return SR_ERR_ARG;
+    if (status == SR_OK) status = arg_rows(n, x && a);
+    if (status != SR_OK) return status;
     for (start = 0; start < n; start += BLOCK) {
         const long m = n - start < BLOCK ? n - start : BLOCK;
         const sr_real *xb = x + start * SR_NX, *ub = u ? u + start * SR_NU : NULL;
@@ -137,13 +139,15 @@ static int accel_rows(const sr_model *model, long n, const sr_real *x, const sr_
             sr_gen_accel_lanes(model->c, m, xb, SR_NX, ub ? ub : sr_zero_u, ub ? SR_NU : 0, block, SR_NV, ok_accel);
         }
         for (i = 0; i < m; ++i) {
-            int status;
+            const sr_real *xi = xb + i * SR_NX, *ui = ub ? ub + i * SR_NU : NULL;
             if (ok_state[i] != 0 && ok_accel[i] != 0) {
                 for (k = 0; k < SR_NV; ++k) ab[i * SR_NV + k] = block[i * SR_NV + k];
                 continue;
             }
-            status = full ? sr_check_state(model, xb + i * SR_NX) : SR_OK;
-            if (status == SR_OK) status = sr_accel(model, xb + i * SR_NX, ub ? ub + i * SR_NU : NULL, ab + i * SR_NV);
+            /* sr_check_state and sr_accel on the row, the model checked above */
+            status = full ? sr_internal_check_state(model, xi) : SR_OK;
+            if (status == SR_OK) status = checks(model, xi, ui);
+            if (status == SR_OK) status = sr_internal_accel(model, xi, ui ? ui : sr_zero_u, ab + i * SR_NV);
             if (status != SR_OK) {
                 if (failed_row) *failed_row = start + i;
                 return status;
@@ -167,7 +171,8 @@ int sr_checked_accel_batch(const sr_model *model, long n, const sr_real *x, cons
 
 int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * SR_NV])
 {
-    int status;
+    int status = arg_model(model);
+    if (status != SR_OK) return status;
     if (!M) return SR_ERR_NULL;
     status = checks(model, x, NULL);
     if (status != SR_OK) return status;
@@ -176,7 +181,8 @@ int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * 
 
 int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NV])
 {
-    int status;
+    int status = arg_model(model);
+    if (status != SR_OK) return status;
     if (!f) return SR_ERR_NULL;
     status = checks(model, x, u);
     if (status != SR_OK) return status;
@@ -185,7 +191,8 @@ int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU]
 
 int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy)
 {
-    int status;
+    int status = arg_model(model);
+    if (status != SR_OK) return status;
     if (!energy) return SR_ERR_NULL;
     status = checks(model, x, NULL);
     if (status != SR_OK) return status;
@@ -194,7 +201,8 @@ int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy)
 
 int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV])
 {
-    int status;
+    int status = arg_model(model);
+    if (status != SR_OK) return status;
     if (!res) return SR_ERR_NULL;
     status = checks(model, x, NULL);
     if (status != SR_OK) return status;

@@ -2,6 +2,7 @@
  * Hand-written; see spherical_robot.h for the contract of every function. */
 #include "sr_checks.h"
 #include "sr_kernels.h"
+#include "sr_argcheck.h"
 
 #include <stddef.h>
 
@@ -19,6 +20,7 @@ const char *sr_status_string(int status)
     case SR_ERR_STEP_SIZE: return "adaptive step size below the rounding level of t";
     case SR_ERR_MAX_STEPS: return "adaptive stepping exceeded max_steps";
     case SR_ERR_ENERGY: return "energy rose without input power beyond the guard's tolerance";
+    case SR_ERR_MODEL: return "model not valid (not filled by sr_model_init, or changed since)";
     default: return "unknown status";
     }
 }
@@ -206,6 +208,8 @@ int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM])
     if (status != SR_OK || !(m.general ? all_finite(m.cg, SR_GEN_GENERAL_NCONST) : all_finite(m.c, SR_GEN_NCONST)))
         return SR_ERR_PARAM;
     if (sr_internal_energy(&m, x, &energy) != SR_OK) return SR_ERR_PARAM;
+    m.stamp = SR_MODEL_STAMP;
+    m.checksum = model_checksum(&m);
     *model = m;
     return SR_OK;
 }

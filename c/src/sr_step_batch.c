@@ -10,6 +10,7 @@
  */
 #include "sr_checks.h"
 #include "sr_lanes.h"
+#include "sr_argcheck.h"
 
 #include <stddef.h>
 
@@ -109,12 +110,12 @@ int sr_step_batch(const sr_model *model, int method, long n, const sr_real *x, c
 {
     sr_real ok[BLOCK], block[BLOCK * SR_NX];
     long start, i;
-    int k;
-    const int lanes = model && !model->general && dt > 0 && isfinite(dt)
-                   && (method == SR_LIE_EULER || method == SR_RKMK4 || method == SR_CF4);
+    int k, lanes, status = arg_model(model);
     if (failed_row) *failed_row = -1;
-    if (!model || (n > 0 && (!x || !x_next))) return SR_ERR_NULL;
-    if (n < 0) return SR_ERR_ARG;
+    if (status == SR_OK) status = arg_rows(n, x && x_next);
+    if (status == SR_OK && (arg_method(method) != SR_OK || arg_dt(dt) != SR_OK)) status = SR_ERR_ARG;
+    if (status != SR_OK) return status;
+    lanes = !model->general && (method == SR_LIE_EULER || method == SR_RKMK4 || method == SR_CF4);
     for (start = 0; start < n; start += BLOCK) {
         const long m = n - start < BLOCK ? n - start : BLOCK;
         const sr_real *xb = x + start * SR_NX, *ub = u ? u + start * SR_NU : NULL;
@@ -125,7 +126,6 @@ int sr_step_batch(const sr_model *model, int method, long n, const sr_real *x, c
             for (i = 0; i < m; ++i) ok[i] = 0;
         }
         for (i = 0; i < m; ++i) {
-            int status;
             if (ok[i] != 0) {
                 for (k = 0; k < SR_NX; ++k) ob[i * SR_NX + k] = block[i * SR_NX + k];
                 continue;

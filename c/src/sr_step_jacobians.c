@@ -18,6 +18,7 @@
 #include "sr_jacobians.h"
 #include "sr_so3.h"
 #include "sr_steppers.h"
+#include "sr_argcheck.h"
 
 #include <string.h>
 
@@ -367,15 +368,17 @@ static int deliver_jacobians(const error dy, sr_real F[SR_NE * SR_NE], sr_real G
     return SR_OK;
 }
 
+/* In the order of sr_argcheck.h: the model, the pointers, dt, then the state and the torques. */
 static int check_step_arguments(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                                 sr_real *F, sr_real *G)
 {
-    int status;
-    if (!F || !G) return SR_ERR_NULL;
-    status = sr_check_state(model, x);
-    if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
+    int status = arg_model(model);
     if (status != SR_OK) return status;
-    return (dt > 0) && isfinite(dt) ? SR_OK : SR_ERR_ARG;
+    if (!x || !F || !G) return SR_ERR_NULL;
+    if (arg_dt(dt) != SR_OK) return SR_ERR_ARG;
+    status = sr_internal_check_state(model, x);
+    if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
+    return status;
 }
 
 SR_JACOBIAN_CLONES int sr_step_jacobian_rkmk4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
@@ -440,11 +443,15 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_cf4(const sr_model *model, const sr_real
 int sr_step_jacobian(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                      sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
 {
+    int status;
     switch (method) {
     case SR_LIE_EULER: return sr_step_jacobian_lie_euler(model, x, u, dt, F, G);
     case SR_RKMK4: return sr_step_jacobian_rkmk4(model, x, u, dt, F, G);
     case SR_CF4: return sr_step_jacobian_cf4(model, x, u, dt, F, G);
-    default: return SR_ERR_ARG;
+    default: /* the model and the pointers before the method, as for every other argument */
+        status = arg_model(model);
+        if (status != SR_OK) return status;
+        return !x || !F || !G ? SR_ERR_NULL : SR_ERR_ARG;
     }
 }
 
@@ -452,11 +459,13 @@ int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_r
                            sr_real *F, sr_real *G, long *failed_row)
 {
     long i;
+    int status = arg_model(model);
     if (failed_row) *failed_row = -1;
-    if (!model || (n > 0 && (!x || !F || !G))) return SR_ERR_NULL;
-    if (n < 0 || (method != SR_LIE_EULER && method != SR_RKMK4 && method != SR_CF4)) return SR_ERR_ARG;
+    if (status == SR_OK) status = arg_rows(n, x && F && G);
+    if (status == SR_OK && (arg_jacobian_method(method) != SR_OK || arg_dt(dt) != SR_OK)) status = SR_ERR_ARG;
+    if (status != SR_OK) return status;
     for (i = 0; i < n; ++i) {
-        const int status = sr_step_jacobian(model, method, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt,
+        status = sr_step_jacobian(model, method, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt,
                                             F + i * SR_NE * SR_NE, G + i * SR_NE * SR_NU);
         if (status != SR_OK) {
             if (failed_row) *failed_row = i;

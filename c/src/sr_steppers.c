@@ -42,6 +42,7 @@
 #include "sr_kernels.h"
 #include "sr_so3.h"
 #include "sr_steppers.h"
+#include "sr_argcheck.h"
 
 #include <stddef.h>
 
@@ -265,8 +266,7 @@ static int lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_rea
 
 int sr_internal_valid_method(int method)
 {
-    const int base = method & ~SR_PROJECT;
-    return base == SR_LIE_EULER || base == SR_RKMK4 || base == SR_CF4;
+    return arg_method(method) == SR_OK;
 }
 
 int sr_internal_advance(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
@@ -288,19 +288,21 @@ int sr_internal_advance(const sr_model *model, int method, const sr_real x[SR_NX
 
 /* ---- the public one-step entry points ---------------------------------------------------- */
 
-/* The argument checks of every one-step entry point, in sr_step's order. */
-static int step_arguments(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+/* The argument checks of every one-step entry point, in the order of sr_argcheck.h: the model,
+ * the pointers, the method and dt, then the state and the torques. */
+static int step_arguments(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
                           sr_real dt, const sr_real *x_next)
 {
-    int status;
-    if (!x_next) return SR_ERR_NULL;
+    int status = arg_model(model);
+    if (status != SR_OK) return status;
+    if (!x || !x_next) return SR_ERR_NULL;
+    if (arg_method(method) != SR_OK || arg_dt(dt) != SR_OK) return SR_ERR_ARG;
     /* The full state check, not only the kernels' cheap one: a firmware loop of single steps
      * would otherwise carry a corrupt attitude (a row of R_S of length 2) on silently.  It costs
      * about a fifth of a Lie-Euler step, a twentieth of an RKMK4 one (measured, docs/robustness.md). */
-    status = sr_check_state(model, x);
+    status = sr_internal_check_state(model, x);
     if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
-    if (status != SR_OK) return status;
-    return dt > 0 && isfinite(dt) ? SR_OK : SR_ERR_ARG;
+    return status;
 }
 
 /* Each method's entry point calls its own stepper only, so that a program calling one of them
@@ -309,7 +311,7 @@ int sr_step_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_re
                       sr_real x_next[SR_NX])
 {
     sr_real tmp[SR_NX];
-    const int status = step_arguments(model, x, u, dt, x_next);
+    const int status = step_arguments(model, SR_LIE_EULER, x, u, dt, x_next);
     if (status != SR_OK) return status;
     return deliver(lie_euler(model, x, u ? u : sr_zero_u, dt, tmp), tmp, SR_NX, x_next);
 }
@@ -318,7 +320,7 @@ int sr_step_rkmk4(const sr_model *model, const sr_real x[SR_NX], const sr_real u
                   sr_real x_next[SR_NX])
 {
     sr_real tmp[SR_NX];
-    const int status = step_arguments(model, x, u, dt, x_next);
+    const int status = step_arguments(model, SR_RKMK4, x, u, dt, x_next);
     if (status != SR_OK) return status;
     return deliver(rkmk4_step(model, x, u ? u : sr_zero_u, dt, NULL, tmp), tmp, SR_NX, x_next);
 }
@@ -327,7 +329,7 @@ int sr_step_cf4(const sr_model *model, const sr_real x[SR_NX], const sr_real u[S
                 sr_real x_next[SR_NX])
 {
     sr_real tmp[SR_NX];
-    const int status = step_arguments(model, x, u, dt, x_next);
+    const int status = step_arguments(model, SR_CF4, x, u, dt, x_next);
     if (status != SR_OK) return status;
     return deliver(cf4_step(model, x, u ? u : sr_zero_u, dt, NULL, tmp), tmp, SR_NX, x_next);
 }
@@ -341,10 +343,9 @@ int sr_step(const sr_model *model, int method, const sr_real x[SR_NX], const sr_
     case SR_LIE_EULER: return sr_step_lie_euler(model, x, u, dt, x_next);
     case SR_RKMK4: return sr_step_rkmk4(model, x, u, dt, x_next);
     case SR_CF4: return sr_step_cf4(model, x, u, dt, x_next);
-    default: /* a projected method, or an unknown one (reported after the other arguments) */
-        status = step_arguments(model, x, u, dt, x_next);
+    default: /* a projected method, or an unknown one */
+        status = step_arguments(model, method, x, u, dt, x_next);
         if (status != SR_OK) return status;
-        if (!sr_internal_valid_method(method)) return SR_ERR_ARG;
         return deliver(sr_internal_advance(model, method, x, u ? u : sr_zero_u, dt, NULL, tmp), tmp,
                        SR_NX, x_next);
     }

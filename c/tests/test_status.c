@@ -113,7 +113,7 @@ static void test_status_codes_are_distinct_and_named(void)
 #ifdef SR_ERR_STEP_SIZE /* the adaptive stepper's codes, where present */
                          , SR_ERR_STEP_SIZE, SR_ERR_MAX_STEPS
 #endif
-                         , SR_ERR_ENERGY
+                         , SR_ERR_ENERGY, SR_ERR_MODEL
     };
     const int n = (int)(sizeof codes / sizeof codes[0]);
     int i, j;

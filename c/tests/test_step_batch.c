@@ -174,7 +174,9 @@ static void test_states_the_full_check_refuses_are_reported_at_their_row(void)
     }
 }
 
-static void test_bad_arguments_get_sr_step_s_status(void)
+/* The arguments are checked before any row, as in every batch call (sr_argcheck.h): a bad dt or
+ * method is refused with failed_row -1, also when there are no rows. */
+static void test_bad_arguments_are_refused_before_any_row(void)
 {
     static sr_real x[N][SR_NX], u[N][SR_NU], y[N][SR_NX];
     sr_model m;
@@ -188,9 +190,11 @@ static void test_bad_arguments_get_sr_step_s_status(void)
     CHECK_STATUS(sr_step_batch(&m, SR_LIE_EULER, 0, x[0], NULL, (sr_real)0.01, y[0], &row), SR_OK);
     CHECK(row == -1);
     CHECK_STATUS(sr_step_batch(&m, SR_LIE_EULER, 2, x[0], NULL, (sr_real)-0.01, y[0], &row), SR_ERR_ARG);
-    CHECK(row == 0);
+    CHECK(row == -1);
     CHECK_STATUS(sr_step_batch(&m, 99, 2, x[0], NULL, (sr_real)0.01, y[0], &row), SR_ERR_ARG);
-    CHECK(row == 0);
+    CHECK(row == -1);
+    CHECK_STATUS(sr_step_batch(&m, 99, 0, NULL, NULL, (sr_real)0.01, NULL, &row), SR_ERR_ARG);
+    CHECK_STATUS(sr_step_batch(&m, SR_LIE_EULER, 0, NULL, NULL, (sr_real)0.0, NULL, &row), SR_ERR_ARG);
 }
 
 void suite_step_batch(void)
@@ -202,5 +206,5 @@ void suite_step_batch(void)
     RUN_TEST(test_in_place_equals_a_separate_output);
     RUN_TEST(test_every_non_finite_entry_is_reported_at_its_row);
     RUN_TEST(test_states_the_full_check_refuses_are_reported_at_their_row);
-    RUN_TEST(test_bad_arguments_get_sr_step_s_status);
+    RUN_TEST(test_bad_arguments_are_refused_before_any_row);
 }

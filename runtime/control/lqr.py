@@ -12,6 +12,7 @@ import numpy as np
 
 from bindings._sr import ffi, lib
 
+from ..errors import KernelError
 from ..model import Model
 from .controller import DEFAULT_U_MAX, Controller
 from . import lqr_design as design
@@ -216,6 +217,8 @@ class Lqr(Controller):
         status = lib.sr_lqr_control(self._c, self._model._model, ffi.cast("double *", ffi.from_buffer(x)),
                                     c_target(target), self._memory, ffi.cast("double *", ffi.from_buffer(self._u)),
                                     ffi.cast("double *", ffi.from_buffer(self._raw)))
+        if status == lib.SR_ERR_MODEL:
+            raise KernelError("model", status, f" (controller lqr at t = {t:g} s)")
         if status != lib.SR_OK:
             raise ValueError(f"controller lqr: {ffi.string(lib.sr_status_string(status)).decode()} "
                              f"at t = {t:g} s")
