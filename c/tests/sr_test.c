@@ -52,6 +52,7 @@ int main(void)
     suite_trig();
     suite_accel_batch();
     suite_step_batch();
+    suite_sensors();
     return sr_test_summary();
 }
 

@@ -74,6 +74,7 @@ void suite_control(void);
 void suite_trig(void);
 void suite_accel_batch(void);
 void suite_step_batch(void);
+void suite_sensors(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 

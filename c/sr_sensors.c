@@ -1,0 +1,217 @@
+/* sr_sensors.c -- the checked sensor models around the generated sr_gen_imu_* / sr_gen_heading_*
+ * kernels (derive/sensors.py).  Hand-written; see sr_sensors.h for the contract of every function. */
+#include "sr_sensors.h"
+#include "sr_internal.h"
+
+#include <string.h>
+
+typedef int (*imu_kernel)(const sr_real *, const sr_real *, const sr_real *, const sr_real *, const sr_real *,
+                          sr_real *);
+typedef int (*imu_jacobian_kernel)(const sr_real *, const sr_real *, const sr_real *, const sr_real *,
+                                   const sr_real *, sr_real *, sr_real *, sr_real *);
+typedef int (*heading_kernel)(const sr_real *, const sr_real *, sr_real *);
+typedef int (*heading_jacobian_kernel)(const sr_real *, const sr_real *, sr_real *, sr_real *);
+
+/* One table per kind, indexed by SR_BODY_*: the body is a run-time choice, the kernels are per body
+ * (each body's chain of joints is unrolled in its own kernel). */
+static imu_kernel imu_kernel_of(int body)
+{
+    return body == SR_BODY_shell ? sr_gen_imu_shell : body == SR_BODY_yoke ? sr_gen_imu_yoke : sr_gen_imu_pendulum;
+}
+
+static imu_jacobian_kernel imu_jacobian_kernel_of(int body)
+{
+    return body == SR_BODY_shell ? sr_gen_imu_shell_jacobian
+         : body == SR_BODY_yoke ? sr_gen_imu_yoke_jacobian : sr_gen_imu_pendulum_jacobian;
+}
+
+static heading_kernel heading_kernel_of(int body)
+{
+    return body == SR_BODY_shell ? sr_gen_heading_shell : body == SR_BODY_yoke ? sr_gen_heading_yoke : sr_gen_heading_pendulum;
+}
+
+static heading_jacobian_kernel heading_jacobian_kernel_of(int body)
+{
+    return body == SR_BODY_shell ? sr_gen_heading_shell_jacobian
+         : body == SR_BODY_yoke ? sr_gen_heading_yoke_jacobian : sr_gen_heading_pendulum_jacobian;
+}
+
+static const sr_real zero_bias[SR_NBIAS] = {0, 0, 0, 0, 0, 0};
+
+/* R (row-major) orthonormal with det +1, to SR_ROTATION_TOL. */
+static int is_rotation(const sr_real *R)
+{
+    int i, j;
+    sr_real det;
+    for (i = 0; i < 3; ++i)
+        for (j = i; j < 3; ++j) {
+            const sr_real dot = R[i] * R[j] + R[3 + i] * R[3 + j] + R[6 + i] * R[6 + j];
+            if (!near(dot, i == j ? 1 : 0)) return 0;
+        }
+    det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) + R[2] * (R[3] * R[7] - R[4] * R[6]);
+    return near(det, 1);
+}
+
+int sr_check_mount(int body, const sr_real mount[SR_NMOUNT])
+{
+    if (!mount) return SR_ERR_NULL;
+    if (body < 0 || body >= SR_NBODY) return SR_ERR_ARG;
+    if (!all_finite(mount, SR_NMOUNT)) return SR_ERR_NONFINITE;
+    if (!is_rotation(mount + SR_MOUNT_R_m)) return SR_ERR_NOT_ROTATION;
+    return SR_OK;
+}
+
+/* The checks every sensor call makes on the model, the state and (if any) the mount. */
+static int check_inputs(const sr_model *model, const sr_real x[SR_NX], int with_mount, int body,
+                        const sr_real mount[SR_NMOUNT])
+{
+    int status;
+    if (!model || !x) return SR_ERR_NULL;
+    status = sr_check_state(model, x);
+    if (status == SR_OK && with_mount) status = sr_check_mount(body, mount);
+    return status;
+}
+
+/* The IMU's checks: state, mount, the n entries of v (nu_dot or u; if given) and bias (NULL: zero) finite. */
+static int check_imu(const sr_model *model, const sr_real x[SR_NX], const sr_real *v, int n, int body,
+                     const sr_real mount[SR_NMOUNT], const sr_real **bias)
+{
+    const int status = check_inputs(model, x, 1, body, mount);
+    if (status != SR_OK) return status;
+    if (v && !all_finite(v, n)) return SR_ERR_NONFINITE;
+    if (!*bias) *bias = zero_bias;
+    return all_finite(*bias, SR_NBIAS) ? SR_OK : SR_ERR_NONFINITE;
+}
+
+int sr_imu_measure(const sr_model *model, const sr_real x[SR_NX], const sr_real nu_dot[SR_NV], int body,
+                   const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU])
+{
+    int status;
+    if (!nu_dot || !y) return SR_ERR_NULL;
+    status = check_imu(model, x, nu_dot, SR_NV, body, mount, &bias);
+    if (status != SR_OK) return status;
+    return imu_kernel_of(body)(model->cg, x, nu_dot, mount, bias, y);
+}
+
+int sr_imu_measure_u(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int body,
+                     const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU])
+{
+    sr_real a[SR_NV];
+    int status;
+    if (!y) return SR_ERR_NULL;
+    status = check_imu(model, x, NULL, 0, body, mount, &bias);
+    if (status == SR_OK) status = sr_accel(model, x, u, a);
+    if (status != SR_OK) return status;
+    return imu_kernel_of(body)(model->cg, x, a, mount, bias, y);
+}
+
+int sr_imu_partials(const sr_model *model, const sr_real x[SR_NX], const sr_real nu_dot[SR_NV], int body,
+                    const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU],
+                    sr_real H[SR_NIMU * SR_NEB], sr_real Hn[SR_NIMU * SR_NV])
+{
+    int status;
+    if (!nu_dot || !y || !H || !Hn) return SR_ERR_NULL;
+    status = check_imu(model, x, nu_dot, SR_NV, body, mount, &bias);
+    if (status != SR_OK) return status;
+    return imu_jacobian_kernel_of(body)(model->cg, x, nu_dot, mount, bias, y, H, Hn);
+}
+
+int sr_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int body,
+                    const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU],
+                    sr_real H[SR_NIMU * SR_NEB])
+{
+    sr_real a[SR_NV], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], yy[SR_NIMU], HH[SR_NIMU * SR_NEB], Hn[SR_NIMU * SR_NV];
+    int status, i, j, k;
+    if (!y || !H) return SR_ERR_NULL;
+    status = check_imu(model, x, u, SR_NU, body, mount, &bias);
+    if (status != SR_OK) return status;
+    status = sr_internal_accel_jacobian(model, x, u ? u : sr_zero_u, a, Ja, Jb);
+    if (status != SR_OK) return status;
+    if (!all_finite(a, SR_NV) || !all_finite(Ja, SR_NV * SR_NE)) return SR_ERR_NONFINITE;
+    status = imu_jacobian_kernel_of(body)(model->cg, x, a, mount, bias, yy, HH, Hn);
+    if (status != SR_OK) return status;
+    /* Only the accelerometer reads nu_dot (the gyroscope's rows of Hn are zero by derivation). */
+    for (i = SR_IMU_accel; i < SR_IMU_accel + 3; ++i)
+        for (k = 0; k < SR_NV; ++k) {
+            const sr_real h = Hn[SR_NV * i + k];
+            for (j = 0; j < SR_NE; ++j) HH[SR_NEB * i + j] += h * Ja[SR_NE * k + j];
+        }
+    if (!all_finite(HH, SR_NIMU * SR_NEB)) return SR_ERR_NONFINITE;
+    memcpy(y, yy, sizeof yy);
+    memcpy(H, HH, sizeof HH);
+    return SR_OK;
+}
+
+int sr_encoders_measure(const sr_model *model, const sr_real x[SR_NX], sr_real y[2])
+{
+    const int status = y ? check_inputs(model, x, 0, 0, NULL) : SR_ERR_NULL;
+    if (status != SR_OK) return status;
+    /* R_Y = rot_x(theta_Y): (cos, sin) in its (1,1), (2,1) entries; R_P = rot_y(theta_P): (0,0), (0,2). */
+    y[0] = SR_ATAN2(x[SR_X_R_Y + 7], x[SR_X_R_Y + 4]);
+    y[1] = SR_ATAN2(x[SR_X_R_P + 2], x[SR_X_R_P + 0]);
+    return SR_OK;
+}
+
+int sr_encoders_jacobian(const sr_model *model, const sr_real x[SR_NX], sr_real y[2], sr_real H[2 * SR_NEB])
+{
+    sr_real yy[2];
+    const int status = H && y ? sr_encoders_measure(model, x, yy) : SR_ERR_NULL;
+    if (status != SR_OK) return status;
+    sr_gen_encoders_jacobian(H);
+    y[0] = yy[0];
+    y[1] = yy[1];
+    return SR_OK;
+}
+
+int sr_position_measure(const sr_model *model, const sr_real x[SR_NX], sr_real y[2])
+{
+    const int status = y ? check_inputs(model, x, 0, 0, NULL) : SR_ERR_NULL;
+    if (status != SR_OK) return status;
+    y[0] = x[SR_X_q + 0];
+    y[1] = x[SR_X_q + 1];
+    return SR_OK;
+}
+
+int sr_position_jacobian(const sr_model *model, const sr_real x[SR_NX], sr_real y[2], sr_real H[2 * SR_NEB])
+{
+    sr_real yy[2];
+    const int status = H && y ? sr_position_measure(model, x, yy) : SR_ERR_NULL;
+    if (status != SR_OK) return status;
+    sr_gen_position_jacobian(H);
+    y[0] = yy[0];
+    y[1] = yy[1];
+    return SR_OK;
+}
+
+/* The floor's components of the sensor's x axis, refused where the heading is undefined. */
+static int heading_vector(const sr_model *model, const sr_real x[SR_NX], int body, const sr_real mount[SR_NMOUNT],
+                          sr_real h[2])
+{
+    int status = check_inputs(model, x, 1, body, mount);
+    if (status == SR_OK) status = heading_kernel_of(body)(x, mount, h);
+    if (status != SR_OK) return status;
+    if (h[0] * h[0] + h[1] * h[1] < SR_HEADING_MIN_HORIZONTAL * SR_HEADING_MIN_HORIZONTAL) return SR_ERR_SINGULAR;
+    return SR_OK;
+}
+
+int sr_heading_measure(const sr_model *model, const sr_real x[SR_NX], int body, const sr_real mount[SR_NMOUNT],
+                       sr_real *heading)
+{
+    sr_real h[2];
+    const int status = heading ? heading_vector(model, x, body, mount, h) : SR_ERR_NULL;
+    if (status != SR_OK) return status;
+    *heading = SR_ATAN2(h[1], h[0]);
+    return SR_OK;
+}
+
+int sr_heading_jacobian(const sr_model *model, const sr_real x[SR_NX], int body, const sr_real mount[SR_NMOUNT],
+                        sr_real *heading, sr_real H[SR_NEB])
+{
+    sr_real h[2], HH[SR_NEB];
+    int status = heading && H ? heading_vector(model, x, body, mount, h) : SR_ERR_NULL;
+    if (status == SR_OK) status = heading_jacobian_kernel_of(body)(x, mount, h, HH);
+    if (status != SR_OK) return status;
+    *heading = SR_ATAN2(h[1], h[0]);
+    memcpy(H, HH, sizeof HH);
+    return SR_OK;
+}
