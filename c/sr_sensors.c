@@ -38,6 +38,13 @@ static heading_jacobian_kernel heading_jacobian_kernel_of(int body)
 
 static const sr_real zero_bias[SR_NBIAS] = {0, 0, 0, 0, 0, 0};
 
+/* The kernels' constants (r, g_x, g_z) from the parameters: of every model, and of a firmware built
+ * without the general kernels (-DSR_PAPER_ONLY), whose model has no general constants. */
+static void sensor_constants(const sr_model *model, sr_real sc[SR_GEN_NSC])
+{
+    sr_gen_sensor_constants(model->p, sc);
+}
+
 /* R (row-major) orthonormal with det +1, to SR_ROTATION_TOL. */
 static int is_rotation(const sr_real *R)
 {
@@ -86,41 +93,46 @@ static int check_imu(const sr_model *model, const sr_real x[SR_NX], const sr_rea
 int sr_imu_measure(const sr_model *model, const sr_real x[SR_NX], const sr_real nu_dot[SR_NV], int body,
                    const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU])
 {
+    sr_real sc[SR_GEN_NSC];
     int status;
     if (!nu_dot || !y) return SR_ERR_NULL;
     status = check_imu(model, x, nu_dot, SR_NV, body, mount, &bias);
     if (status != SR_OK) return status;
-    return imu_kernel_of(body)(model->cg, x, nu_dot, mount, bias, y);
+    sensor_constants(model, sc);
+    return imu_kernel_of(body)(sc, x, nu_dot, mount, bias, y);
 }
 
 int sr_imu_measure_u(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int body,
                      const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU])
 {
-    sr_real a[SR_NV];
+    sr_real a[SR_NV], sc[SR_GEN_NSC];
     int status;
     if (!y) return SR_ERR_NULL;
     status = check_imu(model, x, NULL, 0, body, mount, &bias);
     if (status == SR_OK) status = sr_accel(model, x, u, a);
     if (status != SR_OK) return status;
-    return imu_kernel_of(body)(model->cg, x, a, mount, bias, y);
+    sensor_constants(model, sc);
+    return imu_kernel_of(body)(sc, x, a, mount, bias, y);
 }
 
 int sr_imu_partials(const sr_model *model, const sr_real x[SR_NX], const sr_real nu_dot[SR_NV], int body,
                     const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU],
                     sr_real H[SR_NIMU * SR_NEB], sr_real Hn[SR_NIMU * SR_NV])
 {
+    sr_real sc[SR_GEN_NSC];
     int status;
     if (!nu_dot || !y || !H || !Hn) return SR_ERR_NULL;
     status = check_imu(model, x, nu_dot, SR_NV, body, mount, &bias);
     if (status != SR_OK) return status;
-    return imu_jacobian_kernel_of(body)(model->cg, x, nu_dot, mount, bias, y, H, Hn);
+    sensor_constants(model, sc);
+    return imu_jacobian_kernel_of(body)(sc, x, nu_dot, mount, bias, y, H, Hn);
 }
 
 int sr_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int body,
                     const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU],
                     sr_real H[SR_NIMU * SR_NEB])
 {
-    sr_real a[SR_NV], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], yy[SR_NIMU], HH[SR_NIMU * SR_NEB], Hn[SR_NIMU * SR_NV];
+    sr_real a[SR_NV], sc[SR_GEN_NSC], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], yy[SR_NIMU], HH[SR_NIMU * SR_NEB], Hn[SR_NIMU * SR_NV];
     int status, i, j, k;
     if (!y || !H) return SR_ERR_NULL;
     status = check_imu(model, x, u, SR_NU, body, mount, &bias);
@@ -128,7 +140,8 @@ int sr_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real
     status = sr_internal_accel_jacobian(model, x, u ? u : sr_zero_u, a, Ja, Jb);
     if (status != SR_OK) return status;
     if (!all_finite(a, SR_NV) || !all_finite(Ja, SR_NV * SR_NE)) return SR_ERR_NONFINITE;
-    status = imu_jacobian_kernel_of(body)(model->cg, x, a, mount, bias, yy, HH, Hn);
+    sensor_constants(model, sc);
+    status = imu_jacobian_kernel_of(body)(sc, x, a, mount, bias, yy, HH, Hn);
     if (status != SR_OK) return status;
     /* Only the accelerometer reads nu_dot (the gyroscope's rows of Hn are zero by derivation). */
     for (i = SR_IMU_accel; i < SR_IMU_accel + 3; ++i)

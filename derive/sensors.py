@@ -72,9 +72,18 @@ NIMU = 6
 ESTIMATOR_BLOCKS = S.ERROR_BLOCKS + (("b_g", S.NE, 3), ("b_a", S.NE + 3, 3))
 NEB = S.NE + NBIAS
 
-#: Gravity's components in the floor's frame and the shell radius: the general robot's constants
-#: (sr_gen_general_constants computes them for every model, the paper's too).
-g_x, g_z, radius = R.g_x, R.g_z, P.r
+#: The shell radius and gravity's components in the floor's frame, the general robot's symbols.  The
+#: sensor kernels read them from their own array sc (SR_SC_*), which sr_gen_sensor_constants fills
+#: from the parameters: a model of either kind, and a firmware without the general kernels, has them.
+radius, g_x, g_z = P.r, R.g_x, R.g_z
+CONSTANTS = (radius, g_x, g_z)
+NCONST = 3
+
+
+def constant_expressions():
+    """sc = (r, g sin(slope), g cos(slope)) from the parameters (derive/robot.py's general constants)."""
+    named = dict(R.general_constants())
+    return tuple(named[s] for s in CONSTANTS)
 
 
 #: The joints from the shell to each body: (its one-axis rotation, the reconstruction rate Q̇ = Q Ω_j).

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 8802a7774bd00afe], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources a236c8d2466e5b13], SymPy 1.14.0. */
 #include "sr_generated.h"
 
 #include <math.h>
@@ -3346,12 +3346,29 @@ int sr_gen_general_accel_jacobian_terms(const sr_real cg[SR_GEN_GENERAL_NCONST],
     return SR_GEN_OK;
 }
 
-/* IMU on the shell: y = (gyroscope R_m^T w_B + b_g, accelerometer R_m^T R_B^T (p'' - g) + b_a) in the sensor frame (SR_IMU_*), at the mount's lever arm, given nu_dot (derive.sensors.imu). */
-int sr_gen_imu_shell(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6])
+/* The sensor kernels' constants sc = (r, g sin(slope), g cos(slope)) (SR_SC_*) from the parameters (derive.sensors.constant_expressions). */
+int sr_gen_sensor_constants(const sr_real p[SR_GEN_NPARAM], sr_real sc[SR_GEN_NSC])
 {
-    const sr_real r = cg[0];
-    const sr_real g_x = cg[29];
-    const sr_real g_z = cg[30];
+    const sr_real r = p[0];
+    const sr_real g = p[30];
+    const sr_real slope = p[31];
+    const sr_real out_0 = r;
+    const sr_real out_1 = g*SR_GEN_SIN(slope);
+    const sr_real out_2 = g*SR_GEN_COS(slope);
+    const sr_real out_sum = out_2 + (out_0 + out_1);
+    if (!isfinite(out_sum) && !(isfinite(out_0) && isfinite(out_1) && isfinite(out_2))) return SR_GEN_NONFINITE;
+    sc[0] = out_0;
+    sc[1] = out_1;
+    sc[2] = out_2;
+    return SR_GEN_OK;
+}
+
+/* IMU on the shell: y = (gyroscope R_m^T w_B + b_g, accelerometer R_m^T R_B^T (p'' - g) + b_a) in the sensor frame (SR_IMU_*), at the mount's lever arm, given nu_dot (derive.sensors.imu). */
+int sr_gen_imu_shell(const sr_real sc[SR_GEN_NSC], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6])
+{
+    const sr_real r = sc[0];
+    const sr_real g_x = sc[1];
+    const sr_real g_z = sc[2];
     const sr_real chi_x = x[0];
     const sr_real chi_y = x[1];
     const sr_real chi_z = x[2];
@@ -3408,11 +3425,11 @@ int sr_gen_imu_shell(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR
 }
 
 /* IMU on the shell: y, dy/d(d, b) with nu_dot held (SR_GEN_NIMU x SR_GEN_NEB, row-major, columns SR_EB_*) and dy/d(nu_dot) (SR_GEN_NIMU x SR_GEN_NV), so that dy/dd = H + Hn Ja (derive.sensors.imu_jacobians). */
-int sr_gen_imu_shell_jacobian(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6], sr_real H[108], sr_real Hn[30])
+int sr_gen_imu_shell_jacobian(const sr_real sc[SR_GEN_NSC], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6], sr_real H[108], sr_real Hn[30])
 {
-    const sr_real r = cg[0];
-    const sr_real g_x = cg[29];
-    const sr_real g_z = cg[30];
+    const sr_real r = sc[0];
+    const sr_real g_x = sc[1];
+    const sr_real g_z = sc[2];
     const sr_real chi_x = x[0];
     const sr_real chi_y = x[1];
     const sr_real chi_z = x[2];
@@ -3868,11 +3885,11 @@ int sr_gen_heading_shell_jacobian(const sr_real x[SR_GEN_NX], const sr_real moun
 }
 
 /* IMU on the yoke: y = (gyroscope R_m^T w_B + b_g, accelerometer R_m^T R_B^T (p'' - g) + b_a) in the sensor frame (SR_IMU_*), at the mount's lever arm, given nu_dot (derive.sensors.imu). */
-int sr_gen_imu_yoke(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6])
+int sr_gen_imu_yoke(const sr_real sc[SR_GEN_NSC], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6])
 {
-    const sr_real r = cg[0];
-    const sr_real g_x = cg[29];
-    const sr_real g_z = cg[30];
+    const sr_real r = sc[0];
+    const sr_real g_x = sc[1];
+    const sr_real g_z = sc[2];
     const sr_real chi_x = x[0];
     const sr_real chi_y = x[1];
     const sr_real chi_z = x[2];
@@ -3948,11 +3965,11 @@ int sr_gen_imu_yoke(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_
 }
 
 /* IMU on the yoke: y, dy/d(d, b) with nu_dot held (SR_GEN_NIMU x SR_GEN_NEB, row-major, columns SR_EB_*) and dy/d(nu_dot) (SR_GEN_NIMU x SR_GEN_NV), so that dy/dd = H + Hn Ja (derive.sensors.imu_jacobians). */
-int sr_gen_imu_yoke_jacobian(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6], sr_real H[108], sr_real Hn[30])
+int sr_gen_imu_yoke_jacobian(const sr_real sc[SR_GEN_NSC], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6], sr_real H[108], sr_real Hn[30])
 {
-    const sr_real r = cg[0];
-    const sr_real g_x = cg[29];
-    const sr_real g_z = cg[30];
+    const sr_real r = sc[0];
+    const sr_real g_x = sc[1];
+    const sr_real g_z = sc[2];
     const sr_real chi_x = x[0];
     const sr_real chi_y = x[1];
     const sr_real chi_z = x[2];
@@ -4483,11 +4500,11 @@ int sr_gen_heading_yoke_jacobian(const sr_real x[SR_GEN_NX], const sr_real mount
 }
 
 /* IMU on the pendulum: y = (gyroscope R_m^T w_B + b_g, accelerometer R_m^T R_B^T (p'' - g) + b_a) in the sensor frame (SR_IMU_*), at the mount's lever arm, given nu_dot (derive.sensors.imu). */
-int sr_gen_imu_pendulum(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6])
+int sr_gen_imu_pendulum(const sr_real sc[SR_GEN_NSC], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6])
 {
-    const sr_real r = cg[0];
-    const sr_real g_x = cg[29];
-    const sr_real g_z = cg[30];
+    const sr_real r = sc[0];
+    const sr_real g_x = sc[1];
+    const sr_real g_z = sc[2];
     const sr_real chi_x = x[0];
     const sr_real chi_y = x[1];
     const sr_real chi_z = x[2];
@@ -4573,11 +4590,11 @@ int sr_gen_imu_pendulum(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x
 }
 
 /* IMU on the pendulum: y, dy/d(d, b) with nu_dot held (SR_GEN_NIMU x SR_GEN_NEB, row-major, columns SR_EB_*) and dy/d(nu_dot) (SR_GEN_NIMU x SR_GEN_NV), so that dy/dd = H + Hn Ja (derive.sensors.imu_jacobians). */
-int sr_gen_imu_pendulum_jacobian(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6], sr_real H[108], sr_real Hn[30])
+int sr_gen_imu_pendulum_jacobian(const sr_real sc[SR_GEN_NSC], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6], sr_real H[108], sr_real Hn[30])
 {
-    const sr_real r = cg[0];
-    const sr_real g_x = cg[29];
-    const sr_real g_z = cg[30];
+    const sr_real r = sc[0];
+    const sr_real g_x = sc[1];
+    const sr_real g_z = sc[2];
     const sr_real chi_x = x[0];
     const sr_real chi_y = x[1];
     const sr_real chi_z = x[2];

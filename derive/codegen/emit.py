@@ -93,7 +93,7 @@ def signature(kernel):
     if kernel.solve:
         args.append("sr_real a[SR_GEN_NV]")
     else:
-        sizes = {"c": "SR_GEN_NCONST", "cg": "SR_GEN_GENERAL_NCONST", "p": "SR_GEN_NPARAM"}
+        sizes = {"c": "SR_GEN_NCONST", "cg": "SR_GEN_GENERAL_NCONST", "p": "SR_GEN_NPARAM", "sc": "SR_GEN_NSC"}
         args += [f"sr_real {o.name}[{sizes.get(o.name, len(o.exprs))}]" for o in kernel.outputs]
     return f"int {PREFIX}{kernel.name}({', '.join(args)})"
 
@@ -192,6 +192,8 @@ def layout_macros():
     lines += [f"#define SR_PAPER_{s.name} {i}" for i, s in enumerate(P.PAPER_PARAMETERS)]
     lines += ["/* The bodies a sensor is mounted on (derive/sensors.py). */"]
     lines += [f"#define SR_BODY_{name} {i}" for i, name in enumerate(SE.BODIES)]
+    lines += ["/* Layout of sc[SR_GEN_NSC], the sensor kernels' constants (sr_gen_sensor_constants). */"]
+    lines += [f"#define SR_SC_{s.name} {i}" for i, s in enumerate(SE.CONSTANTS)]
     blocks = (("MOUNT", SE.MOUNT_BLOCKS, SE.NMOUNT, "the sensor mount mount[SR_GEN_NMOUNT]: lever arm in the body's frame, mounting rotation R_m (sensor axes in the body's frame, row-major)"),
               ("BIAS", SE.BIAS_BLOCKS, SE.NBIAS, "the IMU's biases bias[SR_GEN_NBIAS], sensor frame"),
               ("IMU", SE.IMU_BLOCKS, SE.NIMU, "an IMU reading y[SR_GEN_NIMU], sensor frame"),
@@ -233,6 +235,7 @@ def header_text(ks, flops, n_constants, n_general_constants):
 #define SR_GEN_NU {S.NU}
 #define SR_GEN_NV {S.NV}
 #define SR_GEN_NE {S.NE}
+#define SR_GEN_NSC {SE.NCONST}
 #define SR_GEN_NMOUNT {SE.NMOUNT}
 #define SR_GEN_NBIAS {SE.NBIAS}
 #define SR_GEN_NIMU {SE.NIMU}

@@ -29,6 +29,7 @@ INPUT_DOCS = {
     "cg": ("const sr_real cg[SR_GEN_GENERAL_NCONST]", "constants from sr_gen_general_constants"),
     "x": ("const sr_real x[SR_GEN_NX]", "state [R_S | R_Y | R_P | q | w_S | w_Y | w_P]"),
     "u": ("const sr_real u[SR_GEN_NU]", "motor torques (yoke, pendulum) [N m]"),
+    "sc": ("const sr_real sc[SR_GEN_NSC]", "sensor constants from sr_gen_sensor_constants (SR_SC_*)"),
     "nud": ("const sr_real nud[SR_GEN_NV]", "accelerations nu_dot = (dw_S, dw_Y, dw_P) [rad/s^2]"),
     "mount": ("const sr_real mount[SR_GEN_NMOUNT]", "sensor mount: lever arm (body frame) [m], then R_m row-major (SR_MOUNT_*)"),
     "bias": ("const sr_real bias[SR_GEN_NBIAS]", "IMU biases: gyroscope [rad/s], accelerometer [m/s^2] (SR_BIAS_*)"),
@@ -45,6 +46,7 @@ def array_layouts(constants, general_constants):
         "cg": {s: i for i, s in enumerate(general_constants)},
         "x": {**S.STATE_LAYOUT, **SE.STATE_LAYOUT},
         "u": S.INPUT_LAYOUT,
+        "sc": {s: i for i, s in enumerate(SE.CONSTANTS)},
         "nud": {s: i for i, s in enumerate(SE.nu_dot)},
         "mount": SE.MOUNT_LAYOUT,
         "bias": SE.BIAS_LAYOUT,
@@ -190,8 +192,10 @@ def sensor_kernels():
     inputs): the IMU's reading and its Jacobians, the heading vector and the heading's Jacobian, and
     the constant Jacobians of the encoders and the position fix.  The biases, the rows of R_S and
     the joint angles read by atan2 are checked and formed in c/sr_sensors.c."""
-    ks = []
-    imu_inputs = ("cg", "x", "nud", "mount", "bias")
+    ks = [Kernel("sensor_constants", "The sensor kernels' constants sc = (r, g sin(slope), g cos(slope)) (SR_SC_*)"
+                 " from the parameters (derive.sensors.constant_expressions).",
+                 ("p",), (Output("sc", SE.constant_expressions(), "(r, g_x, g_z)"),))]
+    imu_inputs = ("sc", "x", "nud", "mount", "bias")
     for body in SE.BODIES:
         y = SE.imu(body)
         H, Hn = SE.imu_jacobians(body)

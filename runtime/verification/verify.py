@@ -336,9 +336,10 @@ def sensor_rows(n_states=1000, seed=0):
     general = random_general_params(np.random.default_rng(seed + 1))
     n = max(n_states // 5, 30)
     rows = []
-    for label, params in (("paper's robot", None), ("a general robot on a slope", general)):
-        found = (value_checks(n, seed + 2, params) + ad_checks(n, seed + 3, params)
-                 + difference_checks(max(n // 10, 6), seed + 4, params) + measured_accel_check(max(n // 4, 10), seed + 5, params))
+    for k, (label, params) in enumerate((("paper's robot", None), ("a general robot on a slope", general))):
+        s = seed + 10 * k
+        found = (value_checks(n, s + 2, params) + ad_checks(n, s + 3, params)
+                 + difference_checks(max(n // 10, 6), s + 4, params) + measured_accel_check(max(n // 4, 10), s + 5, params))
         rows += [CheckResult(f"{name}, {label}", err, rel, tol, catches=catches)
                  for (name, err, rel, tol), catches in zip(found, SENSOR_CATCHES)]
     return rows
