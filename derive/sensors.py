@@ -90,14 +90,6 @@ def constant_expressions():
 JOINTS = {"shell": (), "yoke": ((S.R_Y, S.Omega_Y),), "pendulum": ((S.R_Y, S.Omega_Y), (S.R_P, S.Omega_P))}
 
 
-def relative_attitude(body):
-    """Q_B = R_Sᵀ R_B: the body's attitude in the shell frame."""
-    Q = sp.eye(3)
-    for R_j, _ in JOINTS[body]:
-        Q = Q * R_j
-    return Q
-
-
 def to_body(body, v):
     """Q_Bᵀ v, one joint at a time (R_Pᵀ (R_Yᵀ v): the nested form the kernels evaluate)."""
     for R_j, _ in JOINTS[body]:
