@@ -5,35 +5,46 @@
 
 #include <string.h>
 
-typedef int (*imu_kernel)(const sr_real *, const sr_real *, const sr_real *, const sr_real *, const sr_real *,
-                          sr_real *);
-typedef int (*imu_jacobian_kernel)(const sr_real *, const sr_real *, const sr_real *, const sr_real *,
-                                   const sr_real *, sr_real *, sr_real *, sr_real *);
-typedef int (*heading_kernel)(const sr_real *, const sr_real *, sr_real *);
-typedef int (*heading_jacobian_kernel)(const sr_real *, const sr_real *, sr_real *, sr_real *);
-
-/* One table per kind, indexed by SR_BODY_*: the body is a run-time choice, the kernels are per body
- * (each body's chain of joints is unrolled in its own kernel). */
-static imu_kernel imu_kernel_of(int body)
+/* The kernels per body (each body's chain of joints unrolled in its own kernel), chosen at run time
+ * by direct calls: taking their addresses instead would reference the GOT in a PIC build. */
+static int imu_kernel(int body, const sr_real sc[SR_GEN_NSC], const sr_real x[SR_NX], const sr_real a[SR_NV],
+                      const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU])
 {
-    return body == SR_BODY_shell ? sr_gen_imu_shell : body == SR_BODY_yoke ? sr_gen_imu_yoke : sr_gen_imu_pendulum;
+    switch (body) {
+    case SR_BODY_shell: return sr_gen_imu_shell(sc, x, a, mount, bias, y);
+    case SR_BODY_yoke: return sr_gen_imu_yoke(sc, x, a, mount, bias, y);
+    default: return sr_gen_imu_pendulum(sc, x, a, mount, bias, y);
+    }
 }
 
-static imu_jacobian_kernel imu_jacobian_kernel_of(int body)
+static int imu_jacobian_kernel(int body, const sr_real sc[SR_GEN_NSC], const sr_real x[SR_NX], const sr_real a[SR_NV],
+                               const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU],
+                               sr_real H[SR_NIMU * SR_NEB], sr_real Hn[SR_NIMU * SR_NV])
 {
-    return body == SR_BODY_shell ? sr_gen_imu_shell_jacobian
-         : body == SR_BODY_yoke ? sr_gen_imu_yoke_jacobian : sr_gen_imu_pendulum_jacobian;
+    switch (body) {
+    case SR_BODY_shell: return sr_gen_imu_shell_jacobian(sc, x, a, mount, bias, y, H, Hn);
+    case SR_BODY_yoke: return sr_gen_imu_yoke_jacobian(sc, x, a, mount, bias, y, H, Hn);
+    default: return sr_gen_imu_pendulum_jacobian(sc, x, a, mount, bias, y, H, Hn);
+    }
 }
 
-static heading_kernel heading_kernel_of(int body)
+static int heading_kernel(int body, const sr_real x[SR_NX], const sr_real mount[SR_NMOUNT], sr_real h[2])
 {
-    return body == SR_BODY_shell ? sr_gen_heading_shell : body == SR_BODY_yoke ? sr_gen_heading_yoke : sr_gen_heading_pendulum;
+    switch (body) {
+    case SR_BODY_shell: return sr_gen_heading_shell(x, mount, h);
+    case SR_BODY_yoke: return sr_gen_heading_yoke(x, mount, h);
+    default: return sr_gen_heading_pendulum(x, mount, h);
+    }
 }
 
-static heading_jacobian_kernel heading_jacobian_kernel_of(int body)
+static int heading_jacobian_kernel(int body, const sr_real x[SR_NX], const sr_real mount[SR_NMOUNT], sr_real h[2],
+                                   sr_real H[SR_NEB])
 {
-    return body == SR_BODY_shell ? sr_gen_heading_shell_jacobian
-         : body == SR_BODY_yoke ? sr_gen_heading_yoke_jacobian : sr_gen_heading_pendulum_jacobian;
+    switch (body) {
+    case SR_BODY_shell: return sr_gen_heading_shell_jacobian(x, mount, h, H);
+    case SR_BODY_yoke: return sr_gen_heading_yoke_jacobian(x, mount, h, H);
+    default: return sr_gen_heading_pendulum_jacobian(x, mount, h, H);
+    }
 }
 
 static const sr_real zero_bias[SR_NBIAS] = {0, 0, 0, 0, 0, 0};
@@ -99,7 +110,7 @@ int sr_imu_measure(const sr_model *model, const sr_real x[SR_NX], const sr_real 
     status = check_imu(model, x, nu_dot, SR_NV, body, mount, &bias);
     if (status != SR_OK) return status;
     sensor_constants(model, sc);
-    return imu_kernel_of(body)(sc, x, nu_dot, mount, bias, y);
+    return imu_kernel(body, sc, x, nu_dot, mount, bias, y);
 }
 
 int sr_imu_measure_u(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int body,
@@ -112,7 +123,7 @@ int sr_imu_measure_u(const sr_model *model, const sr_real x[SR_NX], const sr_rea
     if (status == SR_OK) status = sr_accel(model, x, u, a);
     if (status != SR_OK) return status;
     sensor_constants(model, sc);
-    return imu_kernel_of(body)(sc, x, a, mount, bias, y);
+    return imu_kernel(body, sc, x, a, mount, bias, y);
 }
 
 int sr_imu_partials(const sr_model *model, const sr_real x[SR_NX], const sr_real nu_dot[SR_NV], int body,
@@ -125,7 +136,7 @@ int sr_imu_partials(const sr_model *model, const sr_real x[SR_NX], const sr_real
     status = check_imu(model, x, nu_dot, SR_NV, body, mount, &bias);
     if (status != SR_OK) return status;
     sensor_constants(model, sc);
-    return imu_jacobian_kernel_of(body)(sc, x, nu_dot, mount, bias, y, H, Hn);
+    return imu_jacobian_kernel(body, sc, x, nu_dot, mount, bias, y, H, Hn);
 }
 
 int sr_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int body,
@@ -141,7 +152,7 @@ int sr_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real
     if (status != SR_OK) return status;
     if (!all_finite(a, SR_NV) || !all_finite(Ja, SR_NV * SR_NE)) return SR_ERR_NONFINITE;
     sensor_constants(model, sc);
-    status = imu_jacobian_kernel_of(body)(sc, x, a, mount, bias, yy, HH, Hn);
+    status = imu_jacobian_kernel(body, sc, x, a, mount, bias, yy, HH, Hn);
     if (status != SR_OK) return status;
     /* Only the accelerometer reads nu_dot (the gyroscope's rows of Hn are zero by derivation). */
     for (i = SR_IMU_accel; i < SR_IMU_accel + 3; ++i)
@@ -201,7 +212,7 @@ static int heading_vector(const sr_model *model, const sr_real x[SR_NX], int bod
                           sr_real h[2])
 {
     int status = check_inputs(model, x, 1, body, mount);
-    if (status == SR_OK) status = heading_kernel_of(body)(x, mount, h);
+    if (status == SR_OK) status = heading_kernel(body, x, mount, h);
     if (status != SR_OK) return status;
     if (h[0] * h[0] + h[1] * h[1] < SR_HEADING_MIN_HORIZONTAL * SR_HEADING_MIN_HORIZONTAL) return SR_ERR_SINGULAR;
     return SR_OK;
@@ -222,7 +233,7 @@ int sr_heading_jacobian(const sr_model *model, const sr_real x[SR_NX], int body,
 {
     sr_real h[2], HH[SR_NEB];
     int status = heading && H ? heading_vector(model, x, body, mount, h) : SR_ERR_NULL;
-    if (status == SR_OK) status = heading_jacobian_kernel_of(body)(x, mount, h, HH);
+    if (status == SR_OK) status = heading_jacobian_kernel(body, x, mount, h, HH);
     if (status != SR_OK) return status;
     *heading = SR_ATAN2(h[1], h[0]);
     memcpy(H, HH, sizeof HH);
