@@ -13,7 +13,9 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 SOURCES = sorted(str(p.relative_to(ROOT)) for d in ("generated", "c/src") for p in (ROOT / d).glob("*.c"))
 INCLUDE_DIRS = ["generated", "c/include"]
 
-HEADER = ROOT / "c" / "include" / "spherical_robot.h"
+#: The public headers of c/include/ whose declarations the module exposes, in include order.
+HEADERS = ("spherical_robot.h", "sr_sensors.h")
+INCLUDES = "".join(f'#include "{name}"\n' for name in HEADERS)
 
 
 def compiler():
@@ -22,10 +24,10 @@ def compiler():
 
 
 def preprocessed_header():
-    """(file, line) pairs of the double build of c/include/spherical_robot.h after the C preprocessor,
-    the #define lines kept in place (-dD); file is the header each line comes from."""
+    """(file, line) pairs of the double build of the public headers (HEADERS) after the C
+    preprocessor, the #define lines kept in place (-dD); file is the header each line comes from."""
     out = subprocess.run([*compiler(), "-E", "-dD", "-std=c99", f"-I{ROOT / 'c' / 'include'}", f"-I{ROOT / 'generated'}",
-                          "-x", "c", str(HEADER)], check=True, capture_output=True, text=True).stdout
+                          "-x", "c", "-"], input=INCLUDES, check=True, capture_output=True, text=True).stdout
     current, lines = None, []
     for line in out.splitlines():
         marker = re.match(r'# \d+ "([^"]+)"', line)
@@ -112,7 +114,7 @@ ffibuilder = cffi.FFI()
 ffibuilder.cdef(CDEF + PY_ENTRIES_CDEF)
 ffibuilder.set_source(
     "bindings._sr",
-    '#include "spherical_robot.h"\n' + PY_ENTRIES_SOURCE,
+    INCLUDES + PY_ENTRIES_SOURCE,
     sources=SOURCES,
     include_dirs=INCLUDE_DIRS,
     # No FMA contraction: the firmware example (c/examples) must reproduce the Python runs bit for bit.

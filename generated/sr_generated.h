@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 957fd9ca5d555706], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 1779b65d0aa490a1], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/include/spherical_robot.h.
@@ -22,6 +22,11 @@
 #define SR_GEN_NU 2
 #define SR_GEN_NV 5
 #define SR_GEN_NE 12
+#define SR_GEN_NSC 3
+#define SR_GEN_NMOUNT 12
+#define SR_GEN_NBIAS 6
+#define SR_GEN_NIMU 6
+#define SR_GEN_NEB 18
 
 /* Layout of x[SR_GEN_NX]: offset of each block (matrices row-major; nu = (w_S, w_Y, w_P) starts at SR_X_w_S). */
 #define SR_X_R_S 0
@@ -86,6 +91,31 @@
 #define SR_PAPER_m_P 9
 #define SR_PAPER_k_P 10
 #define SR_PAPER_g 11
+/* The bodies a sensor is mounted on (derive/sensors.py). */
+#define SR_BODY_shell 0
+#define SR_BODY_yoke 1
+#define SR_BODY_pendulum 2
+/* Layout of sc[SR_GEN_NSC], the sensor kernels' constants (sr_gen_sensor_constants). */
+#define SR_SC_r 0
+#define SR_SC_g_x 1
+#define SR_SC_g_z 2
+/* Layout of the sensor mount mount[SR_GEN_NMOUNT]: lever arm in the body's frame, mounting rotation R_m (sensor axes in the body's frame, row-major). */
+#define SR_MOUNT_lever 0
+#define SR_MOUNT_R_m 3
+/* Layout of the IMU's biases bias[SR_GEN_NBIAS], sensor frame. */
+#define SR_BIAS_b_g 0
+#define SR_BIAS_b_a 3
+/* Layout of an IMU reading y[SR_GEN_NIMU], sensor frame. */
+#define SR_IMU_gyro 0
+#define SR_IMU_accel 3
+/* Layout of the estimator's error state [d | b_g | b_a] (SR_GEN_NEB), the columns of the sensor Jacobians. */
+#define SR_EB_xi_S 0
+#define SR_EB_th_Y 3
+#define SR_EB_th_P 4
+#define SR_EB_q 5
+#define SR_EB_nu 7
+#define SR_EB_b_g 12
+#define SR_EB_b_a 15
 
 /* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
 #define SR_GEN_CONSTANTS_FLOPS 43
@@ -103,6 +133,21 @@
 #define SR_GEN_GENERAL_ENERGY_FLOPS 336
 #define SR_GEN_GENERAL_EQUILIBRIUM_RESIDUAL_FLOPS 126
 #define SR_GEN_GENERAL_ACCEL_JACOBIAN_TERMS_FLOPS 4398
+#define SR_GEN_SENSOR_CONSTANTS_FLOPS 4
+#define SR_GEN_IMU_SHELL_FLOPS 95
+#define SR_GEN_IMU_SHELL_JACOBIAN_FLOPS 440
+#define SR_GEN_HEADING_SHELL_FLOPS 11
+#define SR_GEN_HEADING_SHELL_JACOBIAN_FLOPS 63
+#define SR_GEN_IMU_YOKE_FLOPS 124
+#define SR_GEN_IMU_YOKE_JACOBIAN_FLOPS 726
+#define SR_GEN_HEADING_YOKE_FLOPS 17
+#define SR_GEN_HEADING_YOKE_JACOBIAN_FLOPS 91
+#define SR_GEN_IMU_PENDULUM_FLOPS 161
+#define SR_GEN_IMU_PENDULUM_JACOBIAN_FLOPS 1184
+#define SR_GEN_HEADING_PENDULUM_FLOPS 23
+#define SR_GEN_HEADING_PENDULUM_JACOBIAN_FLOPS 127
+#define SR_GEN_ENCODERS_JACOBIAN_FLOPS 0
+#define SR_GEN_POSITION_JACOBIAN_FLOPS 0
 
 /* The float build's symbols carry _f, so a float/double mismatch fails at link time. */
 #ifdef SR_USE_FLOAT
@@ -121,6 +166,21 @@
 #define sr_gen_general_energy sr_gen_general_energy_f
 #define sr_gen_general_equilibrium_residual sr_gen_general_equilibrium_residual_f
 #define sr_gen_general_accel_jacobian_terms sr_gen_general_accel_jacobian_terms_f
+#define sr_gen_sensor_constants sr_gen_sensor_constants_f
+#define sr_gen_imu_shell sr_gen_imu_shell_f
+#define sr_gen_imu_shell_jacobian sr_gen_imu_shell_jacobian_f
+#define sr_gen_heading_shell sr_gen_heading_shell_f
+#define sr_gen_heading_shell_jacobian sr_gen_heading_shell_jacobian_f
+#define sr_gen_imu_yoke sr_gen_imu_yoke_f
+#define sr_gen_imu_yoke_jacobian sr_gen_imu_yoke_jacobian_f
+#define sr_gen_heading_yoke sr_gen_heading_yoke_f
+#define sr_gen_heading_yoke_jacobian sr_gen_heading_yoke_jacobian_f
+#define sr_gen_imu_pendulum sr_gen_imu_pendulum_f
+#define sr_gen_imu_pendulum_jacobian sr_gen_imu_pendulum_jacobian_f
+#define sr_gen_heading_pendulum sr_gen_heading_pendulum_f
+#define sr_gen_heading_pendulum_jacobian sr_gen_heading_pendulum_jacobian_f
+#define sr_gen_encoders_jacobian sr_gen_encoders_jacobian_f
+#define sr_gen_position_jacobian sr_gen_position_jacobian_f
 #define sr_gen_accel_lanes sr_gen_accel_lanes_f
 #endif
 
@@ -252,6 +312,36 @@ int sr_gen_general_energy(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real
 int sr_gen_general_equilibrium_residual(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], sr_real res[5]);
 /* M (upper triangle, row by row), f, ∂f/∂d (5 x SR_GEN_NE, row-major, error coordinates of SR_E_*), ∂f/∂u (5 x 2) and ∂M/∂d along δξ_S, δθ_Y, δθ_P (5 upper triangles) for the accel Jacobian ∂ν̇ = M⁻¹(∂f − (∂M) ν̇). */
 int sr_gen_general_accel_jacobian_terms(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real M[15], sr_real f[5], sr_real df[60], sr_real dfdu[10], sr_real dM[75]);
+/* The sensor kernels' constants sc = (r, g sin(slope), g cos(slope)) (SR_SC_*) from the parameters (derive.sensors.constant_expressions). */
+int sr_gen_sensor_constants(const sr_real p[SR_GEN_NPARAM], sr_real sc[SR_GEN_NSC]);
+/* IMU on the shell: y = (gyroscope R_m^T w_B + b_g, accelerometer R_m^T R_B^T (p'' - g) + b_a) in the sensor frame (SR_IMU_*), at the mount's lever arm, given nu_dot (derive.sensors.imu). */
+int sr_gen_imu_shell(const sr_real sc[SR_GEN_NSC], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6]);
+/* IMU on the shell: y, dy/d(d, b) with nu_dot held (SR_GEN_NIMU x SR_GEN_NEB, row-major, columns SR_EB_*) and dy/d(nu_dot) (SR_GEN_NIMU x SR_GEN_NV), so that dy/dd = H + Hn Ja (derive.sensors.imu_jacobians). */
+int sr_gen_imu_shell_jacobian(const sr_real sc[SR_GEN_NSC], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6], sr_real H[108], sr_real Hn[30]);
+/* Heading sensor on the shell: h = (h_x, h_y), the sensor's x axis R_B R_m e_x on the floor's axes; the heading is atan2(h_y, h_x) (derive.sensors.heading_vector). */
+int sr_gen_heading_shell(const sr_real x[SR_GEN_NX], const sr_real mount[SR_GEN_NMOUNT], sr_real h[2]);
+/* Heading sensor on the shell: h as sr_gen_heading_shell and the heading's d(atan2(h_y, h_x))/d(d, b) (1 x SR_GEN_NEB; not finite where h = 0) (derive.sensors.heading_jacobian). */
+int sr_gen_heading_shell_jacobian(const sr_real x[SR_GEN_NX], const sr_real mount[SR_GEN_NMOUNT], sr_real h[2], sr_real H[18]);
+/* IMU on the yoke: y = (gyroscope R_m^T w_B + b_g, accelerometer R_m^T R_B^T (p'' - g) + b_a) in the sensor frame (SR_IMU_*), at the mount's lever arm, given nu_dot (derive.sensors.imu). */
+int sr_gen_imu_yoke(const sr_real sc[SR_GEN_NSC], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6]);
+/* IMU on the yoke: y, dy/d(d, b) with nu_dot held (SR_GEN_NIMU x SR_GEN_NEB, row-major, columns SR_EB_*) and dy/d(nu_dot) (SR_GEN_NIMU x SR_GEN_NV), so that dy/dd = H + Hn Ja (derive.sensors.imu_jacobians). */
+int sr_gen_imu_yoke_jacobian(const sr_real sc[SR_GEN_NSC], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6], sr_real H[108], sr_real Hn[30]);
+/* Heading sensor on the yoke: h = (h_x, h_y), the sensor's x axis R_B R_m e_x on the floor's axes; the heading is atan2(h_y, h_x) (derive.sensors.heading_vector). */
+int sr_gen_heading_yoke(const sr_real x[SR_GEN_NX], const sr_real mount[SR_GEN_NMOUNT], sr_real h[2]);
+/* Heading sensor on the yoke: h as sr_gen_heading_yoke and the heading's d(atan2(h_y, h_x))/d(d, b) (1 x SR_GEN_NEB; not finite where h = 0) (derive.sensors.heading_jacobian). */
+int sr_gen_heading_yoke_jacobian(const sr_real x[SR_GEN_NX], const sr_real mount[SR_GEN_NMOUNT], sr_real h[2], sr_real H[18]);
+/* IMU on the pendulum: y = (gyroscope R_m^T w_B + b_g, accelerometer R_m^T R_B^T (p'' - g) + b_a) in the sensor frame (SR_IMU_*), at the mount's lever arm, given nu_dot (derive.sensors.imu). */
+int sr_gen_imu_pendulum(const sr_real sc[SR_GEN_NSC], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6]);
+/* IMU on the pendulum: y, dy/d(d, b) with nu_dot held (SR_GEN_NIMU x SR_GEN_NEB, row-major, columns SR_EB_*) and dy/d(nu_dot) (SR_GEN_NIMU x SR_GEN_NV), so that dy/dd = H + Hn Ja (derive.sensors.imu_jacobians). */
+int sr_gen_imu_pendulum_jacobian(const sr_real sc[SR_GEN_NSC], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], const sr_real mount[SR_GEN_NMOUNT], const sr_real bias[SR_GEN_NBIAS], sr_real y[6], sr_real H[108], sr_real Hn[30]);
+/* Heading sensor on the pendulum: h = (h_x, h_y), the sensor's x axis R_B R_m e_x on the floor's axes; the heading is atan2(h_y, h_x) (derive.sensors.heading_vector). */
+int sr_gen_heading_pendulum(const sr_real x[SR_GEN_NX], const sr_real mount[SR_GEN_NMOUNT], sr_real h[2]);
+/* Heading sensor on the pendulum: h as sr_gen_heading_pendulum and the heading's d(atan2(h_y, h_x))/d(d, b) (1 x SR_GEN_NEB; not finite where h = 0) (derive.sensors.heading_jacobian). */
+int sr_gen_heading_pendulum_jacobian(const sr_real x[SR_GEN_NX], const sr_real mount[SR_GEN_NMOUNT], sr_real h[2], sr_real H[18]);
+/* Joint encoders (theta_Y, theta_P): d/d(d, b), 2 x SR_GEN_NEB row-major (derive.sensors.encoders_jacobian). */
+int sr_gen_encoders_jacobian(sr_real H[36]);
+/* Position fix (q_x, q_y): d/d(d, b), 2 x SR_GEN_NEB row-major (derive.sensors.position_jacobian). */
+int sr_gen_position_jacobian(sr_real H[36]);
 /* sr_gen_accel on n states, for the batch calls: one loop without branches that the compiler vectorises across states (the same expressions, so each lane's result is the scalar kernel's, bit for bit); every output is written, and ok[i] is cleared where the scalar kernel would fail (or its outputs' sum overflows: decide such a state by the scalar kernel). GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic), for AVX2 too (SR_LANES_CLONES). */
 void sr_gen_accel_lanes(const sr_real c[SR_GEN_NCONST], long n, const sr_real *restrict x, long x_stride, const sr_real *restrict u, long u_stride, sr_real *restrict a, long a_stride, sr_real *restrict ok);
 

@@ -135,10 +135,11 @@ def test_library_has_no_mutable_globals(build, lib):
             assert int(parts[1]) == 0, f"{lib}: {line.strip()}"
 
 
-def test_every_public_function_returns_a_status_code():
-    text = re.sub(r"/\*.*?\*/", "", (INCLUDE / "spherical_robot.h").read_text(), flags=re.S)
+@pytest.mark.parametrize("header, at_least", [("spherical_robot.h", 12), ("sr_sensors.h", 11)])
+def test_every_public_function_returns_a_status_code(header, at_least):
+    text = re.sub(r"/\*.*?\*/", "", (INCLUDE / header).read_text(), flags=re.S)
     prototypes = re.findall(r"^([A-Za-z_][\w \t\*]*?)\b(sr_\w+)\s*\(", text, flags=re.M)
-    assert len(prototypes) >= 12
+    assert len(prototypes) >= at_least
     for ret, name in prototypes:
         expected = "const char *" if name.endswith("_string") else "int"
         assert ret.strip() == expected.strip(), f"{name} returns {ret.strip()!r}"
@@ -285,7 +286,8 @@ def test_size_report_covers_every_public_function(tmp_path):
            check=False, cwd=tmp_path).returncode != 0:
         pytest.skip("the C compiler has no -fcallgraph-info (GCC >= 10 needed)")
     out = run([sys.executable, str(ROOT / "tools" / "size_report.py"), "--cc", CC]).stdout
-    header = re.sub(r"/\*.*?\*/", "", (INCLUDE / "spherical_robot.h").read_text(), flags=re.S)
+    header = "".join(re.sub(r"/\*.*?\*/", "", (INCLUDE / h).read_text(), flags=re.S)
+                     for h in ("spherical_robot.h", "sr_sensors.h"))
     for name in re.findall(r"^[A-Za-z_][\w \t\*]*?\b(sr_\w+)\s*\(", header, flags=re.M):
         assert out.count(f"| `{name}` |") == 2, name  # one row per scalar type
 
@@ -336,6 +338,38 @@ def test_a_paper_only_build_refuses_other_robots_and_links_no_general_kernel(tmp
         assert out == ["0", str(run_status("SR_ERR_PARAM"))] and not general
     else:
         assert out == ["0", "0"] and "sr_gen_general_system" in general
+
+
+SENSORS_PROBE = """#include "sr_sensors.h"
+#include <stdio.h>
+int main(void) {
+    const sr_real paper[SR_NPAPER] = {0.3, 2, 0.16, 0.2, 0.5, 2, 5, 0.04, 0.2, 1, 0.1, 9.81};
+    const sr_real mount[SR_NMOUNT] = {0, 0, -0.05, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    sr_real p[SR_NPARAM], x[SR_NX] = {0}, y[SR_NIMU];
+    sr_model m;
+    if (sr_paper_params(paper, p) != SR_OK || sr_model_init(&m, p) != SR_OK) return 2;
+    x[SR_X_R_S] = x[SR_X_R_S + 4] = x[SR_X_R_S + 8] = 1;
+    x[SR_X_R_Y] = x[SR_X_R_Y + 4] = x[SR_X_R_Y + 8] = 1;
+    x[SR_X_R_P] = x[SR_X_R_P + 4] = x[SR_X_R_P + 8] = 1;
+    x[SR_X_q + 2] = p[SR_P_r];
+    if (sr_imu_measure_u(&m, x, NULL, SR_BODY_yoke, mount, NULL, y) != SR_OK) return 3;
+    printf("%.6f %.6f %.6f\\n", (double)y[SR_IMU_accel], (double)y[SR_IMU_accel + 1], (double)y[SR_IMU_accel + 2]);
+    return 0;
+}
+"""
+
+
+@pytest.mark.parametrize("paper_only", [True, False], ids=["paper-only", "full"])
+def test_the_sensors_of_a_paper_only_build_read_g_upwards_at_rest(tmp_path, paper_only):
+    """The sensor kernels take their constants from the parameters, not from the general kernels'
+    constants that a paper-only model leaves at zero."""
+    probe = tmp_path / "probe.c"
+    probe.write_text(SENSORS_PROBE)
+    sources = [str(p) for p in sorted((C_DIR / "src").glob("sr_*.c"))] + [str(ROOT / "generated" / "sr_generated.c")]
+    flags = ["-DSR_PAPER_ONLY"] if paper_only else []
+    run([CC, "-std=c99", "-O1", "-Wall", "-Wextra", "-Wpedantic", "-Werror", *flags,
+         f"-I{INCLUDE}", f"-I{ROOT / 'generated'}", str(probe), *sources, "-lm", "-o", str(tmp_path / "probe")])
+    assert run([tmp_path / "probe"]).stdout.split() == ["0.000000", "0.000000", "9.810000"]
 
 
 def run_status(name):

@@ -41,15 +41,15 @@ import tempfile
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 C_DIR = ROOT / "c"
 INCLUDE = C_DIR / "include"
-HEADER = INCLUDE / "spherical_robot.h"
+HEADERS = (INCLUDE / "spherical_robot.h", INCLUDE / "sr_sensors.h")
 BEGIN, END = "<!-- size-report:begin -->", "<!-- size-report:end -->"
 
 Node = collections.namedtuple("Node", "title symbol obj frame qualifier")
 
 
 def public_functions():
-    """Names of the functions declared in spherical_robot.h, in order."""
-    text = re.sub(r"/\*.*?\*/", "", HEADER.read_text(), flags=re.S)
+    """Names of the functions declared in the public headers (HEADERS), in order."""
+    text = "".join(re.sub(r"/\*.*?\*/", "", header.read_text(), flags=re.S) for header in HEADERS)
     return re.findall(r"^[A-Za-z_][\w \t\*]*?\b(sr_\w+)\s*\(", text, flags=re.M)
 
 

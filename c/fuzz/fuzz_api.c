@@ -3,7 +3,8 @@
  *
  * LLVMFuzzerTestOneInput turns the input bytes into parameters, a state, torques, a time
  * step, a method and small step counts, calls every function of spherical_robot.h (the
- * controller's sr_lqr_* with a fuzzed gain schedule, target and memory) and checks their
+ * controller's sr_lqr_* with a fuzzed gain schedule, target and memory) and of sr_sensors.h
+ * (a fuzzed body, mount, nu_dot and biases) and checks their
  * contract (abort() on a violation, so libFuzzer and the plain driver both report it with the
  * input that caused it):
  *
@@ -22,6 +23,7 @@
  *   make fuzz-libfuzzer  clang -fsanitize=fuzzer,address,undefined
  */
 #include "spherical_robot.h"
+#include "sr_sensors.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -297,8 +299,10 @@ static void fuzz_model_validity(reader *r, const sr_model *valid, const sr_real 
                                 sr_real dt, int method)
 {
     static sr_model m;
-    static guarded g, g2;
+    static guarded g, g2, g3;
     static sr_lqr lqr;
+    static const sr_real mount[SR_NMOUNT] = {0, 0, SR_C(-0.05), 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const sr_real mount_nu_dot[SR_NV] = {SR_C(0.1), SR_C(-0.2), SR_C(0.3), SR_C(0.4), SR_C(-0.5)};
     static const sr_lqr_target target = {SR_C(0.3), SR_C(0.5), SR_C(0.2), SR_C(0.05), 1};
     static const sr_real d[SR_NE];
     sr_real x2[2 * SR_NX];
@@ -394,9 +398,100 @@ static void fuzz_model_validity(reader *r, const sr_model *valid, const sr_real 
     expect_model_verdict("sr_lqr_error (model)", status, changed, &g, SR_LQR_NZ);
     status = sr_lqr_control(&lqr, &m, x, &target, &memory, arm(&g, SR_NU), NULL);
     expect_model_verdict("sr_lqr_control (model)", status, changed, &g, SR_NU);
+
+    /* the sensors (sr_sensors.h), on a valid mount: a lever arm along the body's -z, its axes */
+    status = sr_imu_measure(&m, x, mount_nu_dot, SR_BODY_yoke, mount, NULL, arm(&g, SR_NIMU));
+    expect_model_verdict("sr_imu_measure (model)", status, changed, &g, SR_NIMU);
+    status = sr_imu_measure_u(&m, x, u, SR_BODY_pendulum, mount, NULL, arm(&g, SR_NIMU));
+    expect_model_verdict("sr_imu_measure_u (model)", status, changed, &g, SR_NIMU);
+    status = sr_imu_partials(&m, x, mount_nu_dot, SR_BODY_shell, mount, NULL, arm(&g3, SR_NIMU),
+                             arm(&g, SR_NIMU * SR_NEB), arm(&g2, SR_NIMU * SR_NV));
+    expect_model_verdict("sr_imu_partials (model)", status, changed, &g, SR_NIMU * SR_NEB);
+    status = sr_imu_jacobian(&m, x, u, SR_BODY_yoke, mount, NULL, arm(&g3, SR_NIMU), arm(&g, SR_NIMU * SR_NEB));
+    expect_model_verdict("sr_imu_jacobian (model)", status, changed, &g, SR_NIMU * SR_NEB);
+    status = sr_encoders_measure(&m, x, arm(&g, 2));
+    expect_model_verdict("sr_encoders_measure (model)", status, changed, &g, 2);
+    status = sr_encoders_jacobian(&m, x, arm(&g3, 2), arm(&g, 2 * SR_NEB));
+    expect_model_verdict("sr_encoders_jacobian (model)", status, changed, &g, 2 * SR_NEB);
+    status = sr_position_measure(&m, x, arm(&g, 2));
+    expect_model_verdict("sr_position_measure (model)", status, changed, &g, 2);
+    status = sr_position_jacobian(&m, x, arm(&g3, 2), arm(&g, 2 * SR_NEB));
+    expect_model_verdict("sr_position_jacobian (model)", status, changed, &g, 2 * SR_NEB);
+    status = sr_heading_measure(&m, x, SR_BODY_yoke, mount, arm(&g, 1));
+    expect_model_verdict("sr_heading_measure (model)", status, changed, &g, 1);
+    status = sr_heading_jacobian(&m, x, SR_BODY_yoke, mount, arm(&g3, 1), arm(&g, SR_NEB));
+    expect_model_verdict("sr_heading_jacobian (model)", status, changed, &g, SR_NEB);
 }
 
 /* ---- the target ------------------------------------------------------------------------------ */
+/* ---- the sensors (sr_sensors.h): a body code (sometimes out of range), a mount whose rotation is
+ * a valid one unless a pick perturbs it, nu_dot and biases (or NULL biases).  Contract: documented
+ * status; outputs finite on SR_OK and untouched otherwise. */
+static void fuzz_sensors(reader *r, const sr_model *model, const sr_real x[SR_NX], const sr_real *u)
+{
+    static guarded g, g2, g3;
+    sr_real mount[SR_NMOUNT], nu_dot[SR_NV], bias[SR_NBIAS], R[9], S[9];
+    const sr_real *bias_or_null;
+    int i, status;
+    const unsigned b = read_u8(r);
+    const int body = b % 16 == 15 ? (int)(b / 16) - 8 : (int)(b % SR_NBODY);
+    for (i = 0; i < 3; ++i) mount[SR_MOUNT_lever + i] = pick(r, 0.1 * unit(r));
+    rot_axis(0, 3.2 * unit(r), R);
+    rot_axis(2, 3.2 * unit(r), S);
+    for (i = 0; i < 9; ++i) {
+        const int row = i / 3, col = i % 3;
+        const double v = (double)(R[3 * row] * S[col] + R[3 * row + 1] * S[3 + col] + R[3 * row + 2] * S[6 + col]);
+        mount[SR_MOUNT_R_m + i] = pick(r, v);
+    }
+    for (i = 0; i < SR_NV; ++i) nu_dot[i] = pick(r, 20.0 * unit(r));
+    for (i = 0; i < SR_NBIAS; ++i) bias[i] = pick(r, 0.1 * unit(r));
+    bias_or_null = read_u8(r) % 4 == 3 ? NULL : bias;
+
+    status = sr_check_mount(body, mount);
+    EXPECT_STATUS("sr_check_mount", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION);
+    status = sr_imu_measure(model, x, nu_dot, body, mount, bias_or_null, arm(&g, SR_NIMU));
+    EXPECT_STATUS("sr_imu_measure", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT, SR_ERR_ARG);
+    expect("sr_imu_measure", status, &g, status == SR_OK ? SR_NIMU : 0, 1);
+    status = sr_imu_measure_u(model, x, u, body, mount, bias_or_null, arm(&g, SR_NIMU));
+    EXPECT_STATUS("sr_imu_measure_u", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT,
+                  SR_ERR_ARG, SR_ERR_SINGULAR);
+    expect("sr_imu_measure_u", status, &g, status == SR_OK ? SR_NIMU : 0, 1);
+    status = sr_imu_partials(model, x, nu_dot, body, mount, bias_or_null, arm(&g, SR_NIMU), arm(&g2, SR_NIMU * SR_NEB),
+                             arm(&g3, SR_NIMU * SR_NV));
+    EXPECT_STATUS("sr_imu_partials", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT, SR_ERR_ARG);
+    expect("sr_imu_partials", status, &g, status == SR_OK ? SR_NIMU : 0, 1);
+    expect("sr_imu_partials", status, &g2, status == SR_OK ? SR_NIMU * SR_NEB : 0, 1);
+    expect("sr_imu_partials", status, &g3, status == SR_OK ? SR_NIMU * SR_NV : 0, 1);
+    status = sr_imu_jacobian(model, x, u, body, mount, bias_or_null, arm(&g, SR_NIMU), arm(&g2, SR_NIMU * SR_NEB));
+    EXPECT_STATUS("sr_imu_jacobian", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT,
+                  SR_ERR_ARG, SR_ERR_SINGULAR);
+    expect("sr_imu_jacobian", status, &g, status == SR_OK ? SR_NIMU : 0, 1);
+    expect("sr_imu_jacobian", status, &g2, status == SR_OK ? SR_NIMU * SR_NEB : 0, 1);
+    status = sr_heading_measure(model, x, body, mount, arm(&g, 1));
+    EXPECT_STATUS("sr_heading_measure", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT,
+                  SR_ERR_ARG, SR_ERR_SINGULAR);
+    expect("sr_heading_measure", status, &g, status == SR_OK ? 1 : 0, 1);
+    status = sr_heading_jacobian(model, x, body, mount, arm(&g, 1), arm(&g2, SR_NEB));
+    EXPECT_STATUS("sr_heading_jacobian", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT,
+                  SR_ERR_ARG, SR_ERR_SINGULAR);
+    expect("sr_heading_jacobian", status, &g, status == SR_OK ? 1 : 0, 1);
+    expect("sr_heading_jacobian", status, &g2, status == SR_OK ? SR_NEB : 0, 1);
+    status = sr_encoders_jacobian(model, x, arm(&g, 2), arm(&g2, 2 * SR_NEB));
+    EXPECT_STATUS("sr_encoders_jacobian", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+    expect("sr_encoders_jacobian", status, &g, status == SR_OK ? 2 : 0, 1);
+    expect("sr_encoders_jacobian", status, &g2, status == SR_OK ? 2 * SR_NEB : 0, 1);
+    status = sr_encoders_measure(model, x, arm(&g, 2));
+    EXPECT_STATUS("sr_encoders_measure", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+    expect("sr_encoders_measure", status, &g, status == SR_OK ? 2 : 0, 1);
+    status = sr_position_jacobian(model, x, arm(&g, 2), arm(&g2, 2 * SR_NEB));
+    EXPECT_STATUS("sr_position_jacobian", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+    expect("sr_position_jacobian", status, &g, status == SR_OK ? 2 : 0, 1);
+    expect("sr_position_jacobian", status, &g2, status == SR_OK ? 2 * SR_NEB : 0, 1);
+    status = sr_position_measure(model, x, arm(&g, 2));
+    EXPECT_STATUS("sr_position_measure", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+    expect("sr_position_measure", status, &g, status == SR_OK ? 2 : 0, 1);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -672,6 +767,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     /* The controller; read last, for the same reason. */
     fuzz_controller(&rd, &model, x);
+
+    /* The sensors; read last, for the same reason. */
+    fuzz_sensors(&rd, &model, x, u_or_null);
 
     /* NULL pointers */
     EXPECT_STATUS("sr_accel(NULL)", sr_accel(&model, x, u, NULL), SR_ERR_NULL);

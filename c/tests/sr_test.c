@@ -53,6 +53,7 @@ int main(void)
     suite_accel_batch();
     suite_step_batch();
     suite_model_validity();
+    suite_sensors();
     return sr_test_summary();
 }
 

@@ -75,6 +75,7 @@ void suite_trig(void);
 void suite_accel_batch(void);
 void suite_step_batch(void);
 void suite_model_validity(void);
+void suite_sensors(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 

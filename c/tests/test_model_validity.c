@@ -4,6 +4,7 @@
  * arguments of one kind get one check everywhere, before any early return (sr_argcheck.h).
  */
 #include "sr_test.h"
+#include "sr_sensors.h"
 
 #include <math.h>
 #include <string.h>
@@ -16,13 +17,20 @@ typedef struct model_fn {
 } model_fn;
 
 static sr_real X[2 * SR_NX], U[2 * SR_NU], OUT[4 * SR_NE * SR_NE], OUT2[4 * SR_NE * SR_NU];
+static sr_real MOUNT[SR_NMOUNT], NU_DOT[SR_NV];
 static long ROW;
 static sr_lqr LQR;
 
-/* A valid state (x, twice), torques and a one-point schedule with zero gains. */
+/* A valid state (x, twice), torques, a one-point schedule with zero gains, and a sensor mount
+ * (lever arm, axes of the body) with accelerations. */
 static void valid_arguments(double r)
 {
+    int i;
     make_state(X, 0.3, -0.4, r);
+    for (i = 0; i < SR_NMOUNT; ++i) MOUNT[i] = 0;
+    MOUNT[SR_MOUNT_lever + 2] = SR_C(-0.05);
+    MOUNT[SR_MOUNT_R_m + 0] = MOUNT[SR_MOUNT_R_m + 4] = MOUNT[SR_MOUNT_R_m + 8] = 1;
+    for (i = 0; i < SR_NV; ++i) NU_DOT[i] = SR_C(0.1) * (sr_real)(i + 1);
     X[SR_X_w_S] = SR_C(0.2);
     X[SR_X_w_Y] = SR_C(0.5);
     memcpy(X + SR_NX, X, sizeof(sr_real) * SR_NX);
@@ -86,6 +94,36 @@ static int c_lqr_control(const sr_model *m, long n)
     (void)n;
     return sr_lqr_control(&LQR, m, X, &TARGET, &memory, OUT, OUT2);
 }
+static int c_imu_measure(const sr_model *m, long n)
+{
+    (void)n;
+    return sr_imu_measure(m, X, NU_DOT, SR_BODY_yoke, MOUNT, NULL, OUT);
+}
+static int c_imu_measure_u(const sr_model *m, long n)
+{
+    (void)n;
+    return sr_imu_measure_u(m, X, U, SR_BODY_pendulum, MOUNT, NULL, OUT);
+}
+static int c_imu_partials(const sr_model *m, long n)
+{
+    (void)n;
+    return sr_imu_partials(m, X, NU_DOT, SR_BODY_shell, MOUNT, NULL, OUT, OUT + SR_NIMU, OUT2);
+}
+static int c_imu_jacobian(const sr_model *m, long n)
+{
+    (void)n;
+    return sr_imu_jacobian(m, X, U, SR_BODY_yoke, MOUNT, NULL, OUT, OUT + SR_NIMU);
+}
+static int c_encoders_measure(const sr_model *m, long n) { (void)n; return sr_encoders_measure(m, X, OUT); }
+static int c_encoders_jacobian(const sr_model *m, long n) { (void)n; return sr_encoders_jacobian(m, X, OUT, OUT + 2); }
+static int c_position_measure(const sr_model *m, long n) { (void)n; return sr_position_measure(m, X, OUT); }
+static int c_position_jacobian(const sr_model *m, long n) { (void)n; return sr_position_jacobian(m, X, OUT, OUT + 2); }
+static int c_heading_measure(const sr_model *m, long n) { (void)n; return sr_heading_measure(m, X, SR_BODY_yoke, MOUNT, OUT); }
+static int c_heading_jacobian(const sr_model *m, long n)
+{
+    (void)n;
+    return sr_heading_jacobian(m, X, SR_BODY_yoke, MOUNT, OUT, OUT + 1);
+}
 
 static const model_fn TAKES_MODEL[] = {
     {"sr_check_state", c_check_state},
@@ -119,6 +157,16 @@ static const model_fn TAKES_MODEL[] = {
     {"sr_step_jacobian_batch", c_step_jacobian_batch},
     {"sr_lqr_error", c_lqr_error},
     {"sr_lqr_control", c_lqr_control},
+    {"sr_imu_measure", c_imu_measure},
+    {"sr_imu_measure_u", c_imu_measure_u},
+    {"sr_imu_partials", c_imu_partials},
+    {"sr_imu_jacobian", c_imu_jacobian},
+    {"sr_encoders_measure", c_encoders_measure},
+    {"sr_encoders_jacobian", c_encoders_jacobian},
+    {"sr_position_measure", c_position_measure},
+    {"sr_position_jacobian", c_position_jacobian},
+    {"sr_heading_measure", c_heading_measure},
+    {"sr_heading_jacobian", c_heading_jacobian},
 };
 #define N_TAKES_MODEL ((int)(sizeof TAKES_MODEL / sizeof TAKES_MODEL[0]))
 
@@ -340,6 +388,31 @@ static void test_arguments_are_checked_before_the_state(void)
     CHECK_STATUS(sr_simulate(&m, SR_LIE_EULER, X, SR_C(0.01), 2, NULL, traj, NULL), SR_ERR_CONSTRAINT);
 }
 
+/* The sensors keep the same order: the model, then the pointers, then the body and the mount,
+ * then the state and the data beside it. */
+static void test_a_sensor_checks_model_pointers_body_and_mount_before_the_state(void)
+{
+    sr_model m, zeroed;
+    paper_simulation_model(&m);
+    memset(&zeroed, 0, sizeof zeroed);
+    valid_arguments((double)m.p[SR_P_r]);
+    CHECK_STATUS(sr_imu_measure(&zeroed, NULL, NULL, 7, NULL, NULL, NULL), SR_ERR_MODEL);
+    CHECK_STATUS(sr_heading_jacobian(&zeroed, X, -1, MOUNT, NULL, NULL), SR_ERR_MODEL);
+    CHECK_STATUS(sr_encoders_measure(&zeroed, X, NULL), SR_ERR_MODEL);
+    X[SR_X_q + 2] = SR_C(7.0); /* q_z != r */
+    CHECK_STATUS(sr_imu_measure(&m, X, NU_DOT, SR_BODY_yoke, MOUNT, NULL, OUT), SR_ERR_CONSTRAINT);
+    CHECK_STATUS(sr_imu_measure(&m, X, NU_DOT, SR_BODY_yoke, MOUNT, NULL, NULL), SR_ERR_NULL);
+    CHECK_STATUS(sr_imu_measure(&m, X, NU_DOT, SR_NBODY, MOUNT, NULL, OUT), SR_ERR_ARG);
+    CHECK_STATUS(sr_imu_jacobian(&m, X, U, -1, MOUNT, NULL, OUT, OUT + SR_NIMU), SR_ERR_ARG);
+    CHECK_STATUS(sr_heading_measure(&m, X, SR_NBODY, MOUNT, OUT), SR_ERR_ARG);
+    MOUNT[SR_MOUNT_R_m + 0] = SR_C(2.0); /* R_m not a rotation */
+    CHECK_STATUS(sr_imu_partials(&m, X, NU_DOT, SR_BODY_shell, MOUNT, NULL, OUT, OUT + SR_NIMU, OUT2),
+                 SR_ERR_NOT_ROTATION);
+    CHECK_STATUS(sr_heading_jacobian(&m, X, SR_BODY_yoke, MOUNT, OUT, OUT + 1), SR_ERR_NOT_ROTATION);
+    CHECK_STATUS(sr_encoders_measure(&m, X, OUT), SR_ERR_CONSTRAINT);
+    CHECK_STATUS(sr_position_jacobian(&m, X, OUT, NULL), SR_ERR_NULL);
+}
+
 void suite_model_validity(void)
 {
     RUN_TEST(test_a_model_from_sr_model_init_is_valid_everywhere);
@@ -352,4 +425,5 @@ void suite_model_validity(void)
     RUN_TEST(test_an_unknown_method_is_refused_even_without_rows);
     RUN_TEST(test_a_bad_dt_or_row_count_is_refused_before_any_row);
     RUN_TEST(test_arguments_are_checked_before_the_state);
+    RUN_TEST(test_a_sensor_checks_model_pointers_body_and_mount_before_the_state);
 }

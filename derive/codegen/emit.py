@@ -10,6 +10,7 @@ import pathlib
 import sympy as sp
 
 from .. import parameters as P
+from .. import sensors as SE
 from .. import state as S
 from .c_printer import Printer, Scheduler, count_flops, dependency_order
 from .. import robot as R
@@ -92,7 +93,7 @@ def signature(kernel):
     if kernel.solve:
         args.append("sr_real a[SR_GEN_NV]")
     else:
-        sizes = {"c": "SR_GEN_NCONST", "cg": "SR_GEN_GENERAL_NCONST", "p": "SR_GEN_NPARAM"}
+        sizes = {"c": "SR_GEN_NCONST", "cg": "SR_GEN_GENERAL_NCONST", "p": "SR_GEN_NPARAM", "sc": "SR_GEN_NSC"}
         args += [f"sr_real {o.name}[{sizes.get(o.name, len(o.exprs))}]" for o in kernel.outputs]
     return f"int {PREFIX}{kernel.name}({', '.join(args)})"
 
@@ -189,6 +190,18 @@ def layout_macros():
     lines += [f"#define SR_P_{s.name} {i}" for i, s in enumerate(P.PARAMETERS)]
     lines += ["/* Layout of pp[SR_GEN_NPAPER], the paper's parameters (Section 5.2, SI), for sr_gen_paper_params. */"]
     lines += [f"#define SR_PAPER_{s.name} {i}" for i, s in enumerate(P.PAPER_PARAMETERS)]
+    lines += ["/* The bodies a sensor is mounted on (derive/sensors.py). */"]
+    lines += [f"#define SR_BODY_{name} {i}" for i, name in enumerate(SE.BODIES)]
+    lines += ["/* Layout of sc[SR_GEN_NSC], the sensor kernels' constants (sr_gen_sensor_constants). */"]
+    lines += [f"#define SR_SC_{s.name} {i}" for i, s in enumerate(SE.CONSTANTS)]
+    blocks = (("MOUNT", SE.MOUNT_BLOCKS, SE.NMOUNT, "the sensor mount mount[SR_GEN_NMOUNT]: lever arm in the body's frame, mounting rotation R_m (sensor axes in the body's frame, row-major)"),
+              ("BIAS", SE.BIAS_BLOCKS, SE.NBIAS, "the IMU's biases bias[SR_GEN_NBIAS], sensor frame"),
+              ("IMU", SE.IMU_BLOCKS, SE.NIMU, "an IMU reading y[SR_GEN_NIMU], sensor frame"),
+              ("EB", SE.ESTIMATOR_BLOCKS, SE.NEB, "the estimator's error state [d | b_g | b_a] (SR_GEN_NEB), the columns of the sensor Jacobians"))
+    for prefix, table, size, what in blocks:
+        assert sum(n for _, _, n in table) == size
+        lines += [f"/* Layout of {what}. */"]
+        lines += [f"#define SR_{prefix}_{name} {offset}" for name, offset, _ in table]
     return "\n".join(lines)
 
 
@@ -222,6 +235,11 @@ def header_text(ks, flops, n_constants, n_general_constants):
 #define SR_GEN_NU {S.NU}
 #define SR_GEN_NV {S.NV}
 #define SR_GEN_NE {S.NE}
+#define SR_GEN_NSC {SE.NCONST}
+#define SR_GEN_NMOUNT {SE.NMOUNT}
+#define SR_GEN_NBIAS {SE.NBIAS}
+#define SR_GEN_NIMU {SE.NIMU}
+#define SR_GEN_NEB {SE.NEB}
 
 {layout_macros()}
 

@@ -15,6 +15,7 @@ from .. import dynamics as D
 from .. import newton_euler as NE
 from .. import parameters as P
 from .. import robot as R
+from .. import sensors as SE
 from .. import state as S
 from .. import yoke_frame as YF
 from .joint_first import joint_first_system
@@ -28,6 +29,10 @@ INPUT_DOCS = {
     "cg": ("const sr_real cg[SR_GEN_GENERAL_NCONST]", "constants from sr_gen_general_constants"),
     "x": ("const sr_real x[SR_GEN_NX]", "state [R_S | R_Y | R_P | q | w_S | w_Y | w_P]"),
     "u": ("const sr_real u[SR_GEN_NU]", "motor torques (yoke, pendulum) [N m]"),
+    "sc": ("const sr_real sc[SR_GEN_NSC]", "sensor constants from sr_gen_sensor_constants (SR_SC_*)"),
+    "nud": ("const sr_real nud[SR_GEN_NV]", "accelerations nu_dot = (dw_S, dw_Y, dw_P) [rad/s^2]"),
+    "mount": ("const sr_real mount[SR_GEN_NMOUNT]", "sensor mount: lever arm (body frame) [m], then R_m row-major (SR_MOUNT_*)"),
+    "bias": ("const sr_real bias[SR_GEN_NBIAS]", "IMU biases: gyroscope [rad/s], accelerometer [m/s^2] (SR_BIAS_*)"),
 }
 
 
@@ -39,8 +44,12 @@ def array_layouts(constants, general_constants):
         "p": {s: i for i, s in enumerate(P.PARAMETERS)},
         "c": {s: i for i, s in enumerate(constants)},
         "cg": {s: i for i, s in enumerate(general_constants)},
-        "x": S.STATE_LAYOUT,
+        "x": {**S.STATE_LAYOUT, **SE.STATE_LAYOUT},
         "u": S.INPUT_LAYOUT,
+        "sc": {s: i for i, s in enumerate(SE.CONSTANTS)},
+        "nud": {s: i for i, s in enumerate(SE.nu_dot)},
+        "mount": SE.MOUNT_LAYOUT,
+        "bias": SE.BIAS_LAYOUT,
     }
 
 
@@ -100,7 +109,7 @@ def kernels():
         Kernel("paper_params", "The paper's robot (Section 2.3) as a general one: p[SR_P_*] from the"
                " paper's twelve parameters (derive.parameters.from_paper).",
                ("pp",), (Output("p", tuple(P.from_paper()), "parameters of the general robot"),)),
-    ) + general_kernels()
+    ) + general_kernels() + sensor_kernels()
 
 
 UPPER = tuple((i, j) for i in range(S.NV) for j in range(i, S.NV))
@@ -176,3 +185,43 @@ def accel_jacobian_terms(robot, name, inputs):
          Output("df", tuple(J.rhs_jacobian(robot)), "df/dd, row-major 5 x SR_GEN_NE"),
          Output("dfdu", tuple(J.rhs_input_jacobian(robot)), "df/du, row-major 5 x 2"),
          Output("dM", tuple(m[i, j] for m in dM for i, j in upper), "dM/dd_k, k < 5, upper triangles")))
+
+
+def sensor_kernels():
+    """The sensor models of derive.sensors, per body (the mount's lever arm and rotation are run-time
+    inputs): the IMU's reading and its Jacobians, the heading vector and the heading's Jacobian, and
+    the constant Jacobians of the encoders and the position fix.  The biases, the rows of R_S and
+    the joint angles read by atan2 are checked and formed in c/src/sr_sensors.c."""
+    ks = [Kernel("sensor_constants", "The sensor kernels' constants sc = (r, g sin(slope), g cos(slope)) (SR_SC_*)"
+                 " from the parameters (derive.sensors.constant_expressions).",
+                 ("p",), (Output("sc", SE.constant_expressions(), "(r, g_x, g_z)"),))]
+    imu_inputs = ("sc", "x", "nud", "mount", "bias")
+    for body in SE.BODIES:
+        y = SE.imu(body)
+        H, Hn = SE.imu_jacobians(body)
+        ks.append(Kernel(
+            f"imu_{body}", f"IMU on the {body}: y = (gyroscope R_m^T w_B + b_g, accelerometer R_m^T R_B^T (p'' - g) + b_a)"
+            " in the sensor frame (SR_IMU_*), at the mount's lever arm, given nu_dot (derive.sensors.imu).",
+            imu_inputs, (Output("y", tuple(y), "y (SR_IMU_*)"),)))
+        ks.append(Kernel(
+            f"imu_{body}_jacobian", f"IMU on the {body}: y, dy/d(d, b) with nu_dot held (SR_GEN_NIMU x SR_GEN_NEB, row-major,"
+            " columns SR_EB_*) and dy/d(nu_dot) (SR_GEN_NIMU x SR_GEN_NV), so that dy/dd = H + Hn Ja (derive.sensors.imu_jacobians).",
+            imu_inputs, (Output("y", tuple(y), "y (SR_IMU_*)"),
+                         Output("H", tuple(H), "dy/d(d, b), nu_dot held, row-major 6 x SR_GEN_NEB"),
+                         Output("Hn", tuple(Hn), "dy/d(nu_dot), row-major 6 x SR_GEN_NV"))))
+        ks.append(Kernel(
+            f"heading_{body}", f"Heading sensor on the {body}: h = (h_x, h_y), the sensor's x axis R_B R_m e_x on the floor's"
+            " axes; the heading is atan2(h_y, h_x) (derive.sensors.heading_vector).",
+            ("x", "mount"), (Output("h", tuple(SE.heading_vector(body)), "(h_x, h_y)"),)))
+        ks.append(Kernel(
+            f"heading_{body}_jacobian", f"Heading sensor on the {body}: h as sr_gen_heading_{body} and the heading's"
+            " d(atan2(h_y, h_x))/d(d, b) (1 x SR_GEN_NEB; not finite where h = 0) (derive.sensors.heading_jacobian).",
+            ("x", "mount"), (Output("h", tuple(SE.heading_vector(body)), "(h_x, h_y)"),
+                             Output("H", tuple(SE.heading_jacobian(body)), "d heading/d(d, b)"))))
+    ks.append(Kernel("encoders_jacobian", "Joint encoders (theta_Y, theta_P): d/d(d, b), 2 x SR_GEN_NEB row-major"
+                     " (derive.sensors.encoders_jacobian).",
+                     (), (Output("H", tuple(SE.encoders_jacobian()), "d(theta_Y, theta_P)/d(d, b)"),), finite_or_untouched=False))
+    ks.append(Kernel("position_jacobian", "Position fix (q_x, q_y): d/d(d, b), 2 x SR_GEN_NEB row-major"
+                     " (derive.sensors.position_jacobian).",
+                     (), (Output("H", tuple(SE.position_jacobian()), "d(q_x, q_y)/d(d, b)"),), finite_or_untouched=False))
+    return tuple(ks)

@@ -18,6 +18,9 @@ Checks
                 central differences through retract (runtime.verification.jacobians); step_jacobian
                 of each method against Richardson differences of the C step through retract/local,
                 and its derivative in dt at 0 against linearize
+  sensors       the IMU, encoders, position fix and heading (c/include/sr_sensors.h) and their Jacobians against
+                the independent CasADi reference (runtime.verification.sensor_reference) and Richardson
+                differences of the C readings through retract (runtime.verification.sensor_checks)
   linearizations eigenvalues at rest against the reference's AD Jacobian, steady rolling against
                 power balance and statics, the Floquet exponent of rolling against a perturbed
                 simulation (runtime.verification.linearizations)
@@ -325,6 +328,31 @@ def jacobian_rows(n_states=1000, seed=5):
                for row in variational_checks(seed=seed + 4)])
 
 
+#: What each sensor row would show (tests/runtime/verification/test_sensor_checks.py fails each).
+SENSOR_CATCHES = ("a lever arm off by 1e-6 m; the slope left out", "a heading off by 1e-9 rad",
+                  "an encoder angle off by 1e-9 rad", "a Jacobian entry off by 1e-7 (also along nu_dot)",
+                  "a Jacobian entry off by 1e-7", "a Jacobian entry off by 1e-7",
+                  "nu_dot held where it moves with the state; an entry off by 1e-7",
+                  "an entry along nu_dot off by 1e-7", "a Jacobian entry off by 1e-7", "a lever arm off by 1e-6 m")
+
+
+def sensor_rows(n_states=1000, seed=0):
+    """The sensor models (c/include/sr_sensors.h) against the independent CasADi reference
+    (runtime.verification.sensor_reference) and Richardson differences of the C readings, on the
+    paper's robot and on a general robot on a slope (runtime.verification.sensor_checks)."""
+    from .sensor_checks import ad_checks, difference_checks, measured_accel_check, value_checks
+    general = random_general_params(np.random.default_rng(seed + 1))
+    n = max(n_states // 5, 30)
+    rows = []
+    for k, (label, params) in enumerate((("paper's robot", None), ("a general robot on a slope", general))):
+        s = seed + 10 * k
+        found = (value_checks(n, s + 2, params) + ad_checks(n, s + 3, params)
+                 + difference_checks(max(n // 10, 6), s + 4, params) + measured_accel_check(max(n // 4, 10), s + 5, params))
+        rows += [CheckResult(f"{name}, {label}", err, rel, tol, catches=catches)
+                 for (name, err, rel, tol), catches in zip(found, SENSOR_CATCHES)]
+    return rows
+
+
 def linearization_rows():
     """Check rows of the linearisations (equilibria, steady rolling, its stability)."""
     from .linearizations import equilibrium_checks, rolling_stability_checks, steady_rolling_checks
@@ -346,6 +374,7 @@ def run_all(n_states=1000, seed=0, progress=None):
         ("symmetry", planar_symmetry),
         ("jacobians", lambda: jacobian_rows(n_states, seed + 5)),
         ("linearizations", linearization_rows),
+        ("sensors", lambda: sensor_rows(n_states, seed + 9)),
     ]
     results = []
     for i, (name, fn) in enumerate(steps):

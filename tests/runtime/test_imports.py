@@ -8,7 +8,8 @@ from conftest import ROOT
 
 #: Modules that must import without `bindings` (the compiled kernels) and without `derive`.
 INDEPENDENT = ("runtime.so3", "runtime.verification.reference", "runtime.verification.alternatives.kane",
-               "runtime.verification.contact", "runtime.verification.steppers")
+               "runtime.verification.contact", "runtime.verification.steppers",
+               "runtime.verification.sensor_reference")
 
 #: Run in a fresh interpreter: any import of bindings or derive raises ImportError.
 _BLOCKER = """

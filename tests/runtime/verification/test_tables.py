@@ -5,7 +5,7 @@ import numpy as np
 from bindings._sr import lib
 from runtime.so3 import random_rotation
 from runtime.state import initial_state
-from runtime.verification import reference
+from runtime.verification import reference, sensor_reference
 from runtime.verification.alternatives import kane
 
 
@@ -69,6 +69,32 @@ def test_the_kane_tables_follow_the_generated_order():
                "w_S": kane.X_NU, "w_Y": kane.X_NU + 3, "w_P": kane.X_NU + 4}
     assert layout_mismatches(kane.GENERAL_PARAM_NAMES, kane.STATE_DIM, offsets) == []
     assert kane.PARAM_NAMES == generated_paper_order()
+
+
+def sensor_layout_mismatches(bodies, mount, imu_dim, bias_dim, error_dim):
+    """What differs between the sensor reference's tables and the generated SR_BODY_*, SR_MOUNT_*, sizes."""
+    problems = [f"body {b} at {i} != {getattr(lib, f'SR_BODY_{b}', None)}" for i, b in enumerate(bodies)
+                if getattr(lib, f"SR_BODY_{b}", None) != i]
+    problems += [f"mount {k} at {v} != {getattr(lib, f'SR_MOUNT_{k}')}" for k, v in mount.items()
+                 if getattr(lib, f"SR_MOUNT_{k}") != v]
+    sizes = {"imu": (imu_dim, lib.SR_NIMU), "bias": (bias_dim, lib.SR_NBIAS), "error": (error_dim, lib.SR_NE)}
+    problems += [f"{k} size {ours} != {theirs}" for k, (ours, theirs) in sizes.items() if ours != theirs]
+    return problems
+
+
+def test_the_sensor_reference_tables_follow_the_generated_order():
+    s = sensor_reference
+    mount = {"lever": s.MOUNT_LEVER.start, "R_m": s.MOUNT_ROTATION.start}
+    assert s.MOUNT_DIM == lib.SR_NMOUNT and lib.SR_NBODY == len(s.BODIES)
+    assert (lib.SR_IMU_gyro, lib.SR_IMU_accel, lib.SR_BIAS_b_g, lib.SR_BIAS_b_a) == (0, 3, 0, 3)
+    assert (lib.SR_EB_b_g, lib.SR_EB_b_a, lib.SR_NEB) == (s.ERROR_DIM, s.ERROR_DIM + 3, s.ERROR_DIM + s.BIAS_DIM)
+    assert sensor_layout_mismatches(s.BODIES, mount, s.IMU_DIM, s.BIAS_DIM, s.ERROR_DIM) == []
+
+
+def test_a_swapped_sensor_table_is_reported():
+    s = sensor_reference
+    problems = sensor_layout_mismatches(("yoke", "shell", "pendulum"), {"lever": 3, "R_m": 0}, 6, 6, 12)
+    assert len(problems) == 4
 
 
 def test_a_swapped_table_is_reported():

@@ -154,6 +154,12 @@ def test_symmetry_rows_fail_for_a_motion_that_leaks_1e_9_out_of_its_plane(monkey
     assert not verify.planar_symmetry(steps=200)[row].passed
 
 
+def test_sensor_rows_pass_for_both_robots_and_say_what_they_catch():
+    rows = verify.sensor_rows(10)
+    assert len(rows) == 2 * len(verify.SENSOR_CATCHES)
+    assert all(r.passed and r.catches for r in rows), verify.format_table(rows)
+
+
 def test_verify_command_prints_a_table_and_exits_zero():
     out = subprocess.run([sys.executable, "-m", "runtime", "verify", "--states", "10"], cwd=ROOT,
                          capture_output=True, text=True, timeout=300)
