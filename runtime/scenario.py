@@ -224,6 +224,8 @@ def _load_robot(path, source):
         table = tomllib.loads(full.read_text())
     except (OSError, tomllib.TOMLDecodeError) as exc:
         raise ValueError(f"robot: cannot read {full}: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"robot: {full}: not valid TOML (not UTF-8 text: {exc.reason} at byte {exc.start})") from None
     unknown = sorted(set(table) - set(PARAM_NAMES))
     if unknown:
         raise ValueError(f"robot: {full}: unknown key(s) {', '.join(map(repr, unknown))}; allowed: "
