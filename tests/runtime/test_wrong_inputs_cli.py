@@ -91,3 +91,21 @@ def test_view_of_anything_but_a_replay_page_is_refused_naming_it(tmp_path_factor
     folder = tmp_path_factory.mktemp("view")
     status, err = cli(["view", str(folder / name)])
     assert status == 2 and "Traceback" not in err and name in err
+
+
+@pytest.mark.parametrize("command", ["stability", "envelope", "climbing"])
+@pytest.mark.parametrize("where", ["{tmp}/no-such-folder/figure.png", "{tmp}", "{tmp}/file.txt/figure.png"])
+def test_a_figure_that_cannot_be_written_is_refused_before_anything_runs(tmp_path, command, where):
+    (tmp_path / "file.txt").write_text("a file, not a folder")
+    target = where.replace("{tmp}", str(tmp_path))
+    status, err = cli([command, target])
+    assert status == 2 and "Traceback" not in err and target in err.strip().splitlines()[-1]
+
+
+@pytest.mark.parametrize("content", [b"not json", b"\xff\xfe", None])
+def test_bench_names_a_markdown_result_it_cannot_read(tmp_path, content):
+    path = tmp_path / "result.json"
+    if content is not None:
+        path.write_bytes(content)
+    status, err = cli(["bench", "--markdown", str(path)])
+    assert status == 2 and "Traceback" not in err and f"--markdown: cannot read {path}" in err.strip().splitlines()[-1]
