@@ -442,7 +442,7 @@ def torque_signal(torques, dt):
 
 
 def simulate_scenario(fmu_path, scenario, outputs=None):
-    """Runs a scenario (runtime.scenarios.scenario.Scenario) in the FMU with FMPy, one communication
+    """Runs a scenario (runtime.scenario.Scenario) in the FMU with FMPy, one communication
     step per scenario step: FMPy's result (a structured array: time and the outputs)."""
     import fmpy
 
