@@ -454,6 +454,7 @@ def simulate_scenario(fmu_path, scenario, outputs=None):
 
 
 def main(argv):
+    """`python -m runtime export-fmu`: build the FMI 2.0 and 3.0 FMUs into --out."""
     parser = argparse.ArgumentParser(prog="python -m runtime export-fmu",
                                      description="Build the robot as FMI 2.0 and FMI 3.0 co-simulation FMUs.")
     parser.add_argument("--out", default="out/fmu",
