@@ -26,13 +26,13 @@ import importlib
 _API = {
     "Model": "model", "METHODS": "model", "ENERGY_TOL": "model",
     "KernelError": "errors", "SimulationStopped": "errors",
-    "Params": "params",
+    "Params": "params", "PaperParams": "params",
     "initial_state": "state",
     "ROTATION_TOL": "validation", "project_state": "validation",
     "simulate_many": "batch", "BatchResult": "batch",
 }
 
-__all__ = ["Model", "Params", "initial_state", "METHODS", "KernelError", "SimulationStopped",
+__all__ = ["Model", "Params", "PaperParams", "initial_state", "METHODS", "KernelError", "SimulationStopped",
            "ROTATION_TOL", "ENERGY_TOL", "project_state",
            "simulate_many", "BatchResult"]
 

@@ -3,6 +3,7 @@
 Every output is written first to a temporary file in the target's folder,
 then moved over the target with os.replace.
 """
+import argparse
 import contextlib
 import os
 import pathlib
@@ -42,3 +43,17 @@ def write_text(target, text):
     """Writes `text` (UTF-8) to `target` atomically: readers see the old file or the whole new one."""
     with atomic_path(target) as tmp:
         tmp.write_text(text, encoding="utf-8")
+
+
+def output_file(value):
+    """An argparse `type` for a file a command will write: its folder must exist and be a writable
+    folder, checked before the command computes anything (exit status 2, naming the path)."""
+    path = pathlib.Path(value)
+    folder = path.parent
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"{value}: is a folder, expected a file name")
+    if not folder.is_dir():
+        raise argparse.ArgumentTypeError(f"{value}: the folder {folder} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise argparse.ArgumentTypeError(f"{value}: the folder {folder} is not writable")
+    return path

@@ -15,6 +15,7 @@ import pathlib
 import numpy as np
 
 from .params import Params
+from .validation import choice
 
 FOLDER = pathlib.Path(__file__).resolve().parents[1] / "generated" / "casadi"
 NAMES = ("sr_accel", "sr_step_lie_euler", "sr_step_rkmk4", "sr_step_cf4")
@@ -22,9 +23,7 @@ NAMES = ("sr_accel", "sr_step_lie_euler", "sr_step_rkmk4", "sr_step_cf4")
 
 def path(name):
     """The serialized Function `name` (one of NAMES) in generated/casadi/."""
-    if name not in NAMES:
-        raise ValueError(f"casadi_model.load: name must be one of {', '.join(NAMES)}, got {name!r}")
-    return FOLDER / f"{name}.casadi"
+    return FOLDER / f"{choice(name, 'name', NAMES, 'Function')}.casadi"
 
 
 def load(name):

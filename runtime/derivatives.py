@@ -8,7 +8,6 @@ import numpy as np
 
 from bindings._sr import ffi, lib
 
-from .so3 import hat
 from .state import IDX_E_NU, IDX_E_Q, IDX_E_TH_P, IDX_E_TH_Y, IDX_E_XI_S, IDX_WS, NE, NU, NV, rotations
 
 
@@ -48,7 +47,7 @@ class DerivativeMethods:
         lead = x.shape[:-1]
         w = x[..., IDX_WS]
         R_S = rotations(x)[0]
-        W = hat(w) if x.ndim == 1 else np.stack([hat(v) for v in w])
+        W = -np.cross(w[..., None, :], np.eye(3))     # ⟦w⟧ of each state, row k = −(w × e_k); B = 0 too
         P = np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])
         A = np.zeros(lead + (NE, NE))
         B = np.zeros(lead + (NE, NU))

@@ -8,6 +8,7 @@ import numpy as np
 
 from bindings._sr import ffi, lib
 
+from .errors import KernelError
 from .state import NE, NX
 from .validation import check_finite, real_array
 
@@ -26,7 +27,7 @@ class GroupMethods:
         if d.shape[:-1] != x.shape[:-1]:
             raise ValueError(f"d: shape {d.shape} does not match x of shape {x.shape}")
         check_finite(d, "d")
-        return self._group_call(lib.sr_retract, lib.sr_retract_batch, x, d, NX)
+        return self._group_call(lib.sr_retract, lib.sr_retract_batch, x, d, NX, "d", "x ⊕ d")
 
     def local(self, x, y):
         """y ⊖ x: the error(s) d (12,) / (B, 12) with x ⊕ d = y (|ξ_S| ≤ π, joint angles in (−π, π])."""
@@ -34,15 +35,23 @@ class GroupMethods:
         y = self._valid_states(y, "y")
         if y.shape != x.shape:
             raise ValueError(f"y: shape {y.shape} does not match x of shape {x.shape}")
-        return self._group_call(lib.sr_local, lib.sr_local_batch, x, y, NE)
+        return self._group_call(lib.sr_local, lib.sr_local_batch, x, y, NE, "y", "y ⊖ x")
 
-    def _group_call(self, single, batch, x, other, width):
+    def _group_call(self, single, batch, x, other, width, name, result):
+        # Both arguments were checked (x valid, `other` finite): a non-finite result can only be
+        # an overflow of x's entries by `other`'s, and that is `other`'s fault.
         if x.ndim == 1:
             out = np.empty(width)
-            self._check("x", single(self._model, _ptr(x), _ptr(other), _ptr(out)))
+            self._blame(name, result, single(self._model, _ptr(x), _ptr(other), _ptr(out)))
             return out
         out = np.empty((x.shape[0], width))
         failed = ffi.new("long *")
         status = batch(self._model, x.shape[0], _ptr(x), _ptr(other), _ptr(out), failed)
-        self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
+        self._blame(f"{name}[{failed[0]}]" if failed[0] >= 0 else name, result, status)
         return out
+
+    def _blame(self, name, result, status):
+        if status == lib.SR_ERR_NONFINITE:
+            raise KernelError(name, status, message=f"{name}: {result} overflows (is not finite): {name} "
+                                                    f"is too large for this state")
+        self._check("x", status)

@@ -8,9 +8,9 @@ from .errors import KernelError, SimulationStopped
 from .derivatives import DerivativeMethods
 from .step_jacobian import StepJacobianMethods
 from .group import GroupMethods
-from .params import Params
+from .params import FLAT_FIELDS, Params
 from .state import NU, NV, NX
-from .validation import ROTATION_TOL, check_finite, check_states, describe_state, project_state, real_array
+from .validation import ROTATION_TOL, check_finite, check_states, choice, describe_state, project_state, real_array
 
 METHODS = {"lie-euler": lib.SR_LIE_EULER, "rkmk4": lib.SR_RKMK4, "cf4": lib.SR_CF4,
            "rkmk4-projected": lib.SR_RKMK4 | lib.SR_PROJECT, "cf4-projected": lib.SR_CF4 | lib.SR_PROJECT}
@@ -64,19 +64,29 @@ def _ptr(arr):
     return ffi.cast("double *", ffi.from_buffer(arr))
 
 
-def _method(method):
-    try:
-        return METHODS[method]
-    except (KeyError, TypeError):
-        raise ValueError(f"method: unknown integrator {method!r}; choose one of {sorted(METHODS)}") from None
+def _method(method, allowed=METHODS):
+    """The C code of the integrator named `method`, one of `allowed` (ValueError naming `method`)."""
+    return METHODS[choice(method, "method", allowed, "integrator")]
 
 
 _PARAM_MESSAGES = {
-    lib.SR_ERR_SINGULAR: "params: the generalized inertia M is not positive definite at the reference "
-                         "state (masses or lengths so small that the inertias underflow)",
+    lib.SR_ERR_SINGULAR: "params: the generalized inertia M is not positive definite at the reference state "
+                         "in floating point (a value so small that the inertias underflow, or so large that "
+                         "their products overflow)",
     lib.SR_ERR_PARAM: "params: the model overflows at the reference state (masses, lengths or g so "
                       "large that M or the energy is not finite)",
 }
+
+
+def _param_message(params, status):
+    """Why `sr_model_init` refused parameters that pass every rule one by one: the status's reason,
+    and the parameter farthest from 1 in magnitude (each rule holds, so it is the scale that fails)."""
+    values = np.abs(params.as_array())
+    scale = np.where(values > 0, np.abs(np.log10(np.where(values > 0, values, 1.0))), -1.0)
+    name, entry = FLAT_FIELDS[int(np.argmax(scale))]
+    where = name if entry is None else f"{name}[{', '.join(map(str, np.atleast_1d(entry)))}]"
+    shown = float(params.as_array()[int(np.argmax(scale))])
+    return f"{_PARAM_MESSAGES[status]}; the most extreme value is Params.{where} = {shown:g}"
 
 
 class Model(GroupMethods, DerivativeMethods, StepJacobianMethods):
@@ -97,7 +107,8 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods):
         self._model = ffi.new("sr_model *")
         status = lib.sr_model_init(self._model, _ptr(self._p))
         if status != lib.SR_OK:
-            raise KernelError("params", status, message=_PARAM_MESSAGES.get(status))
+            raise KernelError("params", status,
+                              message=_param_message(self.params, status) if status in _PARAM_MESSAGES else None)
         # The one-state fast path of accel and step (bindings/fastcall.c); it keeps self._model alive.
         self._fast = Kernels(_address(self._model), _address(ffi.addressof(lib, "sr_py_accel")),
                              _address(ffi.addressof(lib, "sr_py_step")), self._model)
@@ -338,12 +349,9 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods):
                 raise ValueError(f"{name}: expected a non-negative finite number, got {tol!r}")
         if rtol + atol <= 0:
             raise ValueError("rtol, atol: at least one must be positive")
-        adaptive = ("rkmk4", "rkmk4-projected")
-        if method not in adaptive:
-            raise ValueError(f"method: adaptive stepping supports {', '.join(adaptive)}; got {method!r}")
         if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)) or max_steps <= 0:
             raise ValueError(f"max_steps: expected a positive integer, got {max_steps!r}")
-        code = _method(method)
+        code = _method(method, ("rkmk4", "rkmk4-projected"))    # the methods with an error estimate
         traj = np.empty((n_out + 1, NX))
         stats = ffi.new("sr_adaptive_stats *")
         totals = {"accepted": 0, "rejected": 0, "evaluations": 0, "h_next": 0.0}

@@ -49,9 +49,17 @@ def parameter_order(names, module=lib, prefix="SR_P_", size="SR_NPARAM"):
     return tuple(sorted(names, key=indices.get))
 
 
+def _shown(value):
+    """`value` for a one-line message: an array by its shape and dtype, anything else by a short repr."""
+    if isinstance(value, np.ndarray):
+        return f"an array of shape {value.shape} (dtype {value.dtype})"
+    text = " ".join(repr(value).split())
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
 def _real(owner, name, value):
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise ValueError(f"{owner}.{name}: expected a real number, got {value!r}")
+        raise ValueError(f"{owner}.{name}: expected a real number, got {_shown(value)}")
     return float(value)
 
 
@@ -126,11 +134,15 @@ def _as_shape(name, value, shape):
     if shape == ():
         return _real("Params", name, value)
     try:
-        array = np.asarray(value, dtype=np.float64)
+        array = np.asarray(value)
+        if array.dtype.kind not in "iuf":      # complex, bool, strings, objects: not a length or an inertia
+            raise TypeError
+        array = array.astype(np.float64)
     except (TypeError, ValueError):
-        raise ValueError(f"Params.{name}: expected an array of shape {shape}, got {value!r}") from None
+        raise ValueError(f"Params.{name}: expected an array of real numbers of shape {shape}, "
+                         f"got {_shown(value)}") from None
     if array.shape != shape:
-        raise ValueError(f"Params.{name}: expected an array of shape {shape}, got shape {array.shape}")
+        raise ValueError(f"Params.{name}: expected an array of real numbers of shape {shape}, got shape {array.shape}")
     if len(shape) == 2 and not np.array_equal(array, array.T, equal_nan=True):
         array = _symmetric(name, array)
     return tuple(map(tuple, array.tolist())) if len(shape) == 2 else tuple(array.tolist())

@@ -31,7 +31,7 @@ from .params import PAPER_NAMES, SHAPES, Params
 from .so3 import rot_x, rot_y
 from .state import IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NU, NX
 from .schema import Range, check_ranges, check_table, show
-from .validation import ROTATION_TOL, describe_state
+from .validation import ROTATION_TOL, choice, describe_state
 
 #: The paper's simulations in the order of Section 5.3 (`run all` runs them in this order).
 PAPER_SCENARIOS = ("tilted-pendulum", "tilted-yoke", "t-shape")
@@ -248,7 +248,7 @@ def _parse_params(table, source):
     if "preset" in table and "robot" in table:
         raise ValueError(f"{where}: give a preset or a robot file, not both")
     preset = table.get("preset", "paper")
-    if preset not in PRESETS:
+    if preset.__class__ is not str or preset not in PRESETS:
         raise ValueError(f"{where}.preset: unknown preset {show(preset)}; choose one of {sorted(PRESETS)}")
     changes = {key: (_real(value, f"{where}.{key}") if SHAPES.get(key, ()) == () else value)
                for key, value in table.items() if key not in ("preset", "robot")}
@@ -268,7 +268,7 @@ def _load_robot(path, source):
     full = pathlib.Path(source).parent / path
     try:
         table = tomllib.loads(full.read_text())
-    except (OSError, tomllib.TOMLDecodeError) as exc:
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
         raise ValueError(f"robot: cannot read {full}: {exc}") from None
     check_ranges(table, ROBOT_RANGES, str(full), sep=": ")
     unknown = sorted(set(table) - set(PARAM_NAMES))
@@ -276,7 +276,7 @@ def _load_robot(path, source):
         raise ValueError(f"robot: {full}: unknown key(s) {', '.join(map(repr, unknown))}; allowed: "
                          f"{', '.join(PARAM_NAMES)}")
     try:
-        return Params(**table)
+        return Model(Params(**table)).params     # C's checks of the whole robot too, naming this file
     except ValueError as exc:
         raise ValueError(f"robot: {full}: {exc}") from None
 
@@ -387,10 +387,7 @@ def _whole_steps(duration, dt, where):
 
 
 def _method_name(value, where):
-    methods = _model_module.METHODS      # looked up now: integrators may be registered after import
-    if value not in methods:
-        raise ValueError(f"{where}: unknown integrator {show(value)}; choose one of {sorted(methods)}")
-    return value
+    return choice(value, where, _model_module.METHODS, "integrator")   # METHODS looked up now: it may grow
 
 
 def _vector(value, n, where):

@@ -33,6 +33,7 @@ import argparse
 
 import numpy as np
 
+from .atomic import output_file
 from .model import Model
 from .params import Params
 from .state import IDX_E_TH_Y, IDX_RY, NE, initial_state
@@ -134,7 +135,7 @@ def figure(model, out, speeds=SPEEDS):
 def main(argv=()):
     """Prints the eigenvalues of the equilibria and the Floquet exponents of steady rolling."""
     parser = argparse.ArgumentParser(prog="python -m runtime stability")
-    parser.add_argument("figure", nargs="?", default="docs/figures/rolling-stability.png", help="where to write the figure")
+    parser.add_argument("figure", nargs="?", type=output_file, default="docs/figures/rolling-stability.png", help="where to write the figure")
     args = parser.parse_args(list(argv))
     model = Model(Params.paper_simulation())
     np.set_printoptions(precision=4, suppress=True, linewidth=120)

@@ -16,6 +16,7 @@ import functools
 import numpy as np
 
 from .state import NE, NU, NX
+from .validation import choice
 
 STEPS = {"lie-euler": "sr_step_lie_euler", "rkmk4": "sr_step_rkmk4", "cf4": "sr_step_cf4"}
 
@@ -94,8 +95,7 @@ class StepJacobianMethods:
         or None give (B, 12, 12), (B, 12, 2).  All three in C (sr_step_jacobian, batches by
         sr_step_jacobian_batch; c/sr_jacobians.c, c/sr_step_jacobians.c); `casadi_step_jacobian`
         is CasADi's AD of the exported steps, the independent check."""
-        if method not in STEPS:
-            raise ValueError(f"method: unknown integrator {method!r}; choose one of {sorted(STEPS)}")
+        choice(method, "method", STEPS, "integrator")
         x, u = self._state_and_input(x, u)
         dt = self._dt(dt)
         return self._c_step_jacobian(x, u, dt, method)

@@ -101,6 +101,17 @@ def check_finite(arr, name, entry_names=None):
         raise ValueError(f"{name}: {label} is {float(arr[index])!r}, expected a finite number")
 
 
+def choice(value, name, choices, kind="value"):
+    """`value` if it is one of the strings `choices`, else ValueError naming `name` and the choices.
+
+    The one check of every argument that names one of a fixed set (an integrator, a Function):
+    a non-string (a list, None, a number) is refused like an unknown name, not looked up in a
+    dict, where an unhashable value would raise TypeError.
+    """
+    if value.__class__ is not str or value not in choices:
+        raise ValueError(f"{name}: unknown {kind} {value!r}; choose one of {', '.join(sorted(choices))}")
+    return value
+
 # -- the state rules ----------------------------------------------------------------------------
 def describe_state(x, r, name="x"):
     """Why the single state `x` (35,) breaks the rules of `sr_check_state`, or None if it does not.

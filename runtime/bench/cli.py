@@ -39,7 +39,11 @@ def main(argv=None):
                         help="print a stored run's tables as Markdown (for the README) and exit")
     args = parser.parse_args(argv)
     if args.markdown:
-        print(format_markdown(json.loads(args.markdown.read_text())))
+        try:
+            result = json.loads(args.markdown.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:      # a missing file, not UTF-8, not JSON
+            parser.error(f"--markdown: cannot read {args.markdown}: {exc}")
+        print(format_markdown(result))
         return 0
     if not 1 <= args.states <= 4096:
         parser.error("--states: must be between 1 and 4096")

@@ -30,6 +30,7 @@ METHODS = (("lie_euler", "Lie–Euler"), ("rkmk4", "RKMK4"), ("cf4", "CF4"))
 
 
 def begin_marker(section):
+    """The HTML comment that opens a quoted table of `section` in a Markdown document."""
     return f"<!-- bench-table:{section} -->"
 
 
@@ -162,6 +163,7 @@ RENDERERS = {"headline": headline, "performance": performance}
 
 
 def render(section, res, path_label="bench/results/reference.json"):
+    """The Markdown table of `section` ('headline' or 'performance') rendered from the run `res`."""
     return RENDERERS[section](res, path_label)
 
 
@@ -172,6 +174,7 @@ def quoted_block(text, section):
 
 
 def replace_block(text, section, markdown):
+    """`text` with the section's quoted block replaced by `markdown`; ValueError without markers."""
     if quoted_block(text, section) is None:
         raise ValueError(f"no {begin_marker(section)} ... {END} block")
     pattern = re.escape(begin_marker(section)) + r"\n.*?\n" + re.escape(END)
@@ -179,6 +182,7 @@ def replace_block(text, section, markdown):
 
 
 def main(argv=None):
+    """`python -m runtime bench-table`: print (or --write) the quoted tables rendered from the reference run."""
     parser = argparse.ArgumentParser(prog="python -m runtime bench-table",
                                      description="Render the quoted benchmark tables from the pinned reference run.")
     parser.add_argument("--reference", type=pathlib.Path, default=REFERENCE, metavar="FILE",

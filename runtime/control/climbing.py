@@ -20,6 +20,7 @@ import math
 
 import numpy as np
 
+from ..atomic import output_file
 from ..model import Model
 from ..params import Params
 from ..so3 import rot_y, rot_z
@@ -63,7 +64,7 @@ def main(argv=()):
     docs/figures/climbing-limit.png): simulated against predicted speed over slopes for the paper's
     robot and the battery robot of runtime/scenarios/robots/battery-geared.toml."""
     parser = argparse.ArgumentParser(prog="python -m runtime climbing")
-    parser.add_argument("figure", nargs="?", default="docs/figures/climbing-limit.png", help="where to write the figure")
+    parser.add_argument("figure", nargs="?", type=output_file, default="docs/figures/climbing-limit.png", help="where to write the figure")
     args = parser.parse_args(list(argv))
     import matplotlib
     matplotlib.use("Agg")

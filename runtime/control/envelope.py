@@ -17,6 +17,7 @@ import argparse
 import numpy as np
 from tqdm.auto import tqdm
 
+from ..atomic import output_file
 from ..model import Model
 from ..params import Params
 from ..so3 import rot_z
@@ -121,7 +122,7 @@ def tightest_turn(rows, leans, u_max):
 def main(argv=()):
     """Prints the envelope's numbers and rewrites its figure (docs/control.md)."""
     parser = argparse.ArgumentParser(prog="python -m runtime envelope")
-    parser.add_argument("figure", nargs="?", default="docs/figures/control-envelope.png", help="where to write the figure")
+    parser.add_argument("figure", nargs="?", type=output_file, default="docs/figures/control-envelope.png", help="where to write the figure")
     args = parser.parse_args(list(argv))
     import matplotlib
     matplotlib.use("Agg")

@@ -245,7 +245,7 @@ def parse_task(data, source="<task>", name="task"):
         if spec.kind in (c.kind for c in controllers):
             raise ValueError(f"{source}: controller[{i}].kind: {spec.kind!r} appears twice")
         per = spec.rate * scenario.dt
-        if abs(1 / per - round(1 / per)) > 1e-9 * (1 / per):
+        if not 1e-300 < per < 1e300 or abs(1 / per - round(1 / per)) > 1e-9 * (1 / per):
             raise ValueError(f"{source}: controller.rate: the period 1/{spec.rate:g} s is not a whole number of "
                              f"steps dt = {scenario.dt:g} s")
         controllers.append(spec)

@@ -442,7 +442,7 @@ def torque_signal(torques, dt):
 
 
 def simulate_scenario(fmu_path, scenario, outputs=None):
-    """Runs a scenario (runtime.scenarios.scenario.Scenario) in the FMU with FMPy, one communication
+    """Runs a scenario (runtime.scenario.Scenario) in the FMU with FMPy, one communication
     step per scenario step: FMPy's result (a structured array: time and the outputs)."""
     import fmpy
 
@@ -454,6 +454,7 @@ def simulate_scenario(fmu_path, scenario, outputs=None):
 
 
 def main(argv):
+    """`python -m runtime export-fmu`: build the FMI 2.0 and 3.0 FMUs into --out."""
     parser = argparse.ArgumentParser(prog="python -m runtime export-fmu",
                                      description="Build the robot as FMI 2.0 and FMI 3.0 co-simulation FMUs.")
     parser.add_argument("--out", default="out/fmu",
@@ -470,6 +471,3 @@ def main(argv):
         return 1
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

@@ -11,16 +11,26 @@ import pathlib
 import sys
 import webbrowser
 
+#: What every replay page carries in its head (runtime/scenarios/replay_page.html).
+GENERATOR = b'<meta name="generator" content="runtime.scenarios.replay">'
+
 
 def replay_page(path):
     """The replay.html of a run folder (or the page itself); ValueError naming what is missing."""
     path = pathlib.Path(path)
     page = path / "replay.html" if path.is_dir() else path
+    hint = "run `python -m runtime run` first (without --no-replay)"
     if not page.is_file():
-        hint = "run `python -m runtime run` first (without --no-replay)"
         if not path.exists():
             raise ValueError(f"{path}: no such folder; {hint}")
         raise ValueError(f"{page}: no replay page here; {hint}")
+    try:
+        with open(page, "rb") as f:
+            head = f.read(1024)
+    except OSError as exc:
+        raise ValueError(f"{page}: cannot read the file ({exc.strerror or exc})") from None
+    if GENERATOR not in head:     # any other file would open as if it were a run
+        raise ValueError(f"{page}: not a replay page (written by `python -m runtime run`); {hint}")
     return page.resolve()
 
 

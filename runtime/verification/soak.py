@@ -16,6 +16,7 @@ Exit status 0, or 1 if a guard stopped a run.
 """
 import argparse
 import json
+import math
 import time
 
 import numpy as np
@@ -72,8 +73,16 @@ def main(argv):
     parser.add_argument("--seed", type=int, default=8)
     parser.add_argument("--json", help="also write the results to this JSON file")
     args = parser.parse_args(argv)
-    if args.steps < 1 or args.states < 1 or args.chunk < 1 or not args.dt > 0:
-        parser.error("--steps, --states, --chunk and --dt must be positive")
+    for option, value, ok, rule in (
+            ("--steps", args.steps, args.steps >= 1, "a positive integer"),
+            ("--states", args.states, args.states >= 1, "a positive integer"),
+            ("--chunk", args.chunk, args.chunk >= 1, "a positive integer"),
+            ("--seed", args.seed, args.seed >= 0, "a non-negative integer"),
+            ("--dt", args.dt, math.isfinite(args.dt) and args.dt > 0, "a positive finite number of seconds"),
+            ("--max-speed", args.max_speed, math.isfinite(args.max_speed) and args.max_speed >= 0,
+             "a non-negative finite speed in rad/s")):
+        if not ok:
+            parser.error(f"{option}: expected {rule}, got {value!r}")
 
     model = Model(Params.paper_simulation(k_S=0, k_Y=0, k_P=0))
     rng = np.random.default_rng(args.seed)

@@ -182,7 +182,7 @@ def test_an_asymmetry_just_above_the_rounding_tolerance_is_refused():
 
 @pytest.mark.parametrize("value", [[0.1, 0.2], "abc", [[0.1], [0.2], [0.3]]])
 def test_a_centre_of_the_wrong_shape_is_named(value):
-    with pytest.raises(ValueError, match=r"^Params\.c_Y: expected an array of shape \(3,\)"):
+    with pytest.raises(ValueError, match=r"^Params\.c_Y: expected an array of real numbers of shape \(3,\)"):
         Params(c_Y=value)
 
 
@@ -260,3 +260,15 @@ def test_paper_params_accepts_exactly_what_the_c_conversion_accepts():
             accepted = False
         status = lib.sr_paper_params(ffi.new("double[]", list(values)), ffi.new("double[]", lib.SR_NPARAM))
         assert accepted == (status == lib.SR_OK), values
+
+
+@pytest.mark.parametrize("value", [np.zeros(3, dtype=complex), np.zeros(3, dtype=bool), ["0", "0", "0"]])
+def test_a_centre_that_is_not_real_numbers_is_named(value):
+    with pytest.raises(ValueError, match=r"^Params\.c_Y: expected an array of real numbers of shape \(3,\), got "):
+        Params(c_Y=value)
+
+
+def test_a_wrong_value_is_shown_on_one_line():
+    with pytest.raises(ValueError) as info:
+        Params(r=np.zeros((2, 1)))
+    assert str(info.value) == "Params.r: expected a real number, got an array of shape (2, 1) (dtype float64)"

@@ -17,7 +17,7 @@ from runtime import Model, Params, initial_state  # noqa: E402
 from runtime.control.geometry import heading  # noqa: E402
 from runtime.interop import fmu  # noqa: E402
 from runtime.params import FLAT_FIELDS, flat_names, SHAPES  # noqa: E402
-from runtime.scenarios.scenario import load_scenario, run_scenario  # noqa: E402
+from runtime.scenario import load_scenario, run_scenario  # noqa: E402
 from runtime.verification.contact import ReferenceContact  # noqa: E402
 
 VERSIONS = (2, 3)
