@@ -5,7 +5,7 @@
 
 #include <stddef.h>
 
-static int is_rotation(const sr_real *R)
+int sr_internal_is_rotation(const sr_real *R)
 {
     int i, j;
     sr_real det;
@@ -38,7 +38,7 @@ int sr_internal_check_state(const sr_model *model, const sr_real x[SR_NX])
 {
     const sr_real r = model->p[SR_P_r];
     if (!all_finite(x, SR_NX)) return SR_ERR_NONFINITE;
-    if (!is_rotation(x + SR_X_R_S) || !is_axis_rotation(x + SR_X_R_Y, 0) || !is_axis_rotation(x + SR_X_R_P, 1))
+    if (!sr_internal_is_rotation(x + SR_X_R_S) || !is_axis_rotation(x + SR_X_R_Y, 0) || !is_axis_rotation(x + SR_X_R_P, 1))
         return SR_ERR_NOT_ROTATION;
     if (SR_FABS(x[SR_X_q + 2] - r) > SR_ROTATION_TOL * r) return SR_ERR_CONSTRAINT;
     return SR_OK;

@@ -40,9 +40,13 @@ static inline int checks(const sr_model *model, const sr_real x[SR_NX], const sr
 
 #ifdef SR_USE_FLOAT /* float symbols carry _f, as in spherical_robot.h */
 #define sr_internal_check_lanes sr_internal_check_lanes_f
+#define sr_internal_is_rotation sr_internal_is_rotation_f
 #endif
 
 /* The lanes form of the state checks but finiteness (c/src/sr_checks.c): ok[i] = 1 or 0. */
+/* R (row-major) orthonormal with det +1, to SR_ROTATION_TOL: 1, else 0 (sr_checks.c). */
+int sr_internal_is_rotation(const sr_real *R);
+
 void sr_internal_check_lanes(const sr_model *model, long n, const sr_real *restrict x, long x_stride,
                              sr_real *restrict ok);
 

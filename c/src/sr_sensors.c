@@ -59,26 +59,12 @@ static void sensor_constants(const sr_model *model, sr_real sc[SR_GEN_NSC])
     sr_gen_sensor_constants(model->p, sc);
 }
 
-/* R (row-major) orthonormal with det +1, to SR_ROTATION_TOL. */
-static int is_rotation(const sr_real *R)
-{
-    int i, j;
-    sr_real det;
-    for (i = 0; i < 3; ++i)
-        for (j = i; j < 3; ++j) {
-            const sr_real dot = R[i] * R[j] + R[3 + i] * R[3 + j] + R[6 + i] * R[6 + j];
-            if (!near(dot, i == j ? 1 : 0)) return 0;
-        }
-    det = R[0] * (R[4] * R[8] - R[5] * R[7]) - R[1] * (R[3] * R[8] - R[5] * R[6]) + R[2] * (R[3] * R[7] - R[4] * R[6]);
-    return near(det, 1);
-}
-
 int sr_check_mount(int body, const sr_real mount[SR_NMOUNT])
 {
     if (!mount) return SR_ERR_NULL;
     if (body < 0 || body >= SR_NBODY) return SR_ERR_ARG;
     if (!all_finite(mount, SR_NMOUNT)) return SR_ERR_NONFINITE;
-    if (!is_rotation(mount + SR_MOUNT_R_m)) return SR_ERR_NOT_ROTATION;
+    if (!sr_internal_is_rotation(mount + SR_MOUNT_R_m)) return SR_ERR_NOT_ROTATION;
     return SR_OK;
 }
 
