@@ -25,9 +25,14 @@ run: $(STAMP)
 # The SymPy-emitted kernels (byte-reproducible), the extension rebuilt on them, then the firmware
 # example's gain table (generated/lqr_task.h: an LQR design through LAPACK, whose last bits vary
 # with the CPU; tests/runtime/control/test_firmware.py holds it to a fresh design within 1e-7).
-generate: $(STAMP)
+# derive/ needs only SymPy and CasADi (the `derive` extra), not the compiled extension, so it runs
+# before the package is rebuilt: a C change that needs a newly emitted symbol then builds.
+DERIVE_DEPS = $(shell $(PYTHON) -c "import tomllib; print(' '.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['derive']))")
+generate:
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet $(DERIVE_DEPS)
 	$(PY) -m derive
-	$(PY) -m pip install --quiet --no-deps -e .
+	$(MAKE) install
 	$(PY) -m runtime firmware-table --out generated/lqr_task.h
 
 verify: $(STAMP)
