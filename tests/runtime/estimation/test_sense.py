@@ -201,3 +201,15 @@ def test_sense_refuses_an_out_that_is_a_file(tmp_path, capsys):
 def test_a_log_spec_is_a_frozen_dataclass():
     with pytest.raises(dataclasses.FrozenInstanceError):
         SensorSet.default().imu.rate = 1.0
+
+
+def test_without_process_noise_a_tasks_truth_is_its_closed_loop_run():
+    from runtime.control.closed_loop import simulate_closed_loop
+    from runtime.control.task import load_task
+    task = load_task("circle")
+    task = dataclasses.replace(task, scenario=task.scenario.with_overrides(steps=100))
+    log = simulate_log(task, SensorSet(process=QUIET))
+    run = simulate_closed_loop(task.plant_params, task.controller(), task.reference(), task.scenario.x0,
+                               task.duration, task.scenario.dt, method=task.scenario.method)
+    assert np.abs(log.truth_states() - run.trajectory).max() < 1e-12
+    assert np.abs(log.torques.data - run.torques).max() < 1e-12
