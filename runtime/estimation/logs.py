@@ -20,6 +20,7 @@ import pyarrow.csv as pa_csv
 import pyarrow.parquet as pq
 
 from ..atomic import atomic_path, write_text
+from ..params import Params
 from ..sensor_set import SensorSet
 from ..state import COLUMN_INDEX, NX, STATE_COLUMNS
 
@@ -116,6 +117,22 @@ class Log:
         before the log's first time)."""
         i = np.searchsorted(self.torques.t, np.asarray(t, dtype=float), side="right") - 1
         return self.torques.data[np.clip(i, 0, len(self.torques) - 1)]
+
+    def params(self):
+        """The robot the log claims (log.json's "params", as `Params.as_json` writes it): a
+        runtime.Params, or None when the log does not say."""
+        table = self.meta.get("params")
+        if table is None:
+            return None
+        where = "log.json: params"
+        if not isinstance(table, dict):
+            raise LogError(f"{where}: expected a table of parameters, got {type(table).__name__}")
+        try:
+            if "paper" in table:
+                return Params.paper(**table["paper"])
+            return Params(**table)
+        except (TypeError, ValueError) as exc:
+            raise LogError(f"{where}: {exc}") from None
 
     def truth_states(self):
         """The truth's states (n, 35) in the library's layout (runtime.state), or None without truth."""

@@ -215,3 +215,19 @@ def test_a_log_json_of_something_else_is_refused(tmp_path):
 def test_a_folder_that_is_not_there_is_named(tmp_path):
     with pytest.raises(LogError, match="nothing: no such log folder"):
         read_log(tmp_path / "nothing")
+
+
+def test_the_robot_a_log_claims_comes_back_from_log_json(tmp_path):
+    from runtime import Params
+    for params in (Params.paper_simulation(), Params.paper_simulation().replace(slope=0.1)):
+        log = small_log()
+        write_log(Log(**{**log.__dict__, "meta": {"params": params.as_json()}}), tmp_path)
+        assert read_log(tmp_path).params() == params
+    assert small_log().params() is None
+
+
+def test_a_claimed_robot_that_is_no_robot_is_named(tmp_path):
+    log = small_log()
+    write_log(Log(**{**log.__dict__, "meta": {"params": {"r": -1.0}}}), tmp_path)
+    with pytest.raises(LogError, match=r"^log.json: params: "):
+        read_log(tmp_path).params()

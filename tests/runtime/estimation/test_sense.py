@@ -136,6 +136,7 @@ def test_the_mismatch_case_simulates_another_robot_than_the_log_claims():
     log = simulate_log(scenario, SensorSet(process=QUIET), seed=1, plant_mismatch=True)
     assert log.meta["params"] == scenario.params.as_json() == nominal.meta["params"]
     assert log.meta["truth_params"] == mismatched(scenario.params).as_json()
+    assert log.params() == scenario.params
     assert not np.allclose(log.truth.data, nominal.truth.data)
 
 
