@@ -153,7 +153,8 @@ def samples(kind, t, data):
 # -- writing ----------------------------------------------------------------------------------
 def write_log(log, folder, formats=FORMATS):
     """Write `log` into `folder` (created if missing): every table as `<kind>.<format>` for each of
-    `formats`, and log.json (its sensor set and meta); each file atomically.  Returns the paths."""
+    `formats`, and log.json (its sensor set and meta); each file atomically.  The tables of an earlier
+    log there that this one does not rewrite are deleted.  Returns the paths written."""
     folder = pathlib.Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     unknown = sorted(set(formats) - set(FORMATS))
@@ -173,6 +174,9 @@ def write_log(log, folder, formats=FORMATS):
     meta = {"format": LOG_FORMAT, "version": LOG_VERSION, "kinds": list(log.tables()),
             "sensors": log.sensors.as_table(), **log.meta}
     write_text(folder / META_FILE, json.dumps(meta, indent=2) + "\n")
+    for stale in (folder / f"{kind}.{fmt}" for kind in COLUMNS for fmt in FORMATS):
+        if stale not in written:        # an earlier log's table: the folder never mixes two logs
+            stale.unlink(missing_ok=True)
     return written + [folder / META_FILE]
 
 

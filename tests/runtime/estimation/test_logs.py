@@ -231,3 +231,12 @@ def test_a_claimed_robot_that_is_no_robot_is_named(tmp_path):
     write_log(Log(**{**log.__dict__, "meta": {"params": {"r": -1.0}}}), tmp_path)
     with pytest.raises(LogError, match=r"^log.json: params: "):
         read_log(tmp_path).params()
+
+
+def test_a_log_written_over_another_leaves_none_of_its_tables(tmp_path):
+    write_log(small_log(), tmp_path)
+    log = small_log(SensorSet(fixes=None))
+    write_log(Log(**{**log.__dict__, "fixes": None}), tmp_path, formats=("csv",))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["encoders.csv", "imu.csv", "log.json", "torques.csv",
+                                                          "truth.csv"]
+    assert read_log(tmp_path).fixes is None
