@@ -52,7 +52,7 @@ class LogError(ValueError):
     """A log that cannot be read as one: the message names the file and what is wrong."""
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True, eq=False)
 class Samples:
     """One table of a log: sample times `t` (n,) [s], strictly increasing, and the other columns
     `data` (n, len(columns) − 1), all finite; `columns` names them, `t` first."""
@@ -90,7 +90,7 @@ class Gap:
     t_to: float
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True, eq=False)
 class Log:
     """A sensor log: torques (applied, zero-order hold: a row holds until the next), IMU, encoders,
     optional fixes and heading, optional truth; `sensors` the set that took it; `meta` the rest of
