@@ -182,10 +182,10 @@ def simulate_log(run, sensors=None, seed=0, plant_mismatch=False, progress=None,
     fixes = None
     if "fixes" in times:
         fixes = samples("fixes", times["fixes"] + fix_latency, np.column_stack([times["fixes"], readings["fixes"]]))
-    meta = {"source": scenario.source, "run": scenario.name, "kind": "scenario" if isinstance(run, Scenario) else "task",
-            "seed": int(seed), "dt": dt, "steps": steps, "method": method, "params": nominal.as_json(),
-            "plant_mismatch": bool(plant_mismatch),
-            "truth_params": truth_params.as_json(),
+    meta = {"source": scenario.source, "run": scenario.name,
+            "kind": "scenario" if isinstance(run, Scenario) else "task", "seed": int(seed), "dt": dt,
+            "steps": steps, "method": method, "params": nominal.as_json(),
+            "plant_mismatch": bool(plant_mismatch), "truth_params": truth_params.as_json(),
             "truth_bias": {"gyro": bias[:3].tolist(), "accel": bias[3:].tolist()},
             "wall_time_s": time.perf_counter() - started}
     return Log(torques=samples("torques", np.arange(steps + 1) * dt, applied),
