@@ -31,6 +31,7 @@ from .params import PAPER_NAMES, SHAPES, Params
 from .so3 import rot_x, rot_y
 from .state import IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NU, NX
 from .schema import Range, check_ranges, check_table, show
+from .sensor_set import parse_sensors
 from .validation import ROTATION_TOL, choice, describe_state
 
 #: The paper's simulations in the order of Section 5.3 (`run all` runs them in this order).
@@ -77,7 +78,7 @@ SCENARIO_RANGES = {
                "from_time": _TIME, "to_time": _TIME, "u_Y": _TORQUE, "u_P": _TORQUE},
 }
 
-_TOP_KEYS = {"description", "dt", "steps", "duration", "method", "params", "initial", "torque"}
+_TOP_KEYS = {"description", "dt", "steps", "duration", "method", "params", "initial", "torque", "sensors"}
 _INITIAL_KEYS = {"theta_Y", "theta_P", "R_S", "R_Y", "R_P", "q", "w_S", "w_Y", "w_P"}
 _TORQUE_KEYS = {"from_step", "to_step", "from_time", "to_time", "u_Y", "u_P"}
 
@@ -101,7 +102,8 @@ class TorqueWindow:
 
 @dataclasses.dataclass(frozen=True)
 class Scenario:
-    """A validated scenario.  `source` is the file it came from (for messages and summaries)."""
+    """A validated scenario.  `source` is the file it came from (for messages and summaries);
+    `sensors` its `[sensors]` section (runtime.sensor_set.SensorSet), None without one."""
     name: str
     source: str
     params: Params
@@ -111,6 +113,7 @@ class Scenario:
     method: str
     torques: tuple = ()
     description: str = ""
+    sensors: object = None
 
     @property
     def duration(self):
@@ -222,8 +225,9 @@ def parse_scenario(data, source="<scenario>", name="scenario"):
         raise ValueError(f"{source}: initial: {problem}")
     torques = _parse_torques(data.get("torque", []), dt, steps, source)
     check_scenario_ranges(data, source)
+    sensors = parse_sensors(data["sensors"], source) if "sensors" in data else None
     return Scenario(name=name, source=source, params=params, x0=x0, dt=dt, steps=steps,
-                    method=method, torques=torques, description=description)
+                    method=method, torques=torques, description=description, sensors=sensors)
 
 
 def check_scenario_ranges(data, source):

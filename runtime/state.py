@@ -41,6 +41,14 @@ IDX_E_TH_Y, IDX_E_TH_P = lib.SR_E_th_Y, lib.SR_E_th_P
 IDX_E_Q = slice(lib.SR_E_q, lib.SR_E_q + 2)
 IDX_E_NU = slice(lib.SR_E_nu, lib.SR_E_nu + NV)
 
+STATE_COLUMNS = (("q_x", "q_y", "q_z")
+                 + tuple(f"{m}_{i}{j}" for m in ("R_S", "R_Y", "R_P") for i in (1, 2, 3) for j in (1, 2, 3))
+                 + ("w_S_x", "w_S_y", "w_S_z", "w_Y", "w_P"))
+"""The state's column names in tables (trajectory.csv, logs, estimates), in their order: q, R_S, R_Y,
+R_P (row-major: R_S_12 is row 1, column 2), ω_S, ω_Y, ω_P."""
+COLUMN_INDEX = np.r_[IDX_Q, IDX_RS, IDX_RY, IDX_RP, IDX_WS, IDX_WY, IDX_WP]
+"""x[..., COLUMN_INDEX] is the state in the order of STATE_COLUMNS; x[..., COLUMN_INDEX] = table inverts it."""
+
 
 def rotations(x):
     """(R_S, R_Y, R_P) of a state (35,) or of states (..., 35): arrays (..., 3, 3), views where possible."""

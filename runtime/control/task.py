@@ -40,7 +40,7 @@ from ..state import IDX_Q
 AVAILABLE_CONTROLLERS = {"pid": (Pid, PidGains, GAIN_NAMES), "lqr": (Lqr, LqrGains, LQR_GAIN_NAMES),
                          "nmpc": (Nmpc, NmpcGains, NMPC_GAIN_NAMES)}
 CONTROLLER_KINDS = tuple(AVAILABLE_CONTROLLERS)
-_SCENARIO_KEYS = {"description", "dt", "duration", "steps", "method", "params", "initial"}
+_SCENARIO_KEYS = {"description", "dt", "duration", "steps", "method", "params", "initial", "sensors"}
 _REFERENCE_KEYS = {"kind", "speed", "heading", "offset", "radius", "size", "points"}
 _NEEDS = {"speed": ("speed",), "heading": ("speed", "heading"), "line": ("speed", "offset"),
           "circle": ("speed", "radius"), "figure8": ("speed", "size"), "waypoints": ("speed", "points")}
@@ -134,6 +134,8 @@ class Task:
     rate = property(lambda self: self.controllers[0].rate, doc="The first controller's rate [Hz].")
     u_max = property(lambda self: self.controllers[0].u_max, doc="The first controller's torque limit [N m].")
     gains = property(lambda self: self.controllers[0].gains, doc="The first controller's gains.")
+    sensors = property(lambda self: self.scenario.sensors,
+                       doc="The task's `[sensors]` (runtime.sensor_set.SensorSet), None without one.")
 
     @property
     def controller_kinds(self):

@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from ..state import (IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, absolute_inclinations,
+from ..state import (COLUMN_INDEX, IDX_Q, IDX_WP, IDX_WS, IDX_WY, STATE_COLUMNS, absolute_inclinations,
                      pendulum_angle, yoke_angle)
 from .animation import frame_samples, write_gif
 from ..atomic import write_text
@@ -24,9 +24,7 @@ from .plots import FIGURES, save_figure
 from .replay import write_replay
 
 #: Columns of trajectory.csv, in order (matrices row-major: R_S_12 is row 1, column 2).
-CSV_COLUMNS = (["t", "q_x", "q_y", "q_z"]
-               + [f"{m}_{i}{j}" for m in ("R_S", "R_Y", "R_P") for i in (1, 2, 3) for j in (1, 2, 3)]
-               + ["w_S_x", "w_S_y", "w_S_z", "w_Y", "w_P", "u_Y", "u_P", "E"])
+CSV_COLUMNS = ["t", *STATE_COLUMNS, "u_Y", "u_P", "E"]
 
 
 # -- derived quantities ---------------------------------------------------------------------
@@ -91,8 +89,7 @@ def summary(result, extra_wall_time=None):
 def trajectory_table(result):
     """The rows of trajectory.csv as an array (steps+1, len(CSV_COLUMNS))."""
     x = result.trajectory
-    return np.column_stack([result.time, x[:, IDX_Q], x[:, IDX_RS], x[:, IDX_RY], x[:, IDX_RP],
-                            x[:, IDX_WS], x[:, IDX_WY], x[:, IDX_WP], result.torques, result.energy])
+    return np.column_stack([result.time, x[:, COLUMN_INDEX], result.torques, result.energy])
 
 
 def write_csv(result, target):

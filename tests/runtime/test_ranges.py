@@ -15,6 +15,7 @@ from runtime.params import NAMES as PARAM_NAMES
 from runtime.params import PAPER_NAMES, SHAPES
 from runtime.scenario import ROBOT_RANGES, SCENARIO_RANGES, parse_scenario
 from runtime.schema import check_range, ranges_markdown
+from runtime.sensor_set import SENSOR_RANGES
 from runtime.sweep.spec import FACTOR, SWEEP_RANGES
 
 DOC = ROOT / "docs" / "robustness.md"
@@ -26,13 +27,15 @@ def documented_ranges():
     parts = [("Scenario files", {k: v for k, v in SCENARIO_RANGES.items() if k != "params"}),
              ("Robot files, `[params]` of scenario files, `[plant]` of task files", {"": ROBOT_RANGES}),
              ("Task files (beyond their scenario's keys)", TASK_RANGES),
+             ("Sensor sets (`[sensors]` of scenario, task and sensors files)",
+              {f"sensors.{table}": ranges for table, ranges in SENSOR_RANGES.items()}),
              ("Sweep files (a quantity's numbers: a parameter's as robot files, `relative`: a factor)",
               {**SWEEP_RANGES, "relative = true": {"values, uniform, normal mean": FACTOR}})]
     return "\n\n".join(f"{title}:\n\n{ranges_markdown(sections)}" for title, sections in parts)
 
 
 def every_range():
-    tables = {"scenario": SCENARIO_RANGES, "task": TASK_RANGES, "sweep": SWEEP_RANGES}
+    tables = {"scenario": SCENARIO_RANGES, "task": TASK_RANGES, "sweep": SWEEP_RANGES, "sensors": SENSOR_RANGES}
     return [pytest.param(rng, id=f"{kind}:{section}.{key}") for kind, sections in tables.items()
             for section, ranges in sections.items() for key, rng in ranges.items()]
 

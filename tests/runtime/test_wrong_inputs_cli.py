@@ -37,6 +37,8 @@ OPTIONS = {
                "--scheduler": ["localhost:notaport", "localhost:99999", ":", "tcp://"]}),
     "bench": ([], {"--states": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER,
                    "--loop-steps": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER}),
+    "sense": (["t-shape", "--out", "{tmp}/log"], {"--seed": NOT_A_NUMBER + ["-1", "-5"] + NOT_AN_INTEGER,
+                                                   "--duration": NOT_A_NUMBER + NOT_POSITIVE}),
     "sweep-bench": ([], {"--samples": NOT_A_NUMBER + NOT_POSITIVE, "--samples-per-task": NOT_A_NUMBER + NOT_POSITIVE,
                          "--noop-tasks": NOT_A_NUMBER + NOT_POSITIVE, "--rounds": NOT_A_NUMBER + NOT_POSITIVE}),
 }
