@@ -8,6 +8,7 @@ KINDS = {
     "fmu": ("runtime.interop.fmu", "FMI 2.0 and 3.0 co-simulation FMUs (make fmu)"),
     "mjcf": ("runtime.interop.mjcf", "a MuJoCo model (MJCF) of the robot"),
 }
+"""kind -> (the module whose `main` writes it, what it is)."""
 
 
 def usage():

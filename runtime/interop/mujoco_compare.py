@@ -41,6 +41,7 @@ TARGET_RELATIVE = 1e-3
 TARGET_ABSOLUTE = 1e-3
 """The other runs' target: the largest distance between the centres [m]."""
 RELATIVE_TARGET_SCENARIOS = ("t-shape",)
+"""The scenarios held to TARGET_RELATIVE of their path (a long path); the others to TARGET_ABSOLUTE."""
 
 
 def settings_sweep(timesteps=DEFAULT_TIMESTEPS):
@@ -290,6 +291,11 @@ def main(argv):
     except (ValueError, OSError) as exc:
         print(f"compare-mujoco: {exc}", file=sys.stderr)
         return 2
+    for dt in args.timesteps:
+        if abs(round(scenario.dt / dt) * dt - scenario.dt) > 1e-9 * scenario.dt:
+            print(f"compare-mujoco: --timesteps: {dt:g} s does not divide the scenario's dt {scenario.dt:g} s",
+                  file=sys.stderr)
+            return 2
     out = pathlib.Path(args.out or f"out/mujoco/{scenario.name}")
     from tqdm import tqdm
     try:

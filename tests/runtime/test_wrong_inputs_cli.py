@@ -37,6 +37,8 @@ OPTIONS = {
                "--scheduler": ["localhost:notaport", "localhost:99999", ":", "tcp://"]}),
     "bench": ([], {"--states": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER,
                    "--loop-steps": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER}),
+    "export": (["mjcf", "--out", "{tmp}/robot.xml"], {"--u-max": NOT_A_NUMBER + NOT_POSITIVE}),
+    "compare-mujoco": (["tilted-yoke", "--out", "{tmp}"], {"--timesteps": NOT_A_NUMBER + NOT_POSITIVE + ["0.5", "1e-3,"]}),
     "sweep-bench": ([], {"--samples": NOT_A_NUMBER + NOT_POSITIVE, "--samples-per-task": NOT_A_NUMBER + NOT_POSITIVE,
                          "--noop-tasks": NOT_A_NUMBER + NOT_POSITIVE, "--rounds": NOT_A_NUMBER + NOT_POSITIVE}),
 }
