@@ -228,6 +228,21 @@ def csv_text(comparison):
     return out.getvalue()
 
 
+def _envelope(time, values, bins=400):
+    """(time, values) thinned to at most `bins` points, each the largest value of its stretch of samples
+    (the figures show the worst, not an aliased sample of an oscillation)."""
+    size = max(1, math.ceil(len(values) / bins))
+    count = len(values) // size * size
+    if size == 1 or count == 0:
+        return time, values
+    peaks = np.fmax.reduce(values[:count].reshape(-1, size), axis=1)
+    return time[:count].reshape(-1, size)[:, 0], peaks
+
+
+PLOT_FLOOR = 1e-12
+"""The figures' lower limit: a difference below it (rounding, the start) is drawn at it."""
+
+
 def plot(scenario, comparison, tolerance, path):
     """Position, attitude, energy differences and slip speed over time, one line per setting."""
     import matplotlib
@@ -239,10 +254,11 @@ def plot(scenario, comparison, tolerance, path):
     fig, axes = plt.subplots(2, 2, figsize=(10, 6.5), sharex=True)
     for ax, (key, title) in zip(axes.ravel(), panels):
         for label, _, _, diff in comparison["runs"]:
-            ax.semilogy(time, np.maximum(diff[key], 1e-16), lw=0.8, label=label)
+            ax.semilogy(*_envelope(time, np.maximum(diff[key], PLOT_FLOOR)), lw=0.8, label=label)
         if key == "position":
             ax.axhline(tolerance, color="k", ls="--", lw=0.8, label="target")
         ax.set_title(title, fontsize=9)
+        ax.set_ylim(bottom=PLOT_FLOOR)
         ax.grid(alpha=0.3)
     for ax in axes[1]:
         ax.set_xlabel("t [s]")
