@@ -1,4 +1,6 @@
 """The MJCF twin: MuJoCo loads it with our bodies, runs like the kernels, and a wrong export shows."""
+import json
+
 import numpy as np
 import pytest
 
@@ -130,3 +132,24 @@ def test_export_without_a_kind_lists_the_kinds(capsys):
     assert main(["export"]) == 2
     err = capsys.readouterr().err
     assert "fmu" in err and "mjcf" in err
+
+
+def test_compare_mujoco_writes_its_summary_table_and_figures(tmp_path):
+    scenario = tmp_path / "short.toml"
+    scenario.write_text('dt = 0.01\nsteps = 20\nmethod = "rkmk4"\n[params]\npreset = "paper_simulation"\n'
+                        '[initial]\ntheta_P = 0.5\n[[torque]]\nfrom_step = 1\nto_step = 10\nu_Y = 0.1\n')
+    out = tmp_path / "out"
+    assert main(["compare-mujoco", str(scenario), "--out", str(out), "--timesteps", "2e-3,1e-3"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    labels = [row["setting"] for row in summary["settings"]]
+    assert labels[:2] == ["exported, dt 2 ms", "exported, dt 1 ms"] and len(labels) == 2 + 5
+    assert all(row["position_target_met"] for row in summary["settings"])
+    rows = (out / "comparison.csv").read_text().splitlines()
+    assert len(rows) == 1 + len(labels) * 21
+    assert (out / "comparison.png").stat().st_size > 0 and (out / "convergence.png").stat().st_size > 0
+
+
+def test_compare_mujoco_refuses_a_timestep_that_does_not_divide_the_scenarios(tmp_path, capsys):
+    assert main(["compare-mujoco", "tilted-yoke", "--out", str(tmp_path), "--timesteps", "3e-3"]) == 2
+    assert "--timesteps" in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())
