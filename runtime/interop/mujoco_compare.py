@@ -281,6 +281,7 @@ def plot_convergence(scenario, comparison, tolerance, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
     points = [(c.timestep, _worst(d["position"]), _worst(d["slip"]))
               for label, c, _, d in comparison["runs"] if label.startswith("exported")]
     if not points:
@@ -290,6 +291,8 @@ def plot_convergence(scenario, comparison, tolerance, path):
     ax.loglog(dt * 1e3, position, "o-", label="worst distance between centres [m]")
     ax.loglog(dt * 1e3, slip, "s-", label="worst slip speed [m/s]")
     ax.axhline(tolerance, color="k", ls="--", lw=0.8, label="target")
+    ax.set_xticks(dt * 1e3, [f"{v:g}" for v in dt * 1e3])
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.set_xlabel("MuJoCo time step [ms] (contact time constant: 2 steps)")
     ax.set_title(f"{scenario.name}: exported settings", fontsize=9)
     ax.grid(alpha=0.3, which="both")
