@@ -35,7 +35,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from runtime.atomic import write_text
+from runtime.atomic import output_file, write_text
 from runtime.params import Params
 from runtime.scenario import load_robot
 
@@ -171,7 +171,7 @@ def main(argv):
                              "default: the paper's robot as Section 5.3 runs it")
     parser.add_argument("--u-max", type=_positive, default=DEFAULT_U_MAX,
                         help=f"the motors' torque limit at the joints, N m (default {DEFAULT_U_MAX})")
-    parser.add_argument("--out", required=True, help="the MJCF file to write")
+    parser.add_argument("--out", required=True, type=output_file, help="the MJCF file to write")
     args = parser.parse_args(argv)
     try:
         params = None if args.params is None else load_robot(args.params)

@@ -153,3 +153,10 @@ def test_compare_mujoco_refuses_a_timestep_that_does_not_divide_the_scenarios(tm
     assert main(["compare-mujoco", "tilted-yoke", "--out", str(tmp_path), "--timesteps", "3e-3"]) == 2
     assert "--timesteps" in capsys.readouterr().err
     assert not any(tmp_path.iterdir())
+
+
+def test_an_out_file_in_a_missing_folder_is_refused_naming_it(tmp_path, capsys):
+    out = tmp_path / "no-such-folder" / "robot.xml"
+    with pytest.raises(SystemExit) as exit_:
+        main(["export", "mjcf", "--out", str(out)])
+    assert exit_.value.code == 2 and str(out) in capsys.readouterr().err
