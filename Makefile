@@ -71,7 +71,7 @@ docs: $(STAMP)
 # The robot as FMI 2.0 and FMI 3.0 co-simulation FMUs: out/fmu/SphericalRobot.fmu and
 # out/fmu/fmi3/SphericalRobot.fmu (docs/interop.md).
 fmu: $(STAMP)
-	$(PY) -m runtime export-fmu --out out/fmu
+	$(PY) -m runtime export fmu --out out/fmu
 
 soak: $(STAMP)
 	$(PY) -m runtime soak

@@ -266,10 +266,16 @@ def _parse_params(table, source):
 
 
 def _load_robot(path, source):
-    """A robot file: a TOML table of general parameters (missing ones: the paper's robot's)."""
+    """A scenario's robot file, relative to the scenario file `source`."""
     if not isinstance(path, str):
         raise ValueError(f"robot: expected a file name, got {show(path)}")
-    full = pathlib.Path(source).parent / path
+    return load_robot(pathlib.Path(source).parent / path)
+
+
+def load_robot(path):
+    """The `Params` of a robot file (a TOML table of general parameters, docs/robots.md; the ones it
+    leaves out are the paper's robot's); ValueError naming the file and the field otherwise."""
+    full = pathlib.Path(path)
     try:
         table = tomllib.loads(full.read_text())
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:

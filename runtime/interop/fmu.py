@@ -1,6 +1,6 @@
 """The robot as a Functional Mock-up Unit: FMI 2.0 and FMI 3.0 co-simulation (docs/interop.md).
 
-`python -m runtime export-fmu [--out DIR] [--fmi 2] [--fmi 3]` (`make fmu`) writes
+`python -m runtime export fmu [--out DIR] [--fmi 2] [--fmi 3]` (`make fmu`) writes
 DIR/SphericalRobot.fmu (FMI 2.0) and DIR/fmi3/SphericalRobot.fmu (FMI 3.0): the C library and
 the glue of fmu/ compiled for this platform, and a modelDescription.xml.
 
@@ -218,7 +218,7 @@ def model_description(version, table=None, sources=()):
     common = {"modelName": MODEL_IDENTIFIER,
               "description": "Fiori's yoke-pendulum spherical robot rolling without slipping on a plane "
                              "(Lie-group model; verified C kernels)",
-              "generationTool": "spherical-robot-kernels (python -m runtime export-fmu)",
+              "generationTool": "spherical-robot-kernels (python -m runtime export fmu)",
               "variableNamingConvention": "flat"}
     if version == 2:
         root = ET.Element("fmiModelDescription", fmiVersion="2.0", guid=token(table), numberOfEventIndicators="0",
@@ -454,8 +454,8 @@ def simulate_scenario(fmu_path, scenario, outputs=None):
 
 
 def main(argv):
-    """`python -m runtime export-fmu`: build the FMI 2.0 and 3.0 FMUs into --out."""
-    parser = argparse.ArgumentParser(prog="python -m runtime export-fmu",
+    """`python -m runtime export fmu`: build the FMI 2.0 and 3.0 FMUs into --out."""
+    parser = argparse.ArgumentParser(prog="python -m runtime export fmu",
                                      description="Build the robot as FMI 2.0 and FMI 3.0 co-simulation FMUs.")
     parser.add_argument("--out", default="out/fmu",
                         help="output folder: OUT/SphericalRobot.fmu (FMI 2), OUT/fmi3/SphericalRobot.fmu (FMI 3)")
@@ -467,7 +467,7 @@ def main(argv):
         for version, path in build(sorted(set(args.fmi or (2, 3))), args.out, args.cc).items():
             print(f"FMI {version}.0: {path}")
     except (ValueError, RuntimeError) as exc:
-        print(f"export-fmu: {exc}", file=sys.stderr)
+        print(f"export fmu: {exc}", file=sys.stderr)
         return 1
     return 0
 

@@ -39,6 +39,8 @@ OPTIONS = {
                    "--loop-steps": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER}),
     "sense": (["t-shape", "--out", "{tmp}/log"], {"--seed": NOT_A_NUMBER + ["-1", "-5"] + NOT_AN_INTEGER,
                                                    "--duration": NOT_A_NUMBER + NOT_POSITIVE}),
+    "export": (["mjcf", "--out", "{tmp}/robot.xml"], {"--u-max": NOT_A_NUMBER + NOT_POSITIVE}),
+    "compare-mujoco": (["tilted-yoke", "--out", "{tmp}"], {"--timesteps": NOT_A_NUMBER + NOT_POSITIVE + ["0.5", "1e-3,"]}),
     "sweep-bench": ([], {"--samples": NOT_A_NUMBER + NOT_POSITIVE, "--samples-per-task": NOT_A_NUMBER + NOT_POSITIVE,
                          "--noop-tasks": NOT_A_NUMBER + NOT_POSITIVE, "--rounds": NOT_A_NUMBER + NOT_POSITIVE}),
 }

@@ -229,7 +229,7 @@ def test_a_communication_step_takes_equal_internal_steps_no_longer_than_the_inte
 def test_the_cli_reports_an_unsupported_fmi_version_without_a_traceback(capsys):
     from runtime.__main__ import main
     with pytest.raises(SystemExit) as exit_:
-        main(["export-fmu", "--fmi", "4"])
+        main(["export", "fmu", "--fmi", "4"])
     assert exit_.value.code == 2
     assert "invalid choice: 4" in capsys.readouterr().err
 
