@@ -16,8 +16,9 @@ $(STAMP): pyproject.toml setup.py bindings/build_sr.py bindings/fastcall.c $(C_S
 
 install: $(STAMP)
 
+# One pytest worker per core; work-stealing keeps both busy while the long C builds run.
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n auto --dist worksteal
 
 run: $(STAMP)
 	$(PY) -m runtime run all --out out --force
