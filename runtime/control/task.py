@@ -40,7 +40,7 @@ from ..state import IDX_Q
 AVAILABLE_CONTROLLERS = {"pid": (Pid, PidGains, GAIN_NAMES), "lqr": (Lqr, LqrGains, LQR_GAIN_NAMES),
                          "nmpc": (Nmpc, NmpcGains, NMPC_GAIN_NAMES)}
 CONTROLLER_KINDS = tuple(AVAILABLE_CONTROLLERS)
-_SCENARIO_KEYS = {"description", "dt", "duration", "steps", "method", "params", "initial"}
+_SCENARIO_KEYS = {"description", "dt", "duration", "steps", "method", "params", "initial", "friction"}
 _REFERENCE_KEYS = {"kind", "speed", "heading", "offset", "radius", "size", "points"}
 _NEEDS = {"speed": ("speed",), "heading": ("speed", "heading"), "line": ("speed", "offset"),
           "circle": ("speed", "radius"), "figure8": ("speed", "size"), "waypoints": ("speed", "points")}
