@@ -429,7 +429,7 @@ def _rotation(table, key, where, axis):
 # -- running ------------------------------------------------------------------------------
 def memory_estimate(scenario):
     """{what: bytes} of the arrays a run of `scenario` holds (runtime/memory.py)."""
-    return {"trajectory": memory.trajectory_bytes(scenario.steps)}
+    return {"trajectory": memory.trajectory_bytes(scenario.steps), "contact force": (scenario.steps + 1) * 3 * 8}
 
 
 def check_memory(scenario, budget=None):

@@ -163,10 +163,10 @@ class Task:
 
     def memory_estimate(self):
         """{what: bytes} of the largest arrays a run of the task holds (runtime/memory.py): the
-        plant's trajectory and torques, the estimates, the path table (its points, arc lengths,
+        plant's trajectory and torques, its contact forces, the estimates, the path table (its points, arc lengths,
         tangents, curvatures and the temporaries that build them), the NMPC's condensed problem."""
         steps = self.scenario.steps
-        parts = {"trajectory": memory.trajectory_bytes(steps)}
+        parts = {"trajectory": memory.trajectory_bytes(steps), "contact force": (steps + 1) * 3 * 8}
         spec, x0 = self.reference_spec, self.scenario.x0
         points = path_points(spec["kind"], self.path_length(), spec.get("radius"), spec.get("size"),
                              x0[IDX_Q][:2], spec.get("points"))
