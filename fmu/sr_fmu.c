@@ -130,97 +130,17 @@ int sr_fmu_prepare(sr_fmu *fmu, double start_time)
     return SR_FMU_OK;
 }
 
-static void cross(const sr_real a[3], const sr_real b[3], sr_real out[3])
-{
-    sr_real t[3];
-    t[0] = a[1] * b[2] - a[2] * b[1];
-    t[1] = a[2] * b[0] - a[0] * b[2];
-    t[2] = a[0] * b[1] - a[1] * b[0];
-    out[0] = t[0]; out[1] = t[1]; out[2] = t[2];
-}
-
-/* out = R v for R row-major. */
-static void rotate(const sr_real *R, const sr_real v[3], sr_real out[3])
-{
-    int i;
-    for (i = 0; i < 3; ++i)
-        out[i] = R[3 * i] * v[0] + R[3 * i + 1] * v[1] + R[3 * i + 2] * v[2];
-}
-
-/* C = A B for row-major 3x3. */
-static void compose(const sr_real *A, const sr_real *B, sr_real *C)
-{
-    int i, j;
-    for (i = 0; i < 3; ++i)
-        for (j = 0; j < 3; ++j)
-            C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
-}
-
-/* The acceleration of a body's centre of mass relative to the shell centre, arm = the centre's
- * offset, Omega, alpha the body's angular velocity and acceleration (inertial frame):
- * alpha x arm + Omega x (Omega x arm). */
-static void relative_acceleration(const sr_real arm[3], const sr_real Omega[3], const sr_real alpha[3],
-                                  sr_real out[3])
-{
-    sr_real t[3], w[3];
-    cross(alpha, arm, t);
-    cross(Omega, arm, w);
-    cross(Omega, w, w);
-    out[0] = t[0] + w[0]; out[1] = t[1] + w[1]; out[2] = t[2] + w[2];
-}
-
-/* The force of the floor on the shell at the contact point (plane frame), from the balance of
- * the total momentum: F = dP/dt - m g_vec, P the momentum of shell, yoke and pendulum (the
- * rotors carry no mass of their own).  The bodies' accelerations follow from the state and
- * d(nu)/dt = sr_accel by rigid-body kinematics: Omega_S = R_S w_S, Omega_Y = Omega_S + e_Y w_Y
- * (e_Y = R_S e_x, the yoke's hinge), Omega_P = Omega_Y + e_P w_P (e_P = R_S R_Y e_y), and rolling
- * without slipping, dq/dt = r Omega_S x e_z. */
+/* The force of the floor on the shell at the contact point (plane frame): the library's
+ * sr_contact_force, the balance of the total momentum (derive/contact.py). */
 static int contact_force(sr_fmu *fmu, sr_real F[3])
 {
-    const sr_real *p = fmu->params, *x = fmu->x;
-    const sr_real *R_S = x + SR_X_R_S;
-    const sr_real e_z[3] = {0, 0, 1}, e_x[3] = {1, 0, 0}, e_y[3] = {0, 1, 0};
-    sr_real a[SR_NV], Q[9], QP[9], Omega_S[3], alpha_S[3], Omega_Y[3], alpha_Y[3], Omega_P[3], alpha_P[3];
-    sr_real e_Y[3], e_P[3], arm_Y[3], arm_P[3], acc_Y[3], acc_P[3], acc_q[3], t[3], gravity[3];
-    sr_real m_tot = p[SR_P_m_S] + p[SR_P_m_Y] + p[SR_P_m_P];
-    int i, status = sr_accel(&fmu->model, x, fmu->u, a);
+    int status = sr_contact_force(&fmu->model, fmu->x, fmu->u, F);
 
     if (status != SR_OK) {
-        snprintf(fmu->message, sizeof fmu->message, "contact force at t = %g: the accelerations failed: %s",
-                 fmu->time, sr_status_string(status));
+        snprintf(fmu->message, sizeof fmu->message, "contact force at t = %g: %s", fmu->time,
+                 sr_status_string(status));
         return SR_FMU_ERROR;
     }
-    compose(R_S, x + SR_X_R_Y, Q);
-    compose(Q, x + SR_X_R_P, QP);
-    rotate(R_S, x + SR_X_w_S, Omega_S);
-    rotate(R_S, a, alpha_S);              /* d/dt (R_S w_S) = R_S dw_S/dt: R_S [w_S] w_S = 0 */
-    rotate(R_S, e_x, e_Y);
-    rotate(Q, e_y, e_P);
-    for (i = 0; i < 3; ++i)
-        Omega_Y[i] = Omega_S[i] + e_Y[i] * x[SR_X_w_Y];
-    cross(Omega_S, e_Y, t);
-    for (i = 0; i < 3; ++i)
-        alpha_Y[i] = alpha_S[i] + t[i] * x[SR_X_w_Y] + e_Y[i] * a[3];
-    for (i = 0; i < 3; ++i)
-        Omega_P[i] = Omega_Y[i] + e_P[i] * x[SR_X_w_P];
-    cross(Omega_Y, e_P, t);
-    for (i = 0; i < 3; ++i)
-        alpha_P[i] = alpha_Y[i] + t[i] * x[SR_X_w_P] + e_P[i] * a[4];
-    rotate(Q, p + SR_P_c_Y_x, arm_Y);
-    rotate(QP, p + SR_P_c_P_x, arm_P);
-    relative_acceleration(arm_Y, Omega_Y, alpha_Y, acc_Y);
-    relative_acceleration(arm_P, Omega_P, alpha_P, acc_P);
-    cross(alpha_S, e_z, acc_q);
-    gravity[0] = -p[SR_P_g] * sin(p[SR_P_slope]);
-    gravity[1] = 0;
-    gravity[2] = -p[SR_P_g] * cos(p[SR_P_slope]);
-    for (i = 0; i < 3; ++i)
-        F[i] = m_tot * (p[SR_P_r] * acc_q[i] - gravity[i]) + p[SR_P_m_Y] * acc_Y[i] + p[SR_P_m_P] * acc_P[i];
-    for (i = 0; i < 3; ++i)
-        if (!isfinite(F[i])) {
-            snprintf(fmu->message, sizeof fmu->message, "contact force at t = %g: not finite", fmu->time);
-            return SR_FMU_ERROR;
-        }
     return SR_FMU_OK;
 }
 

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 1779b65d0aa490a1], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources ed87b19eed4023f4], SymPy 1.14.0. */
 #include "sr_generated.h"
 
 #include <math.h>
@@ -28,7 +28,8 @@
  *   c[33] k_21 = j_P + j_yy
  *   c[34] k_22 = 2*j_xx
  *   c[35] k_23 = 2*m_R*r**2
- *   c[36] k_24 = 2*j_P */
+ *   c[36] k_24 = 2*j_P
+ *   c[37] k_25 = l*m_P/2 */
 int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[SR_GEN_NCONST])
 {
     const sr_real r = p[0];
@@ -49,9 +50,9 @@ int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[SR_GEN_NCONST])
     const sr_real t2 = c_P_z*(m_P*c_P_z);
     const sr_real t3 = J_P_xx + t2;
     const sr_real t4 = (r*r)*t1;
-    const sr_real t5 = m_P*r;
-    const sr_real t6 = J_Y_xx + t3;
-    const sr_real t7 = c_P_z*t5;
+    const sr_real t5 = J_Y_xx + t3;
+    const sr_real t6 = c_P_z*m_P;
+    const sr_real t7 = r*t6;
     const sr_real t8 = J_Y_yy + t3;
     const sr_real t9 = j_S + t4;
     const sr_real t10 = J_Y_xx + J_Y_yy;
@@ -76,10 +77,10 @@ int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[SR_GEN_NCONST])
     c[10] = k_Y;
     c[11] = k_P;
     c[12] = t4;
-    c[13] = -(t0*t5);
-    c[14] = j_S + t6;
+    c[13] = -(t0*(m_P*r));
+    c[14] = j_S + t5;
     c[15] = -t7;
-    c[16] = t6;
+    c[16] = t5;
     c[17] = t3 - J_Y_xx;
     c[18] = t8 + t9;
     c[19] = t10 + t9;
@@ -100,6 +101,7 @@ int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[SR_GEN_NCONST])
     c[34] = SR_C(2.0)*J_Y_xx;
     c[35] = SR_C(2.0)*t4;
     c[36] = (SR_C(2.0)*J_P_xx) + (SR_C(2.0)*t2);
+    c[37] = -t6;
     return SR_GEN_OK;
 }
 
@@ -5329,6 +5331,160 @@ int sr_gen_position_jacobian(sr_real H[36])
     H[33] = 0;
     H[34] = 0;
     H[35] = 0;
+    return SR_GEN_OK;
+}
+
+/* Contact force F = (F_x, F_y, F_z) of the floor on the shell, plane frame (z the floor's normal) [N], from the total momentum balance F = sum m_B p''_B - m_R g at the accelerations nud (derive.contact). */
+int sr_gen_contact_force(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real F[3])
+{
+    const sr_real r = c[0];
+    const sr_real g = c[2];
+    const sr_real m_R = c[4];
+    const sr_real k_25 = c[37];
+    const sr_real chi_x = x[0];
+    const sr_real chi_y = x[1];
+    const sr_real chi_z = x[2];
+    const sr_real eta_x = x[3];
+    const sr_real eta_y = x[4];
+    const sr_real eta_z = x[5];
+    const sr_real gamma_x = x[6];
+    const sr_real gamma_y = x[7];
+    const sr_real gamma_z = x[8];
+    const sr_real RY_11 = x[13];
+    const sr_real RY_21 = x[16];
+    const sr_real RP_00 = x[18];
+    const sr_real RP_02 = x[20];
+    const sr_real w_Sx = x[30];
+    const sr_real w_Sy = x[31];
+    const sr_real w_Sz = x[32];
+    const sr_real w_Y = x[33];
+    const sr_real w_P = x[34];
+    const sr_real a_Sx = nud[0];
+    const sr_real a_Sy = nud[1];
+    const sr_real a_Sz = nud[2];
+    const sr_real a_Y = nud[3];
+    const sr_real a_P = nud[4];
+    const sr_real t0 = gamma_z*r;
+    const sr_real t1 = a_Sz*r;
+    const sr_real t2 = RY_11*w_Sz;
+    const sr_real t3 = RY_21*w_Sy;
+    const sr_real t4 = w_Sx + w_Y;
+    const sr_real t5 = t2 - t3;
+    const sr_real t6 = (RP_02*t4) + (RP_00*t5);
+    const sr_real t7 = (RP_00*t4) - (RP_02*t5);
+    const sr_real t8 = -(k_25*t7);
+    const sr_real t9 = (t6*t8) - (k_25*((w_Y*(t2 - t3)) + ((RY_21*a_Sz) + (a_P + (RY_11*a_Sy)))));
+    const sr_real t10 = RY_11*w_Sy;
+    const sr_real t11 = RY_21*w_Sz;
+    const sr_real t12 = t11 + (w_P + t10);
+    const sr_real t13 = k_25*t12;
+    const sr_real t14 = (t12*t13) - (t7*t8);
+    const sr_real t15 = (RP_00*t9) + ((m_R*(((gamma_x*g) + (a_Sy*t0)) - (gamma_y*t1))) + (RP_02*t14));
+    const sr_real t16 = RP_02*w_Y;
+    const sr_real t17 = -((t13*t6) + (k_25*((RP_00*((w_P*t5) - (a_Sx + a_Y))) + ((RP_02*((w_P*t4) + ((RY_11*a_Sz) - (RY_21*a_Sy)))) - (t16*(t10 + t11))))));
+    const sr_real t18 = (RP_00*t14) - (RP_02*t9);
+    const sr_real t19 = (RY_11*t18) + ((m_R*((gamma_z*g) + (r*((a_Sx*gamma_y) - (a_Sy*gamma_x))))) + (RY_21*t17));
+    const sr_real t20 = ((m_R*(((gamma_y*g) + (gamma_x*t1)) - (a_Sx*t0))) + (RY_11*t17)) - (RY_21*t18);
+    const sr_real out_0 = (chi_y*t20) + ((chi_x*t15) + (chi_z*t19));
+    const sr_real out_1 = (eta_y*t20) + ((eta_x*t15) + (eta_z*t19));
+    const sr_real out_2 = (gamma_y*t20) + ((gamma_x*t15) + (gamma_z*t19));
+    const sr_real out_sum = out_2 + (out_0 + out_1);
+    if (!isfinite(out_sum) && !(isfinite(out_0) && isfinite(out_1) && isfinite(out_2))) return SR_GEN_NONFINITE;
+    F[0] = out_0;
+    F[1] = out_1;
+    F[2] = out_2;
+    return SR_GEN_OK;
+}
+
+/* General robot: contact force F = (F_x, F_y, F_z) of the floor on the shell, plane frame (z the floor's normal) [N], from the total momentum balance F = sum m_B p''_B - m_R g at the accelerations nud (derive.contact). */
+int sr_gen_general_contact_force(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real F[3])
+{
+    const sr_real r = cg[0];
+    const sr_real m_R = cg[1];
+    const sr_real h_Y_x = cg[7];
+    const sr_real h_Y_y = cg[8];
+    const sr_real h_Y_z = cg[9];
+    const sr_real h_P_x = cg[10];
+    const sr_real h_P_y = cg[11];
+    const sr_real h_P_z = cg[12];
+    const sr_real g_x = cg[29];
+    const sr_real g_z = cg[30];
+    const sr_real chi_x = x[0];
+    const sr_real chi_y = x[1];
+    const sr_real chi_z = x[2];
+    const sr_real eta_x = x[3];
+    const sr_real eta_y = x[4];
+    const sr_real eta_z = x[5];
+    const sr_real gamma_x = x[6];
+    const sr_real gamma_y = x[7];
+    const sr_real gamma_z = x[8];
+    const sr_real RY_11 = x[13];
+    const sr_real RY_21 = x[16];
+    const sr_real RP_00 = x[18];
+    const sr_real RP_02 = x[20];
+    const sr_real w_Sx = x[30];
+    const sr_real w_Sy = x[31];
+    const sr_real w_Sz = x[32];
+    const sr_real w_Y = x[33];
+    const sr_real w_P = x[34];
+    const sr_real a_Sx = nud[0];
+    const sr_real a_Sy = nud[1];
+    const sr_real a_Sz = nud[2];
+    const sr_real a_Y = nud[3];
+    const sr_real a_P = nud[4];
+    const sr_real t0 = RY_21*a_Sy;
+    const sr_real t1 = RY_11*a_Sz;
+    const sr_real t2 = RY_11*w_Sy;
+    const sr_real t3 = w_Y*t2;
+    const sr_real t4 = RY_21*w_Sz;
+    const sr_real t5 = w_Y*t4;
+    const sr_real t6 = (t0 - t1) + (t3 + t5);
+    const sr_real t7 = RY_11*w_Sz;
+    const sr_real t8 = RY_21*w_Sy;
+    const sr_real t9 = ((RY_11*a_Sy) + (RY_21*a_Sz)) + (w_Y*(t7 - t8));
+    const sr_real t10 = gamma_z*r;
+    const sr_real t11 = a_Sz*r;
+    const sr_real t12 = t2 + t4;
+    const sr_real t13 = w_Sx + w_Y;
+    const sr_real t14 = -t12;
+    const sr_real t15 = (h_Y_y*t13) + (h_Y_x*t14);
+    const sr_real t16 = t7 - t8;
+    const sr_real t17 = -t16;
+    const sr_real t18 = -t13;
+    const sr_real t19 = (h_Y_z*t18) + (h_Y_x*t16);
+    const sr_real t20 = a_P + t9;
+    const sr_real t21 = w_P + t12;
+    const sr_real t22 = -t21;
+    const sr_real t23 = RP_00*t13;
+    const sr_real t24 = t23 - (RP_02*t16);
+    const sr_real t25 = (h_P_x*t22) + (h_P_y*t24);
+    const sr_real t26 = (RP_02*((a_Sx + a_Y) - (w_P*t16))) + ((w_P*t23) + (RP_00*((t1 - (w_Y*(RY_11*w_Sy))) - (RY_21*(a_Sy + (w_Sz*w_Y))))));
+    const sr_real t27 = RP_02*t13;
+    const sr_real t28 = t27 + (RP_00*t16);
+    const sr_real t29 = -t28;
+    const sr_real t30 = -t24;
+    const sr_real t31 = (h_P_x*t28) + (h_P_z*t30);
+    const sr_real t32 = ((h_P_z*t20) + (t21*t25)) + ((t29*t31) - (h_P_y*t26));
+    const sr_real t33 = (h_P_z*t21) + (h_P_y*t29);
+    const sr_real t34 = (RP_02*((t0 - t1) + (t3 + t5))) + ((RP_00*((a_Sx + a_Y) + (w_P*t17))) - (w_P*t27));
+    const sr_real t35 = ((t22*t33) - (h_P_x*t20)) + ((t24*t31) + (h_P_y*t34));
+    const sr_real t36 = (RP_02*t35) + ((((h_Y_y*t6) + (h_Y_z*t9)) + ((m_R*(((chi_x*g_x) + (g_z*gamma_x)) + ((a_Sy*t10) - (gamma_y*t11)))) + ((t12*t15) + (t17*t19)))) + (RP_00*t32));
+    const sr_real t37 = a_Sx + a_Y;
+    const sr_real t38 = (h_Y_z*t12) + (h_Y_y*t17);
+    const sr_real t39 = ((h_Y_y*t37) + (t13*t19)) + ((t14*t38) - (h_Y_x*t9));
+    const sr_real t40 = ((t18*t15) - (h_Y_z*t37)) + ((t16*t38) - (h_Y_x*t6));
+    const sr_real t41 = ((t30*t25) + (t28*t33)) + ((h_P_x*t26) - (h_P_z*t34));
+    const sr_real t42 = (RP_00*t35) - (RP_02*t32);
+    const sr_real t43 = ((m_R*(((chi_z*g_x) + (g_z*gamma_z)) + (r*((a_Sx*gamma_y) - (a_Sy*gamma_x))))) + (RY_21*(t40 + t41))) + (RY_11*(t39 + t42));
+    const sr_real t44 = ((m_R*(((chi_y*g_x) + (g_z*gamma_y)) + ((gamma_x*t11) - (a_Sx*t10)))) + (RY_11*(t40 + t41))) - (RY_21*(t39 + t42));
+    const sr_real out_0 = (chi_y*t44) + ((chi_x*t36) + (chi_z*t43));
+    const sr_real out_1 = (eta_y*t44) + ((eta_x*t36) + (eta_z*t43));
+    const sr_real out_2 = (gamma_y*t44) + ((gamma_x*t36) + (gamma_z*t43));
+    const sr_real out_sum = out_2 + (out_0 + out_1);
+    if (!isfinite(out_sum) && !(isfinite(out_0) && isfinite(out_1) && isfinite(out_2))) return SR_GEN_NONFINITE;
+    F[0] = out_0;
+    F[1] = out_1;
+    F[2] = out_2;
     return SR_GEN_OK;
 }
 

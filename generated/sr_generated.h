@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 1779b65d0aa490a1], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources ed87b19eed4023f4], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/include/spherical_robot.h.
@@ -14,7 +14,7 @@
 
 #define SR_GEN_NPARAM 32
 #define SR_GEN_NPAPER 12
-#define SR_GEN_NCONST 37
+#define SR_GEN_NCONST 38
 #define SR_GEN_NCONST_NAMED 12
 #define SR_GEN_GENERAL_NCONST 104
 #define SR_GEN_GENERAL_NCONST_NAMED 31
@@ -118,7 +118,7 @@
 #define SR_EB_b_a 15
 
 /* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
-#define SR_GEN_CONSTANTS_FLOPS 43
+#define SR_GEN_CONSTANTS_FLOPS 44
 #define SR_GEN_INERTIA_FLOPS 107
 #define SR_GEN_RHS_FLOPS 168
 #define SR_GEN_ENERGY_FLOPS 136
@@ -148,6 +148,8 @@
 #define SR_GEN_HEADING_PENDULUM_JACOBIAN_FLOPS 127
 #define SR_GEN_ENCODERS_JACOBIAN_FLOPS 0
 #define SR_GEN_POSITION_JACOBIAN_FLOPS 0
+#define SR_GEN_CONTACT_FORCE_FLOPS 100
+#define SR_GEN_GENERAL_CONTACT_FORCE_FLOPS 179
 
 /* The float build's symbols carry _f, so a float/double mismatch fails at link time. */
 #ifdef SR_USE_FLOAT
@@ -181,6 +183,8 @@
 #define sr_gen_heading_pendulum_jacobian sr_gen_heading_pendulum_jacobian_f
 #define sr_gen_encoders_jacobian sr_gen_encoders_jacobian_f
 #define sr_gen_position_jacobian sr_gen_position_jacobian_f
+#define sr_gen_contact_force sr_gen_contact_force_f
+#define sr_gen_general_contact_force sr_gen_general_contact_force_f
 #define sr_gen_accel_lanes sr_gen_accel_lanes_f
 #endif
 
@@ -209,7 +213,8 @@
  *   c[33] k_21 = j_P + j_yy
  *   c[34] k_22 = 2*j_xx
  *   c[35] k_23 = 2*m_R*r**2
- *   c[36] k_24 = 2*j_P */
+ *   c[36] k_24 = 2*j_P
+ *   c[37] k_25 = l*m_P/2 */
 int sr_gen_constants(const sr_real p[SR_GEN_NPARAM], sr_real c[SR_GEN_NCONST]);
 /* Generalized inertia M(γ, R_Y, R_P), row-major 5x5, kinetic energy ½νᵀMν. */
 int sr_gen_inertia(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], sr_real M[25]);
@@ -342,6 +347,10 @@ int sr_gen_heading_pendulum_jacobian(const sr_real x[SR_GEN_NX], const sr_real m
 int sr_gen_encoders_jacobian(sr_real H[36]);
 /* Position fix (q_x, q_y): d/d(d, b), 2 x SR_GEN_NEB row-major (derive.sensors.position_jacobian). */
 int sr_gen_position_jacobian(sr_real H[36]);
+/* Contact force F = (F_x, F_y, F_z) of the floor on the shell, plane frame (z the floor's normal) [N], from the total momentum balance F = sum m_B p''_B - m_R g at the accelerations nud (derive.contact). */
+int sr_gen_contact_force(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real F[3]);
+/* General robot: contact force F = (F_x, F_y, F_z) of the floor on the shell, plane frame (z the floor's normal) [N], from the total momentum balance F = sum m_B p''_B - m_R g at the accelerations nud (derive.contact). */
+int sr_gen_general_contact_force(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real F[3]);
 /* sr_gen_accel on n states, for the batch calls: one loop without branches that the compiler vectorises across states (the same expressions, so each lane's result is the scalar kernel's, bit for bit); every output is written, and ok[i] is cleared where the scalar kernel would fail (or its outputs' sum overflows: decide such a state by the scalar kernel). GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic), for AVX2 too (SR_LANES_CLONES). */
 void sr_gen_accel_lanes(const sr_real c[SR_GEN_NCONST], long n, const sr_real *restrict x, long x_stride, const sr_real *restrict u, long u_stride, sr_real *restrict a, long a_stride, sr_real *restrict ok);
 

@@ -164,6 +164,24 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods):
         self._check_batch(x, status, failed[0])
         return out
 
+    def contact_force(self, x, u=None):
+        """The floor's force on the shell [N], plane frame (x up the slope, z the floor's normal):
+        shape (3,) for x (35,), or (B, 3) for x (B, 35); u (2,) / (B, 2) or None.  F_z is the normal
+        force, (F_x, F_y) the friction that rolling without slipping needs (docs/model.md)."""
+        x = real_array(x, "x", (NX,))
+        if x.ndim == 1:
+            x, u = self._state_and_input(x, u, batch=False)
+            out = np.empty(3)
+            self._check("x", lib.sr_contact_force(self._model, _ptr(x), _ptr(u), _ptr(out)))
+            return out
+        u = None if u is None else self._input(u, x)
+        out = np.empty((x.shape[0], 3))
+        failed = ffi.new("long *")
+        status = lib.sr_contact_force_batch(self._model, x.shape[0], _ptr(x), ffi.NULL if u is None else _ptr(u),
+                                            _ptr(out), failed)
+        self._check_batch(x, status, failed[0])
+        return out
+
     def _check_batch(self, x, status, row, detail=""):
         """A batch call's status: the state C stopped at (row) is checked again here, for the message
         that names what is wrong; then the status itself."""

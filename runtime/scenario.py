@@ -67,7 +67,9 @@ SCENARIO_RANGES = {
     "": {"dt": Range(1e-9, 1.0, "s", "below 1 ns a step moves the state by less than its rounding; "
                                      "above 1 s no integrator follows the robot"),
          "steps": Range(1, MAX_STEPS, "", "the trajectory is kept in memory (MAX_STEPS)", whole=True),
-         "duration": Range(0, 1e6, "s", "at most MAX_STEPS steps of at most 1 s", open_low=True)},
+         "duration": Range(0, 1e6, "s", "at most MAX_STEPS steps of at most 1 s", open_low=True),
+         "friction": Range(0, 10, "", "a Coulomb friction coefficient: rubber on dry concrete is about 1",
+                           open_low=True)},
     "params": ROBOT_RANGES,
     "initial": {"theta_Y": _ANGLE, "theta_P": _ANGLE, "R_S": Range(-1, 1, "", "a rotation's entry"),
                 "R_Y": Range(-1, 1, "", "a rotation's entry"), "R_P": Range(-1, 1, "", "a rotation's entry"),
@@ -78,7 +80,7 @@ SCENARIO_RANGES = {
                "from_time": _TIME, "to_time": _TIME, "u_Y": _TORQUE, "u_P": _TORQUE},
 }
 
-_TOP_KEYS = {"description", "dt", "steps", "duration", "method", "params", "initial", "torque", "sensors"}
+_TOP_KEYS = {"description", "dt", "steps", "duration", "method", "params", "initial", "torque", "sensors", "friction"}
 _INITIAL_KEYS = {"theta_Y", "theta_P", "R_S", "R_Y", "R_P", "q", "w_S", "w_Y", "w_P"}
 _TORQUE_KEYS = {"from_step", "to_step", "from_time", "to_time", "u_Y", "u_P"}
 
@@ -114,6 +116,7 @@ class Scenario:
     torques: tuple = ()
     description: str = ""
     sensors: object = None
+    friction: float = None    # μ of the floor, or None: where the motion needs more, its summary says so
 
     @property
     def duration(self):
@@ -167,7 +170,8 @@ class Result:
     trajectory: np.ndarray    # (steps+1, 35)
     torques: np.ndarray       # (steps+1, 2)
     energy: np.ndarray        # (steps+1,)
-    wall_time_s: float        # simulation and energy evaluation
+    wall_time_s: float        # simulation, energy and contact force evaluation
+    contact_force: np.ndarray = None   # (steps+1, 3) [N], plane frame (Model.contact_force)
 
 
 # -- loading ------------------------------------------------------------------------------
@@ -224,10 +228,11 @@ def parse_scenario(data, source="<scenario>", name="scenario"):
     if problem is not None:
         raise ValueError(f"{source}: initial: {problem}")
     torques = _parse_torques(data.get("torque", []), dt, steps, source)
+    friction = _positive_real(data["friction"], f"{source}: friction") if "friction" in data else None
     check_scenario_ranges(data, source)
     sensors = parse_sensors(data["sensors"], source) if "sensors" in data else None
     return Scenario(name=name, source=source, params=params, x0=x0, dt=dt, steps=steps,
-                    method=method, torques=torques, description=description, sensors=sensors)
+                    method=method, torques=torques, description=description, sensors=sensors, friction=friction)
 
 
 def check_scenario_ranges(data, source):
@@ -434,7 +439,7 @@ def _rotation(table, key, where, axis):
 # -- running ------------------------------------------------------------------------------
 def memory_estimate(scenario):
     """{what: bytes} of the arrays a run of `scenario` holds (runtime/memory.py)."""
-    return {"trajectory": memory.trajectory_bytes(scenario.steps)}
+    return {"trajectory": memory.trajectory_bytes(scenario.steps), "contact force": (scenario.steps + 1) * 3 * 8}
 
 
 def check_memory(scenario, budget=None):
@@ -468,5 +473,6 @@ def run_scenario(scenario, progress=None):
 
 def _result(model, scenario, trajectory, torques, started):
     energy = np.array([model.energy(x) for x in trajectory])
+    contact = model.contact_force(trajectory, torques) if len(trajectory) else np.empty((0, 3))
     return Result(scenario=scenario, time=np.arange(len(trajectory)) * scenario.dt, trajectory=trajectory,
-                  torques=torques, energy=energy, wall_time_s=time.perf_counter() - started)
+                  torques=torques, energy=energy, wall_time_s=time.perf_counter() - started, contact_force=contact)

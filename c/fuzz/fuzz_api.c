@@ -354,6 +354,10 @@ static void fuzz_model_validity(reader *r, const sr_model *valid, const sr_real 
     expect_model_verdict("sr_energy (model)", status, changed, &g, 1);
     status = sr_equilibrium_residual(&m, x, arm(&g, SR_NV));
     expect_model_verdict("sr_equilibrium_residual (model)", status, changed, &g, SR_NV);
+    status = sr_contact_force(&m, x, u, arm(&g, 3));
+    expect_model_verdict("sr_contact_force (model)", status, changed, &g, 3);
+    status = sr_contact_force_batch(&m, 2, x2, NULL, arm(&g, 2 * 3), &row);
+    expect_model_verdict("sr_contact_force_batch (model)", status, changed, &g, 2 * 3);
     status = sr_step(&m, method, x, u, dt, arm(&g, SR_NX));
     expect_model_verdict("sr_step (model)", status, changed, &g, SR_NX);
     status = sr_step_lie_euler(&m, x, u, dt, arm(&g, SR_NX));
@@ -568,6 +572,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     status = sr_equilibrium_residual(&model, x, arm(&g, SR_NV));
     EXPECT_STATUS("sr_equilibrium_residual", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION);
     expect("sr_equilibrium_residual", status, &g, status == SR_OK ? SR_NV : 0, 1);
+    status = sr_contact_force(&model, x, u_or_null, arm(&g, 3));
+    EXPECT_STATUS("sr_contact_force", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_SINGULAR);
+    expect("sr_contact_force", status, &g, status == SR_OK ? 3 : 0, 1);
     status = sr_so3_exp(x + SR_X_w_S, arm(&g, 9));
     EXPECT_STATUS("sr_so3_exp", status, SR_OK, SR_ERR_NONFINITE);
     expect("sr_so3_exp", status, &g, status == SR_OK ? 9 : 0, 1);

@@ -76,6 +76,8 @@ extern "C" {
 #define sr_rhs sr_rhs_f
 #define sr_energy sr_energy_f
 #define sr_equilibrium_residual sr_equilibrium_residual_f
+#define sr_contact_force sr_contact_force_f
+#define sr_contact_force_batch sr_contact_force_batch_f
 #define sr_so3_exp sr_so3_exp_f
 #define sr_step sr_step_f
 #define sr_step_lie_euler sr_step_lie_euler_f
@@ -266,6 +268,20 @@ int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy);
 /** Generalized gravity torques at rest (f at nu = 0, u = 0) [N m]; zero exactly at the
  * equilibria R_S R_Y R_P e_z = +-e_z of equation (108). */
 int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV]);
+
+/** Contact force F = (F_x, F_y, F_z) [N] of the floor on the shell at the contact point, in the
+ * plane frame (x up the slope, z the floor's normal: F_z is the normal force, (F_x, F_y) the
+ * friction that rolling without slipping needs), at state x under torques u (u may be NULL: zero
+ * torque).  From the balance of the total momentum, F = sum_B m_B p''_B - m_R g_vec (derive/contact.py),
+ * with the accelerations of sr_accel.  The checks and status codes are sr_accel's (SR_ERR_MODEL
+ * first, then SR_ERR_NULL, then the state's cheap checks); F is written only on SR_OK. */
+int sr_contact_force(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real F[3]);
+
+/** sr_check_state, then sr_contact_force, on each of n states: x is n x SR_NX, u is n x SR_NU (or
+ * NULL), F is n x 3, all row-major.  Stops at the first failing row, whose index goes to
+ * *failed_row (if not NULL; -1 when all rows succeed); only the rows before it are written. */
+int sr_contact_force_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real *F,
+                           long *failed_row);
 
 /** R = Exp([[w]]) by Rodrigues' formula, with a series branch for |w| < 1e-4 rad.
  * SR_ERR_NONFINITE (R untouched) if w is not finite or |w|^2 overflows. */

@@ -48,6 +48,51 @@ static void test_general_kernels_agree_with_the_paper_kernels_on_the_papers_robo
     }
 }
 
+/* The contact force of the paper's robot through the general kernel equals the paper-geometry
+ * kernel's, and one state of a batch is the single call's, bit for bit. */
+static void test_general_contact_force_agrees_with_the_papers_and_the_batch_with_single_calls(void)
+{
+    sr_model paper, general;
+    sr_real p[SR_NPARAM], x[2 * SR_NX], u[2 * SR_NU], F[3], G[3], B[6];
+    test_rng rng = {43};
+    long row;
+    int i, k;
+    paper_simulation_params(p);
+    CHECK_STATUS(sr_model_init(&paper, p), SR_OK);
+    p[SR_P_j_mY] = SR_C(1e-30);
+    CHECK_STATUS(sr_model_init(&general, p), SR_OK);
+    for (i = 0; i < 100; ++i) {
+        double scale = 0;
+        random_state(&rng, p[SR_P_r], 3.0, x);
+        random_state(&rng, p[SR_P_r], 3.0, x + SR_NX);
+        for (k = 0; k < 2 * SR_NU; ++k) u[k] = (sr_real)rng_uniform(&rng, -1, 1);
+        CHECK_STATUS(sr_contact_force(&paper, x, u, F), SR_OK);
+        CHECK_STATUS(sr_contact_force(&general, x, u, G), SR_OK);
+        for (k = 0; k < 3; ++k) scale = fmax(scale, fabs((double)F[k]));
+        for (k = 0; k < 3; ++k) CHECK_NEAR(G[k], F[k], 1e4 * TEST_EPS * scale);
+        CHECK_STATUS(sr_contact_force_batch(&general, 2, x, u, B, &row), SR_OK);
+        CHECK(row == -1);
+        CHECK_STATUS(sr_contact_force(&general, x + SR_NX, u + SR_NU, F), SR_OK);
+        for (k = 0; k < 3; ++k) CHECK(B[k] == G[k] && B[3 + k] == F[k]);
+    }
+}
+
+/* At rest on a flat floor the floor carries the weight m_R g and no more. */
+static void test_at_rest_the_contact_force_is_the_weight(void)
+{
+    sr_model m;
+    sr_real p[SR_NPARAM], x[SR_NX], F[3];
+    double weight;
+    paper_simulation_model(&m);
+    paper_simulation_params(p);
+    weight = (double)((p[SR_P_m_S] + p[SR_P_m_Y] + p[SR_P_m_P]) * p[SR_P_g]);
+    make_state(x, 0.0, 0.0, p[SR_P_r]);
+    CHECK_STATUS(sr_contact_force(&m, x, NULL, F), SR_OK);
+    CHECK_NEAR(F[0], 0.0, 10 * TEST_EPS * weight);
+    CHECK_NEAR(F[1], 0.0, 10 * TEST_EPS * weight);
+    CHECK_NEAR(F[2], weight, 10 * TEST_EPS * weight);
+}
+
 /* Without damping and torque a general robot on its slope keeps its energy (RKMK4 error only). */
 static void test_a_general_robot_keeps_its_energy_on_its_slope(void)
 {
@@ -70,4 +115,6 @@ void suite_general(void)
     RUN_TEST(test_model_init_chooses_the_kernels_by_the_geometry);
     RUN_TEST(test_general_kernels_agree_with_the_paper_kernels_on_the_papers_robot);
     RUN_TEST(test_a_general_robot_keeps_its_energy_on_its_slope);
+    RUN_TEST(test_general_contact_force_agrees_with_the_papers_and_the_batch_with_single_calls);
+    RUN_TEST(test_at_rest_the_contact_force_is_the_weight);
 }

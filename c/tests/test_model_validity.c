@@ -54,6 +54,8 @@ static int c_inertia(const sr_model *m, long n) { (void)n; return sr_inertia(m, 
 static int c_rhs(const sr_model *m, long n) { (void)n; return sr_rhs(m, X, U, OUT); }
 static int c_energy(const sr_model *m, long n) { (void)n; return sr_energy(m, X, OUT); }
 static int c_residual(const sr_model *m, long n) { (void)n; return sr_equilibrium_residual(m, X, OUT); }
+static int c_contact_force(const sr_model *m, long n) { (void)n; return sr_contact_force(m, X, U, OUT); }
+static int c_contact_force_batch(const sr_model *m, long n) { return sr_contact_force_batch(m, n, X, U, OUT, &ROW); }
 static int c_step(const sr_model *m, long n) { (void)n; return sr_step(m, SR_RKMK4 | SR_PROJECT, X, U, SR_C(0.01), OUT); }
 static int c_step_lie_euler(const sr_model *m, long n) { (void)n; return sr_step_lie_euler(m, X, U, SR_C(0.01), OUT); }
 static int c_step_rkmk4(const sr_model *m, long n) { (void)n; return sr_step_rkmk4(m, X, U, SR_C(0.01), OUT); }
@@ -135,6 +137,8 @@ static const model_fn TAKES_MODEL[] = {
     {"sr_rhs", c_rhs},
     {"sr_energy", c_energy},
     {"sr_equilibrium_residual", c_residual},
+    {"sr_contact_force", c_contact_force},
+    {"sr_contact_force_batch", c_contact_force_batch},
     {"sr_step", c_step},
     {"sr_step_lie_euler", c_step_lie_euler},
     {"sr_step_rkmk4", c_step_rkmk4},

@@ -48,6 +48,14 @@ static int call_residual(const sr_model *m, const sr_real *x, const sr_real *u, 
     (void)u;
     return sr_equilibrium_residual(m, x, out);
 }
+static int call_contact_force(const sr_model *m, const sr_real *x, const sr_real *u, sr_real *out)
+{
+    return sr_contact_force(m, x, u, out);
+}
+static int call_contact_force_batch(const sr_model *m, const sr_real *x, const sr_real *u, sr_real *out)
+{
+    return sr_contact_force_batch(m, 1, x, u, out, NULL);
+}
 static int call_step(const sr_model *m, const sr_real *x, const sr_real *u, sr_real *out)
 {
     return sr_step(m, SR_LIE_EULER, x, u, SR_C(0.01), out);
@@ -71,6 +79,8 @@ static const api_fn API[] = {
     {"sr_inertia", call_inertia, 0, 1},
     {"sr_energy", call_energy, 0, 1},
     {"sr_equilibrium_residual", call_residual, 0, 1},
+    {"sr_contact_force", call_contact_force, 1, 1},
+    {"sr_contact_force_batch", call_contact_force_batch, 1, 1},
     {"sr_step", call_step, 1, 1},
     {"sr_simulate", call_simulate, 1, 1},
     {"sr_check_state", call_check_state, 0, 0},

@@ -10,6 +10,7 @@ additionally solves M ν̇ = f, joint accelerations first (see
 `joint_first.emit_shell_solve`: M is symmetric positive definite, so no
 pivoting is needed and no square root is taken).
 """
+from .. import contact as CF
 from .. import derivatives as J
 from .. import dynamics as D
 from .. import newton_euler as NE
@@ -109,7 +110,7 @@ def kernels():
         Kernel("paper_params", "The paper's robot (Section 2.3) as a general one: p[SR_P_*] from the"
                " paper's twelve parameters (derive.parameters.from_paper).",
                ("pp",), (Output("p", tuple(P.from_paper()), "parameters of the general robot"),)),
-    ) + general_kernels() + sensor_kernels()
+    ) + general_kernels() + sensor_kernels() + contact_kernels()
 
 
 UPPER = tuple((i, j) for i in range(S.NV) for j in range(i, S.NV))
@@ -225,3 +226,16 @@ def sensor_kernels():
                      " (derive.sensors.position_jacobian).",
                      (), (Output("H", tuple(SE.position_jacobian()), "d(q_x, q_y)/d(d, b)"),), finite_or_untouched=False))
     return tuple(ks)
+
+
+def contact_kernels():
+    """The floor's force on the shell (derive.contact), for the paper's robot (`c`) and the general
+    one (`cg`), given ν̇ from the accel kernel (c/src/sr_kernels.c: sr_contact_force)."""
+    doc = ("Contact force F = (F_x, F_y, F_z) of the floor on the shell, plane frame (z the floor's normal) [N],"
+           " from the total momentum balance F = sum m_B p''_B - m_R g at the accelerations nud (derive.contact).")
+    return (
+        Kernel("contact_force", doc, ("c", "x", "nud"),
+               (Output("F", tuple(CF.contact_force(R.PAPER)), "contact force, plane frame [N]"),)),
+        Kernel("general_contact_force", doc.replace("Contact force", "General robot: contact force"), ("cg", "x", "nud"),
+               (Output("F", tuple(CF.contact_force(R.GENERAL)), "contact force, plane frame [N]"),)),
+    )

@@ -1,5 +1,6 @@
 """`make control`: every controller of every shipped task (a task file lists its controllers); one table (Markdown and CSV),
-a folder per run with summary.json (metrics under `tracking`) and figures.
+a folder per run with summary.json (metrics under `tracking`, the contact force's extremes under `contact`)
+and figures.
 
     python -m runtime control [--out out/control] [--tasks circle,line] [--duration S]
 
@@ -17,6 +18,8 @@ import sys
 from tqdm.auto import tqdm
 
 from ..atomic import atomic_path, write_text
+from ..contact import contact_summary
+from ..model import Model
 from .closed_loop import simulate_closed_loop
 from .metrics import tracking_metrics
 from .plots import plot_run
@@ -46,6 +49,12 @@ def run_task(task, progress=False):
     every = max(1, round(1 / (task.rate * task.scenario.dt)))
     return result, reference, tracking_metrics(result, reference, task.reference_spec["kind"],
                                                task.plant_params.r, sample_every=every)
+
+
+def run_contact(task, result):
+    """The contact force's extremes and flags (runtime.contact) along a run of `task`, on its plant."""
+    forces = Model(task.plant_params).contact_force(result.trajectory, result.torques)
+    return contact_summary(result.time, forces, task.scenario.friction)
 
 
 def _fmt(value):
@@ -97,7 +106,8 @@ def main(argv=()):
         folder = out / f"{name}-{task.controller_kind}"
         folder.mkdir(exist_ok=True)
         summary = {"task": name, "controller": task.controller_kind, "rate_hz": task.rate, "u_max": task.u_max,
-                   "duration_s": task.duration, "cpu": cpu_name(), "tracking": metrics}
+                   "duration_s": task.duration, "cpu": cpu_name(), "tracking": metrics,
+                   "contact": run_contact(task, result)}
         write_text(folder / "summary.json", json.dumps(summary, indent=2) + "\n")
         plot_run(result, reference, task, folder / "tracking.png")
         rows.append({"task": name, "controller": task.controller_kind, **metrics})

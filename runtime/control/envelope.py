@@ -9,10 +9,16 @@ Computed by simulation with the verified kernels (RKMK4, dt = 0.005 s), Params.p
   the PID's inner lean loop; the steady turn radius is v / mean yaw rate over the last 10 s of a
   40 s run, and the largest |u_P| over those 10 s says whether |u| ≤ u_max holds the turn.
 
+* the friction the benchmark tasks need: every controller of every shipped task (as `make
+  control` runs it), the largest friction ratio |F_t|/F_n of the contact force along the run and
+  the least normal force (runtime.contact): a floor with a smaller μ would let the robot slide.
+
     python -m runtime envelope      # prints the numbers, writes docs/figures/control-envelope.png
+    python -m runtime envelope --friction-only    # the friction table alone
 """
 
 import argparse
+import dataclasses
 
 import numpy as np
 from tqdm.auto import tqdm
@@ -22,10 +28,12 @@ from ..model import Model
 from ..params import Params
 from ..so3 import rot_z
 from ..state import absolute_inclinations, initial_state
+from .benchmark import run_contact, run_task
 from .closed_loop import simulate_closed_loop
 from .geometry import forward_speed, heading, lean
 from .pid import Pid
 from .reference import SpeedHeading
+from .task import load_task, shipped_tasks
 
 DT = 0.005
 #: The lean reference of a turn measurement rises at this rate [rad/s] (quasi-steady; a step flings the pendulum).
@@ -113,6 +121,31 @@ def compute(params=None, u_max=0.5):
             "leans": leans, "turns": turns, "u_max": u_max}
 
 
+def task_friction(names=None, duration=None):
+    """[(task, controller, largest |F_t|/F_n, its time [s], least F_n [N])] of every controller of the
+    shipped tasks (or of `names`), each run as `make control` runs it (cut to `duration` s if given)."""
+    rows = []
+    for name in shipped_tasks() if names is None else names:
+        task = load_task(name)
+        for kind in tqdm(task.controller_kinds, desc=f"friction of {name}", leave=False):
+            run = task.with_controller(kind)
+            if duration is not None:
+                steps = max(1, round(min(duration, run.duration) / run.scenario.dt))
+                run = dataclasses.replace(run, scenario=dataclasses.replace(run.scenario, steps=steps))
+            contact = run_contact(run, run_task(run)[0])
+            rows.append((task.name, kind, contact["largest_friction_ratio"], contact["largest_friction_ratio_time_s"],
+                         contact["least_normal_force_N"]))
+    return rows
+
+
+def friction_table(rows):
+    """The rows of `task_friction` as a Markdown table (a ratio of None: the robot left the floor)."""
+    lines = ["| task | controller | largest \\|F_t\\|/F_n | at t [s] | least F_n [N] |", "|---|---|---|---|---|"]
+    lines += [f"| {task} | {kind} | " + ("lifts off | — " if ratio is None else f"{ratio:.4f} | {t:.2f}") + f" | {fn:.1f} |"
+              for task, kind, ratio, t, fn in rows]
+    return "\n".join(lines)
+
+
 def tightest_turn(rows, leans, u_max):
     """(radius, lean) of the smallest steady radius whose pendulum torque stayed below u_max, or None."""
     held = [(abs(R), phi) for (R, up, _), phi in zip(rows, leans) if up < u_max]
@@ -123,7 +156,12 @@ def main(argv=()):
     """Prints the envelope's numbers and rewrites its figure (docs/control.md)."""
     parser = argparse.ArgumentParser(prog="python -m runtime envelope")
     parser.add_argument("figure", nargs="?", type=output_file, default="docs/figures/control-envelope.png", help="where to write the figure")
+    parser.add_argument("--friction-only", action="store_true", help="print only the friction the benchmark tasks need")
     args = parser.parse_args(list(argv))
+    print("friction the benchmark tasks need (largest |F_t|/F_n along each run):")
+    print(friction_table(task_friction()))
+    if args.friction_only:
+        return 0
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

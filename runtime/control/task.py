@@ -40,7 +40,7 @@ from ..state import IDX_Q
 AVAILABLE_CONTROLLERS = {"pid": (Pid, PidGains, GAIN_NAMES), "lqr": (Lqr, LqrGains, LQR_GAIN_NAMES),
                          "nmpc": (Nmpc, NmpcGains, NMPC_GAIN_NAMES)}
 CONTROLLER_KINDS = tuple(AVAILABLE_CONTROLLERS)
-_SCENARIO_KEYS = {"description", "dt", "duration", "steps", "method", "params", "initial", "sensors"}
+_SCENARIO_KEYS = {"description", "dt", "duration", "steps", "method", "params", "initial", "sensors", "friction"}
 _REFERENCE_KEYS = {"kind", "speed", "heading", "offset", "radius", "size", "points"}
 _NEEDS = {"speed": ("speed",), "heading": ("speed", "heading"), "line": ("speed", "offset"),
           "circle": ("speed", "radius"), "figure8": ("speed", "size"), "waypoints": ("speed", "points")}
@@ -165,10 +165,10 @@ class Task:
 
     def memory_estimate(self):
         """{what: bytes} of the largest arrays a run of the task holds (runtime/memory.py): the
-        plant's trajectory and torques, the estimates, the path table (its points, arc lengths,
+        plant's trajectory and torques, its contact forces, the estimates, the path table (its points, arc lengths,
         tangents, curvatures and the temporaries that build them), the NMPC's condensed problem."""
         steps = self.scenario.steps
-        parts = {"trajectory": memory.trajectory_bytes(steps)}
+        parts = {"trajectory": memory.trajectory_bytes(steps), "contact force": (steps + 1) * 3 * 8}
         spec, x0 = self.reference_spec, self.scenario.x0
         points = path_points(spec["kind"], self.path_length(), spec.get("radius"), spec.get("size"),
                              x0[IDX_Q][:2], spec.get("points"))

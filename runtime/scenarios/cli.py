@@ -25,6 +25,7 @@ import pathlib
 import sys
 
 from . import report
+from ..contact import contact_flags
 from ..errors import KernelError, SimulationStopped
 from .parallel import RunBar, write_runs
 from ..scenario import PAPER_SCENARIOS, check_memory, load_scenario, run_scenario, scenario_path, shipped_scenarios
@@ -102,6 +103,8 @@ def run_many(names, args):
             print(f"{scenario.name}: {scenario.steps} steps of {scenario.dt:g} s ({scenario.method}) in "
                   f"{result.wall_time_s:.3f} s; final position ({x:+.4f}, {y:+.4f}) m, largest excursion "
                   f"{summary['largest_excursion_m']:.4f} m; wrote {len(files)} files to {files[0].parent}/")
+            for flag in contact_flags(result.time, result.contact_force, scenario.friction):
+                print(f"warning: {scenario.name}: {flag.message(scenario.friction)}", file=sys.stderr)
     if failure is not None:
         raise failure
     return summaries

@@ -20,6 +20,7 @@ from ..state import (COLUMN_INDEX, IDX_Q, IDX_WP, IDX_WS, IDX_WY, STATE_COLUMNS,
                      pendulum_angle, yoke_angle)
 from .animation import frame_samples, write_gif
 from ..atomic import write_text
+from ..contact import contact_summary
 from .plots import FIGURES, save_figure
 from .replay import write_replay
 
@@ -80,6 +81,8 @@ def summary(result, extra_wall_time=None):
         },
         "wall_time_s": {"simulation": result.wall_time_s},
     }
+    if result.contact_force is not None and len(result.contact_force):
+        out["contact"] = contact_summary(result.time, result.contact_force, s.friction)
     if extra_wall_time:
         out["wall_time_s"].update(extra_wall_time)
     return out

@@ -12,6 +12,8 @@ Checks
   power         dE/dt = u·(ω_Y, ω_P) − k_S|ω_S|² − k_Y ω_Y² − k_P ω_P² at random states
   rolling       along motions of the C steppers: the contact force the motion implies against the
                 reference's multiplier, and the angular momentum balance about the contact point
+  contact force the contact-force kernel (Model.contact_force) against the reference's multiplier at
+                random states, torques and robots on slopes
   equilibria    accel = 0 at eq. (108); linearization stable below, unstable above
   symmetry      planar motions stay planar
   jacobians     accel_jacobian against CasADi AD of the reference and Richardson-extrapolated
@@ -245,6 +247,27 @@ def rolling_contact(n_runs=3, seed=3, t_end=1.0, dt=2.5e-4, samples=20):
                         catches="C-stepped motion violating Euler's law about the contact point")]
 
 
+def contact_force(n_states=200, seed=10, n_robots=2):
+    """The contact-force kernel (Model.contact_force: the total momentum balance at the kernel's ν̇)
+    against the independent reference's Lagrange multiplier (runtime.verification.contact) at random
+    states and torques, on the paper's robot and on random general robots on slopes."""
+    from .contact import ReferenceContact
+    rng = np.random.default_rng(seed)
+    robots = [Params.paper_simulation()] + [random_general_params(rng) for _ in range(n_robots)]
+    worst = (0.0, 0.0)
+    for params in robots:
+        model, reference = Model(params), ReferenceContact(params.as_dict())
+        for _ in range(n_states):
+            x, u = random_state(rng, params, max_speed=5.0), random_inputs(rng, 1)[0]
+            expected = reference.force(x, u)
+            err = float(np.abs(model.contact_force(x, u) - expected).max())
+            if err / float(np.abs(expected).max()) > worst[1]:
+                worst = (err, err / float(np.abs(expected).max()))
+    return CheckResult(f"contact force vs reference multiplier ({n_states * len(robots)} states, "
+                       f"{len(robots)} robots, slopes)", *worst, 1e-12, "relative to max |λ|",
+                       catches="a force off by 1e-9 relative; a mass or the slope off by 1e-6 in the kernel")
+
+
 def equilibrium_state(theta_Y, theta_P, up, alpha=0.0):
     """The rest state with joint angles theta_Y, theta_P and the pendulum below (or above, `up`) the
     centre."""
@@ -370,6 +393,7 @@ def run_all(n_states=1000, seed=0, progress=None):
         ("energy", lambda: [energy_conservation(seed=seed + 1), energy_conservation(seed=seed + 7, t_end=5.0, general=True)]),
         ("power", lambda: [power_balance(max(n_states // 5, 20), seed=seed + 2)]),
         ("rolling", lambda: rolling_contact(seed=seed + 3)),
+        ("contact force", lambda: [contact_force(max(n_states // 5, 20), seed + 10)]),
         ("equilibria", lambda: equilibria(seed=seed + 4)),
         ("symmetry", planar_symmetry),
         ("jacobians", lambda: jacobian_rows(n_states, seed + 5)),

@@ -87,7 +87,7 @@ def test_every_numeric_key_of_a_task_file_has_a_range():
 
 def test_every_numeric_key_of_a_scenario_file_has_a_range():
     from runtime.scenario import _INITIAL_KEYS, _TORQUE_KEYS
-    assert set(SCENARIO_RANGES[""]) == {"dt", "steps", "duration"}
+    assert set(SCENARIO_RANGES[""]) == {"dt", "steps", "duration", "friction"}
     assert set(SCENARIO_RANGES["initial"]) == _INITIAL_KEYS
     assert set(SCENARIO_RANGES["torque"]) == _TORQUE_KEYS
 

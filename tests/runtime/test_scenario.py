@@ -6,6 +6,7 @@ lean on runtime/scenarios/report.py.  The t-shape torque program is rebuilt here
 the windows of Section 5.3.3 and compared with what the file produces.
 """
 import math
+import tomllib
 
 import numpy as np
 import pytest
@@ -245,6 +246,10 @@ theta_P = 0.5
     (VALID.replace('preset = "paper"', 'preset = "paper"\nc_P = [0.0, -0.1]'), "Params.c_P", "shape (3,)"),
     (VALID.replace('preset = "paper"', 'preset = "paper"\nslope = 0.1\nb = 0.3'), "Params.b", "paper's robot"),
     (VALID.replace('preset = "paper"', 'robot = "no-such-robot.toml"'), "robot", "cannot read"),
+    # the floor's friction coefficient
+    (VALID.replace("dt = 0.01", "dt = 0.01\nfriction = 0.0"), "friction", "must be > 0"),
+    (VALID.replace("dt = 0.01", 'dt = 0.01\nfriction = "0.5"'), "friction", "expected a number"),
+    (VALID.replace("dt = 0.01", "dt = 0.01\nfriction = 20.0"), "friction", "(0, 10]"),
 ])
 def test_invalid_files_name_the_file_the_key_and_the_problem(tmp_path, text, key, what):
     path = tmp_path / "bad.toml"
@@ -262,6 +267,11 @@ def test_valid_base_file_loads(tmp_path):
     s = load_scenario(path)
     np.testing.assert_array_equal(s.x0, initial_state(theta_P=0.5))
     assert s.params == Params() and s.torques == ()
+
+
+def test_the_friction_coefficient_is_optional_and_carried_into_the_scenario():
+    assert parse_scenario(tomllib.loads(VALID)).friction is None
+    assert parse_scenario(tomllib.loads("friction = 0.6\n" + VALID)).friction == 0.6
 
 
 def test_the_documented_example_is_a_valid_scenario(tmp_path):

@@ -21,6 +21,7 @@ ENTRY_POINTS = {
     "inertia": (MODEL.inertia, {"x": X}),
     "rhs": (MODEL.rhs, {"x": X, "u": U}),
     "energy": (MODEL.energy, {"x": X}),
+    "contact_force": (MODEL.contact_force, {"x": X, "u": U}),
     "equilibrium_residual": (MODEL.equilibrium_residual, {"x": X}),
     "project": (MODEL.project, {"x": X}),
     "step": (MODEL.step, {"x": X, "u": U, "dt": 0.01, "method": "rkmk4"}),
@@ -68,7 +69,7 @@ def test_a_wrong_argument_gives_a_value_error_naming_it_or_a_finite_result(entry
     keeps_contract(lambda: call(**{**args, arg: value}), kind, names)
 
 
-BATCHED = {"accel": ("x", "u"), "inertia": ("x",), "rhs": ("x", "u"), "energy": ("x",),
+BATCHED = {"accel": ("x", "u"), "contact_force": ("x", "u"), "inertia": ("x",), "rhs": ("x", "u"), "energy": ("x",),
            "equilibrium_residual": ("x",), "project": ("x",), "step": ("x", "u"), "retract": ("x", "d"),
            "local": ("x", "y"), "accel_jacobian": ("x", "u"), "linearize": ("x", "u"),
            "step_jacobian": ("x", "u")}

@@ -1,4 +1,4 @@
-"""`python -m runtime control`: one table for every task, a summary.json with `tracking` per run."""
+"""`python -m runtime control`: one table for every task, a summary.json with `tracking` and `contact` per run."""
 import csv
 import json
 
@@ -19,6 +19,7 @@ def test_the_benchmark_writes_one_table_row_and_one_summary_per_task_and_control
     for run in ("speed-step-pid", "speed-step-lqr", "speed-step-nmpc", "circle-pid", "circle-lqr", "circle-nmpc"):
         summary = json.loads((tmp_path / run / "summary.json").read_text())
         assert set(summary["tracking"]) == set(COLUMNS)
+        assert summary["contact"]["least_normal_force_N"] > 0 and summary["contact"]["largest_friction_ratio"] > 0
         assert (tmp_path / run / "tracking.png").stat().st_size > 0
 
 

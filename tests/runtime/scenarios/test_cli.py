@@ -58,3 +58,14 @@ def test_cli_reports_a_bad_scenario_and_exits_2(tmp_path, capsys):
     assert "no-such-scenario: no such scenario file" in capsys.readouterr().err
     assert scenario_cli.main(["t-shape", "--out", str(tmp_path), "--method", "rk99", "--no-gif"]) == 2
     assert "method: unknown integrator" in capsys.readouterr().err
+
+
+def test_a_run_that_needs_more_friction_than_its_floor_gives_warns_and_says_so_in_its_summary(tmp_path, capsys):
+    scenario = tmp_path / "slippery.toml"
+    scenario.write_text('dt = 0.01\nsteps = 20\nfriction = 1e-6\n[params]\npreset = "paper_simulation"\n'
+                        '[[torque]]\nfrom_step = 1\nto_step = 20\nu_Y = 0.5\n')
+    assert scenario_cli.main([str(scenario), "--out", str(tmp_path / "out"), "--no-gif", "--no-replay"]) == 0
+    warning = [line for line in capsys.readouterr().err.splitlines() if line.startswith("warning: slippery:")]
+    assert len(warning) == 1 and "would slide" in warning[0]
+    contact = json.loads((tmp_path / "out" / "slippery" / "summary.json").read_text())["contact"]
+    assert contact["friction"] == 1e-6 and [flag["kind"] for flag in contact["flags"]] == ["slide"]

@@ -119,6 +119,23 @@ def test_rolling_rows_fail_for_a_kernel_with_a_parameter_off_by_1e_6(kernel_with
     assert not verify.rolling_contact(n_runs=1, seed=7)[row].passed
 
 
+def test_the_contact_force_kernel_equals_the_reference_multiplier():
+    assert_passed([verify.contact_force(n_states=10, seed=3)])
+
+
+def test_the_contact_force_row_fails_for_a_force_off_by_1e_9(monkeypatch):
+    original = Model.contact_force
+    monkeypatch.setattr(Model, "contact_force", lambda self, x, u=None: original(self, x, u) * (1 + 1e-9))
+    assert not verify.contact_force(n_states=3, seed=3, n_robots=0).passed
+
+
+@pytest.mark.parametrize("name", ["m_Y", "slope"])
+def test_the_contact_force_row_fails_for_a_kernel_with_a_parameter_off_by_1e_6(kernel_with, name):
+    """m_Y enters only through the general robot's yoke first moment, the slope only through gravity."""
+    kernel_with(**{name: 1e-6})
+    assert not verify.contact_force(n_states=3, seed=3, n_robots=1).passed
+
+
 def test_equilibria_are_rest_points_stable_below_and_unstable_above():
     assert_passed(verify.equilibria(seed=8))
 
