@@ -111,8 +111,8 @@ extern "C" {
 #define SR_ERR_ENERGY 10       /**< sr_simulate_guarded: the energy rose without input power beyond the
                                   guard's tolerance (see sr_energy_guard) */
 #define SR_ERR_MODEL 11        /**< the model is not one that sr_model_init filled: never initialised
-                                  (zeroed or garbage memory), or a parameter or constant changed
-                                  since (see sr_model) */
+                                  (zeroed or garbage memory), or an entry that the function reads
+                                  changed since (see sr_model) */
 /** @} */
 
 /** Tolerance on |R^T R - I| (entry-wise) and |det R - 1| accepted by the checks. */
