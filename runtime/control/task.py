@@ -231,10 +231,9 @@ def _parse_estimator(table, source):
     check_table(table, {"kind", *ESTIMATOR_SETTINGS}, where)
     if table.get("kind") != "ekf":
         raise ValueError(f"{where}.kind: expected \"ekf\", got {table.get('kind')!r}")
-    settings = EkfSettings(**{k: _real(v, f"{where}.{k}", positive=k != "rate", nonnegative=k == "rate")
-                              for k, v in table.items() if k != "kind"})
     check_ranges(table, TASK_RANGES["estimator"], where)
-    return settings
+    return EkfSettings(**{k: _real(v, f"{where}.{k}", positive=k != "rate", nonnegative=k == "rate")
+                          for k, v in table.items() if k != "kind"})
 
 
 def _real(value, where, positive=False, nonnegative=False):
