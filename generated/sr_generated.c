@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources ed87b19eed4023f4], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources be3bcc7a70a4e7cf], SymPy 1.14.0. */
 #include "sr_generated.h"
 
 #include <math.h>

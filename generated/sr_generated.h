@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources ed87b19eed4023f4], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources be3bcc7a70a4e7cf], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/include/spherical_robot.h.
@@ -150,6 +150,42 @@
 #define SR_GEN_POSITION_JACOBIAN_FLOPS 0
 #define SR_GEN_CONTACT_FORCE_FLOPS 100
 #define SR_GEN_GENERAL_CONTACT_FORCE_FLOPS 179
+
+/* What each kernel reads of a model (sr_model's p, c or cg): SR_GEN_READS_<kernel>(R) expands to
+ * R(array, first, end) for each run [first, end) of the entries of `array` that its code loads, and
+ * to nothing for a kernel that reads none.  The read sets of the model's checksums (c/src/sr_argcheck.h). */
+#define SR_GEN_READS_constants(R) R(p, 0, 5) R(p, 8, 10) R(p, 14, 16) R(p, 18, 20) R(p, 25, 26) R(p, 30, 31)
+#define SR_GEN_READS_inertia(R) R(c, 8, 9) R(c, 12, 20)
+#define SR_GEN_READS_rhs(R) R(c, 6, 12) R(c, 15, 16) R(c, 20, 22)
+#define SR_GEN_READS_energy(R) R(c, 8, 9) R(c, 12, 13) R(c, 15, 18) R(c, 21, 30)
+#define SR_GEN_READS_equilibrium_residual(R) R(c, 21, 22)
+#define SR_GEN_READS_accel(R) R(c, 6, 17) R(c, 18, 22) R(c, 30, 33)
+#define SR_GEN_READS_accel_jacobian_yoke_terms(R) R(c, 6, 17) R(c, 18, 22) R(c, 31, 32) R(c, 33, 37)
+#define SR_GEN_READS_paper_params(R)
+#define SR_GEN_READS_general_constants(R) R(p, 0, 32)
+#define SR_GEN_READS_general_inertia(R) R(cg, 16, 17) R(cg, 18, 19) R(cg, 22, 23) R(cg, 24, 25) R(cg, 31, 56)
+#define SR_GEN_READS_general_rhs(R) R(cg, 0, 2) R(cg, 4, 13) R(cg, 16, 19) R(cg, 22, 31) R(cg, 56, 62)
+#define SR_GEN_READS_general_system(R) R(cg, 0, 2) R(cg, 4, 13) R(cg, 16, 19) R(cg, 22, 62)
+#define SR_GEN_READS_general_energy(R) R(cg, 16, 17) R(cg, 18, 19) R(cg, 22, 25) R(cg, 31, 32) R(cg, 33, 35) R(cg, 39, 48) R(cg, 49, 51) R(cg, 52, 53) R(cg, 62, 82)
+#define SR_GEN_READS_general_equilibrium_residual(R) R(cg, 67, 70) R(cg, 71, 72) R(cg, 75, 81) R(cg, 82, 83)
+#define SR_GEN_READS_general_accel_jacobian_terms(R) R(cg, 4, 7) R(cg, 16, 17) R(cg, 18, 19) R(cg, 22, 25) R(cg, 31, 56) R(cg, 67, 70) R(cg, 71, 72) R(cg, 75, 81) R(cg, 82, 104)
+#define SR_GEN_READS_sensor_constants(R) R(p, 0, 1) R(p, 30, 32)
+#define SR_GEN_READS_imu_shell(R)
+#define SR_GEN_READS_imu_shell_jacobian(R)
+#define SR_GEN_READS_heading_shell(R)
+#define SR_GEN_READS_heading_shell_jacobian(R)
+#define SR_GEN_READS_imu_yoke(R)
+#define SR_GEN_READS_imu_yoke_jacobian(R)
+#define SR_GEN_READS_heading_yoke(R)
+#define SR_GEN_READS_heading_yoke_jacobian(R)
+#define SR_GEN_READS_imu_pendulum(R)
+#define SR_GEN_READS_imu_pendulum_jacobian(R)
+#define SR_GEN_READS_heading_pendulum(R)
+#define SR_GEN_READS_heading_pendulum_jacobian(R)
+#define SR_GEN_READS_encoders_jacobian(R)
+#define SR_GEN_READS_position_jacobian(R)
+#define SR_GEN_READS_contact_force(R) R(c, 0, 1) R(c, 2, 3) R(c, 4, 5) R(c, 37, 38)
+#define SR_GEN_READS_general_contact_force(R) R(cg, 0, 2) R(cg, 7, 13) R(cg, 29, 31)
 
 /* The float build's symbols carry _f, so a float/double mismatch fails at link time. */
 #ifdef SR_USE_FLOAT

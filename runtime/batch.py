@@ -17,6 +17,7 @@ import numpy as np
 
 from bindings._sr import ffi, lib
 
+from . import memory
 from . import model as _model
 from .params import Params
 from .state import NU, NX
@@ -86,6 +87,9 @@ def simulate_many(params, x0, dt, steps, u=None, method="lie-euler", energy_tol=
     (steps, 2) shared or (n, steps, 2); row k−1 acts on step k.  dt, steps, method, energy_tol:
     as in `Model.simulate`.  trajectories=True also returns every trajectory (n, steps+1, 35).
 
+    With trajectories=True the memory they take is estimated first: beyond runtime.memory's
+    budget, MemoryBudgetExceeded (a ValueError) naming `trajectories`.
+
     Wrong types and shapes raise ValueError naming the argument; a sample whose values are bad
     (parameters out of range, an invalid x0, a NaN torque) or whose run stops at a guard gets
     its status instead, and the others run as if it were not there.
@@ -101,6 +105,9 @@ def simulate_many(params, x0, dt, steps, u=None, method="lie-euler", energy_tol=
         u = real_array(u, "u", (steps, NU))
         arrays["u"] = (u, 2)
     n = _sample_count(arrays)
+    if trajectories:     # before anything is allocated, as a scenario's run
+        memory.check("trajectories", {f"{n} trajectories of {steps + 1} states": n * (steps + 1) * memory.STATE_ROW_BYTES,
+                                      "final states": n * memory.STATE_ROW_BYTES})
     stride = {name: (arr[0].size if arr.ndim > single_ndim else 0) for name, (arr, single_ndim) in arrays.items()}
 
     status = np.full(n, -1, dtype=np.intc)

@@ -11,8 +11,8 @@ _STATUS_HINTS = {
                              "(R_S orthonormal with det +1, R_Y about x, R_P about y)",
     lib.SR_ERR_SINGULAR: "gives a singular generalized inertia",
     lib.SR_ERR_CONSTRAINT: "violates q_z = r",
-    lib.SR_ERR_MODEL: "is not a valid sr_model: not filled by sr_model_init, or a parameter or constant "
-                      "changed since (its checksum differs); build a new Model",
+    lib.SR_ERR_MODEL: "is not a valid sr_model: not filled by sr_model_init, or a parameter or constant that "
+                      "the call reads changed since (its checksum differs); build a new Model",
 }
 
 

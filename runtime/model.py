@@ -300,6 +300,8 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods):
         status = lib.sr_simulate_guarded(self._model, code, _ptr(traj[first]), dt, n,
                                          ffi.NULL if u is None else _ptr(u), guard,
                                          _ptr(traj[first:first + n + 1]), done)
+        if status == lib.SR_ERR_MODEL:    # refused before any step: the model's fault, not the run's
+            raise KernelError("model", status)
         if status != lib.SR_OK:
             step = first + done[0] + 1
             state = traj[step].copy() if step < len(traj) and not np.isnan(traj[step]).all() else None

@@ -30,7 +30,7 @@ from .params import NAMES as PARAM_NAMES
 from .params import PAPER_NAMES, SHAPES, Params
 from .so3 import rot_x, rot_y
 from .state import IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WP, IDX_WS, IDX_WY, NU, NX
-from .schema import Range, check_ranges, check_table, show
+from .schema import Range, check_range, check_ranges, check_table, show
 from .sensor_set import parse_sensors
 from .validation import ROTATION_TOL, choice, describe_state
 
@@ -130,13 +130,17 @@ class Scenario:
         which must be a whole number).  Torque windows keep their time spans.
         """
         where = f"{self.source}: override"
-        new_dt = self.dt if dt is None else _positive_real(dt, f"{where}: dt")
+        keys = SCENARIO_RANGES[""]     # the ranges of the file's own keys
+        new_dt = self.dt if dt is None else check_range(_positive_real(dt, f"{where}: dt"), keys["dt"], f"{where}: dt")
         if steps is not None:
-            new_steps = _step_count(steps, f"{where}: steps")
+            new_steps = check_range(_step_count(steps, f"{where}: steps"), keys["steps"], f"{where}: steps")
         elif dt is not None:
             new_steps = _whole_steps(self.duration, new_dt, f"{where}: dt")
         else:
             new_steps = self.steps
+        if dt is not None or steps is not None:
+            named = " and ".join(n for n, v in (("dt", dt), ("steps", steps)) if v is not None)
+            check_range(new_steps * new_dt, keys["duration"], f"{where}: {named}: the duration steps × dt")
         new_method = self.method if method is None else _method_name(method, f"{where}: method")
         return dataclasses.replace(self, dt=new_dt, steps=new_steps, method=new_method)
 

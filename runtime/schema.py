@@ -68,6 +68,23 @@ def check_range(value, rng, where):
     return value
 
 
+def check_arguments(values, ranges):
+    """The arguments of a constructor ({name: value}) with a range in `ranges` ({name: Range}): each a
+    finite real number (not a bool) inside its range; otherwise ValueError("<name>: ...") naming the
+    argument and giving its range, as a file's key would."""
+    for name, value in values.items():
+        rng = ranges.get(name)
+        if rng is None:
+            continue
+        if not _is_number(value) and not (hasattr(value, "dtype") and getattr(value, "shape", None) == ()
+                                          and value.dtype.kind in "iuf"):
+            raise ValueError(f"{name}: expected {rng}, got {show(value)}")
+        if not math.isfinite(value):
+            raise ValueError(f"{name}: expected {rng}, got {value!r}")
+        check_range(value, rng, name)
+    return values
+
+
 def check_ranges(table, ranges, where, sep="."):
     """Every number of `table` (a dict) under a key of `ranges` ({key: Range}) checked by
     `check_range`, lists and lists of lists entry by entry (`<where>.<key>[i][j]`); `table`

@@ -375,3 +375,59 @@ def test_the_sensors_of_a_paper_only_build_read_g_upwards_at_rest(tmp_path, pape
 def run_status(name):
     from bindings._sr import lib
     return getattr(lib, name)
+
+
+# -- the read sets of the model's checksums (c/src/sr_argcheck.h, generated/sr_generated.h) --------
+# Planted wrong read sets, each in a copy of the sources: c/tests/test_model_validity.c must fail on
+# each, naming the entry point.  (file, text, planted text, what the C tests must then report.)
+READ_SET_PLANTS = {
+    # the library checks too little: the steppers skip the accel kernel's read set
+    "library": ("c/src/sr_steppers.c", "arg_model(model, READS(ACCEL) | READS(STATE))", "arg_model(model, READS(STATE))",
+                r"sr_step_lie_euler \(paper robot\) with c\[\d+\] = [^,]+, which it reads, returned 0"),
+    # the generator lists too little: sr_gen_accel's read set without its last run of constants
+    "generator": ("generated/sr_generated.h", "#define SR_GEN_READS_accel(R) ", None,
+                  r"sr_accel \(paper robot\) with c\[\d+\] = [^,]+, outside its read set"),
+}
+
+
+@pytest.fixture(scope="module")
+def generated_object(tmp_path_factory):
+    """generated/sr_generated.c compiled once (-O0: the fastest build), for the planted builds."""
+    obj = tmp_path_factory.mktemp("plant-gen") / "sr_generated.o"
+    run([CC, "-O0", "-std=c99", f"-I{INCLUDE}", f"-I{ROOT / 'generated'}", "-c", str(ROOT / "generated" / "sr_generated.c"),
+         "-o", str(obj)])
+    return obj
+
+
+def planted_build(tmp_path, generated_object, path, old, new):
+    """The C tests built from a copy of c/ and generated/ with `old` replaced by `new` in `path`
+    (new None: the last R(...) of that line dropped)."""
+    for folder in ("c/include", "c/src", "c/tests", "generated"):
+        shutil.copytree(ROOT / folder, tmp_path / folder, ignore=shutil.ignore_patterns("*.c") if folder == "generated" else None)
+    target = tmp_path / path
+    text = target.read_text()
+    assert text.count(old) >= 1, f"{path}: the text to plant in is gone: {old!r}"
+    if new is None:
+        start = text.index(old)
+        end = text.index("\n", start)
+        line = text[start:end]
+        new_line = line[:line.rindex(" R(")]
+        text = text[:start] + new_line + text[end:]
+    else:
+        text = text.replace(old, new)
+    target.write_text(text)
+    program = tmp_path / "sr_tests"
+    sources = sorted(map(str, (tmp_path / "c" / "src").glob("*.c"))) + sorted(map(str, (tmp_path / "c" / "tests").glob("*.c")))
+    run([CC, "-O0", "-std=c99", f"-I{tmp_path / 'c' / 'include'}", f"-I{tmp_path / 'generated'}",
+         f"-I{tmp_path / 'c' / 'src'}", f"-I{tmp_path / 'c' / 'tests'}", *sources, str(generated_object), "-lm",
+         "-o", str(program)])
+    return program
+
+
+@pytest.mark.parametrize("plant", sorted(READ_SET_PLANTS))
+def test_the_validity_tests_fail_on_a_planted_wrong_read_set(tmp_path, generated_object, plant):
+    path, old, new, report = READ_SET_PLANTS[plant]
+    result = run([planted_build(tmp_path, generated_object, path, old, new)], check=False)
+    assert result.returncode != 0
+    assert re.search(report, result.stderr), result.stderr[-2000:]
+    assert "FAILED test_each_entry_point_refuses_a_change_to_what_it_reads_and_only_that" in result.stderr

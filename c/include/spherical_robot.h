@@ -67,6 +67,7 @@ extern "C" {
 #define sr_paper_params sr_paper_params_f
 #define sr_paper_params_unchecked sr_paper_params_unchecked_f
 #define sr_model_init sr_model_init_f
+#define sr_check_model sr_check_model_f
 #define sr_check_state sr_check_state_f
 #define sr_check_state_batch sr_check_state_batch_f
 #define sr_accel sr_accel_f
@@ -112,8 +113,8 @@ extern "C" {
 #define SR_ERR_ENERGY 10       /**< sr_simulate_guarded: the energy rose without input power beyond the
                                   guard's tolerance (see sr_energy_guard) */
 #define SR_ERR_MODEL 11        /**< the model is not one that sr_model_init filled: never initialised
-                                  (zeroed or garbage memory), or a parameter or constant changed
-                                  since (see sr_model) */
+                                  (zeroed or garbage memory), or an entry that the function reads
+                                  changed since (see sr_model) */
 /** @} */
 
 /** Tolerance on |R^T R - I| (entry-wise) and |det R - 1| accepted by the checks. */
@@ -149,6 +150,9 @@ extern "C" {
                                   constant increments round the same way every step */
 /** @} */
 
+/** The number of read sets of a model, one checksum each (sr_model). */
+#define SR_MODEL_NSUMS 10
+
 /** Model: the parameters and the constants derived from them. Fill with sr_model_init.
  * A robot of the paper's geometry (c_Y = 0, J_Y_zz = J_Y_xx + J_Y_yy, J_Y diagonal, c_P on
  * the pendulum's z axis, J_P = diag(a, a, 0), no rotors, level floor) is evaluated by the
@@ -159,16 +163,21 @@ extern "C" {
  * A model is a value: copy it whole (assignment, memcpy), never change a field.  Every function
  * that takes a model first checks that it is valid, and returns SR_ERR_MODEL for one that is not:
  * its stamp missing (memory that sr_model_init never filled: zeroed, uninitialised, or left
- * untouched by a failed sr_model_init), or its checksum not that of what the kernels read (p,
- * general and the constants of that kind: any one entry changed since, to NaN or to any other
- * value).  The check costs about 8 ns a call (docs/robustness.md). */
+ * untouched by a failed sr_model_init), or a checksum of what that function reads of the model
+ * differing from the one sr_model_init stored.  sr_model_init stores one checksum per read set
+ * (SR_MODEL_NSUMS of them): the entries of p, c or cg that one generated kernel reads (listed by
+ * the generator, SR_GEN_READS_<kernel> in sr_generated.h) or that the hand-written code reads
+ * (r by the state check, the energy guard's masses, centres and g), each with general.  A function
+ * checks the read sets of the kernels it calls: any entry it reads, changed since to NaN or to any
+ * other value, is refused; an entry it does not read may change without that function refusing
+ * (nor its result changing).  sr_check_model re-checks the whole model. */
 typedef struct sr_model {
     sr_real p[SR_NPARAM];                /**< the parameters, as given to sr_model_init */
     int general;                         /**< 1: the general kernels (cg), 0: the paper-geometry ones (c) */
     sr_real c[SR_GEN_NCONST];            /**< derived constants of the paper-geometry kernels */
     sr_real cg[SR_GEN_GENERAL_NCONST];   /**< derived constants of the general kernels */
     uint64_t stamp;                      /**< set by sr_model_init: a model never initialised lacks it */
-    uint64_t checksum;                   /**< of p, general and the constants of that kind, set by sr_model_init */
+    uint64_t sums[SR_MODEL_NSUMS];       /**< one checksum per read set, set by sr_model_init */
 } sr_model;
 
 /** Human-readable name of a status code (static string, never NULL). */
@@ -224,6 +233,11 @@ const char *sr_param_rule_string(int rule);
  * Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE, SR_ERR_PARAM or SR_ERR_SINGULAR; *model is
  * untouched on error. */
 int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM]);
+
+/** The full re-check of a model: its stamp, and its constants, kind and checksums exactly those
+ * that sr_model_init makes of its parameters p (the other entry points check the checksums of
+ * what they read only).  Costs about one sr_model_init.  SR_OK, SR_ERR_NULL or SR_ERR_MODEL. */
+int sr_check_model(const sr_model *model);
 
 /** Full state check: finite entries, R_S orthonormal with det +1, R_Y a rotation
  * about x, R_P a rotation about y (to SR_ROTATION_TOL), |q_z - r| <= SR_ROTATION_TOL*r.

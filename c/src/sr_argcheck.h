@@ -53,24 +53,85 @@ static inline uint64_t model_words_sum(const sr_real *v, int n)
     return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
 }
 
-/* The checksum of what the kernels and checks read from a model: the parameters, the kind
- * (general) and the constants of that kind.  The constants of the other kind are never read. */
-static inline uint64_t model_checksum(const sr_model *model)
+/* ---- the read sets of a model: one checksum each (sr_model.sums) ---------------------------
+ * A read set is what one kernel reads of the model: a generated kernel's entries of p, c or cg
+ * (SR_GEN_READS_<kernel>, emitted by the generator from the code of that kernel; for the kinds that
+ * have two kernels, the paper-geometry one's or the general one's, by the model's kind), or the
+ * hand-written code's own reads of p, listed here.  Every checksum includes general.  An entry
+ * point checks the read sets of the kernels it calls (arg_model's `reads`), and a kernel that
+ * reads more of the model than its set says would be found by c/tests/test_model_validity.c (an
+ * entry changed outside the set must leave the result unchanged). */
+enum {
+    SR_READS_STATE,       /* p[r]: the state check's contact q_z = r, the rolling kinematics, the LQR's rate */
+    SR_READS_ACCEL,       /* sr_gen_accel and its lanes form / sr_gen_general_system */
+    SR_READS_INERTIA,     /* sr_gen_inertia / sr_gen_general_inertia */
+    SR_READS_RHS,         /* sr_gen_rhs / sr_gen_general_rhs */
+    SR_READS_ENERGY,      /* sr_gen_energy / sr_gen_general_energy */
+    SR_READS_EQUILIBRIUM, /* sr_gen_equilibrium_residual / sr_gen_general_equilibrium_residual */
+    SR_READS_JACOBIAN,    /* sr_gen_accel_jacobian_yoke_terms / sr_gen_general_accel_jacobian_terms */
+    SR_READS_SENSORS,     /* sr_gen_sensor_constants (p) */
+    SR_READS_GUARD,       /* the energy guard's scale (c/src/sr_drivers.c): m_Y, c_Y, m_P, c_P, g */
+    SR_READS_WHOLE,       /* all of p and the constants of the model's kind: the entry points off the
+                           * hot path (contact force, parameter Jacobians, estimator, NMPC) */
+    SR_READS_COUNT
+};
+typedef char sr_reads_count_matches[SR_READS_COUNT == SR_MODEL_NSUMS ? 1 : -1];
+
+/* The bit of read set k in arg_model's `reads`. */
+#define READS(k) (1u << SR_READS_##k)
+
+/* The hand-written code's reads of p, as R(array, first, end) like the generated read sets. */
+#define SR_READS_state(R) R(p, SR_P_r, SR_P_r + 1)
+#define SR_READS_guard(R) R(p, SR_P_m_Y, SR_P_c_Y_z + 1) R(p, SR_P_m_P, SR_P_c_P_z + 1) R(p, SR_P_g, SR_P_g + 1)
+
+/* One term of a read set's sum: the words of model->array[first..end). */
+#define SR_READS_TERM(array, first, end) + model_words_sum(model->array + (first), (end) - (first))
+/* The sum of a read set that is one kernel's of either kind (its paper-geometry and general kernels). */
+#define SR_READS_OF_KIND(paper, general_kernel) \
+    (model->general ? 0 SR_GEN_READS_##general_kernel(SR_READS_TERM) : 0 SR_GEN_READS_##paper(SR_READS_TERM))
+
+/* The checksum of read set k of a model (k constant where it is inlined: the switch folds away). */
+static inline uint64_t model_reads_sum(const sr_model *model, int k)
 {
-    const uint64_t constants = model->general ? model_words_sum(model->cg, SR_GEN_GENERAL_NCONST)
-                                              : model_words_sum(model->c, SR_GEN_NCONST);
-    return model_words_sum(model->p, SR_NPARAM) + constants + (uint64_t)(unsigned)model->general;
+    uint64_t sum = 0;
+    switch (k) {
+    case SR_READS_STATE: sum = 0 SR_READS_state(SR_READS_TERM); break;
+    case SR_READS_ACCEL: sum = SR_READS_OF_KIND(accel, general_system); break;
+    case SR_READS_INERTIA: sum = SR_READS_OF_KIND(inertia, general_inertia); break;
+    case SR_READS_RHS: sum = SR_READS_OF_KIND(rhs, general_rhs); break;
+    case SR_READS_ENERGY: sum = SR_READS_OF_KIND(energy, general_energy); break;
+    case SR_READS_EQUILIBRIUM: sum = SR_READS_OF_KIND(equilibrium_residual, general_equilibrium_residual); break;
+    case SR_READS_JACOBIAN: sum = SR_READS_OF_KIND(accel_jacobian_yoke_terms, general_accel_jacobian_terms); break;
+    case SR_READS_SENSORS: sum = 0 SR_GEN_READS_sensor_constants(SR_READS_TERM); break;
+    case SR_READS_GUARD: sum = 0 SR_READS_guard(SR_READS_TERM); break;
+    default:
+        sum = model_words_sum(model->p, SR_NPARAM)
+              + (model->general ? model_words_sum(model->cg, SR_GEN_GENERAL_NCONST) : model_words_sum(model->c, SR_GEN_NCONST));
+        break;
+    }
+    return sum + (uint64_t)(unsigned)model->general;
 }
 
-/* The model argument: not NULL (SR_ERR_NULL), and as sr_model_init left it (SR_ERR_MODEL): its
- * stamp, and the checksum of what the kernels read (a parameter or constant overwritten since,
- * with NaN or any other value, is caught). */
-static inline int arg_model(const sr_model *model)
+/* Whether read set k (an enum name without SR_READS_: ACCEL) is in `reads` and its checksum differs from the stored one. */
+#define READS_SUM_DIFFERS(k) \
+    ((reads & READS(k)) && model->sums[SR_READS_##k] != model_reads_sum(model, SR_READS_##k))
+
+/* The model argument: not NULL (SR_ERR_NULL), and as sr_model_init left it (SR_ERR_MODEL) in what
+ * the caller reads: its stamp, and the checksums of the read sets in `reads` (READS(...) | ...; a
+ * constant, so that only those sums are compiled in). */
+static inline int arg_model(const sr_model *model, unsigned reads)
 {
     if (!model) return SR_ERR_NULL;
-    if (model->stamp != SR_MODEL_STAMP || model->checksum != model_checksum(model)) return SR_ERR_MODEL;
+    if (model->stamp != SR_MODEL_STAMP) return SR_ERR_MODEL;
+    if (READS_SUM_DIFFERS(STATE) || READS_SUM_DIFFERS(ACCEL) || READS_SUM_DIFFERS(INERTIA) || READS_SUM_DIFFERS(RHS)
+        || READS_SUM_DIFFERS(ENERGY) || READS_SUM_DIFFERS(EQUILIBRIUM) || READS_SUM_DIFFERS(JACOBIAN)
+        || READS_SUM_DIFFERS(SENSORS) || READS_SUM_DIFFERS(GUARD) || READS_SUM_DIFFERS(WHOLE))
+        return SR_ERR_MODEL;
     return SR_OK;
 }
+
+/* Every read set. */
+#define READS_ALL ((1u << SR_READS_COUNT) - 1)
 
 /* A stepping method: SR_LIE_EULER, SR_RKMK4 or SR_CF4, optionally | SR_PROJECT. */
 static inline int arg_method(int method)

@@ -46,7 +46,7 @@ int sr_internal_check_state(const sr_model *model, const sr_real x[SR_NX])
 
 int sr_check_state(const sr_model *model, const sr_real x[SR_NX])
 {
-    const int status = arg_model(model);
+    const int status = arg_model(model, READS(STATE));
     if (status != SR_OK) return status;
     if (!x) return SR_ERR_NULL;
     return sr_internal_check_state(model, x);
@@ -55,7 +55,7 @@ int sr_check_state(const sr_model *model, const sr_real x[SR_NX])
 int sr_check_state_batch(const sr_model *model, long n, const sr_real *x, long *failed_row)
 {
     long i;
-    int status = arg_model(model);
+    int status = arg_model(model, READS(STATE));
     if (failed_row) *failed_row = -1;
     if (status == SR_OK) status = arg_rows(n, x != NULL);
     if (status != SR_OK) return status;

@@ -20,7 +20,7 @@ static int contact_force(const sr_model *model, const sr_real x[SR_NX], const sr
 
 int sr_contact_force(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real F[3])
 {
-    int status = arg_model(model);
+    int status = arg_model(model, READS(WHOLE));
     if (status != SR_OK) return status;
     if (!F) return SR_ERR_NULL;
     status = checks(model, x, u);
@@ -32,7 +32,7 @@ int sr_contact_force_batch(const sr_model *model, long n, const sr_real *x, cons
                            long *failed_row)
 {
     long i;
-    int status = arg_model(model);
+    int status = arg_model(model, READS(WHOLE));
     if (failed_row) *failed_row = -1;
     if (status == SR_OK) status = arg_rows(n, x && F);
     if (status != SR_OK) return status;

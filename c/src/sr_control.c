@@ -83,7 +83,7 @@ int sr_lqr_error(const sr_model *model, const sr_real x[SR_NX], const sr_lqr_tar
                  const sr_real integrals[2], sr_real z[SR_LQR_NZ])
 {
     sr_real tmp[SR_LQR_NZ];
-    int status = arg_model(model);
+    int status = arg_model(model, READS(STATE));
     if (status != SR_OK) return status;
     if (!x || !target || !z) return SR_ERR_NULL;
     status = sr_internal_check_state(model, x);
@@ -115,7 +115,7 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
 {
     sr_real z[SR_LQR_NZ], dz[SR_LQR_NZ], out[SR_NU], raw[SR_NU], kappa, step, wv, wk;
     sr_real weight[4];
-    int status = arg_model(model), i0, i1, j0, j1, k, j, n, point[4], clipped = 0;
+    int status = arg_model(model, READS(STATE)), i0, i1, j0, j1, k, j, n, point[4], clipped = 0;
     if (status != SR_OK) return status;
     if (!lqr || !x || !target || !memory || !u) return SR_ERR_NULL;
     if (!valid_sizes(lqr)) return SR_ERR_ARG;

@@ -73,7 +73,9 @@ int sr_simulate_guarded(const sr_model *model, int method, const sr_real x0[SR_N
     int i, status;
     sr_real comp[SR_NX] = {0}; /* Kahan compensation carried across the steps of this call */
     if (steps_done) *steps_done = 0;
-    status = arg_model(model);
+    /* the guard's energies read the energy kernel's constants and the masses, centres and g */
+    status = guard ? arg_model(model, READS(ACCEL) | READS(STATE) | READS(ENERGY) | READS(GUARD))
+                   : arg_model(model, READS(ACCEL) | READS(STATE));
     if (status != SR_OK) return status;
     if (!x0 || !traj) return SR_ERR_NULL;
     if (steps < 0 || arg_dt(dt) != SR_OK || arg_method(method) != SR_OK) return SR_ERR_ARG;
@@ -178,7 +180,7 @@ int sr_simulate_adaptive(const sr_model *model, int method, const sr_real x0[SR_
     int i, base, status;
     if (!stats) stats = &local;
     *stats = local;
-    status = arg_model(model);
+    status = arg_model(model, READS(ACCEL) | READS(STATE));
     if (status != SR_OK) return status;
     if (!x0 || !traj) return SR_ERR_NULL;
     base = method & ~SR_PROJECT;

@@ -58,7 +58,7 @@ static void local(const sr_real x[SR_NX], const sr_real y[SR_NX], sr_real d[SR_N
 int sr_retract(const sr_model *model, const sr_real x[SR_NX], const sr_real d[SR_NE], sr_real y[SR_NX])
 {
     sr_real out[SR_NX];
-    int status = arg_model(model);
+    int status = arg_model(model, READS(STATE));
     if (status != SR_OK) return status;
     if (!x || !d || !y) return SR_ERR_NULL;
     status = sr_internal_check_state(model, x);
@@ -73,7 +73,7 @@ int sr_retract(const sr_model *model, const sr_real x[SR_NX], const sr_real d[SR
 int sr_local(const sr_model *model, const sr_real x[SR_NX], const sr_real y[SR_NX], sr_real d[SR_NE])
 {
     sr_real out[SR_NE];
-    int status = arg_model(model);
+    int status = arg_model(model, READS(STATE));
     if (status != SR_OK) return status;
     if (!x || !y || !d) return SR_ERR_NULL;
     status = sr_internal_check_state(model, x);
@@ -89,7 +89,7 @@ int sr_retract_batch(const sr_model *model, long n, const sr_real *x, const sr_r
                      long *failed_row)
 {
     long i;
-    int status = arg_model(model);
+    int status = arg_model(model, READS(STATE));
     if (failed_row) *failed_row = -1;
     if (status == SR_OK) status = arg_rows(n, x && d && y);
     if (status != SR_OK) return status;
@@ -107,7 +107,7 @@ int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
                    long *failed_row)
 {
     long i;
-    int status = arg_model(model);
+    int status = arg_model(model, READS(STATE));
     if (failed_row) *failed_row = -1;
     if (status == SR_OK) status = arg_rows(n, x && y && d);
     if (status != SR_OK) return status;

@@ -307,7 +307,7 @@ int sr_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_re
                       sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU])
 {
     sr_real a[SR_NV], ja[SR_NV * SR_NE], jb[SR_NV * SR_NU];
-    int status = arg_model(model);
+    int status = arg_model(model, READS(JACOBIAN));
     if (status != SR_OK) return status;
     if (!Ja || !Jb) return SR_ERR_NULL;
     status = checks(model, x, u);
@@ -324,7 +324,7 @@ int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, con
                             sr_real *Ja, sr_real *Jb, long *failed_row)
 {
     long i;
-    int status = arg_model(model);
+    int status = arg_model(model, READS(JACOBIAN));
     if (failed_row) *failed_row = -1;
     if (status == SR_OK) status = arg_rows(n, x && Ja && Jb);
     if (status != SR_OK) return status;
@@ -345,7 +345,7 @@ int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], co
     const sr_real *w, *R;
     sr_real a[SR_NV], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], phi[3], D[9], Jr[9], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
     sr_real v[2][3], r;
-    int status = arg_model(model), i, j;
+    int status = arg_model(model, READS(JACOBIAN) | READS(STATE)), i, j;
     if (status != SR_OK) return status;
     if (!x || !F || !G) return SR_ERR_NULL;
     if (arg_dt(dt) != SR_OK) return SR_ERR_ARG;
@@ -404,7 +404,7 @@ int sr_step_jacobian_lie_euler_batch(const sr_model *model, long n, const sr_rea
                                      sr_real *F, sr_real *G, long *failed_row)
 {
     long i;
-    int status = arg_model(model);
+    int status = arg_model(model, READS(JACOBIAN) | READS(STATE));
     if (failed_row) *failed_row = -1;
     if (status == SR_OK) status = arg_rows(n, x && F && G);
     if (status == SR_OK) status = arg_dt(dt);

@@ -105,7 +105,7 @@ int sr_internal_general_accel_jacobian_terms(const sr_model *model, const sr_rea
 
 int sr_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV])
 {
-    int status = arg_model(model);
+    int status = arg_model(model, READS(ACCEL));
     if (status != SR_OK) return status;
     if (!a) return SR_ERR_NULL;
     status = checks(model, x, u);
@@ -124,7 +124,8 @@ static int accel_rows(const sr_model *model, long n, const sr_real *x, const sr_
     enum { BLOCK = 64 };
     sr_real ok_state[BLOCK], ok_accel[BLOCK], block[BLOCK * SR_NV];
     long start, i;
-    int k, status = arg_model(model);
+    /* the lanes' state check reads r, whether or not the full check decides */
+    int k, status = arg_model(model, READS(ACCEL) | READS(STATE));
     if (failed_row) *failed_row = -1;
     if (status == SR_OK) status = arg_rows(n, x && a);
     if (status != SR_OK) return status;
@@ -171,7 +172,7 @@ int sr_checked_accel_batch(const sr_model *model, long n, const sr_real *x, cons
 
 int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * SR_NV])
 {
-    int status = arg_model(model);
+    int status = arg_model(model, READS(INERTIA));
     if (status != SR_OK) return status;
     if (!M) return SR_ERR_NULL;
     status = checks(model, x, NULL);
@@ -181,7 +182,7 @@ int sr_inertia(const sr_model *model, const sr_real x[SR_NX], sr_real M[SR_NV * 
 
 int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real f[SR_NV])
 {
-    int status = arg_model(model);
+    int status = arg_model(model, READS(RHS));
     if (status != SR_OK) return status;
     if (!f) return SR_ERR_NULL;
     status = checks(model, x, u);
@@ -191,7 +192,7 @@ int sr_rhs(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU]
 
 int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy)
 {
-    int status = arg_model(model);
+    int status = arg_model(model, READS(ENERGY));
     if (status != SR_OK) return status;
     if (!energy) return SR_ERR_NULL;
     status = checks(model, x, NULL);
@@ -201,7 +202,7 @@ int sr_energy(const sr_model *model, const sr_real x[SR_NX], sr_real *energy)
 
 int sr_equilibrium_residual(const sr_model *model, const sr_real x[SR_NX], sr_real res[SR_NV])
 {
-    int status = arg_model(model);
+    int status = arg_model(model, READS(EQUILIBRIUM));
     if (status != SR_OK) return status;
     if (!res) return SR_ERR_NULL;
     status = checks(model, x, NULL);

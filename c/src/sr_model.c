@@ -5,6 +5,7 @@
 #include "sr_argcheck.h"
 
 #include <stddef.h>
+#include <string.h>
 
 const char *sr_status_string(int status)
 {
@@ -209,7 +210,21 @@ int sr_model_init(sr_model *model, const sr_real params[SR_NPARAM])
         return SR_ERR_PARAM;
     if (sr_internal_energy(&m, x, &energy) != SR_OK) return SR_ERR_PARAM;
     m.stamp = SR_MODEL_STAMP;
-    m.checksum = model_checksum(&m);
+    for (i = 0; i < SR_READS_COUNT; ++i) m.sums[i] = model_reads_sum(&m, i);
     *model = m;
+    return SR_OK;
+}
+
+int sr_check_model(const sr_model *model)
+{
+    sr_model fresh;
+    int status = arg_model(model, READS_ALL), i;
+    if (status != SR_OK) return status;
+    if (sr_model_init(&fresh, model->p) != SR_OK || fresh.general != model->general) return SR_ERR_MODEL;
+    for (i = 0; i < SR_READS_COUNT; ++i)
+        if (fresh.sums[i] != model->sums[i]) return SR_ERR_MODEL;
+    /* bit patterns, as the sums: a NaN equals itself, a -0 differs from a +0 */
+    if (model->general ? memcmp(fresh.cg, model->cg, sizeof fresh.cg) != 0 : memcmp(fresh.c, model->c, sizeof fresh.c) != 0)
+        return SR_ERR_MODEL;
     return SR_OK;
 }

@@ -68,13 +68,14 @@ int sr_check_mount(int body, const sr_real mount[SR_NMOUNT])
     return SR_OK;
 }
 
-/* The checks of every sensor call, in the library's order (sr_argcheck.h): the model, the
+/* The checks of every sensor call, in the library's order (sr_argcheck.h): the model (its read
+ * sets `reads`: the state check's, and those of the kernels the call runs), the
  * pointers (outputs: nonzero when the call's outputs are all given), the body and the mount (if
  * the sensor has one), then the state. */
-static int check_inputs(const sr_model *model, const sr_real x[SR_NX], int outputs, int with_mount, int body,
-                        const sr_real mount[SR_NMOUNT])
+static int check_inputs(const sr_model *model, unsigned reads, const sr_real x[SR_NX], int outputs, int with_mount,
+                        int body, const sr_real mount[SR_NMOUNT])
 {
-    int status = arg_model(model);
+    int status = arg_model(model, reads);
     if (status != SR_OK) return status;
     if (!x || !outputs || (with_mount && !mount)) return SR_ERR_NULL;
     if (with_mount && (status = sr_check_mount(body, mount)) != SR_OK) return status;
@@ -83,10 +84,10 @@ static int check_inputs(const sr_model *model, const sr_real x[SR_NX], int outpu
 
 /* The IMU's checks: those of check_inputs with the mount, then the data beside the state: the n
  * entries of v (nu_dot or u; if given) and bias (NULL: zero) finite. */
-static int check_imu(const sr_model *model, const sr_real x[SR_NX], int outputs, const sr_real *v, int n, int body,
-                     const sr_real mount[SR_NMOUNT], const sr_real **bias)
+static int check_imu(const sr_model *model, unsigned reads, const sr_real x[SR_NX], int outputs, const sr_real *v,
+                     int n, int body, const sr_real mount[SR_NMOUNT], const sr_real **bias)
 {
-    const int status = check_inputs(model, x, outputs, 1, body, mount);
+    const int status = check_inputs(model, reads | READS(SENSORS), x, outputs, 1, body, mount);
     if (status != SR_OK) return status;
     if (v && !all_finite(v, n)) return SR_ERR_NONFINITE;
     if (!*bias) *bias = zero_bias;
@@ -97,7 +98,7 @@ int sr_imu_measure(const sr_model *model, const sr_real x[SR_NX], const sr_real 
                    const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU])
 {
     sr_real sc[SR_GEN_NSC];
-    const int status = check_imu(model, x, nu_dot && y, nu_dot, SR_NV, body, mount, &bias);
+    const int status = check_imu(model, READS(STATE), x, nu_dot && y, nu_dot, SR_NV, body, mount, &bias);
     if (status != SR_OK) return status;
     sensor_constants(model, sc);
     return imu_kernel(body, sc, x, nu_dot, mount, bias, y);
@@ -107,7 +108,7 @@ int sr_imu_measure_u(const sr_model *model, const sr_real x[SR_NX], const sr_rea
                      const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU])
 {
     sr_real a[SR_NV], sc[SR_GEN_NSC];
-    int status = check_imu(model, x, y != NULL, u, SR_NU, body, mount, &bias);
+    int status = check_imu(model, READS(STATE) | READS(ACCEL), x, y != NULL, u, SR_NU, body, mount, &bias);
     if (status == SR_OK) status = sr_internal_accel(model, x, u ? u : sr_zero_u, a);
     if (status != SR_OK) return status;
     sensor_constants(model, sc);
@@ -119,7 +120,7 @@ int sr_imu_partials(const sr_model *model, const sr_real x[SR_NX], const sr_real
                     sr_real H[SR_NIMU * SR_NEB], sr_real Hn[SR_NIMU * SR_NV])
 {
     sr_real sc[SR_GEN_NSC];
-    const int status = check_imu(model, x, nu_dot && y && H && Hn, nu_dot, SR_NV, body, mount, &bias);
+    const int status = check_imu(model, READS(STATE), x, nu_dot && y && H && Hn, nu_dot, SR_NV, body, mount, &bias);
     if (status != SR_OK) return status;
     sensor_constants(model, sc);
     return imu_jacobian_kernel(body, sc, x, nu_dot, mount, bias, y, H, Hn);
@@ -131,7 +132,7 @@ int sr_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real
 {
     sr_real a[SR_NV], sc[SR_GEN_NSC], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], yy[SR_NIMU], HH[SR_NIMU * SR_NEB], Hn[SR_NIMU * SR_NV];
     int status, i, j, k;
-    status = check_imu(model, x, y && H, u, SR_NU, body, mount, &bias);
+    status = check_imu(model, READS(STATE) | READS(JACOBIAN), x, y && H, u, SR_NU, body, mount, &bias);
     if (status != SR_OK) return status;
     status = sr_internal_accel_jacobian(model, x, u ? u : sr_zero_u, a, Ja, Jb);
     if (status != SR_OK) return status;
@@ -160,7 +161,7 @@ static void encoder_angles(const sr_real x[SR_NX], sr_real y[2])
 
 int sr_encoders_measure(const sr_model *model, const sr_real x[SR_NX], sr_real y[2])
 {
-    const int status = check_inputs(model, x, y != NULL, 0, 0, NULL);
+    const int status = check_inputs(model, READS(STATE), x, y != NULL, 0, 0, NULL);
     if (status != SR_OK) return status;
     encoder_angles(x, y);
     return SR_OK;
@@ -168,7 +169,7 @@ int sr_encoders_measure(const sr_model *model, const sr_real x[SR_NX], sr_real y
 
 int sr_encoders_jacobian(const sr_model *model, const sr_real x[SR_NX], sr_real y[2], sr_real H[2 * SR_NEB])
 {
-    const int status = check_inputs(model, x, y && H, 0, 0, NULL);
+    const int status = check_inputs(model, READS(STATE), x, y && H, 0, 0, NULL);
     if (status != SR_OK) return status;
     sr_gen_encoders_jacobian(H);
     encoder_angles(x, y);
@@ -177,7 +178,7 @@ int sr_encoders_jacobian(const sr_model *model, const sr_real x[SR_NX], sr_real 
 
 int sr_position_measure(const sr_model *model, const sr_real x[SR_NX], sr_real y[2])
 {
-    const int status = check_inputs(model, x, y != NULL, 0, 0, NULL);
+    const int status = check_inputs(model, READS(STATE), x, y != NULL, 0, 0, NULL);
     if (status != SR_OK) return status;
     y[0] = x[SR_X_q + 0];
     y[1] = x[SR_X_q + 1];
@@ -186,7 +187,7 @@ int sr_position_measure(const sr_model *model, const sr_real x[SR_NX], sr_real y
 
 int sr_position_jacobian(const sr_model *model, const sr_real x[SR_NX], sr_real y[2], sr_real H[2 * SR_NEB])
 {
-    const int status = check_inputs(model, x, y && H, 0, 0, NULL);
+    const int status = check_inputs(model, READS(STATE), x, y && H, 0, 0, NULL);
     if (status != SR_OK) return status;
     sr_gen_position_jacobian(H);
     y[0] = x[SR_X_q + 0];
@@ -198,7 +199,7 @@ int sr_position_jacobian(const sr_model *model, const sr_real x[SR_NX], sr_real 
 static int heading_vector(const sr_model *model, const sr_real x[SR_NX], int outputs, int body,
                           const sr_real mount[SR_NMOUNT], sr_real h[2])
 {
-    int status = check_inputs(model, x, outputs, 1, body, mount);
+    int status = check_inputs(model, READS(STATE), x, outputs, 1, body, mount);
     if (status == SR_OK) status = heading_kernel(body, x, mount, h);
     if (status != SR_OK) return status;
     if (h[0] * h[0] + h[1] * h[1] < SR_HEADING_MIN_HORIZONTAL * SR_HEADING_MIN_HORIZONTAL) return SR_ERR_SINGULAR;

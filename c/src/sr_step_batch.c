@@ -110,7 +110,7 @@ int sr_step_batch(const sr_model *model, int method, long n, const sr_real *x, c
 {
     sr_real ok[BLOCK], block[BLOCK * SR_NX];
     long start, i;
-    int k, lanes, status = arg_model(model);
+    int k, lanes, status = arg_model(model, READS(ACCEL) | READS(STATE));
     if (failed_row) *failed_row = -1;
     if (status == SR_OK) status = arg_rows(n, x && x_next);
     if (status == SR_OK && (arg_method(method) != SR_OK || arg_dt(dt) != SR_OK)) status = SR_ERR_ARG;

@@ -372,7 +372,7 @@ static int deliver_jacobians(const error dy, sr_real F[SR_NE * SR_NE], sr_real G
 static int check_step_arguments(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                                 sr_real *F, sr_real *G)
 {
-    int status = arg_model(model);
+    int status = arg_model(model, READS(JACOBIAN) | READS(STATE));
     if (status != SR_OK) return status;
     if (!x || !F || !G) return SR_ERR_NULL;
     if (arg_dt(dt) != SR_OK) return SR_ERR_ARG;
@@ -449,7 +449,7 @@ int sr_step_jacobian(const sr_model *model, int method, const sr_real x[SR_NX], 
     case SR_RKMK4: return sr_step_jacobian_rkmk4(model, x, u, dt, F, G);
     case SR_CF4: return sr_step_jacobian_cf4(model, x, u, dt, F, G);
     default: /* the model and the pointers before the method, as for every other argument */
-        status = arg_model(model);
+        status = arg_model(model, READS(JACOBIAN) | READS(STATE));
         if (status != SR_OK) return status;
         return !x || !F || !G ? SR_ERR_NULL : SR_ERR_ARG;
     }
@@ -459,7 +459,7 @@ int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_r
                            sr_real *F, sr_real *G, long *failed_row)
 {
     long i;
-    int status = arg_model(model);
+    int status = arg_model(model, READS(JACOBIAN) | READS(STATE));
     if (failed_row) *failed_row = -1;
     if (status == SR_OK) status = arg_rows(n, x && F && G);
     if (status == SR_OK && (arg_jacobian_method(method) != SR_OK || arg_dt(dt) != SR_OK)) status = SR_ERR_ARG;

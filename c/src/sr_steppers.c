@@ -293,7 +293,7 @@ int sr_internal_advance(const sr_model *model, int method, const sr_real x[SR_NX
 static int step_arguments(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
                           sr_real dt, const sr_real *x_next)
 {
-    int status = arg_model(model);
+    int status = arg_model(model, READS(ACCEL) | READS(STATE));
     if (status != SR_OK) return status;
     if (!x || !x_next) return SR_ERR_NULL;
     if (arg_method(method) != SR_OK || arg_dt(dt) != SR_OK) return SR_ERR_ARG;

@@ -133,6 +133,45 @@ def kernel_body(kernel, guard, row=""):
     return used, body + emit_results(scheduler, results, kernel.finite_or_untouched, guard)
 
 
+#: The arrays of a model (c/include/spherical_robot.h's sr_model) that kernels read.
+MODEL_ARRAYS = ("p", "c", "cg")
+
+
+def model_reads(kernel, layouts):
+    """{array: sorted indices} of the model's entries (MODEL_ARRAYS) that the kernel's code loads: the
+    inputs its outputs and definitions use, as `input_entries` reads them."""
+    defined = {symbol for symbol, _ in kernel.definitions}
+    exprs = [value for _, value in kernel.definitions] + [e for o in kernel.outputs for e in o.exprs]
+    used = set().union(*(e.free_symbols for e in exprs)) - defined if exprs else set()
+    reads = {}
+    for _, array, index in input_entries(kernel, used, layouts):
+        if array in MODEL_ARRAYS:
+            reads.setdefault(array, set()).add(index)
+    return {array: tuple(sorted(indices)) for array, indices in reads.items()}
+
+
+def index_ranges(indices):
+    """Sorted indices as ranges (first, end) of consecutive runs: (6, 7, 8, 30) -> ((6, 9), (30, 31))."""
+    ranges = []
+    for i in indices:
+        if ranges and ranges[-1][1] == i:
+            ranges[-1][1] = i + 1
+        else:
+            ranges.append([i, i + 1])
+    return tuple(tuple(r) for r in ranges)
+
+
+def read_set_macros(ks, layouts):
+    """SR_GEN_READS_<kernel>(R): the kernel's read set of the model as data, one R(array, first, end) per
+    range of consecutive entries, for every kernel (empty for one that reads no model array)."""
+    lines = []
+    for k in ks:
+        reads = model_reads(k, layouts)
+        items = [f"R({array}, {first}, {end})" for array in MODEL_ARRAYS for first, end in index_ranges(reads.get(array, ()))]
+        lines.append(f"#define SR_GEN_READS_{k.name}(R) {' '.join(items)}".rstrip())
+    return "\n".join(lines)
+
+
 def emit_kernel(kernel, layouts):
     """C text of one kernel and its flop count."""
     used, body = kernel_body(kernel, scalar_guard)
@@ -205,7 +244,7 @@ def layout_macros():
     return "\n".join(lines)
 
 
-def header_text(ks, flops, n_constants, n_general_constants):
+def header_text(ks, flops, n_constants, n_general_constants, reads):
     guard = "SR_GENERATED_H"
     protos = "\n".join(f"/* {k.doc} */\n{signature(k)};" for k in ks)
     protos += "".join(f"\n{lanes_doc(k)}\n{lanes_signature(k)};" for k in ks if k.lanes)
@@ -246,6 +285,11 @@ def header_text(ks, flops, n_constants, n_general_constants):
 /* Arithmetic operations (+ - * /) per call, counted in the emitted code after CSE. */
 {flop_macros}
 
+/* What each kernel reads of a model (sr_model's p, c or cg): SR_GEN_READS_<kernel>(R) expands to
+ * R(array, first, end) for each run [first, end) of the entries of `array` that its code loads, and
+ * to nothing for a kernel that reads none.  The read sets of the model's checksums (c/src/sr_argcheck.h). */
+{reads}
+
 /* The float build's symbols carry _f, so a float/double mismatch fails at link time. */
 #ifdef SR_USE_FLOAT
 {float_names}
@@ -274,7 +318,7 @@ def write(out_dir):
     emitted = [emit_kernel(k, layouts) for k in ks]
     flops = {k.name: n for k, (_, n) in zip(ks, emitted)}
     emitted += [(emit_lanes(k, layouts), None) for k in ks if k.lanes]
-    files = {HEADER_NAME: header_text(ks, flops, len(constants), len(general_constants)),
+    files = {HEADER_NAME: header_text(ks, flops, len(constants), len(general_constants), read_set_macros(ks, layouts)),
              SOURCE_NAME: source_text(emitted)}
     files.update(casadi_files())
     for name, text in files.items():

@@ -9,6 +9,9 @@ import time
 
 import numpy as np
 
+from ..schema import check_arguments
+from .ranges import CONTROLLER_RANGES
+
 #: Default torque limit [N m]: the low end of the paper's 0.5–2 N m.
 DEFAULT_U_MAX = 0.5
 #: A torque within this fraction of u_max counts as saturated: clipped (PID, LQR) or held at its
@@ -21,10 +24,7 @@ class Controller:
     kind = "abstract"
 
     def __init__(self, params, rate, u_max=DEFAULT_U_MAX):
-        if not rate > 0:
-            raise ValueError(f"controller.rate: must be > 0 Hz, got {rate!r}")
-        if not u_max > 0:
-            raise ValueError(f"controller.u_max: must be > 0 N m, got {u_max!r}")
+        check_arguments({"rate": rate, "u_max": u_max}, CONTROLLER_RANGES)
         self.params, self.rate, self.u_max = params, float(rate), float(u_max)
         self.samples = 0
         self.saturated = 0

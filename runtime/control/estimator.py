@@ -21,6 +21,8 @@ import dataclasses
 import numpy as np
 
 from ..model import Model
+from ..schema import check_arguments
+from .ranges import ESTIMATOR_RANGES
 from ..state import IDX_E_NU, IDX_E_Q, IDX_E_TH_P, IDX_E_TH_Y, IDX_E_XI_S, NE
 
 
@@ -35,13 +37,7 @@ class EkfSettings:
     rate: float = 0.0                   # the sensors' rate [Hz], a whole multiple of the controller's; 0: the controller's
 
     def __post_init__(self):
-        for field in dataclasses.fields(self):
-            value = getattr(self, field.name)
-            if field.name == "rate":
-                if not (isinstance(value, (int, float)) and np.isfinite(value) and value >= 0):
-                    raise ValueError(f"rate: expected a finite number of Hz >= 0 (0: the controller's rate), got {value!r}")
-            elif not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
-                raise ValueError(f"{field.name}: a standard deviation must be a finite number > 0, got {value!r}")
+        check_arguments(dataclasses.asdict(self), ESTIMATOR_RANGES)
 
 
 SETTING_NAMES = tuple(f.name for f in dataclasses.fields(EkfSettings))

@@ -7,6 +7,7 @@ integrators (∫e_y, ∫ of the rolling-rate error) advance by one period unless
 (conditional anti-windup).
 """
 import dataclasses
+import typing
 
 import numpy as np
 
@@ -14,7 +15,9 @@ from bindings._sr import ffi, lib
 
 from ..errors import KernelError
 from ..model import Model
+from ..schema import check_arguments
 from .controller import DEFAULT_U_MAX, Controller
+from .ranges import LQR_RANGES
 from . import lqr_design as design
 
 
@@ -43,17 +46,11 @@ class LqrGains:
     preview_m: float = 0.3            # the path's curvature is averaged over preview_m ± smoothing_m [m]
     smoothing_m: float = 0.5          # ... along the path from the nearest point (0: the curvature there)
     integral_zone_m: float = 0.1      # ∫e_y advances only while |e_y| ≤ this [m]
+    #: The ranges of the settings (runtime/control/ranges.py: those of a task file's keys).
+    RANGES: typing.ClassVar[dict] = LQR_RANGES
 
     def __post_init__(self):
-        for name in ("tilt_rad", "attitude_rad", "pendulum_rad", "rolling_rate_rad_s", "rate_rad_s",
-                     "joint_rate_rad_s", "cross_track_m", "cross_track_integral_m_s", "speed_integral_rad",
-                     "integral_zone_m"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"{name}: an error size must be > 0, got {getattr(self, name)!r}")
-        for name in ("n_speeds", "n_curvatures"):
-            n = getattr(self, name)
-            if n != int(n) or n < 1:
-                raise ValueError(f"{name}: expected a whole number >= 1, got {n!r}")
+        check_arguments(dataclasses.asdict(self), self.RANGES)
         if self.n_speeds > 1 and not self.v_max > self.v_min:
             raise ValueError(f"v_max: must exceed v_min = {self.v_min!r} when n_speeds > 1, got {self.v_max!r}")
         if self.n_curvatures > 1 and not self.kappa_max > 0:

@@ -27,6 +27,7 @@ import pathlib
 import shutil
 import subprocess
 import tempfile
+import typing
 
 import numpy as np
 
@@ -34,6 +35,7 @@ from ..casadi_model import load, parameter_vector
 from .controller import DEFAULT_U_MAX, Controller
 from . import lqr_design as design
 from .lqr import LqrGains, design_schedule
+from .ranges import NMPC_RANGES
 
 #: The NMPC's state: the robot's error coordinates, the cross-track error and its integral
 #: (offset-free tracking of a robot heavier than the model); the speed's integrator is left out.
@@ -155,13 +157,8 @@ class NmpcGains(LqrGains):
     horizon: float = 30               # N nodes
     node_periods: float = 2           # controller periods per node: the horizon is N × node_periods / rate
     iterations: float = 1             # real-time iterations per sample
-
-    def __post_init__(self):
-        super().__post_init__()
-        for name in ("horizon", "node_periods", "iterations"):
-            n = getattr(self, name)
-            if n != int(n) or n < 1:
-                raise ValueError(f"{name}: expected a whole number >= 1, got {n!r}")
+    #: The ranges of the settings (runtime/control/ranges.py: those of a task file's keys).
+    RANGES: typing.ClassVar[dict] = NMPC_RANGES
 
 
 GAIN_NAMES = tuple(f.name for f in dataclasses.fields(NmpcGains))

@@ -18,9 +18,11 @@ while their loop's torque is clipped (conditional anti-windup).
 import dataclasses
 import math
 
+from ..schema import check_arguments
 
 from .controller import DEFAULT_U_MAX, Controller
 from .geometry import forward_speed, heading, lean, lean_for_curvature, wrap_angle
+from .ranges import PID_RANGES
 
 
 @dataclasses.dataclass(frozen=True)
@@ -36,6 +38,9 @@ class PidGains:
     k_phi: float = 4.0      # pendulum torque per lean error [N m/rad]
     k_phii: float = 0.0     # ... per integrated lean error [N m/(rad s)]
     k_phid: float = 2.0     # ... per lean rate [N m s/rad]
+
+    def __post_init__(self):
+        check_arguments(dataclasses.asdict(self), PID_RANGES)
 
 
 GAIN_NAMES = tuple(f.name for f in dataclasses.fields(PidGains))

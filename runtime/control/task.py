@@ -15,7 +15,6 @@ import tomllib
 
 import numpy as np
 
-from bindings._sr import lib
 
 from .. import memory
 from ..params import NAMES as PARAM_NAMES
@@ -33,6 +32,7 @@ from .nmpc import Nmpc, NmpcGains
 from .estimator import SETTING_NAMES as ESTIMATOR_SETTINGS
 from .estimator import Ekf, EkfSettings
 from .pid import GAIN_NAMES, Pid, PidGains
+from .ranges import CONTROLLER_RANGES, ESTIMATOR_RANGES, LQR_RANGES, NMPC_RANGES, PID_RANGES
 from .reference import KINDS, SpeedHeading, path_points, circle_path, figure8_path, line_path, waypoints_path
 from ..state import IDX_Q
 
@@ -44,24 +44,9 @@ _SCENARIO_KEYS = {"description", "dt", "duration", "steps", "method", "params", 
 _REFERENCE_KEYS = {"kind", "speed", "heading", "offset", "radius", "size", "points"}
 _NEEDS = {"speed": ("speed",), "heading": ("speed", "heading"), "line": ("speed", "offset"),
           "circle": ("speed", "radius"), "figure8": ("speed", "size"), "waypoints": ("speed", "points")}
-_ERROR_SIZE = Range(1e-6, 1e6, "", "a Bryson error size (its unit: the key's); 0 or a huge one makes the Riccati "
-                    "weights singular")
-_PID_GAIN = Range(0, 1e6, "", "a gain (its unit: docs/control.md)")
-_LQR_RANGES = {
-    **{name: _ERROR_SIZE for name in ("tilt_rad", "attitude_rad", "pendulum_rad", "rolling_rate_rad_s", "rate_rad_s",
-                                      "joint_rate_rad_s", "cross_track_m", "cross_track_integral_m_s",
-                                      "speed_integral_rad", "integral_zone_m")},
-    "v_min": Range(0, 10, "m/s", "the design grid's speeds"), "v_max": Range(0, 10, "m/s", "the design grid's speeds"),
-    "n_speeds": Range(1, lib.SR_LQR_MAX_SPEEDS, "", "the C controller's grid holds SR_LQR_MAX_SPEEDS", whole=True),
-    "kappa_max": Range(0, 100, "1/m", "a turn of 1 cm radius at most"),
-    "n_curvatures": Range(1, lib.SR_LQR_MAX_CURVATURES, "", "the C controller's grid holds SR_LQR_MAX_CURVATURES",
-                          whole=True),
-    "kappa_rate": Range(0, 1e4, "1/(m s)", "how fast the operating point may follow the path"),
-    "preview_m": Range(0, 100, "m", "a preview along the path"),
-    "smoothing_m": Range(0, 100, "m", "a smoothing window along the path"),
-}
 #: The ranges of the numbers of a task file beyond its scenario's (runtime/scenario.py's
-#: SCENARIO_RANGES): by table, the controllers' settings by kind ("controller.<kind>").
+#: SCENARIO_RANGES): by table, the controllers' settings by kind ("controller.<kind>"); the
+#: controllers' and the estimator's are those of their constructors (runtime/control/ranges.py).
 TASK_RANGES = {
     "reference": {"speed": Range(-10, 10, "m/s", "the robot's speed: 10 m/s is 5 turns a second of a 0.3 m shell"),
                   "heading": Range(-1e3, 1e3, "rad", "an angle: further out it keeps too few digits"),
@@ -70,25 +55,11 @@ TASK_RANGES = {
                                                   "holds a point every 5 mm"),
                   "size": Range(0.05, 1e3, "m", "a figure eight's lobe radius, as a circle's"),
                   "points": Range(-1e4, 1e4, "m", "a waypoint: its legs are tabled every 5 mm")},
-    "controller": {"rate": Range(0.01, 1e4, "Hz", "a sampling rate: its period is a whole number of steps dt"),
-                   "u_max": Range(1e-6, 100, "N m", "a torque limit: the paper's motors give 0.5-2 N m")},
-    "controller.pid": {**{name: _PID_GAIN for name in ("k_v", "k_vi", "k_y", "k_psi", "k_r", "k_ri", "k_phi",
-                                                      "k_phii", "k_phid")},
-                       "phi_max": Range(0, 1.5, "rad", "a lean short of lying on the side")},
-    "controller.lqr": _LQR_RANGES,
-    "controller.nmpc": {**_LQR_RANGES,
-                        "torque_step_n_m": Range(1e-6, 1e6, "N m", "a torque change worth the full cost"),
-                        "horizon": Range(1, 200, "", "nodes of the horizon: the QP has 2N unknowns and a dense "
-                                                     "(2N)^2 Hessian", whole=True),
-                        "node_periods": Range(1, 100, "", "controller periods per node", whole=True),
-                        "iterations": Range(1, 100, "", "real-time iterations per sample: each solves a QP",
-                                            whole=True)},
-    "estimator": {"position_m": Range(1e-9, 1e3, "m", "a standard deviation"),
-                  "attitude_rad": Range(1e-9, 10, "rad", "a standard deviation"),
-                  "joint_rad": Range(1e-9, 10, "rad", "a standard deviation"),
-                  "rate_rad_s": Range(1e-9, 1e3, "rad/s", "a standard deviation"),
-                  "accel_rad_s2": Range(1e-9, 1e4, "rad/s^2/sqrt(Hz)", "a process noise"),
-                  "rate": Range(0, 1e5, "Hz", "the sensors' rate (0: the controller's)")},
+    "controller": CONTROLLER_RANGES,
+    "controller.pid": PID_RANGES,
+    "controller.lqr": LQR_RANGES,
+    "controller.nmpc": NMPC_RANGES,
+    "estimator": ESTIMATOR_RANGES,
     "plant": {**ROBOT_RANGES,
               "noise_position_m": Range(0, 1e3, "m", "a standard deviation"),
               "noise_attitude_rad": Range(0, 10, "rad", "a standard deviation"),
@@ -262,10 +233,9 @@ def _parse_estimator(table, source):
     check_table(table, {"kind", *ESTIMATOR_SETTINGS}, where)
     if table.get("kind") != "ekf":
         raise ValueError(f"{where}.kind: expected \"ekf\", got {table.get('kind')!r}")
-    settings = EkfSettings(**{k: _real(v, f"{where}.{k}", positive=k != "rate", nonnegative=k == "rate")
-                              for k, v in table.items() if k != "kind"})
     check_ranges(table, TASK_RANGES["estimator"], where)
-    return settings
+    return EkfSettings(**{k: _real(v, f"{where}.{k}", positive=k != "rate", nonnegative=k == "rate")
+                          for k, v in table.items() if k != "kind"})
 
 
 def _real(value, where, positive=False, nonnegative=False):

@@ -165,3 +165,71 @@ def test_docs_robustness_lists_the_ranges_of_the_tables():
     if os.environ.get("SR_UPDATE_DOCS") == "1":
         DOC.write_text(head + current + tail)
     assert f"{BEGIN}{rest.split(END)[0]}{END}" == current, "docs/robustness.md: rerun with SR_UPDATE_DOCS=1"
+
+
+# -- the same ranges for the Python constructors, the command line's overrides and batch runs --------
+from runtime import Params, simulate_many, initial_state                       # noqa: E402
+from runtime.control.estimator import EkfSettings                               # noqa: E402
+from runtime.control.lqr import LqrGains                                        # noqa: E402
+from runtime.control.nmpc import NmpcGains                                      # noqa: E402
+from runtime.control.pid import Pid, PidGains                                   # noqa: E402
+from runtime.control.ranges import (CONTROLLER_RANGES, ESTIMATOR_RANGES, LQR_RANGES, NMPC_RANGES,  # noqa: E402
+                                    PID_RANGES)
+from runtime.memory import MemoryBudgetExceeded                                 # noqa: E402
+from runtime.scenario import MAX_STEPS, load_scenario                           # noqa: E402
+
+SETTINGS_CLASSES = {"pid": (PidGains, PID_RANGES), "lqr": (LqrGains, LQR_RANGES), "nmpc": (NmpcGains, NMPC_RANGES),
+                    "estimator": (EkfSettings, ESTIMATOR_RANGES)}
+SETTINGS_CASES = [pytest.param(kind, key, id=f"{kind}.{key}") for kind, (_, ranges) in SETTINGS_CLASSES.items()
+                  for key in ranges]
+
+
+def test_the_task_files_and_the_constructors_share_one_table():
+    assert TASK_RANGES["controller"] is CONTROLLER_RANGES
+    assert TASK_RANGES["controller.pid"] is PID_RANGES and TASK_RANGES["controller.lqr"] is LQR_RANGES
+    assert TASK_RANGES["controller.nmpc"] is NMPC_RANGES and TASK_RANGES["estimator"] is ESTIMATOR_RANGES
+
+
+@pytest.mark.parametrize("kind, key", SETTINGS_CASES)
+def test_a_constructor_refuses_a_setting_beyond_its_range_naming_the_argument(kind, key):
+    cls, ranges = SETTINGS_CLASSES[kind]
+    rng = ranges[key]
+    for value in outside_ends(rng):
+        with pytest.raises(ValueError, match=rf"^{key}: expected {re.escape(str(rng))}, got "):
+            cls(**{key: value})
+
+
+@pytest.mark.parametrize("kind", SETTINGS_CLASSES)
+def test_a_constructor_refuses_a_setting_that_is_not_a_finite_number(kind):
+    cls, ranges = SETTINGS_CLASSES[kind]
+    key = next(iter(ranges))
+    for value in ("1", None, True, math.nan, math.inf):
+        with pytest.raises(ValueError, match=rf"^{key}: expected "):
+            cls(**{key: value})
+
+
+@pytest.mark.parametrize("key", CONTROLLER_RANGES)
+def test_a_controller_refuses_a_rate_or_torque_limit_beyond_its_range(key):
+    for value in outside_ends(CONTROLLER_RANGES[key]):
+        with pytest.raises(ValueError, match=rf"^{key}: expected "):
+            Pid(Params(), **{key: value})
+
+
+def test_the_command_lines_overrides_get_the_scenario_files_ranges():
+    scenario = load_scenario("tilted-pendulum")
+    for dt in (2.0, 1e-10):
+        with pytest.raises(ValueError, match=r"override: dt: expected a number in \[1e-09, 1\] s, got "):
+            scenario.with_overrides(dt=dt)
+    with pytest.raises(ValueError, match=r"override: dt and steps: the duration steps × dt: expected "):
+        scenario.with_overrides(dt=1.0, steps=MAX_STEPS)
+    assert scenario.with_overrides(dt=1.0, steps=10).steps == 10
+
+
+def test_simulate_many_refuses_trajectories_beyond_the_memory_budget(monkeypatch):
+    x0 = initial_state()
+    monkeypatch.setenv("SR_MEMORY_FRACTION", "1e-12")
+    with pytest.raises(MemoryBudgetExceeded, match=r"^trajectories: the run needs about .*\(3 trajectories of 11 states"):
+        simulate_many(Params(), [x0] * 3, 0.01, 10, trajectories=True)
+    assert simulate_many(Params(), [x0] * 3, 0.01, 10).status.tolist() == [0, 0, 0]   # no trajectories kept
+    monkeypatch.delenv("SR_MEMORY_FRACTION")
+    assert simulate_many(Params(), [x0] * 3, 0.01, 10, trajectories=True).trajectories.shape == (3, 11, 35)

@@ -24,8 +24,9 @@ OPTIONS = {
                   "--dt": NOT_A_NUMBER + NOT_POSITIVE,
                   "--max-speed": NOT_A_NUMBER + ["-1", "-1e308"],
                   "--method": ["", "euler", "RKMK4"]}),
-    "run": (["tilted-pendulum", "--out", "{tmp}"], {"--dt": NOT_A_NUMBER + NOT_POSITIVE,
-                                                     "--steps": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER,
+    "run": (["tilted-pendulum", "--out", "{tmp}"], {"--dt": NOT_A_NUMBER + NOT_POSITIVE + ["2", "1e-10"],
+                                                     "--steps": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER
+                                                                + ["10000001"],
                                                      "--method": ["", "euler", "RKMK4"]}),
     "control": (["--tasks", "circle", "--out", "{tmp}"], {"--duration": ["abc", "", "nan", "-inf"] + NOT_POSITIVE,
                                                          "--tasks": ["", ",", "no-such-task", "{tmp}"]}),

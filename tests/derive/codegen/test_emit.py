@@ -110,3 +110,53 @@ def test_provenance_covers_every_file_of_the_package(tmp_path, monkeypatch):
     nested = tmp_path / "derive" / "codegen" / "c_printer.py"
     nested.write_text(nested.read_text() + "# changed\n")
     assert emit.provenance() != before
+
+
+# -- the read sets: what each kernel's emitted code loads of a model (p, c, cg) ----------------------
+def header_read_sets(header):
+    """{kernel: {(array, index)}} of the SR_GEN_READS_<kernel>(R) macros of a header."""
+    return {name: {(a, i) for a, first, end in re.findall(r"R\((\w+), (\d+), (\d+)\)", body)
+                   for i in range(int(first), int(end))}
+            for name, body in re.findall(r"^#define SR_GEN_READS_(\w+)\(R\)(.*)$", header, re.M)}
+
+
+def source_loads(source):
+    """{function: {(array, index)}}: the model entries each function of the generated source loads."""
+    loads = {}
+    for name, body in re.findall(r"^(?:SR_LANES_CLONES )?(?:int|void) sr_gen_(\w+)\(.*?\n\{\n(.*?)\n\}\n", source, re.M | re.S):
+        loads[name] = {(a, int(i)) for a, i in re.findall(r"= (p|c|cg)\[(\d+)\];", body)}
+    return loads
+
+
+def read_set_mismatches(header, source):
+    """Kernels whose read set in the header is not what their code (and their lanes form's) loads."""
+    sets, loads = header_read_sets(header), source_loads(source)
+    kernels = {name for name in loads if not name.endswith("_lanes")}
+    bad = {name: (sets.get(name), loads[name]) for name in kernels if sets.get(name) != loads[name]}
+    bad.update({name: (sets.get(name[:-len("_lanes")]), loads[name]) for name in loads
+                if name.endswith("_lanes") and sets.get(name[:-len("_lanes")]) != loads[name]})
+    return bad
+
+
+def test_every_kernel_has_the_read_set_that_its_code_loads():
+    header = (ROOT / "generated" / "sr_generated.h").read_text()
+    source = (ROOT / "generated" / "sr_generated.c").read_text()
+    assert read_set_mismatches(header, source) == {}
+    prototypes = set(re.findall(r"^int sr_gen_(\w+)\(", header, re.M))
+    assert set(header_read_sets(header)) == prototypes and header_read_sets(header)["accel"]
+
+
+@pytest.mark.parametrize("perturb", [
+    lambda h: h.replace("#define SR_GEN_READS_accel(R) R(c, 6, 17)", "#define SR_GEN_READS_accel(R) R(c, 7, 17)"),
+    lambda h: re.sub(r"^#define SR_GEN_READS_inertia\(R\).*\n", "", h, flags=re.M),
+], ids=["an entry missing", "a kernel missing"])
+def test_the_read_set_check_fails_for_a_perturbed_header(perturb):
+    header = (ROOT / "generated" / "sr_generated.h").read_text()
+    perturbed = perturb(header)
+    assert perturbed != header
+    assert read_set_mismatches(perturbed, (ROOT / "generated" / "sr_generated.c").read_text()) != {}
+
+
+def test_index_ranges_are_the_runs_of_consecutive_indices():
+    assert emit.index_ranges((6, 7, 8, 30)) == ((6, 9), (30, 31))
+    assert emit.index_ranges(()) == ()
