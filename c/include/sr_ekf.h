@@ -19,7 +19,8 @@
  * Update (one sample y of m entries, H its Jacobian in (d, db), R = diag(sigma^2)):
  *   r = y - h(x, b)  (angles wrapped into (-pi, pi]),  S = H P H^T + R = L L^T (Cholesky),
  *   NIS = r^T S^-1 r: if NIS > gate the sample is counted in gated[kind] and nothing else changes;
- *   else K = P H^T S^-1, e = K r, P <- (I - K H) P (I - K H)^T + K R K^T (Joseph form),
+ *   else K = P H^T S^-1, e = K r, P <- (I - K H) P (I - K H)^T + K R K^T (Joseph form; evaluated
+ *   expanded, P - K C^T - (C - K S) K^T with C = P H^T: the same polynomial in K, in O(18^2 m)),
  *   x <- x (+) e_d (sr_retract), b <- b + e_b, and the reset P <- G P G^T, G = I but for the
  *   shell block, the right Jacobian Jr(e_xi_S) of SO(3) (the error after the injection is
  *   Exp(e_xi) Exp(d') = Exp(d): d' = Jr(e_xi)(d - e_xi) to first order).
