@@ -208,7 +208,7 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
 static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_real *r, const sr_real *H,
                   const sr_real *Rd, sr_real gate)
 {
-    sr_real C[NB * MAXM], S[MAXM * MAXM], L[MAXM * MAXM], K[NB * MAXM], D[NB * MAXM], Pn[NB * NB];
+    sr_real C[NB * MAXM], S[MAXM * MAXM] = {0}, L[MAXM * MAXM], K[NB * MAXM], D[NB * MAXM], Pn[NB * NB];
     sr_real Hc[MAXM * NB], Pc[NB], z[MAXM], e[NB], xn[SR_NX], Jr[9], T[3 * NB], nis = 0;
     int cols[NB], nc = 0, a, b, i, j, k, status;
 
