@@ -13,6 +13,7 @@ Every build goes to a fresh directory under pytest's tmp (c/Makefile's BUILD=...
 rather than c/build, so that concurrent test runs in one checkout cannot race
 on the same objects.  No Python is involved in building the C.
 """
+import json
 import os
 import re
 import shutil
@@ -135,7 +136,7 @@ def test_library_has_no_mutable_globals(build, lib):
             assert int(parts[1]) == 0, f"{lib}: {line.strip()}"
 
 
-@pytest.mark.parametrize("header, at_least", [("spherical_robot.h", 12), ("sr_sensors.h", 11)])
+@pytest.mark.parametrize("header, at_least", [("spherical_robot.h", 12), ("sr_sensors.h", 11), ("sr_ekf.h", 7)])
 def test_every_public_function_returns_a_status_code(header, at_least):
     text = re.sub(r"/\*.*?\*/", "", (INCLUDE / header).read_text(), flags=re.S)
     prototypes = re.findall(r"^([A-Za-z_][\w \t\*]*?)\b(sr_\w+)\s*\(", text, flags=re.M)
@@ -275,6 +276,18 @@ def test_a_program_calling_a_fourth_order_step_links_it(build, tmp_path):
     run([CC, "-std=c99", "-O2", f"-I{INCLUDE}", f"-I{ROOT / 'generated'}", str(probe), str(build / "libsphericalrobot.a"),
          "-lm", "-Wl,--gc-sections", "-o", str(tmp_path / "probe")])
     assert "sr_step_rkmk4" in defined_functions(tmp_path / "probe")
+
+
+def test_the_ekf_timing_driver_builds_warning_free_and_reports_every_part(build, tmp_path):
+    """bench/bench_ekf.c (`make bench`'s EKF sample) against the library: strict C99, and one JSON
+    line with a time for the whole sample, each part, and the step Jacobian it is compared with."""
+    exe = tmp_path / "bench_ekf"
+    run([CC, "-std=c99", "-O2", "-Wall", "-Wextra", "-Wpedantic", "-Werror", f"-I{INCLUDE}", f"-I{ROOT / 'generated'}",
+         str(ROOT / "bench" / "bench_ekf.c"), str(build / "libsphericalrobot.a"), "-lm", "-o", str(exe)])
+    out = json.loads(run([str(exe), "5"]).stdout)
+    assert out["samples"] == 5
+    for part in ("predict_imu_encoders", "predict", "update_imu", "update_encoders", "step_jacobian_rkmk4"):
+        assert out[f"{part}_ns"] > 0
 
 
 # ---- documentation tools ------------------------------------------------------------------------

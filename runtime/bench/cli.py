@@ -15,8 +15,8 @@ from ..verification.sampling import random_inputs, random_states
 from .baselines import python_timings
 from .checks import WrongNumbers
 from .kane_compiled import kane_inputs as kane_coordinates, write_kane_c
-from .harness import (ROOT, build_harness, casadi_reference_c, check_harness, memory_floor, run_harness,
-                      step_anatomy)
+from .harness import (ROOT, build_harness, casadi_reference_c, check_harness, ekf_sample, memory_floor,
+                      run_harness, step_anatomy)
 from .report import format_markdown, format_report, write_results
 from .timing import cpu_name, pin_to_one_core
 
@@ -88,6 +88,8 @@ def run(args, core, progress):
             check_harness(result["c_loop"], model, X, U)
             progress("the anatomy of a fourth-order step (its accelerations and everything else)")
             result["step_anatomy"] = step_anatomy(build, exe.parent / "input.bin", max(1, args.repeats // 4))
+            progress("one 200 Hz sample of the EKF: predict, an IMU and an encoder update")
+            result["ekf_sample"] = ekf_sample(build)
             if args.native:
                 exe = build_harness(build, native=True, with_casadi=False)
                 result["c_loop_native"] = run_harness(exe, params, X, U, args.repeats)

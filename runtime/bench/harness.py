@@ -89,6 +89,18 @@ def step_anatomy(build, input_file, repeats):
     return out
 
 
+def ekf_sample(build, samples=2000):
+    """One 200 Hz sample of the error-state EKF (bench/bench_ekf.c): an RKMK4 predict, an IMU and an
+    encoder update over a recorded run, each part alone too, and one RKMK4 step Jacobian in the same
+    run; ns, best of 11 rounds.  The portable -O2 build, as the firmware's."""
+    exe = build / "bench_ekf"
+    flags = [f for f in LIBRARY_FLAGS if f != "-O3"] + ["-O2", "-ffp-contract=off"]
+    subprocess.run([_compiler(), *flags, str(ROOT / "bench" / "bench_ekf.c"), *map(str, _library_sources()), "-lm",
+                    "-o", str(exe)], check=True)
+    out = subprocess.run([str(exe), str(samples)], check=True, capture_output=True, text=True).stdout
+    return json.loads(out)
+
+
 def memory_floor(build, states, rounds=7):
     """ns per state of bench/memory_floor.c on `states` states: the batch accel's memory traffic
     alone (read x and u, write 5 numbers a state), compiled as fast as it goes."""

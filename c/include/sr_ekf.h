@@ -1,0 +1,126 @@
+/**
+ * sr_ekf.h -- an error-state extended Kalman filter on the robot's group: the state x of
+ * spherical_robot.h and the IMU's biases estimated from the sensors of sr_sensors.h
+ * (docs/estimation.md, "The filter").
+ *
+ * Error state.  The filter keeps a point x of SO(3) x SO(2) x SO(2) x R^2 x R^5 and the biases
+ * b = (b_g, b_a), and the covariance P (SR_NEB x SR_NEB, row-major) of the error
+ * e = (d, db): the truth is x (+) d (sr_retract's right-trivialised coordinates) and b + db.
+ *
+ * Predict (one sample of dt, torques u held):
+ *   x <- step(x, u, dt)                     sr_step with the given method
+ *   P_dd <- F P_dd F^T + Q_d,  P_db <- F P_db,  P_bb <- P_bb + Q_b
+ * F = d step / d d (sr_step_jacobian at the prior x); the biases do not enter the step, so only
+ * the 12 x 12 block and the cross terms move.  Q_d is white generalized torque noise w on nu
+ * (M nu' = f + w; spectral densities: the shell's three axes, the yoke joint, the pendulum joint,
+ * process->torque_psd [N m/sqrt(Hz)]), Q_d = dt M^-1 diag(psd^2) M^-1 in the nu block, M the
+ * inertia at the prior x; Q_b = dt diag(rw^2) for the biases' random walks.
+ *
+ * Update (one sample y of m entries, H its Jacobian in (d, db), R = diag(sigma^2)):
+ *   r = y - h(x, b)  (angles wrapped into (-pi, pi]),  S = H P H^T + R = L L^T (Cholesky),
+ *   NIS = r^T S^-1 r: if NIS > gate the sample is counted in gated[kind] and nothing else changes;
+ *   else K = P H^T S^-1, e = K r, P <- (I - K H) P (I - K H)^T + K R K^T (Joseph form; evaluated
+ *   expanded, P - K C^T - (C - K S) K^T with C = P H^T: the same polynomial in K, in O(18^2 m)),
+ *   x <- x (+) e_d (sr_retract), b <- b + e_b, and the reset P <- G P G^T, G = I but for the
+ *   shell block, the right Jacobian Jr(e_xi_S) of SO(3) (the error after the injection is
+ *   Exp(e_xi) Exp(d') = Exp(d): d' = Jr(e_xi)(d - e_xi) to first order).
+ * gate: the caller's threshold on the NIS, e.g. the 99.9 % quantile of chi-square with m degrees
+ * of freedom (10.83, 13.82, 22.46 for m = 1, 2, 6); +INFINITY accepts every sample.
+ *
+ * Checks, in the library's order (docs/robustness.md): the model (SR_ERR_NULL, SR_ERR_MODEL), the
+ * other pointers (SR_ERR_NULL), the arguments (SR_ERR_ARG: method, dt, a standard deviation or a
+ * noise density not finite and > 0 (>= 0 for the process noise), gate not > 0 or NaN, body; the
+ * mount as sr_check_mount), then the data: the sample and u finite (SR_ERR_NONFINITE), the
+ * filter's x (sr_check_state) and its biases and P finite.  A failing call writes nothing, the
+ * counters included; SR_ERR_SINGULAR where S (or M) is not positive definite, SR_ERR_NONFINITE
+ * where a result overflows.  No dynamic allocation, no globals: the caller owns the sr_ekf.
+ * @file
+ */
+#ifndef SR_EKF_H
+#define SR_EKF_H
+
+#include "sr_sensors.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#ifdef SR_USE_FLOAT
+#define sr_ekf_init sr_ekf_init_f
+#define sr_ekf_init_diagonal sr_ekf_init_diagonal_f
+#define sr_ekf_predict sr_ekf_predict_f
+#define sr_ekf_update_imu sr_ekf_update_imu_f
+#define sr_ekf_update_encoders sr_ekf_update_encoders_f
+#define sr_ekf_update_position sr_ekf_update_position_f
+#define sr_ekf_update_heading sr_ekf_update_heading_f
+#endif
+
+/** @name Sensor kinds: the index of each update's counters and last NIS */
+/** @{ */
+#define SR_EKF_IMU 0           /**< sr_ekf_update_imu (6 entries: gyroscope, accelerometer) */
+#define SR_EKF_ENCODERS 1      /**< sr_ekf_update_encoders (theta_Y, theta_P) */
+#define SR_EKF_POSITION 2      /**< sr_ekf_update_position (q_x, q_y) */
+#define SR_EKF_HEADING 3       /**< sr_ekf_update_heading (one angle) */
+#define SR_EKF_NKINDS 4        /**< the number of sensor kinds */
+/** @} */
+
+/** The filter's state, owned by the caller; fill it with sr_ekf_init or sr_ekf_init_diagonal. */
+typedef struct sr_ekf {
+    sr_real x[SR_NX];                 /**< the state estimate (layout of spherical_robot.h) */
+    sr_real bias[SR_NBIAS];           /**< the IMU's bias estimate: b_g (SR_BIAS_b_g), b_a (SR_BIAS_b_a) */
+    sr_real P[SR_NEB * SR_NEB];       /**< covariance of (d, db), row-major, offsets SR_EB_* */
+    long accepted[SR_EKF_NKINDS];     /**< samples applied, per kind (SR_EKF_*) */
+    long gated[SR_EKF_NKINDS];        /**< samples refused by the gate, per kind */
+    sr_real nis[SR_EKF_NKINDS];       /**< the last sample's r^T S^-1 r, per kind (applied or gated) */
+} sr_ekf;
+
+/** The process noise of sr_ekf_predict (all >= 0 and finite). */
+typedef struct sr_ekf_process {
+    sr_real torque_psd[3];    /**< white generalized torques on the shell (each axis), the yoke joint and the pendulum joint [N m/sqrt(Hz)] */
+    sr_real gyro_bias_rw;     /**< the gyroscope biases' random walk [rad/s/sqrt(s)] (0: constant) */
+    sr_real accel_bias_rw;    /**< the accelerometer biases' random walk [m/s^2/sqrt(s)] (0: constant) */
+} sr_ekf_process;
+
+/** Starts the filter at x0 (checked as sr_check_state), biases bias (NULL: zero), covariance
+ * P0 (SR_NEB x SR_NEB row-major: finite, symmetric to 1e-12 relative of its largest diagonal
+ * entry, else SR_ERR_ARG; positive definite, else SR_ERR_SINGULAR); counters and NIS zeroed.
+ * Returns SR_OK or an error code; *ekf is written only on SR_OK. */
+int sr_ekf_init(sr_ekf *ekf, const sr_model *model, const sr_real x0[SR_NX], const sr_real bias[SR_NBIAS],
+                const sr_real P0[SR_NEB * SR_NEB]);
+
+/** sr_ekf_init with P0 = diag(sigma^2), sigma[SR_NEB] the standard deviations of (d, db), each
+ * finite and > 0 (else SR_ERR_ARG). */
+int sr_ekf_init_diagonal(sr_ekf *ekf, const sr_model *model, const sr_real x0[SR_NX], const sr_real bias[SR_NBIAS],
+                         const sr_real sigma[SR_NEB]);
+
+/** One prediction over dt > 0 under the torques u (NULL: zero) by the stepping method
+ * (SR_LIE_EULER, SR_RKMK4 or SR_CF4, optionally | SR_PROJECT for the step; F is the Jacobian of the
+ * method without projection), process noise *process (see the file's description). */
+int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real u[SR_NU], sr_real dt,
+                   const sr_ekf_process *process);
+
+/** One IMU sample y[SR_NIMU] (gyroscope [rad/s], accelerometer [m/s^2], in the sensor's axes)
+ * from the IMU on body at mount, while the torques u (NULL: zero) act: the reading and H of
+ * sr_imu_jacobian at the estimate (nu' moving with the state), R = diag(sigma_gyro^2 x 3,
+ * sigma_accel^2 x 3) (per-sample standard deviations), gated at gate. */
+int sr_ekf_update_imu(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
+                      int body, const sr_real mount[SR_NMOUNT], sr_real sigma_gyro, sr_real sigma_accel, sr_real gate);
+
+/** One encoder sample y = (theta_Y, theta_P) [rad], standard deviation sigma each (e.g. a count's
+ * quantisation, 2 pi / (counts sqrt(12))), gated at gate; the innovations are wrapped into (-pi, pi]. */
+int sr_ekf_update_encoders(sr_ekf *ekf, const sr_model *model, const sr_real y[2], sr_real sigma, sr_real gate);
+
+/** One position fix y = (q_x, q_y) [m], standard deviation sigma each, gated at gate. */
+int sr_ekf_update_position(sr_ekf *ekf, const sr_model *model, const sr_real y[2], sr_real sigma, sr_real gate);
+
+/** One heading sample [rad] of the sensor on body at mount (sr_heading_measure), standard deviation
+ * sigma, gated at gate; the innovation is wrapped into (-pi, pi].  SR_ERR_SINGULAR where the
+ * estimate's sensor x axis is along the floor's normal (the heading is undefined there). */
+int sr_ekf_update_heading(sr_ekf *ekf, const sr_model *model, sr_real y, int body, const sr_real mount[SR_NMOUNT],
+                          sr_real sigma, sr_real gate);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SR_EKF_H */

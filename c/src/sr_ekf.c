@@ -1,0 +1,374 @@
+/* sr_ekf.c -- the error-state EKF on the group (contract and equations: c/include/sr_ekf.h).
+ * Every call works on local copies and writes the filter only when it succeeds. */
+#include "sr_ekf.h"
+#include "sr_argcheck.h"
+#include "sr_checks.h"
+#include "sr_so3.h"
+
+#include <string.h>
+
+#define NB SR_NEB
+#define NE SR_NE
+#define MAXM SR_NIMU /* the largest sample */
+
+#ifdef SR_USE_FLOAT
+#define SR_FMOD fmodf
+#else
+#define SR_FMOD fmod
+#endif
+
+static const sr_real pi_ = SR_C(3.14159265358979323846);
+
+/* a - b wrapped into (-pi, pi]: the innovation of an angle. */
+static sr_real angle_difference(sr_real a, sr_real b)
+{
+    const sr_real two_pi = 2 * pi_;
+    sr_real w = SR_FMOD(a - b + pi_, two_pi);
+    if (w < 0) w += two_pi;
+    w -= pi_;
+    return w == -pi_ ? pi_ : w;
+}
+
+/* A = L L^T for a symmetric n x n A (row-major; only its lower triangle is read).  SR_ERR_SINGULAR
+ * when a pivot is not positive (A not positive definite, or NaN). */
+static int cholesky(int n, const sr_real *A, sr_real *L)
+{
+    int i, j, k;
+    for (j = 0; j < n; ++j) {
+        sr_real s = A[n * j + j];
+        for (k = 0; k < j; ++k) s -= L[n * j + k] * L[n * j + k];
+        if (!(s > 0)) return SR_ERR_SINGULAR;
+        L[n * j + j] = SR_SQRT(s);
+        for (i = j + 1; i < n; ++i) {
+            sr_real t = A[n * i + j];
+            for (k = 0; k < j; ++k) t -= L[n * i + k] * L[n * j + k];
+            L[n * i + j] = t / L[n * j + j];
+        }
+        for (i = 0; i < j; ++i) L[n * i + j] = 0;
+    }
+    return SR_OK;
+}
+
+/* b <- L^-1 b, then (solve_both) L^-T of that: b <- (L L^T)^-1 b. */
+static void forward(int n, const sr_real *L, sr_real *b)
+{
+    int i, k;
+    for (i = 0; i < n; ++i) {
+        sr_real s = b[i];
+        for (k = 0; k < i; ++k) s -= L[n * i + k] * b[k];
+        b[i] = s / L[n * i + i];
+    }
+}
+
+static void solve_both(int n, const sr_real *L, sr_real *b)
+{
+    int i, k;
+    forward(n, L, b);
+    for (i = n - 1; i >= 0; --i) {
+        sr_real s = b[i];
+        for (k = i + 1; k < n; ++k) s -= L[n * k + i] * b[k];
+        b[i] = s / L[n * i + i];
+    }
+}
+
+/* The filter's own data: x a valid state, biases and P finite. */
+static int check_filter(const sr_model *model, const sr_ekf *ekf)
+{
+    const int status = sr_internal_check_state(model, ekf->x);
+    if (status != SR_OK) return status;
+    return all_finite(ekf->bias, SR_NBIAS) && all_finite(ekf->P, NB * NB) ? SR_OK : SR_ERR_NONFINITE;
+}
+
+static int positive(sr_real v) { return v > 0 && isfinite(v); }
+
+/* A gate: > 0, +infinity allowed (every sample accepted), NaN refused. */
+static int valid_gate(sr_real gate) { return gate > 0; }
+
+int sr_ekf_init(sr_ekf *ekf, const sr_model *model, const sr_real x0[SR_NX], const sr_real bias[SR_NBIAS],
+                const sr_real P0[SR_NEB * SR_NEB])
+{
+    sr_real L[NB * NB], scale = 0;
+    int status = arg_model(model, READS(WHOLE)), i, j;
+    if (status != SR_OK) return status;
+    if (!ekf || !x0 || !P0) return SR_ERR_NULL;
+    if (!all_finite(P0, NB * NB)) return SR_ERR_ARG;
+    for (i = 0; i < NB; ++i) scale = P0[NB * i + i] > scale ? P0[NB * i + i] : scale;
+    for (i = 0; i < NB; ++i)
+        for (j = 0; j < i; ++j)
+            if (SR_FABS(P0[NB * i + j] - P0[NB * j + i]) > SR_C(1e-12) * scale) return SR_ERR_ARG;
+    status = sr_internal_check_state(model, x0);
+    if (status != SR_OK) return status;
+    if (bias && !all_finite(bias, SR_NBIAS)) return SR_ERR_NONFINITE;
+    status = cholesky(NB, P0, L);
+    if (status != SR_OK) return status;
+    memset(ekf, 0, sizeof *ekf);
+    memcpy(ekf->x, x0, sizeof ekf->x);
+    if (bias) memcpy(ekf->bias, bias, sizeof ekf->bias);
+    /* Stored exactly symmetric: the updates read one triangle as the whole. */
+    for (i = 0; i < NB; ++i)
+        for (j = 0; j < NB; ++j) ekf->P[NB * i + j] = j >= i ? P0[NB * i + j] : P0[NB * j + i];
+    return SR_OK;
+}
+
+int sr_ekf_init_diagonal(sr_ekf *ekf, const sr_model *model, const sr_real x0[SR_NX], const sr_real bias[SR_NBIAS],
+                         const sr_real sigma[SR_NEB])
+{
+    sr_real P0[NB * NB];
+    int status = arg_model(model, READS(WHOLE)), i;
+    if (status != SR_OK) return status;
+    if (!ekf || !x0 || !sigma) return SR_ERR_NULL;
+    for (i = 0; i < NB; ++i)
+        if (!positive(sigma[i])) return SR_ERR_ARG;
+    memset(P0, 0, sizeof P0);
+    for (i = 0; i < NB; ++i) P0[NB * i + i] = sigma[i] * sigma[i];
+    return sr_ekf_init(ekf, model, x0, bias, P0);
+}
+
+static int valid_process(const sr_ekf_process *q)
+{
+    int i;
+    for (i = 0; i < 3; ++i)
+        if (!(q->torque_psd[i] >= 0 && isfinite(q->torque_psd[i]))) return 0;
+    return q->gyro_bias_rw >= 0 && isfinite(q->gyro_bias_rw) && q->accel_bias_rw >= 0 && isfinite(q->accel_bias_rw);
+}
+
+/* Q_nu = dt M^-1 D^2 M^-1 (D = diag of the torque densities): Z = M^-1 D by a Cholesky solve,
+ * Q = dt Z Z^T. */
+static int torque_noise(const sr_model *model, const sr_real x[SR_NX], const sr_ekf_process *q, sr_real dt,
+                        sr_real Q[SR_NV * SR_NV])
+{
+    sr_real M[SR_NV * SR_NV], L[SR_NV * SR_NV], Z[SR_NV * SR_NV], col[SR_NV];
+    const sr_real d[SR_NV] = {q->torque_psd[0], q->torque_psd[0], q->torque_psd[0], q->torque_psd[1],
+                              q->torque_psd[2]};
+    int status = sr_inertia(model, x, M), i, j, k;
+    if (status == SR_OK) status = cholesky(SR_NV, M, L);
+    if (status != SR_OK) return status;
+    for (j = 0; j < SR_NV; ++j) {
+        for (i = 0; i < SR_NV; ++i) col[i] = i == j ? d[j] : 0;
+        solve_both(SR_NV, L, col);
+        for (i = 0; i < SR_NV; ++i) Z[SR_NV * i + j] = col[i];
+    }
+    for (i = 0; i < SR_NV; ++i)
+        for (j = 0; j < SR_NV; ++j) {
+            sr_real s = 0;
+            for (k = 0; k < SR_NV; ++k) s += Z[SR_NV * i + k] * Z[SR_NV * j + k];
+            Q[SR_NV * i + j] = dt * s;
+        }
+    return SR_OK;
+}
+
+int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real u[SR_NU], sr_real dt,
+                   const sr_ekf_process *process)
+{
+    sr_real xn[SR_NX], F[NE * NE], G[NE * SR_NU], Qnu[SR_NV * SR_NV], T[NE * NB], Pn[NB * NB];
+    int status = arg_model(model, READS(WHOLE)), i, j, k;
+    if (status != SR_OK) return status;
+    if (!ekf || !process) return SR_ERR_NULL;
+    if (arg_method(method) != SR_OK || arg_dt(dt) != SR_OK || !valid_process(process)) return SR_ERR_ARG;
+    if (u && !all_finite(u, SR_NU)) return SR_ERR_NONFINITE;
+    status = check_filter(model, ekf);
+    if (status == SR_OK) status = sr_step(model, method, ekf->x, u, dt, xn);
+    if (status == SR_OK) status = sr_step_jacobian(model, method & ~SR_PROJECT, ekf->x, u, dt, F, G);
+    if (status == SR_OK) status = torque_noise(model, ekf->x, process, dt, Qnu);
+    if (status != SR_OK) return status;
+
+    /* T = F [P_dd P_db] (the cross terms F P_db come with it), then F P_dd F^T on the upper triangle. */
+    for (i = 0; i < NE; ++i) {
+        for (j = 0; j < NB; ++j) T[NB * i + j] = 0;
+        for (k = 0; k < NE; ++k) {
+            const sr_real f = F[NE * i + k];
+            for (j = 0; j < NB; ++j) T[NB * i + j] += f * ekf->P[NB * k + j];
+        }
+    }
+    for (i = 0; i < NE; ++i)
+        for (j = i; j < NE; ++j) {
+            sr_real s = 0;
+            for (k = 0; k < NE; ++k) s += T[NB * i + k] * F[NE * j + k];
+            Pn[NB * i + j] = Pn[NB * j + i] = s;
+        }
+    for (i = 0; i < SR_NV; ++i)
+        for (j = 0; j < SR_NV; ++j) Pn[NB * (SR_EB_nu + i) + SR_EB_nu + j] += Qnu[SR_NV * i + j];
+    /* The cross terms F P_db (in T already); the bias block only gains its random walk. */
+    for (i = 0; i < NE; ++i)
+        for (j = NE; j < NB; ++j) Pn[NB * i + j] = Pn[NB * j + i] = T[NB * i + j];
+    for (i = NE; i < NB; ++i)
+        for (j = NE; j < NB; ++j) Pn[NB * i + j] = ekf->P[NB * i + j];
+    for (i = 0; i < 3; ++i) {
+        Pn[NB * (SR_EB_b_g + i) + SR_EB_b_g + i] += dt * process->gyro_bias_rw * process->gyro_bias_rw;
+        Pn[NB * (SR_EB_b_a + i) + SR_EB_b_a + i] += dt * process->accel_bias_rw * process->accel_bias_rw;
+    }
+    if (!all_finite(Pn, NB * NB)) return SR_ERR_NONFINITE;
+    memcpy(ekf->x, xn, sizeof xn);
+    memcpy(ekf->P, Pn, sizeof Pn);
+    return SR_OK;
+}
+
+/* The update of sr_ekf.h for an m-entry sample with innovation r, Jacobian H (m x NB) and noise
+ * variances Rd: gate, gain, Joseph form, injection, reset; the filter is written only on SR_OK. */
+static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_real *r, const sr_real *H,
+                  const sr_real *Rd, sr_real gate)
+{
+    sr_real C[NB * MAXM], S[MAXM * MAXM] = {0}, L[MAXM * MAXM], K[NB * MAXM], D[NB * MAXM], Pn[NB * NB];
+    sr_real Hc[MAXM * NB], Pc[NB], z[MAXM], e[NB], xn[SR_NX], Jr[9], T[3 * NB], nis = 0;
+    int cols[NB], nc = 0, a, b, i, j, k, status;
+
+    /* H is sparse (the encoders and the fix read two columns, the heading four): its nonzero
+     * columns are gathered, Hc (m x nc), and only they enter C = P H^T and S = H C + R. */
+    for (k = 0; k < NB; ++k)
+        for (i = 0; i < m; ++i)
+            if (H[NB * i + k] != 0) {
+                for (j = 0; j < m; ++j) Hc[NB * j + nc] = H[NB * j + k];
+                cols[nc++] = k;
+                break;
+            }
+    for (a = 0; a < NB; ++a) {
+        const sr_real *Pa = ekf->P + NB * a;
+        for (k = 0; k < nc; ++k) Pc[k] = Pa[cols[k]];
+        for (i = 0; i < m; ++i) {
+            sr_real s = 0;
+            for (k = 0; k < nc; ++k) s += Pc[k] * Hc[NB * i + k];
+            C[MAXM * a + i] = s;
+        }
+    }
+    for (i = 0; i < m; ++i)
+        for (j = i; j < m; ++j) {
+            sr_real s = i == j ? Rd[i] : 0;
+            for (k = 0; k < nc; ++k) s += Hc[NB * i + k] * C[MAXM * cols[k] + j];
+            S[m * i + j] = S[m * j + i] = s;
+        }
+    status = cholesky(m, S, L);
+    if (status != SR_OK) return status;
+    for (i = 0; i < m; ++i) z[i] = r[i];
+    forward(m, L, z);
+    for (i = 0; i < m; ++i) nis += z[i] * z[i];
+    if (!isfinite(nis)) return SR_ERR_NONFINITE;
+    if (!(nis <= gate)) {
+        ekf->gated[kind] += 1;
+        ekf->nis[kind] = nis;
+        return SR_OK;
+    }
+
+    /* K = C S^-1, row by row (S symmetric: K^T = S^-1 C^T); e = K r */
+    for (a = 0; a < NB; ++a) {
+        for (i = 0; i < m; ++i) z[i] = C[MAXM * a + i];
+        solve_both(m, L, z);
+        e[a] = 0;
+        for (i = 0; i < m; ++i) {
+            K[MAXM * a + i] = z[i];
+            e[a] += z[i] * r[i];
+        }
+    }
+    /* The Joseph form (I - K H) P (I - K H)^T + K R K^T, expanded with C = P H^T and S = H P H^T + R:
+     * P - K C^T - C K^T + K S K^T = P - K C^T - (C - K S) K^T.  The same polynomial in K (exact
+     * for any gain, so an error in K enters only to second order), in O(NB^2 m) on the upper
+     * triangle instead of the products of 18 x 18 matrices. */
+    for (a = 0; a < NB; ++a)
+        for (i = 0; i < m; ++i) {
+            sr_real s = C[MAXM * a + i];
+            for (j = 0; j < m; ++j) s -= K[MAXM * a + j] * S[m * j + i];
+            D[MAXM * a + i] = s;
+        }
+    for (a = 0; a < NB; ++a)
+        for (b = a; b < NB; ++b) {
+            sr_real s = ekf->P[NB * a + b];
+            for (i = 0; i < m; ++i) s -= K[MAXM * a + i] * C[MAXM * b + i] + D[MAXM * a + i] * K[MAXM * b + i];
+            Pn[NB * a + b] = Pn[NB * b + a] = s;
+        }
+
+    /* Injection, then the reset of the shell's block by Jr(e_xi). */
+    status = sr_retract(model, ekf->x, e, xn);
+    if (status != SR_OK) return status;
+    so3_right_jacobian(e + SR_EB_xi_S, Jr);
+    for (i = 0; i < 3; ++i)
+        for (b = 0; b < NB; ++b)
+            T[NB * i + b] = Jr[3 * i] * Pn[NB * (SR_EB_xi_S) + b] + Jr[3 * i + 1] * Pn[NB * (SR_EB_xi_S + 1) + b]
+                          + Jr[3 * i + 2] * Pn[NB * (SR_EB_xi_S + 2) + b];
+    for (i = 0; i < 3; ++i) {
+        for (b = 3; b < NB; ++b) Pn[NB * (SR_EB_xi_S + i) + b] = Pn[NB * b + SR_EB_xi_S + i] = T[NB * i + b];
+        for (j = i; j < 3; ++j) {
+            const sr_real s = T[NB * i] * Jr[3 * j] + T[NB * i + 1] * Jr[3 * j + 1] + T[NB * i + 2] * Jr[3 * j + 2];
+            Pn[NB * i + j] = Pn[NB * j + i] = s;
+        }
+    }
+    if (!all_finite(Pn, NB * NB) || !all_finite(e, NB)) return SR_ERR_NONFINITE;
+    memcpy(ekf->x, xn, sizeof xn);
+    for (i = 0; i < SR_NBIAS; ++i) ekf->bias[i] += e[SR_EB_b_g + i];
+    memcpy(ekf->P, Pn, sizeof Pn);
+    ekf->accepted[kind] += 1;
+    ekf->nis[kind] = nis;
+    return SR_OK;
+}
+
+int sr_ekf_update_imu(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
+                      int body, const sr_real mount[SR_NMOUNT], sr_real sigma_gyro, sr_real sigma_accel, sr_real gate)
+{
+    sr_real yh[SR_NIMU], H[SR_NIMU * NB], r[SR_NIMU], Rd[SR_NIMU];
+    int status = arg_model(model, READS(WHOLE)), i;
+    if (status != SR_OK) return status;
+    if (!ekf || !y || !mount) return SR_ERR_NULL;
+    status = sr_check_mount(body, mount);
+    if (status != SR_OK) return status;
+    if (!positive(sigma_gyro) || !positive(sigma_accel) || !valid_gate(gate)) return SR_ERR_ARG;
+    if (!all_finite(y, SR_NIMU) || (u && !all_finite(u, SR_NU))) return SR_ERR_NONFINITE;
+    status = check_filter(model, ekf);
+    if (status == SR_OK) status = sr_imu_jacobian(model, ekf->x, u, body, mount, ekf->bias, yh, H);
+    if (status != SR_OK) return status;
+    for (i = 0; i < SR_NIMU; ++i) r[i] = y[i] - yh[i];
+    for (i = 0; i < 3; ++i) {
+        Rd[SR_IMU_gyro + i] = sigma_gyro * sigma_gyro;
+        Rd[SR_IMU_accel + i] = sigma_accel * sigma_accel;
+    }
+    return update(ekf, model, SR_EKF_IMU, SR_NIMU, r, H, Rd, gate);
+}
+
+/* The checks of the two-entry samples and the one-angle sample: model, pointers, sigma and gate, data. */
+static int check_simple(const sr_ekf *ekf, const sr_model *model, const sr_real *y, int n, sr_real sigma, sr_real gate)
+{
+    const int status = arg_model(model, READS(WHOLE));
+    if (status != SR_OK) return status;
+    if (!ekf || !y) return SR_ERR_NULL;
+    if (!positive(sigma) || !valid_gate(gate)) return SR_ERR_ARG;
+    if (!all_finite(y, n)) return SR_ERR_NONFINITE;
+    return check_filter(model, ekf);
+}
+
+int sr_ekf_update_encoders(sr_ekf *ekf, const sr_model *model, const sr_real y[2], sr_real sigma, sr_real gate)
+{
+    sr_real yh[2], H[2 * NB], r[2], Rd[2];
+    int status = check_simple(ekf, model, y, 2, sigma, gate);
+    if (status == SR_OK) status = sr_encoders_jacobian(model, ekf->x, yh, H);
+    if (status != SR_OK) return status;
+    r[0] = angle_difference(y[0], yh[0]);
+    r[1] = angle_difference(y[1], yh[1]);
+    Rd[0] = Rd[1] = sigma * sigma;
+    return update(ekf, model, SR_EKF_ENCODERS, 2, r, H, Rd, gate);
+}
+
+int sr_ekf_update_position(sr_ekf *ekf, const sr_model *model, const sr_real y[2], sr_real sigma, sr_real gate)
+{
+    sr_real yh[2], H[2 * NB], r[2], Rd[2];
+    int status = check_simple(ekf, model, y, 2, sigma, gate);
+    if (status == SR_OK) status = sr_position_jacobian(model, ekf->x, yh, H);
+    if (status != SR_OK) return status;
+    r[0] = y[0] - yh[0];
+    r[1] = y[1] - yh[1];
+    Rd[0] = Rd[1] = sigma * sigma;
+    return update(ekf, model, SR_EKF_POSITION, 2, r, H, Rd, gate);
+}
+
+int sr_ekf_update_heading(sr_ekf *ekf, const sr_model *model, sr_real y, int body, const sr_real mount[SR_NMOUNT],
+                          sr_real sigma, sr_real gate)
+{
+    sr_real yh, H[NB], r, Rd;
+    int status = arg_model(model, READS(WHOLE));
+    if (status != SR_OK) return status;
+    if (!ekf || !mount) return SR_ERR_NULL;
+    status = sr_check_mount(body, mount);
+    if (status != SR_OK) return status;
+    status = check_simple(ekf, model, &y, 1, sigma, gate);
+    if (status == SR_OK) status = sr_heading_jacobian(model, ekf->x, body, mount, &yh, H);
+    if (status != SR_OK) return status;
+    r = angle_difference(y, yh);
+    Rd = sigma * sigma;
+    return update(ekf, model, SR_EKF_HEADING, 1, &r, H, &Rd, gate);
+}

@@ -1,0 +1,169 @@
+/*
+ * test_ekf.c -- the error-state EKF (c/src/sr_ekf.c): updates whose answer is known by hand (a
+ * position fix on a diagonal covariance is a scalar Kalman filter per axis), the block structure
+ * of the prediction, gating, the bias states, and status codes with nothing written on error.
+ */
+#include "sr_test.h"
+#include "sr_ekf.h"
+
+#include <math.h>
+#include <string.h>
+
+static const sr_real chi2_2 = SR_C(13.815510557964274); /* 99.9 % quantile, 2 degrees of freedom */
+
+static void start(sr_ekf *ekf, sr_model *m, double sigma_all)
+{
+    sr_real x[SR_NX], sigma[SR_NEB];
+    int i;
+    paper_simulation_model(m);
+    make_state(x, 0.1, -0.2, (double)m->p[SR_P_r]);
+    for (i = 0; i < SR_NEB; ++i) sigma[i] = (sr_real)sigma_all;
+    CHECK_STATUS(sr_ekf_init_diagonal(ekf, m, x, NULL, sigma), SR_OK);
+}
+
+static void test_a_position_fix_on_a_diagonal_covariance_is_the_scalar_filter_per_axis(void)
+{
+    /* P = p I, R = s^2: K = p/(p + s^2), q <- q + K r, P_qq <- (1-K)^2 p + K^2 s^2 = p s^2/(p + s^2) */
+    sr_ekf ekf;
+    sr_model m;
+    const double p = 0.04, s = 0.1, k = p / (p + s * s);
+    const sr_real y[2] = {SR_C(0.3), SR_C(-0.1)};
+    start(&ekf, &m, sqrt(p));
+    CHECK_STATUS(sr_ekf_update_position(&ekf, &m, y, (sr_real)s, chi2_2), SR_OK);
+    CHECK_NEAR(ekf.x[SR_X_q + 0], k * 0.3, 8 * TEST_EPS);
+    CHECK_NEAR(ekf.x[SR_X_q + 1], k * -0.1, 8 * TEST_EPS);
+    CHECK_NEAR(ekf.P[SR_NEB * SR_EB_q + SR_EB_q], p * s * s / (p + s * s), 8 * TEST_EPS);
+    CHECK_NEAR(ekf.P[SR_NEB * (SR_EB_q + 1) + SR_EB_q], 0, 8 * TEST_EPS);
+    CHECK_NEAR(ekf.P[SR_NEB * SR_EB_nu + SR_EB_nu], p, 8 * TEST_EPS);
+    CHECK(ekf.accepted[SR_EKF_POSITION] == 1 && ekf.gated[SR_EKF_POSITION] == 0);
+}
+
+static void test_an_outlier_is_gated_counted_and_not_applied(void)
+{
+    sr_ekf ekf, before;
+    sr_model m;
+    const sr_real y[2] = {SR_C(1.0), SR_C(0.0)}; /* 10 sigma off */
+    start(&ekf, &m, 0.01);
+    before = ekf;
+    CHECK_STATUS(sr_ekf_update_position(&ekf, &m, y, SR_C(0.1), chi2_2), SR_OK);
+    CHECK(ekf.gated[SR_EKF_POSITION] == 1 && ekf.accepted[SR_EKF_POSITION] == 0);
+    CHECK(memcmp(ekf.x, before.x, sizeof ekf.x) == 0 && memcmp(ekf.P, before.P, sizeof ekf.P) == 0);
+    CHECK(ekf.nis[SR_EKF_POSITION] > chi2_2);
+    /* with the gate open the same sample is applied */
+    CHECK_STATUS(sr_ekf_update_position(&ekf, &m, y, SR_C(0.1), (sr_real)INFINITY), SR_OK);
+    CHECK(ekf.accepted[SR_EKF_POSITION] == 1);
+}
+
+static void test_encoder_innovations_wrap_around_pi(void)
+{
+    /* The estimate at theta_Y = 0.1; a reading of 0.1 - 2 pi is the same angle: no correction. */
+    sr_ekf ekf;
+    sr_model m;
+    const sr_real y[2] = {(sr_real)(0.1 - 2 * 3.14159265358979323846), SR_C(-0.2)};
+    sr_real before;
+    start(&ekf, &m, 0.01);
+    before = ekf.x[SR_X_R_Y + 7];
+    CHECK_STATUS(sr_ekf_update_encoders(&ekf, &m, y, SR_C(0.001), chi2_2), SR_OK);
+    CHECK(ekf.accepted[SR_EKF_ENCODERS] == 1);
+    CHECK_NEAR(ekf.x[SR_X_R_Y + 7], before, 64 * TEST_EPS);
+}
+
+static void test_predict_leaves_the_bias_block_alone_and_moves_the_cross_terms(void)
+{
+    sr_ekf ekf;
+    sr_model m;
+    sr_ekf_process q = {{SR_C(0.01), SR_C(0.01), SR_C(0.01)}, 0, 0};
+    const sr_real u[2] = {SR_C(0.1), SR_C(0.0)};
+    const sr_real y[SR_NIMU] = {0, 0, 0, 0, 0, SR_C(9.81)};
+    sr_real mount[SR_NMOUNT] = {0, 0, SR_C(-0.05), 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    sr_real bias_block[36];
+    int i, j, nonzero = 0;
+    start(&ekf, &m, 0.01);
+    /* an IMU update correlates the biases with the rest */
+    CHECK_STATUS(sr_ekf_update_imu(&ekf, &m, y, u, SR_BODY_yoke, mount, SR_C(0.003), SR_C(0.02), (sr_real)INFINITY),
+                 SR_OK);
+    for (i = 0; i < 6; ++i)
+        for (j = 0; j < 6; ++j) bias_block[6 * i + j] = ekf.P[SR_NEB * (SR_EB_b_g + i) + SR_EB_b_g + j];
+    CHECK_STATUS(sr_ekf_predict(&ekf, &m, SR_RKMK4, u, SR_C(0.005), &q), SR_OK);
+    for (i = 0; i < 6; ++i)
+        for (j = 0; j < 6; ++j) CHECK(ekf.P[SR_NEB * (SR_EB_b_g + i) + SR_EB_b_g + j] == bias_block[6 * i + j]);
+    for (i = 0; i < SR_NE; ++i)
+        for (j = SR_NE; j < SR_NEB; ++j) {
+            CHECK(ekf.P[SR_NEB * i + j] == ekf.P[SR_NEB * j + i]);
+            nonzero += ekf.P[SR_NEB * i + j] != 0;
+        }
+    CHECK(nonzero > 0);
+}
+
+static void test_a_constant_gyro_offset_at_rest_is_learnt_as_the_gyro_bias(void)
+{
+    sr_ekf ekf;
+    sr_model m;
+    sr_ekf_process q = {{SR_C(0.01), SR_C(0.01), SR_C(0.01)}, 0, 0};
+    sr_real mount[SR_NMOUNT] = {0, 0, SR_C(-0.05), 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    sr_real x[SR_NX], sigma[SR_NEB], y[SR_NIMU];
+    int i, k;
+    paper_simulation_model(&m);
+    make_state(x, 0, 0, (double)m.p[SR_P_r]);
+    for (i = 0; i < SR_NEB; ++i) sigma[i] = SR_C(0.01);
+    for (i = 0; i < 3; ++i) sigma[SR_EB_b_g + i] = SR_C(0.05);
+    CHECK_STATUS(sr_ekf_init_diagonal(&ekf, &m, x, NULL, sigma), SR_OK);
+    CHECK_STATUS(sr_imu_measure_u(&m, x, NULL, SR_BODY_yoke, mount, NULL, y), SR_OK);
+    y[SR_IMU_gyro + 2] += SR_C(0.02);
+    for (k = 0; k < 400; ++k) {
+        CHECK_STATUS(sr_ekf_predict(&ekf, &m, SR_RKMK4, NULL, SR_C(0.005), &q), SR_OK);
+        CHECK_STATUS(sr_ekf_update_imu(&ekf, &m, y, NULL, SR_BODY_yoke, mount, SR_C(0.003), SR_C(0.02), (sr_real)INFINITY),
+                     SR_OK);
+    }
+    CHECK_NEAR(ekf.bias[SR_BIAS_b_g + 2], 0.02, 0.002);
+    CHECK(sqrt((double)ekf.P[SR_NEB * (SR_EB_b_g + 2) + SR_EB_b_g + 2]) < 0.01);
+}
+
+static void test_bad_input_gives_a_status_and_writes_nothing(void)
+{
+    sr_ekf ekf, before;
+    sr_model m, broken;
+    sr_ekf_process q = {{SR_C(0.01), SR_C(0.01), SR_C(0.01)}, 0, 0};
+    sr_real mount[SR_NMOUNT] = {0, 0, SR_C(-0.05), 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    sr_real y[SR_NIMU] = {0, 0, 0, 0, 0, SR_C(9.81)}, P0[SR_NEB * SR_NEB];
+    const sr_real fix[2] = {0, 0};
+    int i;
+    start(&ekf, &m, 0.01);
+    before = ekf;
+    broken = m;
+    broken.p[SR_P_r] = SR_C(0.5);
+    CHECK_STATUS(sr_ekf_update_position(&ekf, &broken, fix, SR_C(0.1), chi2_2), SR_ERR_MODEL);
+    CHECK_STATUS(sr_ekf_predict(&ekf, &broken, SR_RKMK4, NULL, SR_C(0.005), &q), SR_ERR_MODEL);
+    CHECK_STATUS(sr_ekf_update_position(NULL, &m, fix, SR_C(0.1), chi2_2), SR_ERR_NULL);
+    CHECK_STATUS(sr_ekf_update_position(&ekf, &m, fix, SR_C(0.0), chi2_2), SR_ERR_ARG);
+    CHECK_STATUS(sr_ekf_update_position(&ekf, &m, fix, SR_C(0.1), (sr_real)NAN), SR_ERR_ARG);
+    CHECK_STATUS(sr_ekf_predict(&ekf, &m, 7, NULL, SR_C(0.005), &q), SR_ERR_ARG);
+    CHECK_STATUS(sr_ekf_predict(&ekf, &m, SR_RKMK4, NULL, SR_C(-0.005), &q), SR_ERR_ARG);
+    q.torque_psd[1] = (sr_real)NAN;
+    CHECK_STATUS(sr_ekf_predict(&ekf, &m, SR_RKMK4, NULL, SR_C(0.005), &q), SR_ERR_ARG);
+    y[SR_IMU_accel + 1] = (sr_real)NAN;
+    CHECK_STATUS(sr_ekf_update_imu(&ekf, &m, y, NULL, SR_BODY_yoke, mount, SR_C(0.003), SR_C(0.02), chi2_2),
+                 SR_ERR_NONFINITE);
+    CHECK_STATUS(sr_ekf_update_imu(&ekf, &m, y, NULL, 5, mount, SR_C(0.003), SR_C(0.02), chi2_2), SR_ERR_ARG);
+    CHECK_STATUS(sr_ekf_update_heading(&ekf, &m, (sr_real)NAN, SR_BODY_yoke, mount, SR_C(0.05), chi2_2),
+                 SR_ERR_NONFINITE);
+    CHECK(memcmp(&ekf, &before, sizeof ekf) == 0);
+    /* a covariance that is not symmetric, or not positive definite */
+    memcpy(P0, ekf.P, sizeof P0);
+    P0[1] = SR_C(1e-5);
+    CHECK_STATUS(sr_ekf_init(&ekf, &m, before.x, NULL, P0), SR_ERR_ARG);
+    P0[1] = 0;
+    for (i = 0; i < SR_NEB; ++i) P0[SR_NEB * i + i] = i == 4 ? -1 : 1;
+    CHECK_STATUS(sr_ekf_init(&ekf, &m, before.x, NULL, P0), SR_ERR_SINGULAR);
+    CHECK(memcmp(&ekf, &before, sizeof ekf) == 0);
+}
+
+void suite_ekf(void)
+{
+    RUN_TEST(test_a_position_fix_on_a_diagonal_covariance_is_the_scalar_filter_per_axis);
+    RUN_TEST(test_an_outlier_is_gated_counted_and_not_applied);
+    RUN_TEST(test_encoder_innovations_wrap_around_pi);
+    RUN_TEST(test_predict_leaves_the_bias_block_alone_and_moves_the_cross_terms);
+    RUN_TEST(test_a_constant_gyro_offset_at_rest_is_learnt_as_the_gyro_bias);
+    RUN_TEST(test_bad_input_gives_a_status_and_writes_nothing);
+}

@@ -1,0 +1,305 @@
+"""The error-state EKF on the group, in C (c/include/sr_ekf.h): the state and the IMU's biases
+from an IMU, the joint encoders, position fixes and a heading (docs/estimation.md, "The filter").
+
+    from runtime import Model, Params
+    from runtime.ekf import EkfNoise, start_from_measurements
+    model = Model(Params.paper_simulation())
+    ekf = start_from_measurements(model, accel=(0.0, 0.0, 9.81), encoders=(0.0, 0.0), fix=(0.0, 0.0))
+    for each sample of period dt, torques u:
+        ekf.predict(u, dt)
+        ekf.update_imu(y_imu, u)                    # (6,): gyroscope [rad/s], accelerometer [m/s²]
+        ekf.update_encoders((theta_Y, theta_P))     # as the samples arrive, any rate
+        ekf.update_position((q_x, q_y))
+    ekf.x, ekf.biases, ekf.sigma, ekf.counters
+
+Every call is one C call on a caller-owned `sr_ekf`; the arguments are checked here first (a
+ValueError names the one that is wrong).  Each update returns True when the sample was applied,
+False when the chi-square gate refused it (counted in `counters`).
+"""
+import dataclasses
+import math
+
+import numpy as np
+from scipy.stats import chi2
+
+from bindings._sr import ffi, lib
+
+from .errors import KernelError
+from .model import Model
+from .sensors import DEFAULT_MOUNT, BODIES, Mount, NEB
+from .so3 import exp as so3_exp, rot_x, rot_y
+from .state import IDX_E_NU, IDX_E_Q, IDX_E_TH_P, IDX_E_TH_Y, IDX_E_XI_S, NU, initial_state
+from .validation import check_finite, choice, real_array
+
+#: The sensor kinds, in the order of the C counters (SR_EKF_IMU ...).
+KINDS = ("imu", "encoders", "position", "heading")
+#: The stepping methods of the prediction.
+METHODS = {"lie-euler": lib.SR_LIE_EULER, "rkmk4": lib.SR_RKMK4, "cf4": lib.SR_CF4}
+#: The size of each kind's sample (the degrees of freedom of its gate).
+SAMPLE_SIZES = {"imu": lib.SR_NIMU, "encoders": 2, "position": 2, "heading": 1}
+#: The bias blocks of the error state.
+IDX_EB_BG = slice(lib.SR_EB_b_g, lib.SR_EB_b_g + 3)
+IDX_EB_BA = slice(lib.SR_EB_b_a, lib.SR_EB_b_a + 3)
+
+
+def _ptr(arr):
+    return ffi.cast("double *", ffi.from_buffer(arr))
+
+
+@dataclasses.dataclass(frozen=True)
+class EkfNoise:
+    """What the filter assumes of its sensors and of the robot (plain numbers, SI units).
+
+    Per-sample standard deviations of the readings, the biases' spread per run, their random
+    walks (0: constant over the run), and the process noise: white generalized torques on the
+    shell (each axis) and on both joints, one spectral density [N·m/√Hz]."""
+    gyro: float = 0.003                                   # rad/s, per axis and sample
+    accel: float = 0.02                                   # m/s², per axis and sample
+    gyro_bias: float = 0.005                              # rad/s, 1σ of b_g per axis at the start
+    accel_bias: float = 0.05                              # m/s², 1σ of b_a per axis at the start
+    gyro_bias_rw: float = 0.0                             # rad/s/√s
+    accel_bias_rw: float = 0.0                            # m/s²/√s
+    encoder: float = 2 * math.pi / 4096 / math.sqrt(12)   # rad: a count's quantisation at 4096 counts/rev
+    position: float = 0.01                                # m, per axis of a fix
+    heading: float = 0.05                                 # rad
+    torque_psd: float = 0.01                              # N·m/√Hz
+
+    def __post_init__(self):
+        for field in dataclasses.fields(self):
+            value = getattr(self, field.name)
+            zero_ok = field.name.endswith("_rw") or field.name == "torque_psd"
+            if not (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+                    and (value >= 0 if zero_ok else value > 0)):
+                rule = ">= 0" if zero_ok else "> 0"
+                raise ValueError(f"{field.name}: expected a finite number {rule}, got {value!r}")
+
+
+def gate_threshold(probability, size):
+    """The chi-square quantile of `probability` for a sample of `size` entries (1: no gate, +inf)."""
+    return math.inf if probability == 1 else float(chi2.ppf(probability, size))
+
+
+def _vector(value, name, n):
+    arr = real_array(value, name, (n,), batch=False)
+    check_finite(arr, name)
+    return arr
+
+
+class Ekf:
+    """The filter on one robot (`model`), started at x0 with biases (6,) (None: zero) and either
+    the covariance P0 (18, 18) or the standard deviations sigma (18,) of the error state (the 12
+    error coordinates of `Model.retract`, then b_g, b_a).  `mount`: the IMU's (and the heading
+    sensor's, unless `heading_mount`); `method`: the prediction's stepper; `gate`: the probability
+    of the chi-square gate of every update (1: no gate)."""
+
+    def __init__(self, model, x0, *, P0=None, sigma=None, biases=None, noise=None, mount=None, heading_mount=None,
+                 method="rkmk4", gate=0.999):
+        if not isinstance(model, Model):
+            raise ValueError(f"model: expected a runtime.Model, got {type(model).__name__}")
+        self.model = model
+        self.noise = EkfNoise() if noise is None else noise
+        if not isinstance(self.noise, EkfNoise):
+            raise ValueError(f"noise: expected an EkfNoise, got {type(noise).__name__}")
+        self.mount = _mount(mount, "mount")
+        self.heading_mount = self.mount if heading_mount is None else _mount(heading_mount, "heading_mount")
+        self.method = choice(method, "method", METHODS, "integrator")
+        if not (isinstance(gate, (int, float)) and 0 < gate <= 1):
+            raise ValueError(f"gate: expected a probability in (0, 1], got {gate!r}")
+        self.gate = {kind: gate_threshold(gate, n) for kind, n in SAMPLE_SIZES.items()}
+        x = model._valid_states(x0, "x0", batch=False)
+        b = np.zeros(6) if biases is None else _vector(biases, "biases", 6)
+        self._ekf = ffi.new("sr_ekf *")
+        if (P0 is None) == (sigma is None):
+            raise ValueError("P0, sigma: give exactly one of them")
+        if P0 is not None:
+            P = real_array(P0, "P0", (NEB, NEB), batch=False)
+            check_finite(P, "P0")
+            status = lib.sr_ekf_init(self._ekf, model._model, _ptr(x), _ptr(b), _ptr(P))
+            what = "P0"
+        else:
+            s = _vector(sigma, "sigma", NEB)
+            if not (s > 0).all():
+                raise ValueError(f"sigma: every standard deviation must be > 0, got {s.min()!r}")
+            status = lib.sr_ekf_init_diagonal(self._ekf, model._model, _ptr(x), _ptr(b), _ptr(s))
+            what = "sigma"
+        if status == lib.SR_ERR_ARG:
+            raise ValueError("P0: not symmetric")
+        if status == lib.SR_ERR_SINGULAR:
+            raise ValueError(f"{what}: the covariance is not positive definite")
+        _check(status, "x0")
+        n = self.noise
+        self._process = ffi.new("sr_ekf_process *")
+        self._process.torque_psd = [n.torque_psd] * 3
+        self._process.gyro_bias_rw = n.gyro_bias_rw
+        self._process.accel_bias_rw = n.accel_bias_rw
+        self._imu_mount, self._heading_mount = self.mount.as_array(), self.heading_mount.as_array()
+
+    # -- the filter's equations ------------------------------------------------------------------
+    def predict(self, u, dt):
+        """One step of dt [s] > 0 under the torques u (2,) [N·m] (None: zero)."""
+        torque = np.zeros(NU) if u is None else _vector(u, "u", NU)
+        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+            raise ValueError(f"dt: expected a finite number of seconds > 0, got {dt!r}")
+        _check(lib.sr_ekf_predict(self._ekf, self.model._model, METHODS[self.method], _ptr(torque), dt,
+                                  self._process), "x")
+
+    def _applied(self, kind, status, singular):
+        if status == lib.SR_ERR_SINGULAR:
+            raise KernelError("x", status, message=f"x: {singular}")
+        _check(status, "x")
+        return self._ekf.accepted[KINDS.index(kind)] > self._before
+
+    def update_imu(self, y, u=None):
+        """One IMU sample (6,): gyroscope [rad/s] then accelerometer [m/s²] in the sensor's axes,
+        while the torques u (2,) act (None: zero)."""
+        y = _vector(y, "y", 6)
+        torque = np.zeros(NU) if u is None else _vector(u, "u", NU)
+        self._before = self._ekf.accepted[0]
+        m = self.mount
+        status = lib.sr_ekf_update_imu(self._ekf, self.model._model, _ptr(y), _ptr(torque), BODIES[m.body],
+                                       _ptr(self._imu_mount), self.noise.gyro, self.noise.accel, self.gate["imu"])
+        return self._applied("imu", status, "the innovation covariance or the inertia is not positive definite")
+
+    def update_encoders(self, y):
+        """One encoder sample (θ_Y, θ_P) [rad]."""
+        y = _vector(y, "y", 2)
+        self._before = self._ekf.accepted[1]
+        status = lib.sr_ekf_update_encoders(self._ekf, self.model._model, _ptr(y), self.noise.encoder,
+                                            self.gate["encoders"])
+        return self._applied("encoders", status, "the innovation covariance is not positive definite")
+
+    def update_position(self, y):
+        """One position fix (q_x, q_y) [m]."""
+        y = _vector(y, "y", 2)
+        self._before = self._ekf.accepted[2]
+        status = lib.sr_ekf_update_position(self._ekf, self.model._model, _ptr(y), self.noise.position,
+                                            self.gate["position"])
+        return self._applied("position", status, "the innovation covariance is not positive definite")
+
+    def update_heading(self, y):
+        """One heading sample [rad] of the heading sensor's x axis."""
+        value = float(_vector([y], "y", 1)[0]) if np.ndim(y) == 0 else None
+        if value is None:
+            raise ValueError(f"y: expected one number (a heading in rad), got shape {np.shape(y)}")
+        self._before = self._ekf.accepted[3]
+        m = self.heading_mount
+        status = lib.sr_ekf_update_heading(self._ekf, self.model._model, value, BODIES[m.body],
+                                           _ptr(self._heading_mount), self.noise.heading, self.gate["heading"])
+        return self._applied("heading", status, "the sensor's x axis is along the floor's normal or the "
+                                                "innovation covariance is not positive definite")
+
+    # -- what it holds -----------------------------------------------------------------------------
+    @property
+    def x(self):
+        """The state estimate (35,)."""
+        return np.frombuffer(ffi.buffer(self._ekf.x), dtype=np.float64).copy()
+
+    @property
+    def biases(self):
+        """The IMU's bias estimate (6,): b_g [rad/s], b_a [m/s²]."""
+        return np.frombuffer(ffi.buffer(self._ekf.bias), dtype=np.float64).copy()
+
+    @property
+    def P(self):
+        """The covariance (18, 18) of the error state (d, b_g, b_a)."""
+        return np.frombuffer(ffi.buffer(self._ekf.P), dtype=np.float64).reshape(NEB, NEB).copy()
+
+    @property
+    def sigma(self):
+        """The standard deviations (18,) of the error state: √diag(P)."""
+        return np.sqrt(np.diag(self.P))
+
+    @property
+    def counters(self):
+        """Per kind ("imu", "encoders", "position", "heading"): {"accepted", "gated", "nis"}, nis the
+        last sample's normalised innovation squared."""
+        e = self._ekf
+        return {kind: {"accepted": int(e.accepted[i]), "gated": int(e.gated[i]), "nis": float(e.nis[i])}
+                for i, kind in enumerate(KINDS)}
+
+
+def _mount(mount, name):
+    if mount is None:
+        return DEFAULT_MOUNT
+    if not isinstance(mount, Mount):
+        raise ValueError(f"{name}: expected a runtime.sensors.Mount, got {type(mount).__name__}")
+    return mount
+
+
+def _check(status, field):
+    if status != lib.SR_OK:
+        raise KernelError(field, status)
+
+
+def _rotation_between(a, b):
+    """The smallest rotation taking the unit vector a to the unit vector b."""
+    axis, c = np.cross(a, b), float(a @ b)
+    s = float(np.linalg.norm(axis))
+    if s < 1e-12:
+        if c > 0:
+            return np.eye(3)
+        other = np.eye(3)[int(np.argmin(np.abs(a)))]
+        axis = np.cross(a, other)
+        return so3_exp(np.pi * axis / np.linalg.norm(axis))
+    return so3_exp(axis / s * math.atan2(s, c))
+
+
+def start_from_measurements(model, accel, *, encoders=None, fix=None, heading=None, noise=None, mount=None,
+                            rate_sigma=0.01, heading_sigma=math.radians(10), **ekf_options):
+    """An `Ekf` started by the rule of docs/estimation.md: at rest (ν = 0, σ `rate_sigma` rad/s),
+    the position at the first fix (x, y) or the origin (σ `noise.position`), the joints at the
+    encoders' angles (None: 0, σ 1 rad), the tilt from the accelerometer (one sample (3,) or the
+    mean of several (n, 3) taken at rest: at rest it reads +g along the upward vertical), the
+    heading of the IMU's x axis from `heading` (σ `noise.heading`) or 0 (σ `heading_sigma`, 10°),
+    the biases 0 (σ `noise.gyro_bias`, `noise.accel_bias`).  `ekf_options` go to `Ekf`."""
+    noise = EkfNoise() if noise is None else noise
+    if not isinstance(noise, EkfNoise):
+        raise ValueError(f"noise: expected an EkfNoise, got {type(noise).__name__}")
+    mount = _mount(mount, "mount")
+    for name, value in (("rate_sigma", rate_sigma), ("heading_sigma", heading_sigma)):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise ValueError(f"{name}: expected a finite number > 0, got {value!r}")
+    a = real_array(accel, "accel", (3,), batch=True)
+    check_finite(a, "accel")
+    samples = 1 if a.ndim == 1 else a.shape[0]
+    f = a if a.ndim == 1 else a.mean(axis=0)
+    if not np.linalg.norm(f) > 0:
+        raise ValueError("accel: a zero specific force gives no vertical")
+    theta = np.zeros(2) if encoders is None else _vector(encoders, "encoders", 2)
+    position = np.zeros(2) if fix is None else _vector(fix, "fix", 2)
+    if heading is not None and not (isinstance(heading, (int, float)) and math.isfinite(heading)):
+        raise ValueError(f"heading: expected a finite number of rad, got {heading!r}")
+    p = model.params.as_array()
+    r, g, slope = p[lib.SR_P_r], p[lib.SR_P_g], p[lib.SR_P_slope]
+    up = np.array([math.sin(slope), 0.0, math.cos(slope)])
+    R_m = np.array(mount.rotation)
+    # The body's attitude R_B turns the measured vertical (in the body's axes) onto the world's,
+    # then about that vertical until the sensor's x axis has the heading.
+    R_B = _rotation_between(R_m @ (f / np.linalg.norm(f)), up)
+    target = 0.0 if heading is None else float(heading)
+    for _ in range(8):
+        h = R_B @ R_m[:, 0]
+        if math.hypot(h[0], h[1]) < 1e-6:
+            break
+        R_B = so3_exp(up * math.remainder(target - math.atan2(h[1], h[0]), 2 * math.pi)) @ R_B
+    Q_B = {"shell": np.eye(3), "yoke": rot_x(theta[0]), "pendulum": rot_x(theta[0]) @ rot_y(theta[1])}[mount.body]
+    R_S = R_B @ Q_B.T
+    x0 = initial_state(theta[0], theta[1], R_S=R_S, q=(position[0], position[1], r), r=r)
+
+    tilt = math.sqrt(noise.accel ** 2 / samples + noise.accel_bias ** 2) / g if g > 0 else 1.0
+    yaw = heading_sigma if heading is None else noise.heading
+    e1 = np.cross(up, [0.0, 1.0, 0.0]) if abs(up[1]) < 0.9 else np.cross(up, [1.0, 0.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    U = np.column_stack([e1, np.cross(up, e1), up])
+    world = U @ np.diag([tilt ** 2, tilt ** 2, yaw ** 2]) @ U.T
+    P0 = np.zeros((NEB, NEB))
+    P0[IDX_E_XI_S, IDX_E_XI_S] = R_S.T @ world @ R_S       # the shell's error is in its own axes
+    joint = noise.encoder if encoders is not None else 1.0
+    P0[IDX_E_TH_Y, IDX_E_TH_Y] = P0[IDX_E_TH_P, IDX_E_TH_P] = joint ** 2
+    P0[IDX_E_Q, IDX_E_Q] = noise.position ** 2 * np.eye(2)
+    P0[IDX_E_NU, IDX_E_NU] = rate_sigma ** 2 * np.eye(IDX_E_NU.stop - IDX_E_NU.start)
+    P0[IDX_EB_BG, IDX_EB_BG] = noise.gyro_bias ** 2 * np.eye(3)
+    P0[IDX_EB_BA, IDX_EB_BA] = noise.accel_bias ** 2 * np.eye(3)
+    P0 = 0.5 * (P0 + P0.T)
+    return Ekf(model, x0, P0=P0, noise=noise, mount=mount, **ekf_options)
+

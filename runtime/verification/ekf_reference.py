@@ -1,0 +1,133 @@
+"""The error-state EKF of c/include/sr_ekf.h written out in NumPy, from the equations: the check
+that the C filter (runtime.ekf) computes what the documentation says (docs/estimation.md).
+
+It takes the model's pieces from the runtime (the step `Model.step`, its Jacobian by CasADi's AD of
+the exported steps `Model.casadi_step_jacobian`, the inertia, the sensors of runtime.sensors, the
+retraction `Model.retract`) and writes the filter in its textbook form, without the C's
+shortcuts: the full 18 × 18 transition, the inverse of M, the gain through a solve with S, the
+Joseph form as the product (I − K H) P (I − K H)ᵀ + K R Kᵀ, the reset as G P Gᵀ with G the
+right Jacobian of SO(3) as its power series, angle innovations wrapped through the unit circle.
+"""
+import numpy as np
+
+from .. import sensors
+from ..state import IDX_E_NU, IDX_E_XI_S, NE
+
+NB = NE + 6
+KINDS = ("imu", "encoders", "position", "heading")
+
+
+def right_jacobian(phi):
+    """Jr(φ) of SO(3), Exp(φ + ε) = Exp(φ) Exp(Jr(φ) ε) + O(ε²), as its power series
+    Σₖ (−[φ]×)ᵏ / (k + 1)!: no closed form, whose 1 − cos t and t − sin t cancel for small angles."""
+    W = np.array([[0.0, -phi[2], phi[1]], [phi[2], 0.0, -phi[0]], [-phi[1], phi[0], 0.0]])
+    J, term = np.eye(3), np.eye(3)
+    for k in range(1, 40):
+        term = term @ (-W) / (k + 1)
+        J = J + term
+    return J
+
+
+def wrapped(angle):
+    """An angle difference brought into (−π, π] through the unit circle."""
+    return float(np.angle(np.exp(1j * angle)))
+
+
+class EkfReference:
+    """The filter's state (x, b, P) and its counters; one method per equation of sr_ekf.h."""
+
+    def __init__(self, model, x0, bias, P0, method="rkmk4"):
+        self.model, self.method = model, method
+        self.x = np.array(x0, dtype=float)
+        self.b = np.array(bias, dtype=float)
+        self.P = np.array(P0, dtype=float)
+        self.accepted = dict.fromkeys(KINDS, 0)
+        self.gated = dict.fromkeys(KINDS, 0)
+        self.nis = dict.fromkeys(KINDS, 0.0)
+
+    def process_noise(self, dt, torque_psd, gyro_bias_rw, accel_bias_rw):
+        """Q (18, 18) over dt: white generalized torques on ν through M⁻¹, random-walk biases."""
+        Minv = np.linalg.inv(self.model.inertia(self.x))
+        s, y, p = torque_psd
+        W = np.diag([s * s, s * s, s * s, y * y, p * p])
+        Q = np.zeros((NB, NB))
+        Q[IDX_E_NU, IDX_E_NU] = dt * Minv @ W @ Minv.T
+        Q[NE:NE + 3, NE:NE + 3] = dt * gyro_bias_rw ** 2 * np.eye(3)
+        Q[NE + 3:, NE + 3:] = dt * accel_bias_rw ** 2 * np.eye(3)
+        return Q
+
+    def propagate(self, F, Q):
+        """Φ P Φᵀ + Q with Φ = diag(F, I₆): the biases do not enter the step."""
+        Phi = np.eye(NB)
+        Phi[:NE, :NE] = F
+        return Phi @ self.P @ Phi.T + Q
+
+    def predict(self, u, dt, torque_psd, gyro_bias_rw=0.0, accel_bias_rw=0.0):
+        """x ← step(x, u, dt); P ← Φ P Φᵀ + Q, F at the prior x."""
+        u = np.asarray(u, dtype=float)
+        F, _ = self.model.casadi_step_jacobian(self.x, u, dt, self.method)
+        Q = self.process_noise(dt, torque_psd, gyro_bias_rw, accel_bias_rw)
+        self.x = self.model.step(self.x, u, dt, self.method)
+        self.P = self.propagate(F, Q)
+
+    @staticmethod
+    def accepts(nis, gate):
+        """The chi-square gate."""
+        return nis <= gate
+
+    def gain(self, H, S):
+        """K = P Hᵀ S⁻¹ (through a solve with S; S and P symmetric)."""
+        return np.linalg.solve(S, H @ self.P).T
+
+    def joseph(self, K, H, R):
+        """(I − K H) P (I − K H)ᵀ + K R Kᵀ."""
+        A = np.eye(NB) - K @ H
+        return A @ self.P @ A.T + K @ R @ K.T
+
+    def inject(self, e):
+        """x ← x ⊕ e_d, b ← b + e_b."""
+        self.x = self.model.retract(self.x, e[:NE])
+        self.b = self.b + e[NE:]
+
+    def reset(self, e):
+        """P ← G P Gᵀ, G = I but Jr(e_ξ) on the shell's block."""
+        G = np.eye(NB)
+        G[IDX_E_XI_S, IDX_E_XI_S] = right_jacobian(e[IDX_E_XI_S])
+        self.P = G @ self.P @ G.T
+
+    def _update(self, kind, r, H, R, gate):
+        S = H @ self.P @ H.T + R
+        nis = float(r @ np.linalg.solve(S, r))
+        self.nis[kind] = nis
+        if not self.accepts(nis, gate):
+            self.gated[kind] += 1
+            return False
+        K = self.gain(H, S)
+        e = K @ r
+        self.P = self.joseph(K, H, R)
+        self.inject(e)
+        self.reset(e)
+        self.accepted[kind] += 1
+        return True
+
+    def update_imu(self, y, u, mount, sigma_gyro, sigma_accel, gate):
+        """One IMU sample (6,) under the torques u."""
+        yh, H = sensors.imu_jacobian(self.model, self.x, u, mount=mount, bias=self.b)
+        R = np.diag([sigma_gyro ** 2] * 3 + [sigma_accel ** 2] * 3)
+        return self._update("imu", np.asarray(y) - yh, H, R, gate)
+
+    def update_encoders(self, y, sigma, gate):
+        """One encoder sample (θ_Y, θ_P)."""
+        yh, H = sensors.encoders_jacobian(self.model, self.x)
+        r = np.array([wrapped(y[0] - yh[0]), wrapped(y[1] - yh[1])])
+        return self._update("encoders", r, H, sigma ** 2 * np.eye(2), gate)
+
+    def update_position(self, y, sigma, gate):
+        """One position fix (q_x, q_y)."""
+        yh, H = sensors.position_jacobian(self.model, self.x)
+        return self._update("position", np.asarray(y) - yh, H, sigma ** 2 * np.eye(2), gate)
+
+    def update_heading(self, y, mount, sigma, gate):
+        """One heading sample."""
+        yh, H = sensors.heading_jacobian(self.model, self.x, mount)
+        return self._update("heading", np.array([wrapped(y - yh)]), H[None, :], np.array([[sigma ** 2]]), gate)
