@@ -21,6 +21,7 @@ COMMANDS = {
     "climbing": ("runtime.control.climbing", "the climbing limit on a slope; writes docs/figures/climbing-limit.png"),
     "firmware-table": ("runtime.control.firmware", "the firmware example's LQR gain table, generated/lqr_task.h (make generate)"),
     "sweep-bench": ("runtime.bench.sweep", "what a sweep costs (make sweep-bench)"),
+    "base-parameters": ("runtime.param_derivatives", "the identifiable combinations of the inertial parameters (docs/identification.md)"),
 }
 
 
