@@ -7,10 +7,9 @@ change of the parameters p, differentiating M ν̇ = f with the state and the to
 
 so the one generated kernel needed is the derivative of the residual M ν̇ − f with ν̇ an input
 (`residual_param_jacobian`); the solve reuses the general robot's factorisation of M in C
-(c/src/sr_param_jacobians.c).  The general kernels read the per-model constants of
-`robot.general_constants` (first moments and tensors about O, the total mass, gravity's
-components); the kernel here computes those it needs from p as definitions, so that its
-derivative carries the chain rule through them and CSE shares the work.
+(c/src/sr_param_jacobians.c).  The residual is linear in the inertial parameters π below, so its
+derivative is taken through the regressor: Y ∂π/∂p plus the derivatives of Y in the few
+parameters it depends on.
 
 The regressor.  The Lagrangian is linear in each body's mass, first moment m·c and tensor about
 O, in the rotors' axial inertias and, through the Rayleigh forces, in the dampings, and the
@@ -39,26 +38,6 @@ def residual(robot=R.GENERAL):
     """M ν̇ − f at u = 0 (5-vector in the robot's symbols, ν̇ the symbols of `sensors.nu_dot`)."""
     at_rest = {s: 0 for s in S.u}
     return D.inertia(robot) * SE.nu_dot - D.rhs(robot).xreplace(at_rest)
-
-
-def constants_definitions():
-    """(symbol, expression in PARAMETERS) of the general kernels' constants that are not parameters
-    themselves, in array order."""
-    return tuple((s, e) for s, e in R.general_constants() if s not in P.PARAMETERS)
-
-
-@functools.lru_cache(maxsize=None)
-def residual_param_jacobian():
-    """∂(M ν̇ − f)/∂p (5 × len(PARAMETERS), ν̇ held), in the general constants' symbols and the
-    parameters: ∂/∂p_j = Σ_c ∂/∂c · ∂c/∂p_j + ∂/∂p_j (parameters read directly).  Together with
-    `constants_definitions` it is evaluated from p alone."""
-    res = residual()
-    definitions = constants_definitions()
-    constants = [s for s, _ in definitions]
-    by_constant = res.jacobian(constants)                       # 5 × (constants)
-    direct = res.jacobian(list(P.PARAMETERS))                   # the parameters that M, f read themselves
-    chain = sp.Matrix([[sp.diff(e, p) for p in P.PARAMETERS] for _, e in definitions])
-    return (direct + by_constant * chain).applyfunc(sp.expand)
 
 
 # ---- the regressor ---------------------------------------------------------------------------
@@ -123,6 +102,33 @@ def check_regressor():
     pi = sp.Matrix(INERTIAL_PARAMETERS)
     free = [e for e in Y if e.free_symbols & set(INERTIAL_PARAMETERS)]
     return free + [e for e in (Y * pi - regressor_residual()).applyfunc(sp.expand) if e != 0]
+
+
+@functools.lru_cache(maxsize=None)
+def residual_param_jacobian():
+    """∂(M ν̇ − f)/∂p (5 × len(PARAMETERS), ν̇ held) through the regressor form: the residual is
+    Y(x, ν̇; k) π(p), k the known parameters (r, n_Y, n_P, g, slope), so
+
+        ∂/∂p_j = Y ∂π/∂p_j + Σ_k (∂Y/∂k π) ∂k/∂p_j,
+
+    exact given `check_regressor` and `check_inertial_parameters`; in the parameters alone."""
+    Y = regressor()
+    pi = sp.Matrix(inertial_parameters_from_general())
+    out = Y * pi.jacobian(list(P.PARAMETERS))
+    for k in KNOWN_PARAMETERS:
+        j = P.PARAMETERS.index(k)
+        out[:, j] = out[:, j] + Y.diff(k) * pi
+    return out
+
+
+def check_inertial_parameters():
+    """The residues, all zero, of the general kernels' constants written through π: the constants
+    of `general_constants_in_inertial` at π = `inertial_parameters_from_general` are those of
+    robot.general_constants."""
+    pi = dict(zip(INERTIAL_PARAMETERS, inertial_parameters_from_general()))
+    through_pi = general_constants_in_inertial()
+    residues = [sp.simplify(sp.expand(through_pi.get(s, s).xreplace(pi) - e)) for s, e in R.general_constants()]
+    return [r for r in residues if r != 0]
 
 
 def inertial_parameters_from_general():

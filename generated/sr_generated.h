@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources eaef65331942fe1d], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 1505a5db3143b959], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/include/spherical_robot.h.
@@ -162,7 +162,7 @@
 #define SR_GEN_GENERAL_ENERGY_FLOPS 336
 #define SR_GEN_GENERAL_EQUILIBRIUM_RESIDUAL_FLOPS 126
 #define SR_GEN_GENERAL_ACCEL_JACOBIAN_TERMS_FLOPS 4398
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_JACOBIAN_FLOPS 5915
+#define SR_GEN_GENERAL_PARAM_RESIDUAL_JACOBIAN_FLOPS 2812
 #define SR_GEN_REGRESSOR_FLOPS 1488
 #define SR_GEN_SENSOR_CONSTANTS_FLOPS 4
 #define SR_GEN_IMU_SHELL_FLOPS 95

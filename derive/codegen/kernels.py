@@ -153,11 +153,11 @@ def param_kernels():
     Jacobians of c/src/sr_param_jacobians.c (∂ν̇/∂p = −M⁻¹ ∂(M ν̇ − f)/∂p), and the regressor Y with
     M ν̇ − f(u = 0) = Y π.  Both read the parameters and ν̇ (as an input, held)."""
     proven("regressor", PD.check_regressor())
+    proven("inertial parameters", PD.check_inertial_parameters())
     return (
         Kernel("general_param_residual_jacobian", "∂(M ν̇ − f)/∂p of the general robot with ν̇ held (5 x SR_GEN_NPARAM,"
                " row-major, columns SR_P_*), for ∂ν̇/∂p = −M⁻¹ ∂(M ν̇ − f)/∂p (derive.param_derivatives).",
-               ("p", "x", "nud"), (Output("dR", tuple(PD.residual_param_jacobian()), "d(M nu_dot - f)/dp, row-major 5 x SR_GEN_NPARAM"),),
-               definitions=PD.constants_definitions()),
+               ("p", "x", "nud"), (Output("dR", tuple(PD.residual_param_jacobian()), "d(M nu_dot - f)/dp, row-major 5 x SR_GEN_NPARAM"),)),
         Kernel("regressor", "The regressor Y (5 x SR_GEN_NPI, row-major, columns SR_PI_*): M ν̇ − f(u = 0) = Y π, π the"
                " inertial parameters and dampings (derive.param_derivatives.INERTIAL_PARAMETERS).",
                ("p", "x", "nud"), (Output("Y", tuple(PD.regressor()), "Y, row-major 5 x SR_GEN_NPI"),)),

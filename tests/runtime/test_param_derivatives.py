@@ -35,9 +35,8 @@ def test_param_jacobian_of_a_batch_is_that_of_each_state(params):
         np.testing.assert_array_equal(J[i], model.param_jacobian(X[i], U[i]))
 
 
-def test_the_shell_radius_moves_the_accelerations_only_through_the_dynamics_and_gravity_not_q():
-    """Both hinges sit at O, so no parameter's column of dν̇/dp depends on q (a spot check of the
-    chain rule: q_x, q_y moved, the Jacobian unchanged)."""
+def test_the_param_jacobian_does_not_depend_on_where_the_robot_stands():
+    """q enters no dynamics, so no column of dν̇/dp depends on q_x, q_y."""
     model = Model(GENERAL)
     x, u = states(model, 1)
     moved = x[0].copy()
