@@ -123,6 +123,27 @@ class ParamDerivativeMethods:
         return self._rows(lib.sr_regressor, lib.sr_regressor_batch, x, out, _ptr(x), _ptr(nudot))
 
 
+def trajectory_sensitivities(model, x0, dt, steps, u=None, method="rkmk4"):
+    """(X, S, Phi): the trajectory X (steps + 1, 35) of `method` from x0 under u (None or
+    (steps, 2), row k held over step k + 1), its sensitivities S (steps + 1, 12, 32) to the
+    parameters and Phi (steps + 1, 12, 12) to the initial state, in the error coordinates at each
+    x_k: x_k(x0 ⊕ d, p + δp) ⊖ x_k = Phi_k d + S_k δp + O(2).  Chained step by step,
+    S_{k+1} = F_k S_k + Jp_k and Phi_{k+1} = F_k Phi_k with F_k of `Model.step_jacobian` and Jp_k of
+    `Model.step_param_jacobian` (a loop over C calls; what a prediction-error or a
+    multiple-shooting fit needs)."""
+    choice(method, "method", STEP_METHODS, "integrator with a parameter Jacobian")
+    X = model.simulate(x0, dt, steps, u=u, method=method, energy_tol=None)
+    U = np.zeros((steps, 2)) if u is None else np.asarray(u, dtype=float)
+    S = np.zeros((steps + 1, NE, NPARAM))
+    Phi = np.zeros((steps + 1, NE, NE))
+    Phi[0] = np.eye(NE)
+    for k in range(steps):
+        F, _ = model.step_jacobian(X[k], U[k], dt, method)
+        S[k + 1] = F @ S[k] + model.step_param_jacobian(X[k], U[k], dt, method)
+        Phi[k + 1] = F @ Phi[k]
+    return X, S, Phi
+
+
 @dataclasses.dataclass(frozen=True)
 class BaseParameters:
     """The identifiable combinations of π: base parameter k is π[independent[k]] + Σ_j
