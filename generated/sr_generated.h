@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources be3bcc7a70a4e7cf], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 19c6a7b61f2be7e1], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/include/spherical_robot.h.
@@ -14,6 +14,7 @@
 
 #define SR_GEN_NPARAM 32
 #define SR_GEN_NPAPER 12
+#define SR_GEN_NPI 27
 #define SR_GEN_NCONST 38
 #define SR_GEN_NCONST_NAMED 12
 #define SR_GEN_GENERAL_NCONST 104
@@ -91,6 +92,34 @@
 #define SR_PAPER_m_P 9
 #define SR_PAPER_k_P 10
 #define SR_PAPER_g 11
+/* Layout of pi[SR_GEN_NPI], the parameters the equations of motion are linear in (the regressor's columns, derive/param_derivatives.py): per body m, m c, the tensor about O, the damping; the rotors. */
+#define SR_PI_m_S 0
+#define SR_PI_j_S 1
+#define SR_PI_k_S 2
+#define SR_PI_m_Y 3
+#define SR_PI_mc_Y_x 4
+#define SR_PI_mc_Y_y 5
+#define SR_PI_mc_Y_z 6
+#define SR_PI_JO_Y_xx 7
+#define SR_PI_JO_Y_yy 8
+#define SR_PI_JO_Y_zz 9
+#define SR_PI_JO_Y_xy 10
+#define SR_PI_JO_Y_xz 11
+#define SR_PI_JO_Y_yz 12
+#define SR_PI_k_Y 13
+#define SR_PI_m_P 14
+#define SR_PI_mc_P_x 15
+#define SR_PI_mc_P_y 16
+#define SR_PI_mc_P_z 17
+#define SR_PI_JO_P_xx 18
+#define SR_PI_JO_P_yy 19
+#define SR_PI_JO_P_zz 20
+#define SR_PI_JO_P_xy 21
+#define SR_PI_JO_P_xz 22
+#define SR_PI_JO_P_yz 23
+#define SR_PI_k_P 24
+#define SR_PI_j_mY 25
+#define SR_PI_j_mP 26
 /* The bodies a sensor is mounted on (derive/sensors.py). */
 #define SR_BODY_shell 0
 #define SR_BODY_yoke 1
@@ -133,6 +162,8 @@
 #define SR_GEN_GENERAL_ENERGY_FLOPS 336
 #define SR_GEN_GENERAL_EQUILIBRIUM_RESIDUAL_FLOPS 126
 #define SR_GEN_GENERAL_ACCEL_JACOBIAN_TERMS_FLOPS 4398
+#define SR_GEN_GENERAL_PARAM_RESIDUAL_JACOBIAN_FLOPS 2812
+#define SR_GEN_REGRESSOR_FLOPS 1488
 #define SR_GEN_SENSOR_CONSTANTS_FLOPS 4
 #define SR_GEN_IMU_SHELL_FLOPS 95
 #define SR_GEN_IMU_SHELL_JACOBIAN_FLOPS 440
@@ -169,6 +200,8 @@
 #define SR_GEN_READS_general_energy(R) R(cg, 16, 17) R(cg, 18, 19) R(cg, 22, 25) R(cg, 31, 32) R(cg, 33, 35) R(cg, 39, 48) R(cg, 49, 51) R(cg, 52, 53) R(cg, 62, 82)
 #define SR_GEN_READS_general_equilibrium_residual(R) R(cg, 67, 70) R(cg, 71, 72) R(cg, 75, 81) R(cg, 82, 83)
 #define SR_GEN_READS_general_accel_jacobian_terms(R) R(cg, 4, 7) R(cg, 16, 17) R(cg, 18, 19) R(cg, 22, 25) R(cg, 31, 56) R(cg, 67, 70) R(cg, 71, 72) R(cg, 75, 81) R(cg, 82, 104)
+#define SR_GEN_READS_general_param_residual_jacobian(R) R(p, 0, 2) R(p, 4, 8) R(p, 15, 19) R(p, 26, 32)
+#define SR_GEN_READS_regressor(R) R(p, 0, 1) R(p, 27, 28) R(p, 29, 32)
 #define SR_GEN_READS_sensor_constants(R) R(p, 0, 1) R(p, 30, 32)
 #define SR_GEN_READS_imu_shell(R)
 #define SR_GEN_READS_imu_shell_jacobian(R)
@@ -204,6 +237,8 @@
 #define sr_gen_general_energy sr_gen_general_energy_f
 #define sr_gen_general_equilibrium_residual sr_gen_general_equilibrium_residual_f
 #define sr_gen_general_accel_jacobian_terms sr_gen_general_accel_jacobian_terms_f
+#define sr_gen_general_param_residual_jacobian sr_gen_general_param_residual_jacobian_f
+#define sr_gen_regressor sr_gen_regressor_f
 #define sr_gen_sensor_constants sr_gen_sensor_constants_f
 #define sr_gen_imu_shell sr_gen_imu_shell_f
 #define sr_gen_imu_shell_jacobian sr_gen_imu_shell_jacobian_f
@@ -353,6 +388,10 @@ int sr_gen_general_energy(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real
 int sr_gen_general_equilibrium_residual(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], sr_real res[5]);
 /* M (upper triangle, row by row), f, ∂f/∂d (5 x SR_GEN_NE, row-major, error coordinates of SR_E_*), ∂f/∂u (5 x 2) and ∂M/∂d along δξ_S, δθ_Y, δθ_P (5 upper triangles) for the accel Jacobian ∂ν̇ = M⁻¹(∂f − (∂M) ν̇). */
 int sr_gen_general_accel_jacobian_terms(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real M[15], sr_real f[5], sr_real df[60], sr_real dfdu[10], sr_real dM[75]);
+/* ∂(M ν̇ − f)/∂p of the general robot with ν̇ held (5 x SR_GEN_NPARAM, row-major, columns SR_P_*), for ∂ν̇/∂p = −M⁻¹ ∂(M ν̇ − f)/∂p (derive.param_derivatives). */
+int sr_gen_general_param_residual_jacobian(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[160]);
+/* The regressor Y (5 x SR_GEN_NPI, row-major, columns SR_PI_*): M ν̇ − f(u = 0) = Y π, π the inertial parameters and dampings (derive.param_derivatives.INERTIAL_PARAMETERS). */
+int sr_gen_regressor(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real Y[135]);
 /* The sensor kernels' constants sc = (r, g sin(slope), g cos(slope)) (SR_SC_*) from the parameters (derive.sensors.constant_expressions). */
 int sr_gen_sensor_constants(const sr_real p[SR_GEN_NPARAM], sr_real sc[SR_GEN_NSC]);
 /* IMU on the shell: y = (gyroscope R_m^T w_B + b_g, accelerometer R_m^T R_B^T (p'' - g) + b_a) in the sensor frame (SR_IMU_*), at the mount's lever arm, given nu_dot (derive.sensors.imu). */

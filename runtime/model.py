@@ -6,6 +6,7 @@ from bindings._sr import ffi, lib
 
 from .errors import KernelError, SimulationStopped
 from .derivatives import DerivativeMethods
+from .param_derivatives import ParamDerivativeMethods
 from .step_jacobian import StepJacobianMethods
 from .group import GroupMethods
 from .params import FLAT_FIELDS, Params
@@ -89,7 +90,7 @@ def _param_message(params, status):
     return f"{_PARAM_MESSAGES[status]}; the most extreme value is Params.{where} = {shown:g}"
 
 
-class Model(GroupMethods, DerivativeMethods, StepJacobianMethods):
+class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativeMethods):
     """The spherical robot with parameters `params` (default: `Params()`, Section 5.2 as printed).
 
     Every method validates its input in full (c/spherical_robot.h, `sr_check_state`; the rules

@@ -35,7 +35,8 @@
 #define GUARD 8             /* canary reals on each side of an output */
 #define CANARY 0xA5      /* byte pattern of the model before sr_model_init */
 #define MAX_STEPS 6         /* largest step count of a fuzzed simulation */
-#define MAX_OUT (2 * SR_NE * SR_NE)  /* two step Jacobians; more than (MAX_STEPS + 1) rows of a simulation */
+#define MAX_OUT (2 * SR_NE * SR_NPARAM)  /* two step sensitivities to the parameters; more than two step
+                                         * Jacobians and (MAX_STEPS + 1) rows of a simulation */
 
 typedef struct reader {
     const uint8_t *p;
@@ -400,6 +401,12 @@ static void fuzz_model_validity(reader *r, const sr_model *valid, const sr_real 
     ON_BOTH_MODELS("sr_step_jacobian_batch (model)", SR_NE * SR_NE, sr_step_jacobian_batch(M, method, 1, x, u, dt, arm(&g, SR_NE * SR_NE), arm(&g2, SR_NE * SR_NU), &row));
     ON_BOTH_MODELS("sr_lqr_error (model)", SR_LQR_NZ, sr_lqr_error(M, x, &target, NULL, arm(&g, SR_LQR_NZ)));
     ON_BOTH_MODELS("sr_lqr_control (model)", SR_NU, sr_lqr_control(&lqr, M, x, &target, &memory, arm(&g, SR_NU), NULL));
+    ON_BOTH_MODELS("sr_accel_param_jacobian (model)", SR_NV * SR_NPARAM, sr_accel_param_jacobian(M, x, u, arm(&g, SR_NV * SR_NPARAM)));
+    ON_BOTH_MODELS("sr_accel_param_jacobian_batch (model)", SR_NV * SR_NPARAM, sr_accel_param_jacobian_batch(M, 1, x, u, arm(&g, SR_NV * SR_NPARAM), &row));
+    ON_BOTH_MODELS("sr_step_param_jacobian (model)", SR_NE * SR_NPARAM, sr_step_param_jacobian(M, SR_RKMK4, x, u, dt, arm(&g, SR_NE * SR_NPARAM)));
+    ON_BOTH_MODELS("sr_step_param_jacobian_batch (model)", SR_NE * SR_NPARAM, sr_step_param_jacobian_batch(M, SR_LIE_EULER, 1, x, u, dt, arm(&g, SR_NE * SR_NPARAM), &row));
+    ON_BOTH_MODELS("sr_regressor (model)", SR_NV * SR_NPI, sr_regressor(M, x, mount_nu_dot, arm(&g, SR_NV * SR_NPI)));
+    ON_BOTH_MODELS("sr_regressor_batch (model)", SR_NV * SR_NPI, sr_regressor_batch(M, 1, x, mount_nu_dot, arm(&g, SR_NV * SR_NPI), &row));
 
     /* the sensors (sr_sensors.h), on a valid mount: a lever arm along the body's -z, its axes */
     ON_BOTH_MODELS("sr_imu_measure (model)", SR_NIMU, sr_imu_measure(M, x, mount_nu_dot, SR_BODY_yoke, mount, NULL, arm(&g, SR_NIMU)));
@@ -736,6 +743,40 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             fail("sr_step_jacobian_batch", status, "bad failed_row");
         expect("sr_step_jacobian_batch", status, &g, status == SR_OK ? 2 * SR_NE * SR_NE : (row > 0 ? (int)row * SR_NE * SR_NE : 0), 1);
         expect("sr_step_jacobian_batch", status, &g2, status == SR_OK ? 2 * SR_NE * SR_NU : (row > 0 ? (int)row * SR_NE * SR_NU : 0), 1);
+        /* the parameter sensitivities and the regressor (nu_dot: the state's speeds, fuzzed with it) */
+        status = sr_accel_param_jacobian(&model, x, u_or_null, arm(&g, SR_NV * SR_NPARAM));
+        EXPECT_STATUS("sr_accel_param_jacobian", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
+        expect("sr_accel_param_jacobian", status, &g, status == SR_OK ? SR_NV * SR_NPARAM : 0, 1);
+        status = sr_step_param_jacobian(&model, jmethod, x, u_or_null, dt, arm(&g, SR_NE * SR_NPARAM));
+        EXPECT_STATUS("sr_step_param_jacobian", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT, SR_ERR_SINGULAR, SR_ERR_ARG);
+        expect("sr_step_param_jacobian", status, &g, status == SR_OK ? SR_NE * SR_NPARAM : 0, 1);
+        status = sr_step_param_jacobian_batch(&model, jmethod, 2, x2, u_or_null, dt, arm(&g, 2 * SR_NE * SR_NPARAM), &row);
+        EXPECT_STATUS("sr_step_param_jacobian_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT, SR_ERR_SINGULAR, SR_ERR_ARG);
+        if (status == SR_ERR_ARG ? row != -1 : ((status == SR_OK) != (row == -1) || row < -1 || row > 1))
+            fail("sr_step_param_jacobian_batch", status, "bad failed_row");
+        expect("sr_step_param_jacobian_batch", status, &g, status == SR_OK ? 2 * SR_NE * SR_NPARAM
+               : (row > 0 ? (int)row * SR_NE * SR_NPARAM : 0), 1);
+        status = sr_accel_param_jacobian_batch(&model, 2, x2, u_or_null, arm(&g, 2 * SR_NV * SR_NPARAM), &row);
+        EXPECT_STATUS("sr_accel_param_jacobian_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
+        if ((status == SR_OK) != (row == -1) || row < -1 || row > 1) fail("sr_accel_param_jacobian_batch", status, "bad failed_row");
+        expect("sr_accel_param_jacobian_batch", status, &g, status == SR_OK ? 2 * SR_NV * SR_NPARAM
+               : (row > 0 ? (int)row * SR_NV * SR_NPARAM : 0), 1);
+        status = sr_regressor(&model, x, x + SR_X_w_S, arm(&g, SR_NV * SR_NPI));
+        EXPECT_STATUS("sr_regressor", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+        expect("sr_regressor", status, &g, status == SR_OK ? SR_NV * SR_NPI : 0, 1);
+        {
+            sr_real a2[2 * SR_NV];
+            memcpy(a2, x + SR_X_w_S, sizeof(sr_real) * SR_NV);
+            memcpy(a2 + SR_NV, x + SR_X_w_S, sizeof(sr_real) * SR_NV);
+            status = sr_regressor_batch(&model, 2, x2, a2, arm(&g, 2 * SR_NV * SR_NPI), &row);
+            EXPECT_STATUS("sr_regressor_batch", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+            if ((status == SR_OK) != (row == -1) || row < -1 || row > 1) fail("sr_regressor_batch", status, "bad failed_row");
+            expect("sr_regressor_batch", status, &g, status == SR_OK ? 2 * SR_NV * SR_NPI : (row > 0 ? (int)row * SR_NV * SR_NPI : 0), 1);
+        }
         {
             sr_real d2[2 * SR_NE];
             memcpy(d2, d, sizeof d);

@@ -499,6 +499,12 @@ int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 #define sr_step_jacobian_cf4 sr_step_jacobian_cf4_f
 #define sr_step_jacobian sr_step_jacobian_f
 #define sr_step_jacobian_batch sr_step_jacobian_batch_f
+#define sr_accel_param_jacobian sr_accel_param_jacobian_f
+#define sr_accel_param_jacobian_batch sr_accel_param_jacobian_batch_f
+#define sr_step_param_jacobian sr_step_param_jacobian_f
+#define sr_step_param_jacobian_batch sr_step_param_jacobian_batch_f
+#define sr_regressor sr_regressor_f
+#define sr_regressor_batch sr_regressor_batch_f
 #endif
 
 /** Jacobians of the accelerations in the error coordinates:
@@ -553,6 +559,59 @@ int sr_step_jacobian(const sr_model *model, int method, const sr_real x[SR_NX], 
                      sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU]);
 int sr_step_jacobian_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u, sr_real dt,
                            sr_real *F, sr_real *G, long *failed_row);
+/** @} */
+
+/** @name Derivatives in the parameters and the regressor (c/src/sr_param_jacobians.c) */
+/** @{ */
+/** Entries of pi, the parameters the equations of motion are linear in (the regressor's columns,
+ * SR_PI_* of sr_generated.h): m_S, j_S, k_S; for the yoke and then the pendulum its mass, first
+ * moment m c (3, body frame), standard inertia tensor about the shell centre O,
+ * J + m (|c|^2 I - c c^T) (xx, yy, zz, xy, xz, yz), damping; then j_mY, j_mP. */
+#define SR_NPI SR_GEN_NPI
+
+/** Jacobian of the accelerations in the parameters, the state and the torques held:
+ *   nu'(x, u; p + dp) = nu'(x, u; p) + J dp + O(|dp|^2),
+ * J row-major SR_NV x SR_NPARAM, columns SR_P_*.  From M nu' = f: J = -M^-1 d(M nu' - f)/dp with
+ * nu' held in the bracket (derive/param_derivatives.py, SR_GEN_GENERAL_PARAM_RESIDUAL_JACOBIAN_FLOPS),
+ * M by its Cholesky factor; a robot of the paper's geometry is evaluated with the general kernels,
+ * so that every parameter has its column.  Checks in the order of every entry point: the model
+ * (SR_ERR_NULL, SR_ERR_MODEL), the pointers (SR_ERR_NULL; u may be NULL: zero torque), then the
+ * full state check (sr_check_state) and u finite; SR_ERR_SINGULAR, SR_ERR_NONFINITE as sr_accel.
+ * J is written only on SR_OK. */
+int sr_accel_param_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                            sr_real J[SR_NV * SR_NPARAM]);
+
+/** The same over n rows (x n x SR_NX, u n x SR_NU or NULL, J n x SR_NV x SR_NPARAM); stops at the
+ * first failing row, its index in *failed_row (-1 when all succeed). */
+int sr_accel_param_jacobian_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real *J,
+                                  long *failed_row);
+
+/** Sensitivity of one step to the parameters, in the error coordinates, the state and the torque held:
+ *   step(x, u; p + dp) (-) step(x, u; p) = Jp dp + O(|dp|^2),
+ * Jp row-major SR_NE x SR_NPARAM: the exact derivative of the step of sr_steppers.c as implemented,
+ * by the chain rule through its stages (sr_accel_param_jacobian and sr_accel_jacobian at each stage
+ * state, the rolling kinematics' r, RKMK4's dexp^-1 differentiated).  method: SR_LIE_EULER or
+ * SR_RKMK4, else SR_ERR_ARG; checks and status codes as sr_step_jacobian; Jp written only on SR_OK. */
+int sr_step_param_jacobian(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                           sr_real dt, sr_real Jp[SR_NE * SR_NPARAM]);
+
+/** The same over n rows (x n x SR_NX, u n x SR_NU or NULL, Jp n x SR_NE x SR_NPARAM), one method
+ * and dt; stops at the first failing row, its index in *failed_row (-1 when all succeed). */
+int sr_step_param_jacobian_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u,
+                                 sr_real dt, sr_real *Jp, long *failed_row);
+
+/** The regressor Y (row-major SR_NV x SR_NPI, columns SR_PI_*) of the model's robot at state x and
+ * accelerations nudot: M nu' - f(u = 0) = Y pi for the robot's pi, so that along any motion
+ * Y pi = (0, 0, 0, u_Y, u_P).  Y depends on the parameters only through r, n_Y, n_P, g and slope.
+ * Checks: the model, the pointers (SR_ERR_NULL), sr_check_state, nudot finite (SR_ERR_NONFINITE);
+ * Y written only on SR_OK. */
+int sr_regressor(const sr_model *model, const sr_real x[SR_NX], const sr_real nudot[SR_NV],
+                 sr_real Y[SR_NV * SR_NPI]);
+
+/** The same over n rows (x n x SR_NX, nudot n x SR_NV, Y n x SR_NV x SR_NPI); stops at the first
+ * failing row, its index in *failed_row (-1 when all succeed). */
+int sr_regressor_batch(const sr_model *model, long n, const sr_real *x, const sr_real *nudot, sr_real *Y,
+                       long *failed_row);
 /** @} */
 
 /** @name The firmware controller: LQR gain-scheduled on speed and curvature (c/src/sr_control.c)

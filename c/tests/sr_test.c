@@ -55,6 +55,7 @@ int main(void)
     suite_model_validity();
     suite_sensors();
     suite_ekf();
+    suite_param_jacobians();
     return sr_test_summary();
 }
 

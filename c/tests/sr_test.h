@@ -77,6 +77,7 @@ void suite_step_batch(void);
 void suite_model_validity(void);
 void suite_sensors(void);
 void suite_ekf(void);
+void suite_param_jacobians(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 

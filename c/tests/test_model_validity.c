@@ -80,7 +80,7 @@ typedef struct model_fn {
     unsigned reads;
 } model_fn;
 
-static sr_real X[2 * SR_NX], U[2 * SR_NU], OUT[4 * SR_NE * SR_NE], OUT2[4 * SR_NE * SR_NU];
+static sr_real X[2 * SR_NX], U[2 * SR_NU], NUDOT[2 * SR_NV], OUT[4 * SR_NE * SR_NPARAM], OUT2[4 * SR_NE * SR_NU];
 static sr_real MOUNT[SR_NMOUNT], NU_DOT[SR_NV];
 static long ROW;
 static sr_lqr LQR;
@@ -185,6 +185,15 @@ static int c_position_jacobian(const sr_model *m, long n) { (void)n; return sr_p
 static int c_heading_measure(const sr_model *m, long n) { (void)n; return sr_heading_measure(m, X, SR_BODY_yoke, MOUNT, OUT); }
 static int c_contact_force(const sr_model *m, long n) { (void)n; return sr_contact_force(m, X, U, OUT); }
 static int c_contact_force_batch(const sr_model *m, long n) { return sr_contact_force_batch(m, n, X, U, OUT, &ROW); }
+static int c_accel_param_jacobian(const sr_model *m, long n) { (void)n; return sr_accel_param_jacobian(m, X, U, OUT); }
+static int c_accel_param_jacobian_batch(const sr_model *m, long n) { return sr_accel_param_jacobian_batch(m, n, X, U, OUT, &ROW); }
+static int c_step_param_jacobian(const sr_model *m, long n) { (void)n; return sr_step_param_jacobian(m, SR_RKMK4, X, U, SR_C(0.01), OUT); }
+static int c_step_param_jacobian_batch(const sr_model *m, long n)
+{
+    return sr_step_param_jacobian_batch(m, SR_LIE_EULER, n, X, U, SR_C(0.01), OUT, &ROW);
+}
+static int c_regressor(const sr_model *m, long n) { (void)n; return sr_regressor(m, X, NUDOT, OUT); }
+static int c_regressor_batch(const sr_model *m, long n) { return sr_regressor_batch(m, n, X, NUDOT, OUT, &ROW); }
 static int c_heading_jacobian(const sr_model *m, long n)
 {
     (void)n;
@@ -203,6 +212,12 @@ static const model_fn TAKES_MODEL[] = {
     {"sr_equilibrium_residual", c_residual, R_EQUILIBRIUM},
     {"sr_contact_force", c_contact_force, R_WHOLE},
     {"sr_contact_force_batch", c_contact_force_batch, R_WHOLE},
+    {"sr_accel_param_jacobian", c_accel_param_jacobian, R_WHOLE},
+    {"sr_accel_param_jacobian_batch", c_accel_param_jacobian_batch, R_WHOLE},
+    {"sr_step_param_jacobian", c_step_param_jacobian, R_WHOLE},
+    {"sr_step_param_jacobian_batch", c_step_param_jacobian_batch, R_WHOLE},
+    {"sr_regressor", c_regressor, R_WHOLE},
+    {"sr_regressor_batch", c_regressor_batch, R_WHOLE},
     {"sr_step", c_step, R_ACCEL | R_STATE},
     {"sr_step_lie_euler", c_step_lie_euler, R_ACCEL | R_STATE},
     {"sr_step_rkmk4", c_step_rkmk4, R_ACCEL | R_STATE},

@@ -9,6 +9,7 @@ import pathlib
 
 import sympy as sp
 
+from .. import param_derivatives as PD
 from .. import parameters as P
 from .. import sensors as SE
 from .. import state as S
@@ -229,6 +230,9 @@ def layout_macros():
     lines += [f"#define SR_P_{s.name} {i}" for i, s in enumerate(P.PARAMETERS)]
     lines += ["/* Layout of pp[SR_GEN_NPAPER], the paper's parameters (Section 5.2, SI), for sr_gen_paper_params. */"]
     lines += [f"#define SR_PAPER_{s.name} {i}" for i, s in enumerate(P.PAPER_PARAMETERS)]
+    lines += ["/* Layout of pi[SR_GEN_NPI], the parameters the equations of motion are linear in (the regressor's"
+              " columns, derive/param_derivatives.py): per body m, m c, the tensor about O, the damping; the rotors. */"]
+    lines += [f"#define SR_PI_{s.name} {i}" for i, s in enumerate(PD.INERTIAL_PARAMETERS)]
     lines += ["/* The bodies a sensor is mounted on (derive/sensors.py). */"]
     lines += [f"#define SR_BODY_{name} {i}" for i, name in enumerate(SE.BODIES)]
     lines += ["/* Layout of sc[SR_GEN_NSC], the sensor kernels' constants (sr_gen_sensor_constants). */"]
@@ -266,6 +270,7 @@ def header_text(ks, flops, n_constants, n_general_constants, reads):
 
 #define SR_GEN_NPARAM {len(P.PARAMETERS)}
 #define SR_GEN_NPAPER {len(P.PAPER_PARAMETERS)}
+#define SR_GEN_NPI {len(PD.INERTIAL_PARAMETERS)}
 #define SR_GEN_NCONST {n_constants}
 #define SR_GEN_NCONST_NAMED {len(P.CONSTANTS)}
 #define SR_GEN_GENERAL_NCONST {n_general_constants}

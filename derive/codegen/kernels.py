@@ -14,6 +14,7 @@ from .. import contact as CF
 from .. import derivatives as J
 from .. import dynamics as D
 from .. import newton_euler as NE
+from .. import param_derivatives as PD
 from .. import parameters as P
 from .. import robot as R
 from .. import sensors as SE
@@ -145,6 +146,22 @@ def general_kernels():
         Kernel("general_equilibrium_residual", "f at ν = 0, u = 0 for the general robot.",
                ("cg", "x"), (Output("res", tuple(D.equilibrium_residual(robot)), "residual"),)),
         accel_jacobian_terms(robot, "general_accel_jacobian_terms", ("cg", "x", "u")),
+    ) + param_kernels()
+
+
+def param_kernels():
+    """The derivatives in the parameters (derive.param_derivatives): ∂(M ν̇ − f)/∂p for the parameter
+    Jacobians of c/src/sr_param_jacobians.c (∂ν̇/∂p = −M⁻¹ ∂(M ν̇ − f)/∂p), and the regressor Y with
+    M ν̇ − f(u = 0) = Y π.  Both read the parameters and ν̇ (as an input, held)."""
+    proven("regressor", PD.check_regressor())
+    proven("inertial parameters", PD.check_inertial_parameters())
+    return (
+        Kernel("general_param_residual_jacobian", "∂(M ν̇ − f)/∂p of the general robot with ν̇ held (5 x SR_GEN_NPARAM,"
+               " row-major, columns SR_P_*), for ∂ν̇/∂p = −M⁻¹ ∂(M ν̇ − f)/∂p (derive.param_derivatives).",
+               ("p", "x", "nud"), (Output("dR", tuple(PD.residual_param_jacobian()), "d(M nu_dot - f)/dp, row-major 5 x SR_GEN_NPARAM"),)),
+        Kernel("regressor", "The regressor Y (5 x SR_GEN_NPI, row-major, columns SR_PI_*): M ν̇ − f(u = 0) = Y π, π the"
+               " inertial parameters and dampings (derive.param_derivatives.INERTIAL_PARAMETERS).",
+               ("p", "x", "nud"), (Output("Y", tuple(PD.regressor()), "Y, row-major 5 x SR_GEN_NPI"),)),
     )
 
 

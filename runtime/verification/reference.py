@@ -114,6 +114,11 @@ from ..so3 import rot_y as _rot_y_np
 #: The general robot: scalars, c_* 3-vectors, J_* 3x3 tensors about the centre of mass.
 PARAM_NAMES = ("r", "m_S", "j_S", "k_S", "m_Y", "c_Y", "J_Y", "k_Y", "m_P", "c_P", "J_P", "k_P",
                "j_mY", "n_Y", "j_mP", "n_P", "g", "slope")
+#: The flat parameter vector of `ReferenceModel.parametric`: c_* by x, y, z, J_* by xx, yy, zz, xy, xz, yz.
+FLAT_PARAM_NAMES = tuple(
+    n for name in PARAM_NAMES for n in (
+        [f"{name}_{a}" for a in "xyz"] if name in ("c_Y", "c_P") else
+        [f"{name}_{k}" for k in ("xx", "yy", "zz", "xy", "xz", "yz")] if name in ("J_Y", "J_P") else [name]))
 #: The paper's robot (Section 5.2), built here from its rods (`paper_robot`).
 PAPER_PARAM_NAMES = ("r", "m_S", "k_S", "b", "h", "m_b", "m_h", "k_Y", "l", "m_P", "k_P", "g")
 
@@ -167,6 +172,11 @@ def _time_derivative(expr, s, sdot):
     """d/dt expr(s) = (d expr/ds) sdot, for a matrix/vector expression."""
     flat = ca.vec(expr)
     return ca.reshape(ca.jtimes(flat, s, sdot), expr.shape[0], expr.shape[1])
+
+
+def _casadi(value):
+    """A CasADi matrix of value: a number array as DM, a CasADi expression as it is."""
+    return value if isinstance(value, (ca.SX, ca.DM)) else ca.DM(value)
 
 
 class _Body:
@@ -246,6 +256,38 @@ class ReferenceModel:
         self.params = checked_params(params)
         self._build()
 
+    @classmethod
+    def parametric(cls):
+        """The model with its parameters as a CasADi symbol p (the flat vector of
+        `FLAT_PARAM_NAMES`): only `parametric_accel` is available on it."""
+        model = cls.__new__(cls)
+        model.paper = None
+        p = ca.SX.sym("p", len(FLAT_PARAM_NAMES))
+        entries = dict(zip(FLAT_PARAM_NAMES, ca.vertsplit(p)))
+        params = {}
+        for name in PARAM_NAMES:
+            if name in ("c_Y", "c_P"):
+                params[name] = ca.vertcat(*(entries[f"{name}_{a}"] for a in "xyz"))
+            elif name in ("J_Y", "J_P"):
+                e = {k: entries[f"{name}_{k}"] for k in ("xx", "yy", "zz", "xy", "xz", "yz")}
+                params[name] = ca.vertcat(ca.horzcat(e["xx"], e["xy"], e["xz"]), ca.horzcat(e["xy"], e["yy"], e["yz"]),
+                                          ca.horzcat(e["xz"], e["yz"], e["zz"]))
+            else:
+                params[name] = entries[name]
+        model.params = params
+        model._p = p
+        model._build(parameters=(p,))
+        return model
+
+    def parametric_accel(self):
+        """SX (x, u, p, accel): the accelerations of a `parametric` model as an expression in fresh
+        symbols x (35), u (2) and its p, for AD in the parameters."""
+        x, u = ca.SX.sym("x", STATE_DIM), ca.SX.sym("u", 2)
+        K, rhs = self._f_kkt(x, u, self._p)
+        sol = ca.solve(K, rhs)
+        J, b0 = self._f_conv(x, self._p)
+        return x, u, self._p, ca.vertcat(J @ sol[:7] + b0, sol[3:5])
+
     # ------------------------------------------------------------------ build
     def _bodies(self):
         """Shell, yoke, pendulum and the motors' rotors (axial inertia only; a rotor turns n times
@@ -253,19 +295,21 @@ class ReferenceModel:
         p = self.params
         ex, ey = np.eye(3)[0], np.eye(3)[1]
         return [
-            _Body(p["m_S"], p["j_S"] * np.eye(3), np.zeros(3), "S"),
+            _Body(p["m_S"], p["j_S"] * ca.DM.eye(3), np.zeros(3), "S"),
             _Body(p["m_Y"], p["J_Y"], p["c_Y"], "Y"),
             _Body(p["m_P"], p["J_P"], p["c_P"], "P"),
-            _Body(0.0, p["j_mY"] * np.outer(ex, ex), np.zeros(3), "mY"),
-            _Body(0.0, p["j_mP"] * np.outer(ey, ey), np.zeros(3), "mP"),
+            _Body(0.0, p["j_mY"] * ca.DM(np.outer(ex, ex)), np.zeros(3), "mY"),
+            _Body(0.0, p["j_mP"] * ca.DM(np.outer(ey, ey)), np.zeros(3), "mP"),
         ]
 
-    def _build(self):
+    def _build(self, parameters=()):
+        """The CasADi Functions; `parameters`: SX symbols the parameter values are made of
+        (`parametric`), appended to the inputs of the accelerations' Functions."""
         p = self.params
         r, g = p["r"], p["g"]
         kS, kY, kP = p["k_S"], p["k_Y"], p["k_P"]
         # Gravity in the plane's frame (x up the slope): -g (sin(slope) e_x + cos(slope) e_z).
-        gravity = -g * ca.DM([np.sin(p["slope"]), 0.0, np.cos(p["slope"])])
+        gravity = -g * ca.vertcat(ca.sin(p["slope"]), 0.0, ca.cos(p["slope"]))
         ez = ca.DM([0, 0, 1])
 
         # Current state (the chart's base point) and inputs.
@@ -291,11 +335,11 @@ class ReferenceModel:
         potential = 0
         for body in self._bodies():
             Rb = frames[body.frame]
-            pos = q + Rb @ ca.DM(body.c_local)
+            pos = q + Rb @ _casadi(body.c_local)
             vel = ca.jtimes(pos, s, sd)
             w_body = _vee_skew(Rb.T @ _time_derivative(Rb, s, sd))
             kinetic += 0.5 * body.mass * ca.dot(vel, vel)
-            kinetic += 0.5 * ca.dot(w_body, ca.DM(body.inertia) @ w_body)
+            kinetic += 0.5 * ca.dot(w_body, _casadi(body.inertia) @ w_body)
             potential -= body.mass * ca.dot(gravity, pos)
         lagr = kinetic - potential
 
@@ -330,7 +374,11 @@ class ReferenceModel:
         def at_state(expr):
             return ca.substitute(expr, ca.vertcat(s, sd), ca.vertcat(zero_s, sd_nu))
 
-        self._f_kkt = ca.Function("kkt", [x0, u], [at_state(kkt), at_state(rhs)])
+        self._f_kkt = ca.Function("kkt", [x0, u, *parameters], [at_state(kkt), at_state(rhs)])
+        if parameters:   # the accelerations only: the other Functions need numbers
+            self._f_conv = ca.Function("conv", [x0, *parameters], [at_state(ca.jacobian(wS_dot, sdd)),
+                                                      at_state(ca.substitute(wS_dot, sdd, ca.DM.zeros(7)))])
+            return
         conv_J = at_state(ca.jacobian(wS_dot, sdd))
         conv_b = at_state(ca.substitute(wS_dot, sdd, ca.DM.zeros(7)))
         self._f_conv = ca.Function("conv", [x0], [conv_J, conv_b])

@@ -20,6 +20,9 @@ Checks
                 central differences through retract (runtime.verification.jacobians); step_jacobian
                 of each method against Richardson differences of the C step through retract/local,
                 and its derivative in dt at 0 against linearize
+  parameters    param_jacobian against CasADi AD in the parameters of the reference and Richardson
+                differences in p; step_param_jacobian (Lie–Euler, RKMK4) against AD in p of the exported
+                steps and Richardson differences of the C step (runtime.verification.param_jacobians)
   sensors       the IMU, encoders, position fix and heading (c/include/sr_sensors.h) and their Jacobians against
                 the independent CasADi reference (runtime.verification.sensor_reference) and Richardson
                 differences of the C readings through retract (runtime.verification.sensor_checks)
@@ -351,6 +354,15 @@ def jacobian_rows(n_states=1000, seed=5):
                for row in variational_checks(seed=seed + 4)])
 
 
+def param_jacobian_rows(n_states=1000, seed=0):
+    """Check rows of the parameter Jacobians against AD and differences in the parameters."""
+    from .param_jacobians import param_jacobian_checks, step_param_jacobian_checks
+    return ([CheckResult(*row, catches="a column of dν̇/dp off by 1e-6 of the largest entry")
+             for row in param_jacobian_checks(max(n_states // 5, 20), seed)]
+            + [CheckResult(*row, catches="a row of the step's dx/dp off by 1e-6 of the largest entry")
+               for row in step_param_jacobian_checks(min(n_states, 10), seed + 1)])
+
+
 #: What each sensor row would show (tests/runtime/verification/test_sensor_checks.py fails each).
 SENSOR_CATCHES = ("a lever arm off by 1e-6 m; the slope left out", "a heading off by 1e-9 rad",
                   "an encoder angle off by 1e-9 rad", "a Jacobian entry off by 1e-7 (also along nu_dot)",
@@ -398,6 +410,7 @@ def run_all(n_states=1000, seed=0, progress=None):
         ("symmetry", planar_symmetry),
         ("jacobians", lambda: jacobian_rows(n_states, seed + 5)),
         ("linearizations", linearization_rows),
+        ("parameters", lambda: param_jacobian_rows(n_states, seed + 11)),
         ("sensors", lambda: sensor_rows(n_states, seed + 9)),
     ]
     results = []

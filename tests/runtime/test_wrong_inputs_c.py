@@ -12,7 +12,7 @@ from wrong_inputs import HUGE, NONFINITE, SETTINGS
 from bindings._sr import ffi, lib
 from runtime import Model, Params, initial_state
 
-NX, NU, NV, NE = lib.SR_NX, lib.SR_NU, lib.SR_NV, lib.SR_NE
+NX, NU, NV, NE, NP = lib.SR_NX, lib.SR_NU, lib.SR_NV, lib.SR_NE, lib.SR_NPARAM
 MODEL = Model(Params.paper_simulation())
 X = initial_state(theta_Y=0.2, theta_P=0.4, w_S=[0.1, -0.2, 0.3], r=MODEL.params.r)
 CODES = set(range(0, 11))
@@ -42,15 +42,25 @@ FUNCTIONS = {
     "sr_accel_jacobian_batch": ["model", "n", ("x", NX), ("u", NU), ("out", NV * NE), ("out", NV * NU), "failed"],
     "sr_step_jacobian_batch": ["model", "method", "n", ("x", NX), ("u", NU), "dt", ("out", NE * NE),
                                ("out", NE * NU), "failed"],
+    "sr_accel_param_jacobian": ["model", ("x", NX), ("u", NU), ("out", NV * NP)],
+    "sr_accel_param_jacobian_batch": ["model", "n", ("x", NX), ("u", NU), ("out", NV * NP), "failed"],
+    "sr_step_param_jacobian": ["model", "method", ("x", NX), ("u", NU), "dt", ("out", NE * NP)],
+    "sr_step_param_jacobian_batch": ["model", "method", "n", ("x", NX), ("u", NU), "dt", ("out", NE * NP), "failed"],
+    "sr_regressor": ["model", ("x", NX), ("a", NV), ("out", NV * lib.SR_NPI)],
+    "sr_regressor_batch": ["model", "n", ("x", NX), ("a", NV), ("out", NV * lib.SR_NPI), "failed"],
 }
 VALID = {"x": X, "y": MODEL.retract(X, np.full(NE, 0.01)), "u": np.array([0.1, -0.1]),
-         "d": np.linspace(-0.1, 0.1, NE), "w": np.array([0.1, 0.2, -0.3])}
+         "d": np.linspace(-0.1, 0.1, NE), "w": np.array([0.1, 0.2, -0.3]), "a": np.array([0.5, -0.2, 0.1, 1.0, -2.0])}
 #: Pointers a function may take as NULL (documented: u, zero torque; failed_row).
 OPTIONAL = {"failed"}
 FULL_CHECK = {"sr_check_state", "sr_check_state_batch", "sr_checked_accel_batch", "sr_step", "sr_step_batch",
-              "sr_step_jacobian", "sr_step_jacobian_batch",
+              "sr_step_jacobian", "sr_step_jacobian_batch", "sr_accel_param_jacobian", "sr_accel_param_jacobian_batch",
+              "sr_step_param_jacobian", "sr_step_param_jacobian_batch", "sr_regressor", "sr_regressor_batch",
               "sr_retract", "sr_local", "sr_retract_batch", "sr_local_batch"}
 METHODS = {lib.SR_LIE_EULER, lib.SR_RKMK4, lib.SR_CF4}
+#: The methods of the functions that take fewer (the parameter Jacobians: Lie-Euler and RKMK4).
+METHODS_OF = {"sr_step_param_jacobian": {lib.SR_LIE_EULER, lib.SR_RKMK4},
+              "sr_step_param_jacobian_batch": {lib.SR_LIE_EULER, lib.SR_RKMK4}}
 
 
 @st.composite
@@ -58,7 +68,8 @@ def calls(draw, name):
     """(arguments as Python values, the mutation, the status it calls for or None for any documented)."""
     spec = FUNCTIONS[name]
     rows = draw(st.integers(1, 4)) if "n" in spec else 1
-    args = {"n": rows, "dt": 0.01, "method": draw(st.sampled_from(sorted(METHODS)))}
+    methods = METHODS_OF.get(name, METHODS)
+    args = {"n": rows, "dt": 0.01, "method": draw(st.sampled_from(sorted(methods)))}
     buffers = [np.tile(VALID[arg[0]], (rows, 1)).ravel() if arg[0] != "out" else np.full(rows * arg[1], CANARY)
                for arg in spec if isinstance(arg, tuple)]
     kinds = ["nonfinite", "huge", "null"]
@@ -82,7 +93,7 @@ def calls(draw, name):
         null = draw(st.sampled_from(pointers))
         expect = None if spec[null] in OPTIONAL or spec[null] == ("u", NU) else lib.SR_ERR_NULL
     elif kind == "method":
-        args["method"] = draw(st.integers(-2**31, 2**31 - 1).filter(lambda m: m not in METHODS | {m | 16 for m in METHODS}))
+        args["method"] = draw(st.integers(-2**31, 2**31 - 1).filter(lambda m: m not in methods | {m | 16 for m in methods}))
         expect = lib.SR_ERR_ARG
     elif kind == "n":
         args["n"] = draw(st.sampled_from([-1, -2**63]))

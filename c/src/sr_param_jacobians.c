@@ -1,0 +1,300 @@
+/*
+ * sr_param_jacobians.c -- derivatives in the parameters: of the accelerations, of one step of
+ * Lie-Euler or RKMK4, and the regressor form of the equations of motion.
+ *
+ * With the state and the torques held, M nu' = f gives d(nu')/dp = -M^-1 d(M nu' - f)/dp, nu'
+ * held in the bracket (derive/param_derivatives.py): one generated kernel for the bracket, the
+ * general robot's M and f and its Cholesky factor for the solve.  A robot of the paper's geometry
+ * is evaluated with the general kernels too (its general constants computed per call), so that
+ * every parameter, the ones the paper's kernels fold into constants included, has its column.
+ *
+ * A step's sensitivity follows the stages of sr_steppers.c with the state held (x fixed, so its
+ * error enters nowhere): for the action y = x . exp(th), y (-) y0 = B(th) dth with B of
+ * sr_step_jacobians.c; for the vector field at a stage state y, df = J_f(y) dy + df/dp(y), where
+ * df/dp has the accelerations' rows and, since q' = r (R_S w) x e_z, q'/r in the column of r;
+ * and RKMK4's dexp^-1 on the SO(3) block, dk_S = P df_S + Q dth_S (sr_dexpinv.h).
+ */
+#include "sr_checks.h"
+#include "sr_dexpinv.h"
+#include "sr_finite.h"
+#include "sr_jacobians.h"
+#include "sr_kernels.h"
+#include "sr_steppers.h"
+#include "sr_argcheck.h"
+
+#include <string.h>
+
+#define NP SR_NPARAM
+
+typedef sr_real tangent_p[SR_NT][NP];   /* d(13-vector)/dp */
+typedef sr_real error_p[SR_NE][NP];     /* d(state error)/dp */
+
+/* nu' and d(nu')/dp at a state the caller checked (u not NULL); J row-major SR_NV x NP. */
+static int accel_param_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                sr_real a[SR_NV], sr_real J[SR_NV][NP])
+{
+    sr_real cg[SR_GEN_GENERAL_NCONST], Mu[15], f[SR_NV], L[SR_NV * SR_NV], inv[SR_NV], dR[SR_NV * NP];
+    const sr_real *constants = model->cg;
+    int i, k, c, status;
+    if (!model->general) {   /* the paper's kernels fold parameters into constants: take the general ones */
+        sr_gen_general_constants(model->p, cg);
+        constants = cg;
+    }
+    status = sr_gen_general_system(constants, x, u, Mu, f);
+    if (status == SR_OK) status = sr_internal_cholesky(Mu, L, inv);
+    if (status != SR_OK) return status;
+    for (i = 0; i < SR_NV; ++i) {   /* a = M^-1 f */
+        sr_real s = f[i];
+        for (k = 0; k < i; ++k) s -= L[SR_NV * i + k] * a[k];
+        a[i] = s * inv[i];
+    }
+    for (i = SR_NV - 1; i >= 0; --i) {
+        sr_real s = a[i];
+        for (k = i + 1; k < SR_NV; ++k) s -= L[SR_NV * k + i] * a[k];
+        a[i] = s * inv[i];
+    }
+    status = sr_gen_general_param_residual_jacobian(model->p, x, a, dR);
+    if (status != SR_OK) return status;
+    for (i = 0; i < SR_NV; ++i) {   /* J = -M^-1 dR, all columns at once */
+        for (c = 0; c < NP; ++c) J[i][c] = -dR[NP * i + c];
+        for (k = 0; k < i; ++k)
+            for (c = 0; c < NP; ++c) J[i][c] -= L[SR_NV * i + k] * J[k][c];
+        for (c = 0; c < NP; ++c) J[i][c] *= inv[i];
+    }
+    for (i = SR_NV - 1; i >= 0; --i) {
+        for (k = i + 1; k < SR_NV; ++k)
+            for (c = 0; c < NP; ++c) J[i][c] -= L[SR_NV * k + i] * J[k][c];
+        for (c = 0; c < NP; ++c) J[i][c] *= inv[i];
+    }
+    return SR_OK;
+}
+
+int sr_accel_param_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                            sr_real J[SR_NV * SR_NPARAM])
+{
+    sr_real a[SR_NV], j[SR_NV][NP];
+    int status = arg_model(model, READS(WHOLE));
+    if (status != SR_OK) return status;
+    if (!x || !J) return SR_ERR_NULL;
+    status = sr_internal_check_state(model, x);
+    if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
+    if (status == SR_OK) status = accel_param_jacobian(model, x, u ? u : sr_zero_u, a, j);
+    if (status != SR_OK) return status;
+    if (!all_finite_long(&j[0][0], SR_NV * NP)) return SR_ERR_NONFINITE;
+    memcpy(J, j, sizeof j);
+    return SR_OK;
+}
+
+int sr_accel_param_jacobian_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real *J,
+                                  long *failed_row)
+{
+    long i;
+    int status = arg_model(model, READS(WHOLE));
+    if (failed_row) *failed_row = -1;
+    if (status == SR_OK) status = arg_rows(n, x && J);
+    if (status != SR_OK) return status;
+    for (i = 0; i < n; ++i) {
+        status = sr_accel_param_jacobian(model, x + i * SR_NX, u ? u + i * SR_NU : NULL, J + i * SR_NV * NP);
+        if (status != SR_OK) {
+            if (failed_row) *failed_row = i;
+            return status;
+        }
+    }
+    return SR_OK;
+}
+
+/* ---- one step ------------------------------------------------------------------------------- */
+
+/* dy = B(th) dth: the error of y = x . exp(th) along p with x held (q_z does not move). */
+static void action_rows(const sr_real th[SR_NT], const tangent_p dth, error_p dy)
+{
+    sr_real Jr[9];
+    int i, c;
+    so3_right_jacobian(th + SR_T_S, Jr);
+    for (i = 0; i < 3; ++i)
+        for (c = 0; c < NP; ++c)
+            dy[SR_E_xi_S + i][c] = Jr[3 * i] * dth[SR_T_S][c] + Jr[3 * i + 1] * dth[SR_T_S + 1][c]
+                                   + Jr[3 * i + 2] * dth[SR_T_S + 2][c];
+    memcpy(dy[SR_E_th_Y], dth[SR_T_Y], sizeof dy[0]);
+    memcpy(dy[SR_E_th_P], dth[SR_T_P], sizeof dy[0]);
+    for (i = 0; i < 2; ++i) memcpy(dy[SR_E_q + i], dth[SR_T_Q + i], sizeof dy[0]);
+    for (i = 0; i < SR_NV; ++i) memcpy(dy[SR_E_nu + i], dth[SR_T_V + i], sizeof dy[0]);
+}
+
+/* The vector field f at y and df = J_f(y) dy + df/dp(y) (dy NULL: y is the step's start, dy = 0). */
+static int field_rows(const sr_model *model, const sr_real y[SR_NX], const sr_real u[SR_NU], const error_p dy,
+                      sr_real f[SR_NT], tangent_p df)
+{
+    const sr_real *R = y + SR_X_R_S, *w = y + SR_X_w_S, r = model->p[SR_P_r];
+    sr_real a[SR_NV], Jp[SR_NV][NP], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], p[2][3], wxp[2][3];
+    int i, j, c, status;
+    sr_internal_kinematics(model, y, f);
+    status = accel_param_jacobian(model, y, u, f + SR_T_V, Jp);
+    if (status == SR_OK && dy) status = sr_internal_accel_jacobian(model, y, u, a, Ja, Jb);
+    /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
+    if (status != SR_OK) return status == SR_ERR_SINGULAR && !all_finite(y, SR_NX) ? SR_ERR_NONFINITE : status;
+    memset(df, 0, sizeof(tangent_p));
+    for (i = 0; i < SR_NV; ++i) memcpy(df[SR_T_V + i], Jp[i], sizeof Jp[0]);
+    for (i = 0; i < 2; ++i) df[SR_T_Q + i][SR_P_r] = f[SR_T_Q + i] / r;   /* q' is linear in r */
+    if (!dy) return SR_OK;
+    for (i = 0; i < 3; ++i) memcpy(df[SR_T_S + i], dy[SR_E_nu + i], sizeof df[0]);   /* th_S' = w_S */
+    memcpy(df[SR_T_Y], dy[SR_E_nu + 3], sizeof df[0]);
+    memcpy(df[SR_T_P], dy[SR_E_nu + 4], sizeof df[0]);
+    for (j = 0; j < 3; ++j) {   /* d(q') = p . dw + (w x p) . dxi, as in sr_step_jacobian_lie_euler */
+        p[0][j] = r * R[3 + j];
+        p[1][j] = -r * R[j];
+    }
+    for (i = 0; i < 2; ++i) {
+        wxp[i][0] = w[1] * p[i][2] - w[2] * p[i][1];
+        wxp[i][1] = w[2] * p[i][0] - w[0] * p[i][2];
+        wxp[i][2] = w[0] * p[i][1] - w[1] * p[i][0];
+        for (j = 0; j < 3; ++j)
+            for (c = 0; c < NP; ++c)
+                df[SR_T_Q + i][c] += p[i][j] * dy[SR_E_nu + j][c] + wxp[i][j] * dy[SR_E_xi_S + j][c];
+    }
+    for (i = 0; i < SR_NV; ++i)   /* the accelerations: Ja dy (q's columns of Ja are zero) */
+        for (j = 0; j < SR_NE; ++j) {
+            const sr_real m = Ja[SR_NE * i + j];
+            if (j == SR_E_q || j == SR_E_q + 1) continue;
+            for (c = 0; c < NP; ++c) df[SR_T_V + i][c] += m * dy[j][c];
+        }
+    return SR_OK;
+}
+
+/* RKMK4 with the state held: K1 = f(x), K_s = dexp^-1(th_s, f(x . exp(th_s))), th_s = a_s h K_(s-1),
+ * x_new = x . exp(sum_k b_k K_k); dy the error of x_new along p. */
+static int rkmk4_param(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
+                       error_p dy)
+{
+    static const sr_real a_diag[3] = {SR_C(0.5), SR_C(0.5), SR_C(1.0)};
+    const sr_real b[4] = {h / 6, h / 3, h / 3, h / 6};
+    sr_real K[4][SR_NT], th[SR_NT], D[9], y[SR_NX];
+    tangent_p dK[4], dth;
+    error_p dstage;
+    int s, i, c, status = field_rows(model, x, u, NULL, K[0], dK[0]);
+    for (s = 1; s < 4 && status == SR_OK; ++s) {
+        const sr_real hs = a_diag[s - 1] * h;
+        for (i = 0; i < SR_NT; ++i) th[i] = hs * K[s - 1][i];
+        for (i = 0; i < SR_NT; ++i)
+            for (c = 0; c < NP; ++c) dth[i][c] = hs * dK[s - 1][i][c];
+        so3_exp_minus_identity(th + SR_T_S, D);
+        act_increment(x, D, th, NULL, y);   /* the stepper's stage state */
+        action_rows(th, (const sr_real(*)[NP])dth, dstage);
+        status = field_rows(model, y, u, (const sr_real(*)[NP])dstage, K[s], dK[s]);
+        if (status == SR_OK) {   /* k_S = dexp^-1(th, f_S): dk_S = P df_S + Q dth_S */
+            sr_real P[9], Q[9], kS[3], dS[3][NP];
+            int j;
+            dexpinv_and_derivatives(th, K[s], kS, P, Q);
+            for (i = 0; i < 3; ++i)
+                for (c = 0; c < NP; ++c) {
+                    dS[i][c] = 0;
+                    for (j = 0; j < 3; ++j) dS[i][c] += P[3 * i + j] * dK[s][SR_T_S + j][c] + Q[3 * i + j] * dth[SR_T_S + j][c];
+                }
+            for (i = 0; i < 3; ++i) {
+                K[s][SR_T_S + i] = kS[i];
+                memcpy(dK[s][SR_T_S + i], dS[i], sizeof dS[0]);
+            }
+        }
+    }
+    if (status != SR_OK) return status;
+    for (i = 0; i < SR_NT; ++i) {   /* as the stepper's combine */
+        th[i] = 0;
+        for (s = 0; s < 4; ++s) th[i] += b[s] * K[s][i];
+        for (c = 0; c < NP; ++c) {
+            dth[i][c] = 0;
+            for (s = 0; s < 4; ++s) dth[i][c] += b[s] * dK[s][i][c];
+        }
+    }
+    action_rows(th, (const sr_real(*)[NP])dth, dy);
+    return SR_OK;
+}
+
+/* Lie-Euler: x_new = x . exp(h f(x)). */
+static int lie_euler_param(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
+                           error_p dy)
+{
+    sr_real f[SR_NT], th[SR_NT];
+    tangent_p df;
+    int i, c, status = field_rows(model, x, u, NULL, f, df);
+    if (status != SR_OK) return status;
+    for (i = 0; i < SR_NT; ++i) {
+        th[i] = h * f[i];
+        for (c = 0; c < NP; ++c) df[i][c] *= h;
+    }
+    action_rows(th, (const sr_real(*)[NP])df, dy);
+    return SR_OK;
+}
+
+int sr_step_param_jacobian(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                           sr_real dt, sr_real Jp[SR_NE * SR_NPARAM])
+{
+    error_p dy;
+    int status = arg_model(model, READS(WHOLE));
+    if (status != SR_OK) return status;
+    if (!x || !Jp) return SR_ERR_NULL;
+    if ((method != SR_LIE_EULER && method != SR_RKMK4) || arg_dt(dt) != SR_OK) return SR_ERR_ARG;
+    status = sr_internal_check_state(model, x);
+    if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
+    if (status != SR_OK) return status;
+    if (!u) u = sr_zero_u;
+    status = method == SR_LIE_EULER ? lie_euler_param(model, x, u, dt, dy) : rkmk4_param(model, x, u, dt, dy);
+    if (status != SR_OK) return status;
+    if (!all_finite_long(&dy[0][0], SR_NE * NP)) return SR_ERR_NONFINITE;
+    memcpy(Jp, dy, sizeof dy);
+    return SR_OK;
+}
+
+int sr_step_param_jacobian_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u,
+                                 sr_real dt, sr_real *Jp, long *failed_row)
+{
+    long i;
+    int status = arg_model(model, READS(WHOLE));
+    if (failed_row) *failed_row = -1;
+    if (status == SR_OK) status = arg_rows(n, x && Jp);
+    if (status == SR_OK && ((method != SR_LIE_EULER && method != SR_RKMK4) || arg_dt(dt) != SR_OK)) status = SR_ERR_ARG;
+    if (status != SR_OK) return status;
+    for (i = 0; i < n; ++i) {
+        status = sr_step_param_jacobian(model, method, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt,
+                                        Jp + i * SR_NE * NP);
+        if (status != SR_OK) {
+            if (failed_row) *failed_row = i;
+            return status;
+        }
+    }
+    return SR_OK;
+}
+
+/* ---- the regressor -------------------------------------------------------------------------- */
+
+int sr_regressor(const sr_model *model, const sr_real x[SR_NX], const sr_real nudot[SR_NV],
+                 sr_real Y[SR_NV * SR_NPI])
+{
+    sr_real y[SR_NV * SR_NPI];
+    int status = arg_model(model, READS(WHOLE));
+    if (status != SR_OK) return status;
+    if (!x || !nudot || !Y) return SR_ERR_NULL;
+    status = sr_internal_check_state(model, x);
+    if (status == SR_OK && !all_finite(nudot, SR_NV)) status = SR_ERR_NONFINITE;
+    if (status == SR_OK) status = sr_gen_regressor(model->p, x, nudot, y);
+    if (status != SR_OK) return status;
+    memcpy(Y, y, sizeof y);
+    return SR_OK;
+}
+
+int sr_regressor_batch(const sr_model *model, long n, const sr_real *x, const sr_real *nudot, sr_real *Y,
+                       long *failed_row)
+{
+    long i;
+    int status = arg_model(model, READS(WHOLE));
+    if (failed_row) *failed_row = -1;
+    if (status == SR_OK) status = arg_rows(n, x && nudot && Y);
+    if (status != SR_OK) return status;
+    for (i = 0; i < n; ++i) {
+        status = sr_regressor(model, x + i * SR_NX, nudot + i * SR_NV, Y + i * SR_NV * SR_NPI);
+        if (status != SR_OK) {
+            if (failed_row) *failed_row = i;
+            return status;
+        }
+    }
+    return SR_OK;
+}
