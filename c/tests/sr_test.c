@@ -54,6 +54,7 @@ int main(void)
     suite_step_batch();
     suite_model_validity();
     suite_sensors();
+    suite_nmpc();
     return sr_test_summary();
 }
 

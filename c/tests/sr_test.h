@@ -76,6 +76,7 @@ void suite_accel_batch(void);
 void suite_step_batch(void);
 void suite_model_validity(void);
 void suite_sensors(void);
+void suite_nmpc(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 
