@@ -7,8 +7,9 @@
  * nearest point of the circle (centre NMPC_TASK_CENTRE, counter-clockwise), computes the torques
  * and holds them for NMPC_TASK_STEPS_PER_SAMPLE plant steps (sr_step, RKMK4).
  *
- * Output (stdout): one line "samples N p50_us P p99_us Q max_us M cross_track_rms_m E restarts R
- * failures F" (the cross-track RMS over the second half of the run).  Build and run:
+ * Output (stdout): one line: the samples; the wall-clock time of sr_nmpc_step, p50, p99 and max [us];
+ * the same in the thread's CPU time; the QP's factorisations per sample (the last iteration's), p50,
+ * p99, max; the cross-track RMS over the second half of the run [m]; restarts and failures.  Build and run:
  * `python -m runtime nmpc-c --timing` (docs/control.md).  Exit status 0, or 1 with a message on stderr.
  */
 #include "nmpc_task.h"
@@ -20,7 +21,8 @@
 #include <time.h>
 
 static sr_nmpc_memory memory; /* the controller's whole workspace, static: no heap, not on the stack */
-static double elapsed_us[NMPC_TASK_SAMPLES];
+static double elapsed_us[NMPC_TASK_SAMPLES], cpu_us[NMPC_TASK_SAMPLES];
+static int qp_iterations[NMPC_TASK_SAMPLES];
 
 static int by_value(const void *a, const void *b)
 {
@@ -28,10 +30,18 @@ static int by_value(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static double now_us(void)
+static int by_int(const void *a, const void *b)
+{
+    const int x = *(const int *)a, y = *(const int *)b;
+    return (x > y) - (x < y);
+}
+
+/* Wall-clock time, or (cpu) the thread's CPU time: on a shared machine the latter leaves out the
+ * time the process waited for a core. */
+static double now_us(int cpu)
 {
     struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
+    clock_gettime(cpu ? CLOCK_THREAD_CPUTIME_ID : CLOCK_MONOTONIC, &t);
     return 1e6 * (double)t.tv_sec + 1e-3 * (double)t.tv_nsec;
 }
 
@@ -55,16 +65,19 @@ int main(void)
     target.curvature = 1 / NMPC_TASK_RADIUS;
     for (k = 0; k < NMPC_TASK_SAMPLES; ++k) {
         const double dx = (double)x[SR_X_q] - NMPC_TASK_CENTRE[0], dy = (double)x[SR_X_q + 1] - NMPC_TASK_CENTRE[1];
-        double t0;
+        double t0, c0;
         target.heading = (sr_real)(atan2(dy, dx) + pi / 2);
         target.cross_track = (sr_real)(NMPC_TASK_RADIUS - sqrt(dx * dx + dy * dy));
         if (2 * k >= NMPC_TASK_SAMPLES) {
             sum2 += (double)target.cross_track * target.cross_track;
             ++counted;
         }
-        t0 = now_us();
+        c0 = now_us(1);
+        t0 = now_us(0);
         status = sr_nmpc_step(&NMPC_DESIGN, &memory, &model, x, &target, u);
-        elapsed_us[k] = now_us() - t0;
+        elapsed_us[k] = now_us(0) - t0;
+        cpu_us[k] = now_us(1) - c0;
+        qp_iterations[k] = memory.qp_iterations;
         for (i = 0; i < NMPC_TASK_STEPS_PER_SAMPLE && status == SR_OK; ++i)
             status = sr_step(&model, SR_RKMK4, x, u, NMPC_TASK_DT, x);
         if (status != SR_OK) {
@@ -73,9 +86,14 @@ int main(void)
         }
     }
     qsort(elapsed_us, NMPC_TASK_SAMPLES, sizeof elapsed_us[0], by_value);
-    printf("samples %d p50_us %.1f p99_us %.1f max_us %.1f cross_track_rms_m %.5f restarts %ld failures %ld\n",
+    qsort(cpu_us, NMPC_TASK_SAMPLES, sizeof cpu_us[0], by_value);
+    qsort(qp_iterations, NMPC_TASK_SAMPLES, sizeof qp_iterations[0], by_int);
+    printf("samples %d p50_us %.1f p99_us %.1f max_us %.1f cpu_p50_us %.1f cpu_p99_us %.1f cpu_max_us %.1f "
+           "qp_iterations_p50 %d p99 %d max %d cross_track_rms_m %.5f restarts %ld failures %ld\n",
            NMPC_TASK_SAMPLES, elapsed_us[NMPC_TASK_SAMPLES / 2], elapsed_us[(99 * NMPC_TASK_SAMPLES) / 100],
-           elapsed_us[NMPC_TASK_SAMPLES - 1], sqrt(sum2 / (double)(counted ? counted : 1)), memory.restarts,
-           memory.failures);
+           elapsed_us[NMPC_TASK_SAMPLES - 1], cpu_us[NMPC_TASK_SAMPLES / 2], cpu_us[(99 * NMPC_TASK_SAMPLES) / 100],
+           cpu_us[NMPC_TASK_SAMPLES - 1], qp_iterations[NMPC_TASK_SAMPLES / 2],
+           qp_iterations[(99 * NMPC_TASK_SAMPLES) / 100], qp_iterations[NMPC_TASK_SAMPLES - 1],
+           sqrt(sum2 / (double)(counted ? counted : 1)), memory.restarts, memory.failures);
     return 0;
 }

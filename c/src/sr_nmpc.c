@@ -175,6 +175,19 @@ static void project(const sr_model *model, const sr_real x[SR_NX], sr_real v, sr
     }
 }
 
+/* The columns of project()'s J that can be nonzero, by row: their count, then their indices. */
+static const unsigned char PROJECT_COLUMNS[NZ - 1][8] = {
+    {6, SR_E_xi_S, SR_E_xi_S + 1, SR_E_xi_S + 2, SR_E_th_Y, SR_E_q, SR_E_q + 1},
+    {6, SR_E_xi_S, SR_E_xi_S + 1, SR_E_xi_S + 2, SR_E_th_Y, SR_E_q, SR_E_q + 1},
+    {6, SR_E_xi_S, SR_E_xi_S + 1, SR_E_xi_S + 2, SR_E_th_Y, SR_E_q, SR_E_q + 1},
+    {1, SR_E_th_P},
+    {4, SR_E_th_Y, SR_E_nu, SR_E_nu + 1, SR_E_nu + 2},
+    {4, SR_E_th_Y, SR_E_nu, SR_E_nu + 1, SR_E_nu + 2},
+    {4, SR_E_th_Y, SR_E_nu, SR_E_nu + 1, SR_E_nu + 2},
+    {1, SR_E_nu + 3},
+    {1, SR_E_nu + 4},
+    {2, SR_E_q, SR_E_q + 1}};
+
 /* sr_nmpc_node without its argument checks (sr_step checks the lifted state). */
 static int node(const sr_model *model, const sr_real z[NZ], const sr_real u[SR_NU], sr_real v, sr_real kappa,
                 sr_real dt, sr_real z_next[NZ], sr_real *A, sr_real *B)
@@ -190,16 +203,17 @@ static int node(const sr_model *model, const sr_real z[NZ], const sr_real u[SR_N
     z_next[Z_IY] = z[Z_IY] + h2 * (z[Z_EY] + z_next[Z_EY]); /* the trapezoid of e_y over the node */
     if (!all_finite(z_next, NZ)) return SR_ERR_NONFINITE;
     if (!A) return SR_OK;
+    /* T = J F, B = J G over the columns project() can fill (J is sparse: a third of the products). */
     for (i = 0; i < NZ - 1; ++i) {
-        for (j = 0; j < NE; ++j) {
-            sr_real acc = 0;
-            for (k = 0; k < NE; ++k) acc += J[i * NE + k] * F[k * NE + j];
-            T[i * NE + j] = acc;
-        }
-        for (j = 0; j < SR_NU; ++j) {
-            sr_real acc = 0;
-            for (k = 0; k < NE; ++k) acc += J[i * NE + k] * G[k * SR_NU + j];
-            B[i * SR_NU + j] = acc;
+        const unsigned char *col = PROJECT_COLUMNS[i];
+        for (j = 0; j < NE; ++j) T[i * NE + j] = 0;
+        B[i * SR_NU] = B[i * SR_NU + 1] = 0;
+        for (k = 1; k <= col[0]; ++k) {
+            const sr_real Jik = J[i * NE + col[k]];
+            const sr_real *Fk = F + col[k] * NE;
+            for (j = 0; j < NE; ++j) T[i * NE + j] += Jik * Fk[j];
+            B[i * SR_NU] += Jik * G[col[k] * SR_NU];
+            B[i * SR_NU + 1] += Jik * G[col[k] * SR_NU + 1];
         }
     }
     /* The lift's derivative: dxi = J_r(E) dE, dth_P, dq_y = de_y, dnu = (dOm, dw_Y, dw_P). */
@@ -286,6 +300,17 @@ static void references(const sr_nmpc *d, sr_nmpc_memory *m, sr_real v)
     }
 }
 
+/* out = v A: a row of NZ times an NZ x NZ matrix, as rows of A scaled and added (vectorisable). */
+static void row_times(const sr_real *restrict v, const sr_real *restrict A, sr_real *restrict out)
+{
+    int l, b;
+    for (b = 0; b < NZ; ++b) out[b] = 0;
+    for (l = 0; l < NZ; ++l) {
+        const sr_real vl = v[l];
+        for (b = 0; b < NZ; ++b) out[b] += vl * A[l * NZ + b];
+    }
+}
+
 /* One Gauss-Newton QP around the nodes (m->Z, m->U) into (m->Zn, m->Un); nonzero when the
  * prediction or the QP gives no finite answer. */
 static int iteration(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, const sr_real z0[NZ], sr_real v,
@@ -338,18 +363,17 @@ static int iteration(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model,
                 m->SB[k][i * SR_NU + a] = acc;
             }
         if (k == 0) break;
-        for (i = 0; i < NZ; ++i) /* tmp = S A_k */
-            for (j = 0; j < NZ; ++j) {
-                sr_real acc = 0;
-                for (a = 0; a < NZ; ++a) acc += m->S[i * NZ + a] * m->A[k][a * NZ + j];
-                tmp[i * NZ + j] = acc;
+        for (i = 0; i < NZ; ++i) row_times(m->S + i * NZ, m->A[k], tmp + i * NZ); /* tmp = S A_k */
+        for (i = 0; i < NZ; ++i) { /* S = A_k^T tmp + diag(q): row i of A_k^T tmp = sum_a A[a][i] tmp[a][:] */
+            sr_real *Si = m->S + i * NZ;
+            for (j = 0; j < NZ; ++j) Si[j] = 0;
+            for (a = 0; a < NZ; ++a) {
+                const sr_real Aai = m->A[k][a * NZ + i];
+                const sr_real *t = tmp + a * NZ;
+                for (j = 0; j < NZ; ++j) Si[j] += Aai * t[j];
             }
-        for (i = 0; i < NZ; ++i) /* S = A_k^T tmp + diag(q), symmetric */
-            for (j = 0; j <= i; ++j) {
-                sr_real acc = 0;
-                for (a = 0; a < NZ; ++a) acc += m->A[k][a * NZ + i] * tmp[a * NZ + j];
-                m->S[i * NZ + j] = m->S[j * NZ + i] = acc + (i == j ? q[i] : 0);
-            }
+            Si[i] += q[i];
+        }
     }
     for (i = 0; i < N; ++i) {
         for (a = 0; a < SR_NU; ++a)
@@ -364,13 +388,8 @@ static int iteration(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model,
                     m->H[(SR_NU * j + b) * nq + SR_NU * i + a] = acc;
                 }
             if (j == 0) break;
-            for (a = 0; a < SR_NU; ++a)
-                for (b = 0; b < NZ; ++b) {
-                    sr_real acc = 0;
-                    int l;
-                    for (l = 0; l < NZ; ++l) acc += M[a][l] * m->A[j][l * NZ + b];
-                    M2[a][b] = acc;
-                }
+            row_times(M[0], m->A[j], M2[0]);
+            row_times(M[1], m->A[j], M2[1]);
             memcpy(M, M2, sizeof M);
         }
     }

@@ -56,10 +56,17 @@ def design_initializer(controller, name="NMPC_DESIGN"):
     return "\n".join(lines) + "\n"
 
 
+def c_task(task_name):
+    """The task with its NMPC run by the C NMPC (kind nmpc-c, the same settings)."""
+    import dataclasses
+    from .task import load_task
+    task = load_task(task_name).with_controller("nmpc")
+    return dataclasses.replace(task, controllers=(dataclasses.replace(task.controllers[0], kind="nmpc-c"),))
+
+
 def task_header(task_name="circle"):
     """The header c/examples/nmpc_loop.c compiles against: the C NMPC designed for the task (a circle)."""
-    from .task import load_task
-    task = load_task(task_name).with_controller("nmpc-c")
+    task = c_task(task_name)
     spec = task.reference_spec
     if spec["kind"] != "circle":
         raise ValueError(f"--task: the C driver follows a circle; {task_name!r} is a {spec['kind']!r} task")
@@ -77,7 +84,7 @@ def task_header(task_name="circle"):
         "#ifndef NMPC_TASK_H", "#define NMPC_TASK_H", '#include "sr_nmpc.h"',
         f"static const sr_real NMPC_TASK_PARAMS[SR_NPARAM] = {_reals(params)};",
         f"static const sr_real NMPC_TASK_X0[SR_NX] = {_reals(x0)};",
-        f"static const double NMPC_TASK_CENTRE[2] = {{{centre[0]!r}, {centre[1]!r}}};",
+        f"static const double NMPC_TASK_CENTRE[2] = {{{float(centre[0])!r}, {float(centre[1])!r}}};",
         f"#define NMPC_TASK_RADIUS {float(spec['radius'])!r}",
         f"#define NMPC_TASK_SPEED SR_C({float(spec['speed'])!r})",
         f"#define NMPC_TASK_DT SR_C({float(task.scenario.dt)!r})",
@@ -87,15 +94,17 @@ def task_header(task_name="circle"):
 
 
 def timing(task_name="circle", cc="cc"):
-    """Builds the C library (make -C c lib) and c/examples/nmpc_loop.c on the task's header (-O2),
-    runs it and returns its output line."""
-    subprocess.run(["make", "-s", "-C", str(ROOT / "c"), "lib"], check=True)
+    """Builds c/examples/nmpc_loop.c on the task's header with the library's sources, with the
+    Python extension's flags (bindings/build_sr.py: -O3, the AVX2 clones of the step Jacobians where
+    the compiler and CPU have them), runs it and returns its output line."""
+    from bindings.build_sr import SOURCES
     with tempfile.TemporaryDirectory() as tmp:
         write_text(pathlib.Path(tmp, "nmpc_task.h"), task_header(task_name))
         exe = str(pathlib.Path(tmp, "nmpc_loop"))
-        subprocess.run([cc, "-std=c99", "-O2", "-D_POSIX_C_SOURCE=199309L", f"-I{tmp}", f"-I{ROOT / 'c' / 'include'}",
-                        f"-I{ROOT / 'generated'}", str(ROOT / "c" / "examples" / "nmpc_loop.c"),
-                        str(ROOT / "c" / "build" / "libsphericalrobot.a"), "-lm", "-o", exe], check=True)
+        subprocess.run([cc, "-std=c99", "-O3", "-ffp-contract=off", "-DSR_CLONES", "-D_POSIX_C_SOURCE=199309L",
+                        f"-I{tmp}", f"-I{ROOT / 'c' / 'include'}", f"-I{ROOT / 'generated'}",
+                        str(ROOT / "c" / "examples" / "nmpc_loop.c"), *(str(ROOT / s) for s in SOURCES), "-lm",
+                        "-o", exe], check=True)
         return subprocess.run([exe], check=True, capture_output=True, text=True).stdout.strip()
 
 
@@ -148,12 +157,11 @@ def main(argv=()):
         if args.timing:
             print(timing(args.task))
         if args.qp_samples > 0:
-            from .task import load_task
             worst, count, active = 0.0, 0, 0
             names = args.tasks.split(",")
             per_task = -(-args.qp_samples // len(names))
             for name in names:
-                for H, g, lb, ub, x in recorded_qps(load_task(name).with_controller("nmpc-c"), per_task):
+                for H, g, lb, ub, x in recorded_qps(c_task(name), per_task):
                     ref, flag = daqp_solution(H, g, lb, ub)
                     if flag < 1:
                         raise ValueError(f"DAQP found no solution (exit flag {flag}) on a QP of {name}")
