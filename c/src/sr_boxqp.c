@@ -8,38 +8,45 @@
 /* Not finite: NaN or +-inf (x - x is 0 only for finite x). */
 static int finite1(sr_real v) { return v - v == 0; }
 
-/* L L^T = H[free, free] in L (nf x nf, row-major, lower triangle); 0 when not positive definite. */
-static int factor(int n, const sr_real *H, const int *free, int nf, sr_real *L)
+/* U^T U = H[free, free] in U (nf x nf, row-major, upper triangle), right-looking: every update is a
+ * scaled row added to a row (contiguous, vectorisable without reordering a sum); 0 when H is not
+ * positive definite there. */
+static int factor(int n, const sr_real *H, const int *free, int nf, sr_real *U)
 {
     int i, j, k;
-    for (i = 0; i < nf; ++i) {
-        for (j = 0; j <= i; ++j) {
-            sr_real s = H[free[i] * n + free[j]];
-            for (k = 0; k < j; ++k) s -= L[i * nf + k] * L[j * nf + k];
-            if (i == j) {
-                if (!(s > 0)) return 0;
-                L[i * nf + i] = SR_SQRT(s);
-            } else {
-                L[i * nf + j] = s / L[j * nf + j];
-            }
+    for (i = 0; i < nf; ++i)
+        for (k = i; k < nf; ++k)
+            U[i * nf + k] = H[free[k] * n + free[i]]; /* free[] increases: (free[k], free[i]) is in the lower triangle */
+    for (j = 0; j < nf; ++j) {
+        sr_real *Uj = U + j * nf, d = Uj[j];
+        if (!(d > 0)) return 0;
+        d = SR_SQRT(d);
+        Uj[j] = d;
+        for (k = j + 1; k < nf; ++k) Uj[k] /= d;
+        for (i = j + 1; i < nf; ++i) {
+            sr_real *Ui = U + i * nf;
+            const sr_real a = Uj[i];
+            for (k = i; k < nf; ++k) Ui[k] -= a * Uj[k];
         }
     }
     return 1;
 }
 
-/* b <- (L L^T)^-1 b */
-static void solve(int nf, const sr_real *L, sr_real *b)
+/* b <- (U^T U)^-1 b */
+static void solve(int nf, const sr_real *U, sr_real *b)
 {
     int i, k;
-    for (i = 0; i < nf; ++i) {
-        sr_real s = b[i];
-        for (k = 0; k < i; ++k) s -= L[i * nf + k] * b[k];
-        b[i] = s / L[i * nf + i];
+    for (i = 0; i < nf; ++i) { /* U^T y = b, y in b */
+        const sr_real *Ui = U + i * nf;
+        const sr_real y = b[i] / Ui[i];
+        b[i] = y;
+        for (k = i + 1; k < nf; ++k) b[k] -= Ui[k] * y;
     }
     for (i = nf - 1; i >= 0; --i) {
+        const sr_real *Ui = U + i * nf;
         sr_real s = b[i];
-        for (k = i + 1; k < nf; ++k) s -= L[k * nf + i] * b[k];
-        b[i] = s / L[i * nf + i];
+        for (k = i + 1; k < nf; ++k) s -= Ui[k] * b[k];
+        b[i] = s / Ui[i];
     }
 }
 
