@@ -178,8 +178,8 @@ int sr_nmpc_node(const sr_model *model, const sr_real z[SR_NMPC_NZ], const sr_re
  * condense, solve the torque-limited QP, advance the integral).  A sample whose iterations fail
  * from the warm start is solved afresh from the reference (memory->restarts); one that fails
  * from there too returns the reference's torques u*_0 (memory->failures) and SR_OK.  Checks the
- * design's sizes (SR_ERR_ARG; run sr_nmpc_check once on a design), x in full (sr_check_state),
- * the target's finiteness.  Returns SR_OK, SR_ERR_NULL, SR_ERR_MODEL, SR_ERR_ARG, SR_ERR_NONFINITE,
+ * design (sr_nmpc_check: SR_ERR_ARG, SR_ERR_NONFINITE), x in full (sr_check_state), the target's
+ * and the memory's integral and heading for finiteness.  Returns SR_OK, SR_ERR_NULL, SR_ERR_MODEL, SR_ERR_ARG, SR_ERR_NONFINITE,
  * SR_ERR_NOT_ROTATION or SR_ERR_CONSTRAINT; u and the memory are written only on SR_OK, u within
  * +-u_max. */
 int sr_nmpc_step(const sr_nmpc *design, sr_nmpc_memory *memory, const sr_model *model, const sr_real x[SR_NX],

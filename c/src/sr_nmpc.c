@@ -466,7 +466,9 @@ int sr_nmpc_step(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, con
     int status = arg_model(model), N, k, j, cold, path, failed;
     if (status != SR_OK) return status;
     if (!d || !m || !x || !target || !u) return SR_ERR_NULL;
-    if (!valid_sizes(d)) return SR_ERR_ARG;
+    /* The whole design, every sample (a few microseconds): a corrupt entry never reaches the torques. */
+    status = sr_nmpc_check(d);
+    if (status != SR_OK) return status;
     N = d->horizon;
     path = target->path != 0;
     if (!all_finite(&target->speed, 1) || !all_finite(&target->heading, 1)
