@@ -4,7 +4,8 @@
  * LLVMFuzzerTestOneInput turns the input bytes into parameters, a state, torques, a time
  * step, a method and small step counts, calls every function of spherical_robot.h (the
  * controller's sr_lqr_* with a fuzzed gain schedule, target and memory) and of sr_sensors.h
- * (a fuzzed body, mount, nu_dot and biases) and checks their
+ * (a fuzzed body, mount, nu_dot and biases) and of sr_nmpc.h (a fuzzed box QP; a fuzzed NMPC design
+ * of a short horizon, target and curvatures ahead) and checks their
  * contract (abort() on a violation, so libFuzzer and the plain driver both report it with the
  * input that caused it):
  *
@@ -24,6 +25,7 @@
  */
 #include "spherical_robot.h"
 #include "sr_sensors.h"
+#include "sr_nmpc.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -273,6 +275,117 @@ static void fuzz_controller(reader *r, const sr_model *model, const sr_real x[SR
     }
     EXPECT_STATUS("sr_lqr_control(NULL)", sr_lqr_control(&lqr, model, x, &target, NULL, arm(&gu, SR_NU), NULL),
                   SR_ERR_NULL);
+}
+
+#define QP_N 6   /* unknowns of a fuzzed box QP */
+
+/* sr_boxqp_solve on a fuzzed QP (H = M M^T + d I, perturbed), and sr_nmpc_* on a fuzzed design. */
+static void fuzz_nmpc(reader *r, const sr_model *model, const sr_real x[SR_NX])
+{
+    static sr_nmpc design;           /* 60 kB: not on the stack of the fuzz target */
+    static sr_nmpc_memory memory, before;
+    static guarded gx, gu, gz, gA, gB;
+    sr_real H[QP_N * QP_N], g[QP_N], lb[QP_N], ub[QP_N], work[SR_BOXQP_WORK_REALS(QP_N)], M[QP_N * QP_N];
+    sr_real z[SR_NMPC_NZ], ahead[SR_NMPC_MAX_HORIZON + 1], u0[SR_NU];
+    sr_nmpc_target target;
+    int iwork[SR_BOXQP_WORK_INTS(QP_N)], i, j, k, status, iterations = -1, n, max_it, use_ahead;
+    sr_real *xq;
+    n = 1 + (int)(read_u8(r) % QP_N);
+    max_it = read_u8(r) % 8 == 7 ? (int)(read_u8(r) % 3) : 4 * n;
+    for (i = 0; i < n * n; ++i) M[i] = (sr_real)unit(r);
+    for (i = 0; i < n; ++i)
+        for (j = 0; j < n; ++j) {
+            sr_real acc = i == j ? SR_C(0.1) : 0;
+            for (k = 0; k < n; ++k) acc += M[i * n + k] * M[j * n + k];
+            H[i * n + j] = pick(r, (double)acc);
+        }
+    xq = arm(&gx, n);
+    for (i = 0; i < n; ++i) {
+        g[i] = pick(r, 3 * unit(r));
+        lb[i] = pick(r, -1 + 0.5 * unit(r));
+        ub[i] = pick(r, 1 + 0.5 * unit(r));
+        xq[i] = pick(r, unit(r));
+    }
+    memcpy(M, xq, (size_t)n * sizeof *xq);
+    status = sr_boxqp_solve(n, H, g, lb, ub, max_it, xq, work, iwork, &iterations);
+    EXPECT_STATUS("sr_boxqp_solve", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_SINGULAR, SR_ERR_MAX_STEPS);
+    if (status == SR_OK) {
+        expect("sr_boxqp_solve", status, &gx, n, 1);
+        for (i = 0; i < n; ++i)
+            if (!(xq[i] >= lb[i] && xq[i] <= ub[i])) fail("sr_boxqp_solve", status, "solution outside the box");
+        if (iterations < 1 || iterations > max_it) fail("sr_boxqp_solve", status, "iterations out of range");
+    } else if (memcmp(M, xq, (size_t)n * sizeof *xq) != 0) {
+        fail("sr_boxqp_solve", status, "changed x on error");
+    }
+
+    /* the prediction node */
+    for (i = 0; i < SR_NMPC_NZ; ++i) z[i] = pick(r, 0.1 * unit(r));
+    u0[0] = pick(r, 0.2 * unit(r));
+    u0[1] = pick(r, 0.2 * unit(r));
+    {
+        const sr_real v = pick(r, 0.5 * unit(r)), kappa = pick(r, unit(r)), dt = pick(r, 0.1);
+        status = sr_nmpc_node(model, z, u0, v, kappa, dt, arm(&gz, SR_NMPC_NZ), arm(&gA, SR_NMPC_NZ * SR_NMPC_NZ),
+                              arm(&gB, SR_NMPC_NZ * SR_NU));
+        EXPECT_STATUS("sr_nmpc_node", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_ARG, SR_ERR_SINGULAR,
+                      SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT);
+        expect("sr_nmpc_node", status, &gz, status == SR_OK ? SR_NMPC_NZ : 0, 1);
+        expect("sr_nmpc_node", status, &gA, status == SR_OK ? SR_NMPC_NZ * SR_NMPC_NZ : 0, 1);
+        expect("sr_nmpc_node", status, &gB, status == SR_OK ? SR_NMPC_NZ * SR_NU : 0, 1);
+    }
+
+    /* a short design: identity-like weights and cost-to-go, fuzzed sizes and entries */
+    memset(&design, 0, sizeof design);
+    design.horizon = 1 + (int)(read_u8(r) % 4);
+    if (read_u8(r) % 16 == 15) design.horizon = (int)read_u8(r) - 128;
+    design.node_periods = 1 + (int)(read_u8(r) % 3);
+    design.cold_iterations = 1 + (int)(read_u8(r) % 3);
+    design.iterations = 1;
+    design.qp_max_iterations = 1 + (int)(read_u8(r) % 40);
+    design.period = pick(r, 0.05);
+    design.u_max = pick(r, 0.5);
+    design.r = pick(r, 4.0);
+    design.r_step = pick(r, 100.0);
+    design.integral_zone = pick(r, 0.02);
+    design.heading_jump = pick(r, 0.3);
+    design.n_speeds = design.n_curvatures = 1;
+    design.speeds[0] = pick(r, 0.3);
+    for (i = 0; i < SR_NMPC_NZ; ++i) {
+        design.q_path[i] = pick(r, 1.0);
+        design.q_heading[i] = pick(r, 1.0);
+        design.z_star[0][i] = pick(r, 0.0);
+        design.P_path[0][i * (SR_NMPC_NZ + 1)] = pick(r, 10.0);
+        design.P_heading[0][i * (SR_NMPC_NZ + 1)] = pick(r, 10.0);
+    }
+    design.u_star[0][0] = pick(r, 0.1);
+    design.u_star[0][1] = pick(r, 0.0);
+    target.speed = pick(r, 0.3);
+    target.heading = pick(r, 3.2 * unit(r));
+    target.curvature = pick(r, 0.5 * unit(r));
+    target.cross_track = pick(r, 0.05 * unit(r));
+    target.path = (int)(read_u8(r) % 2);
+    use_ahead = read_u8(r) % 2;
+    for (i = 0; i <= SR_NMPC_MAX_HORIZON; ++i) ahead[i] = pick(r, 0.5);
+    target.curvature_ahead = use_ahead ? ahead : NULL;
+
+    status = sr_nmpc_check(&design);
+    EXPECT_STATUS("sr_nmpc_check", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_ARG);
+    EXPECT_STATUS("sr_nmpc_check(NULL)", sr_nmpc_check(NULL), SR_ERR_NULL);
+    EXPECT_STATUS("sr_nmpc_reset", sr_nmpc_reset(&memory), SR_OK);
+    for (i = 0; i < 2; ++i) {   /* two samples: the second warm-started from the first */
+        before = memory;
+        status = sr_nmpc_step(&design, &memory, model, x, &target, arm(&gu, SR_NU));
+        EXPECT_STATUS("sr_nmpc_step", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT,
+                      SR_ERR_ARG);
+        expect("sr_nmpc_step", status, &gu, status == SR_OK ? SR_NU : 0, 1);
+        if (status == SR_OK) {
+            for (j = 0; j < SR_NU; ++j)
+                if (!(fabs((double)gu.buf[GUARD + j]) <= (double)design.u_max)) fail("sr_nmpc_step", status, "torque beyond u_max");
+        } else if (memory.samples != before.samples || memory.have_guess != before.have_guess
+                   || memcmp(memory.Z, before.Z, sizeof memory.Z) != 0 || memory.integral != before.integral) {
+            fail("sr_nmpc_step", status, "changed the memory on error");
+        }
+    }
+    EXPECT_STATUS("sr_nmpc_step(NULL)", sr_nmpc_step(&design, NULL, model, x, &target, arm(&gu, SR_NU)), SR_ERR_NULL);
 }
 
 /* ---- the validity stamp: every entry point on a model whose bytes the input changed ------------
@@ -799,6 +912,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     /* The controller; read last, for the same reason. */
     fuzz_controller(&rd, &model, x);
+
+    /* The NMPC; read last, for the same reason. */
+    fuzz_nmpc(&rd, &model, x);
 
     /* The sensors; read last, for the same reason. */
     fuzz_sensors(&rd, &model, x, u_or_null);

@@ -56,6 +56,7 @@ int main(void)
     suite_sensors();
     suite_ekf();
     suite_param_jacobians();
+    suite_nmpc();
     return sr_test_summary();
 }
 

@@ -78,6 +78,7 @@ void suite_model_validity(void);
 void suite_sensors(void);
 void suite_ekf(void);
 void suite_param_jacobians(void);
+void suite_nmpc(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 

@@ -164,11 +164,15 @@ class NmpcGains(LqrGains):
 GAIN_NAMES = tuple(f.name for f in dataclasses.fields(NmpcGains))
 
 _NODES = {}
+_TERMINAL_COSTS = {}
 #: Gauss–Newton iterations of the first sample, from the operating points as the guess.
 COLD_START_ITERATIONS = 8
 #: A jump of the reference's heading between samples (a waypoint's corner) larger than this
 #: starts the iterations afresh: the last solution's coordinates are relative to the old heading.
 HEADING_JUMP_RAD = 0.3
+#: The C NMPC's bound on a QP's factorisations, per unknown (an active-set solve from a cold start
+#: frees or fixes each torque about once).
+QP_MAX_ITERATIONS_PER_UNKNOWN = 4
 
 
 class _Diverged(Exception):
@@ -185,16 +189,10 @@ class Nmpc(Controller):
 
     def __init__(self, params, rate=20.0, u_max=DEFAULT_U_MAX, gains=NmpcGains()):
         super().__init__(params, rate, u_max)
-        ca = _casadi()
         self.gains, self.n = gains, int(gains.horizon)
         self.node_periods = int(gains.node_periods)
         self.node_period = self.period * self.node_periods
         self.schedule = design_schedule(params, rate, u_max, gains)
-        key = (self.node_period, self.n)
-        if key not in _NODES:
-            _NODES[key] = compiled(node_function(self.node_period).map(self.n))
-        self._nodes = _NODES[key]
-
         self._p = parameter_vector(params)
         q = gains.weights(u_max).q_diagonal()[:NZ_N]
         self._q_path = q
@@ -205,14 +203,30 @@ class Nmpc(Controller):
         self._D = np.eye(n2) - np.eye(n2, k=-2)
         self._r_step = 1.0 / gains.torque_step_n_m ** 2
         self._P_path, self._P_heading = self._terminal_costs()
+        self._build_solver()
+        self.reset(None)
+
+    def _build_solver(self):
+        """The prediction (the N nodes as one compiled CasADi Function) and the QP solver (DAQP)."""
+        ca = _casadi()
+        key = (self.node_period, self.n)
+        if key not in _NODES:
+            _NODES[key] = compiled(node_function(self.node_period).map(self.n))
+        self._nodes = _NODES[key]
         n2 = 2 * self.n
         self._qp = ca.conic("nmpc_qp", "daqp", {"h": ca.Sparsity.dense(n2, n2), "a": ca.Sparsity(0, n2)},
                             {"error_on_fail": False})
-        self.reset(None)
 
     def _terminal_costs(self):
         """The discrete Riccati cost-to-go of the prediction model at every operating point of the
-        schedule, with the cross-track error (paths) and without it (speed and heading)."""
+        schedule, with the cross-track error (paths) and without it (speed and heading); cached
+        (the Python and the C NMPC of a task share them, and building the node takes seconds)."""
+        key = (self._p.tobytes(), self.node_period, self.u_max, self.gains)
+        if key not in _TERMINAL_COSTS:
+            _TERMINAL_COSTS[key] = self._riccati_costs()
+        return _TERMINAL_COSTS[key]
+
+    def _riccati_costs(self):
         from scipy.linalg import solve_discrete_are
         s = self.schedule
         shape = s.z_star.shape[:2] + (NZ_N, NZ_N)
@@ -347,3 +361,90 @@ class Nmpc(Controller):
             raise _Diverged
         Z_new = Z + c + (G @ dU)
         return Z_new, U + dU.reshape(n, 2)
+
+
+class NmpcC(Nmpc):
+    """`Nmpc`'s formulation with every sample in C (`sr_nmpc_step`, c/src/sr_nmpc.c, sr_nmpc.h): the
+    same horizon, nodes, weights, integral, cost-to-go (computed here as `Nmpc`'s) and torque limits;
+    a node's prediction is one RKMK4 step of the full model (`sr_step`) with its exact Jacobian
+    (`sr_step_jacobian`) instead of CasADi's RK4 of the reduced field, the QP the library's box
+    QP solver (`sr_boxqp_solve`) instead of DAQP.  No CasADi at run time."""
+    kind = "nmpc-c"
+
+    def __init__(self, params, rate=20.0, u_max=DEFAULT_U_MAX, gains=NmpcGains()):
+        from bindings._sr import lib
+        if gains.horizon > lib.SR_NMPC_MAX_HORIZON:     # before the design's seconds are spent
+            raise ValueError(f"controller.horizon: the C NMPC holds at most {lib.SR_NMPC_MAX_HORIZON} nodes, "
+                             f"got {gains.horizon:g}")
+        super().__init__(params, rate, u_max, gains)
+
+    def _build_solver(self):
+        """The design as the C struct `sr_nmpc` (checked by `sr_nmpc_check`) and the C memory."""
+        from bindings._sr import ffi, lib
+        from ..model import Model
+        s = self.schedule
+        nv, nk = len(s.speeds), len(s.curvatures)
+        if nv > lib.SR_LQR_MAX_SPEEDS or nk > lib.SR_LQR_MAX_CURVATURES:
+            raise ValueError(f"controller: the design grid has {nv} speeds and {nk} curvatures; the C NMPC "
+                             f"holds at most {lib.SR_LQR_MAX_SPEEDS} and {lib.SR_LQR_MAX_CURVATURES}")
+        c = ffi.new("sr_nmpc *")
+        c.horizon, c.node_periods = self.n, self.node_periods
+        c.cold_iterations, c.iterations = COLD_START_ITERATIONS, int(self.gains.iterations)
+        c.qp_max_iterations = QP_MAX_ITERATIONS_PER_UNKNOWN * 2 * self.n
+        c.period, c.u_max, c.r, c.r_step = self.period, self.u_max, self._r, self._r_step
+        c.integral_zone, c.heading_jump = self.gains.integral_zone_m, HEADING_JUMP_RAD
+        c.q_path[0:NZ_N] = self._q_path.tolist()
+        c.q_heading[0:NZ_N] = self._q_heading.tolist()
+        c.n_speeds, c.n_curvatures = nv, nk
+        c.speeds[0:nv] = s.speeds.tolist()
+        c.curvatures[0:nk] = s.curvatures.tolist()
+        for i, j in np.ndindex(nv, nk):
+            k = i * nk + j
+            c.z_star[k][0:NZ_N] = s.z_star[i, j][:NZ_N].tolist()
+            c.u_star[k][0:2] = s.u_star[i, j].tolist()
+            c.P_path[k][0:NZ_N * NZ_N] = self._P_path[i, j].ravel().tolist()
+            c.P_heading[k][0:NZ_N * NZ_N] = self._P_heading[i, j].ravel().tolist()
+        status = lib.sr_nmpc_check(c)
+        if status != lib.SR_OK:
+            raise ValueError(f"controller: the NMPC design is not valid for the C NMPC "
+                             f"({ffi.string(lib.sr_status_string(status)).decode()})")
+        self._ffi, self._lib, self._c = ffi, lib, c
+        self._model = Model(self.params)
+        self._memory = ffi.new("sr_nmpc_memory *")
+        self._target = ffi.new("sr_nmpc_target *")
+        self._curvatures = ffi.new("double[]", self.n + 1)
+        self._u = np.zeros(2)
+
+    def reset(self, x0):
+        """Starts a run at x0: forgets the warm start, the heading and the integral (sr_nmpc_reset)."""
+        super().reset(x0)
+        self._lib.sr_nmpc_reset(self._memory)
+
+    @property
+    def memory(self):
+        """The C controller's memory (`sr_nmpc_memory`, cffi): the last solution and the last QP."""
+        return self._memory
+
+    def compute(self, t, x, target):
+        """The torques of one sample of `sr_nmpc_step` for state x and the target."""
+        from ..errors import KernelError
+        ffi, lib, c = self._ffi, self._lib, self._target
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        c.speed, c.heading = target.speed, target.heading
+        c.path = target.cross_track is not None
+        c.curvature_ahead = ffi.NULL
+        if c.path:
+            c.curvature, c.cross_track = target.curvature, target.cross_track
+            ahead = target.curvature_ahead
+            if ahead is not None and len(ahead) == self.n + 1:
+                self._curvatures[0:self.n + 1] = np.asarray(ahead, dtype=float).tolist()
+                c.curvature_ahead = self._curvatures
+        status = lib.sr_nmpc_step(self._c, self._memory, self._model._model, ffi.cast("double *", ffi.from_buffer(x)),
+                                  c, ffi.cast("double *", ffi.from_buffer(self._u)))
+        if status == lib.SR_ERR_MODEL:
+            raise KernelError("model", status, f" (controller {self.kind} at t = {t:g} s)")
+        if status != lib.SR_OK:
+            raise ValueError(f"controller {self.kind}: {ffi.string(lib.sr_status_string(status)).decode()} "
+                             f"at t = {t:g} s")
+        self.integral, self.restarts = self._memory.integral, self._memory.restarts
+        return self._u.copy()

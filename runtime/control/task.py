@@ -28,7 +28,7 @@ from .lqr import GAIN_NAMES as LQR_GAIN_NAMES
 from .lqr import Lqr, LqrGains
 from .nmpc import GAIN_NAMES as NMPC_GAIN_NAMES
 from .nmpc import NZ_N as NMPC_NZ
-from .nmpc import Nmpc, NmpcGains
+from .nmpc import Nmpc, NmpcC, NmpcGains
 from .estimator import SETTING_NAMES as ESTIMATOR_SETTINGS
 from .estimator import Ekf, EkfSettings
 from .pid import GAIN_NAMES, Pid, PidGains
@@ -38,7 +38,7 @@ from ..state import IDX_Q
 
 #: Controller kinds: (class, its settings, the settings' names).
 AVAILABLE_CONTROLLERS = {"pid": (Pid, PidGains, GAIN_NAMES), "lqr": (Lqr, LqrGains, LQR_GAIN_NAMES),
-                         "nmpc": (Nmpc, NmpcGains, NMPC_GAIN_NAMES)}
+                         "nmpc": (Nmpc, NmpcGains, NMPC_GAIN_NAMES), "nmpc-c": (NmpcC, NmpcGains, NMPC_GAIN_NAMES)}
 CONTROLLER_KINDS = tuple(AVAILABLE_CONTROLLERS)
 _SCENARIO_KEYS = {"description", "dt", "duration", "steps", "method", "params", "initial", "sensors", "friction"}
 _REFERENCE_KEYS = {"kind", "speed", "heading", "offset", "radius", "size", "points"}
@@ -66,6 +66,8 @@ TASK_RANGES = {
               "noise_rate_rad_s": Range(0, 1e3, "rad/s", "a standard deviation"),
               "noise_seed": Range(0, 2**63 - 1, "", "a seed of NumPy's generator", whole=True)},
 }
+# The C NMPC takes the NMPC's settings (its horizon is at most SR_NMPC_MAX_HORIZON, checked when it is built).
+TASK_RANGES["controller.nmpc-c"] = TASK_RANGES["controller.nmpc"]
 #: Bytes per sample of a path table: points (2), arc length, tangent, curvature, and the
 #: differences, segment lengths and turns that build them.
 PATH_ROW_BYTES = 12 * 8

@@ -48,6 +48,7 @@ SECTIONS = {"reference": lambda d, k, v: d["reference"].update(
             "controller.pid": lambda d, k, v: d["controller"][0].update({k: v}),
             "controller.lqr": lambda d, k, v: d["controller"][1].update({k: v}),
             "controller.nmpc": lambda d, k, v: d["controller"][2].update({k: v}),
+            "controller.nmpc-c": lambda d, k, v: d["controller"][2].update({"kind": "nmpc-c", k: v}),
             "estimator": lambda d, k, v: d.update(estimator={"kind": "ekf", k: v}),
             "plant": lambda d, k, v: d.update(plant={k: [v, 0.0, 0.0] if k in ("c_Y", "c_P") else
                                                      [[v, 0, 0], [0, 1, 0], [0, 0, 1]] if k in ("J_Y", "J_P")
