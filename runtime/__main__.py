@@ -24,7 +24,8 @@ COMMANDS = {
     "firmware-table": ("runtime.control.firmware", "the firmware example's LQR gain table, generated/lqr_task.h (make generate)"),
     "sweep-bench": ("runtime.bench.sweep", "what a sweep costs (make sweep-bench)"),
     "sense": ("runtime.estimation.sense", "simulate the sensors along a scenario or task: a log and its truth"),
-    "base-parameters": ("runtime.param_derivatives", "the identifiable combinations of the inertial parameters (docs/identification.md)"),
+    "estimate": ("runtime.estimation.estimate", "run the EKF over a sensor log: the estimate, its sigmas, the errors"),
+    "base-parameters": ("runtime.identification.base_parameters", "the identifiable combinations of the inertial parameters (docs/identification.md)"),
 }
 
 

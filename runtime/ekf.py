@@ -245,12 +245,13 @@ def _rotation_between(a, b):
 
 
 def start_from_measurements(model, accel, *, encoders=None, fix=None, heading=None, noise=None, mount=None,
-                            rate_sigma=0.01, heading_sigma=math.radians(10), **ekf_options):
+                            rate_sigma=0.01, heading_sigma=math.radians(10), heading_prior=0.0, **ekf_options):
     """An `Ekf` started by the rule of docs/estimation.md: at rest (ν = 0, σ `rate_sigma` rad/s),
     the position at the first fix (x, y) or the origin (σ `noise.position`), the joints at the
     encoders' angles (None: 0, σ 1 rad), the tilt from the accelerometer (one sample (3,) or the
     mean of several (n, 3) taken at rest: at rest it reads +g along the upward vertical), the
-    heading of the IMU's x axis from `heading` (σ `noise.heading`) or 0 (σ `heading_sigma`, 10°),
+    heading of the IMU's x axis from `heading` (σ `noise.heading`) or `heading_prior` [rad] (σ
+    `heading_sigma`, 10°: what the operator knows),
     the biases 0 (σ `noise.gyro_bias`, `noise.accel_bias`).  `ekf_options` go to `Ekf`."""
     noise = EkfNoise() if noise is None else noise
     if not isinstance(noise, EkfNoise):
@@ -276,7 +277,9 @@ def start_from_measurements(model, accel, *, encoders=None, fix=None, heading=No
     # The body's attitude R_B turns the measured vertical (in the body's axes) onto the world's,
     # then about that vertical until the sensor's x axis has the heading.
     R_B = _rotation_between(R_m @ (f / np.linalg.norm(f)), up)
-    target = 0.0 if heading is None else float(heading)
+    if not (isinstance(heading_prior, (int, float)) and math.isfinite(heading_prior)):
+        raise ValueError(f"heading_prior: expected a finite number of rad, got {heading_prior!r}")
+    target = float(heading_prior) if heading is None else float(heading)
     for _ in range(8):
         h = R_B @ R_m[:, 0]
         if math.hypot(h[0], h[1]) < 1e-6:

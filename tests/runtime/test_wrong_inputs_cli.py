@@ -38,6 +38,7 @@ OPTIONS = {
                "--scheduler": ["localhost:notaport", "localhost:99999", ":", "tcp://"]}),
     "bench": ([], {"--states": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER,
                    "--loop-steps": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER}),
+    "estimate": (["{tmp}/log", "--out", "{tmp}/est"], {"--heading": NOT_A_NUMBER}),
     "sense": (["t-shape", "--out", "{tmp}/log"], {"--seed": NOT_A_NUMBER + ["-1", "-5"] + NOT_AN_INTEGER,
                                                    "--duration": NOT_A_NUMBER + NOT_POSITIVE}),
     "export": (["mjcf", "--out", "{tmp}/robot.xml"], {"--u-max": NOT_A_NUMBER + NOT_POSITIVE}),

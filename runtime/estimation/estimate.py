@@ -1,0 +1,298 @@
+"""The error-state EKF over a sensor log (`python -m runtime estimate`, docs/estimation.md, "Estimates").
+
+    log = read_log("out/circle-log")
+    result = estimate_log(log)                  # the filter started by the start rule, run over every sample
+    result.x, result.sigma, errors(log, result)
+
+The filter (runtime.ekf, C in c/src/sr_ekf.c) assumes what the log's sensor set declares
+(`ekf_noise`); between two samples it predicts under the torques the log says were applied (a
+torque row holds until the next); samples of one time are applied IMU first, then encoders,
+fixes and heading.  A fix is applied when it arrived, as if measured then (its latency is not
+modelled).  The IMU update runs while the filter's `accel` standard deviation includes what the
+process noise adds to the accelerometer's reading (`ekf_noise`), since the filter's measurement
+model sees the applied torques only.
+"""
+import dataclasses
+import math
+
+import numpy as np
+
+from ..ekf import EkfNoise, start_from_measurements
+from ..model import Model
+from ..sensors import heading as heading_of
+from ..sensors import imu_partials
+from ..state import COLUMN_INDEX, IDX_Q, IDX_RS, IDX_WS, NX, STATE_COLUMNS, initial_state
+
+#: The error state's names (the 12 error coordinates of Model.retract, then the IMU's biases), the
+#: columns `sigma_<name>` of estimate.csv.
+ERROR_NAMES = ("xi_S_x", "xi_S_y", "xi_S_z", "theta_Y", "theta_P", "q_x", "q_y", "w_S_x", "w_S_y", "w_S_z",
+               "w_Y", "w_P", "b_g_x", "b_g_y", "b_g_z", "b_a_x", "b_a_y", "b_a_z")
+#: Errors are scored after this long [s] (the filter's start-up), or after half the log if shorter.
+SETTLE_S = 10.0
+#: IMU samples averaged by the start rule's tilt (the robot at rest at the start).
+START_SAMPLES = 20
+#: The speeds' standard deviation [rad/s] at the start of a robot that already moves.
+MOVING_RATE_SIGMA = 2.0
+
+
+def ekf_noise(sensors, params, x0=None):
+    """The EkfNoise a log's sensor set declares.  The accelerometer's standard deviation adds to its
+    white noise what the process noise puts into its reading at the IMU's rate (the largest axis,
+    at x0: the robot at rest by default), because the filter's measurement model sees the applied
+    torques only."""
+    model = Model(params)
+    x0 = initial_state(r=params.r) if x0 is None else x0
+    imu = sensors.imu
+    _, _, Hn = imu_partials(model, x0, np.zeros(5), mount=imu.mount)
+    Minv = np.linalg.inv(model.inertia(x0))
+    q2 = sensors.process.generalized() ** 2 * imu.rate             # (q/√dt)² at the IMU's period
+    cov = Hn[3:] @ Minv @ np.diag(q2) @ Minv.T @ Hn[3:].T
+    return EkfNoise(gyro=imu.gyro_noise, accel=math.sqrt(imu.accel_noise ** 2 + float(np.max(np.diag(cov)))),
+                    gyro_bias=imu.gyro_bias, accel_bias=imu.accel_bias,
+                    encoder=sensors.encoders.step / math.sqrt(12),
+                    position=sensors.fixes.noise if sensors.fixes is not None else EkfNoise.position,
+                    heading=sensors.heading.noise if sensors.heading is not None else EkfNoise.heading,
+                    torque_psd=float(np.max(sensors.process.generalized())))
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Estimate:
+    """The filter's output at every torque row and sample time `t` (n,): the state `x` (n, 35) and
+    the error state's standard deviations `sigma` (n, 18) (ERROR_NAMES), the biases (n, 6), and the
+    filter's counters per sensor kind ({"accepted", "gated", "nis"})."""
+    t: np.ndarray
+    x: np.ndarray
+    sigma: np.ndarray
+    biases: np.ndarray
+    counters: dict
+
+
+def start_heading(log):
+    """The operator's knowledge of the IMU's heading at the start [rad] when a log does not say
+    (log.json's "start_heading"): the truth's, when the log has truth, else 0."""
+    if "start_heading" in log.meta:
+        return float(log.meta["start_heading"])
+    if log.truth is None:
+        return 0.0
+    from ..params import Params
+    model = Model(log.params() or Params.paper_simulation())
+    return heading_of(model, log.truth_states()[0], log.sensors.imu.mount)
+
+
+def moving_at_start(log):
+    """Whether the gyroscope's first START_SAMPLES samples say the body turns (any axis beyond five
+    noise and three bias standard deviations): the start rule's "at rest" does not hold."""
+    imu = log.sensors.imu
+    gyro = log.imu.select("gyro_x", "gyro_y", "gyro_z")[:START_SAMPLES].mean(axis=0)
+    return bool(np.any(np.abs(gyro) > 5 * imu.gyro_noise / math.sqrt(START_SAMPLES) + 3 * imu.gyro_bias))
+
+
+def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progress=None):
+    """Run the filter over `log` (runtime.estimation.logs.Log) for the robot `params` (None: the one
+    the log claims, else the paper's simulation robot), started by the start rule (the first
+    START_SAMPLES accelerometer samples, the first encoder sample, the first fix and heading if the
+    log has them; the heading known to 10° around `heading` [rad], None: `start_heading`).  A robot
+    already moving at the start (`moving_at_start`) starts with speeds of σ MOVING_RATE_SIGMA
+    instead of at rest.  `progress(done, total)` is called every 1000 times."""
+    from ..params import Params
+    params = params if params is not None else (log.params() or Params.paper_simulation())
+    model = Model(params)
+    sensors = log.sensors
+    noise = noise if noise is not None else ekf_noise(sensors, params)
+    events = [(log.imu, "imu"), (log.encoders, "encoders"), (log.fixes, "fixes"), (log.heading, "heading")]
+    events = [(table, kind) for table, kind in events if table is not None and len(table)]
+    start = {"accel": log.imu.select("accel_x", "accel_y", "accel_z")[:START_SAMPLES],
+             "encoders": log.encoders.data[0]}
+    if log.fixes is not None and len(log.fixes):
+        start["fix"] = log.fixes.select("x", "y")[0]
+    if log.heading is not None and len(log.heading):
+        start["heading"] = float(log.heading["psi"][0])
+    ekf = start_from_measurements(model, noise=noise, mount=sensors.imu.mount, gate=gate,
+                                  heading_prior=start_heading(log) if heading is None else heading,
+                                  rate_sigma=MOVING_RATE_SIGMA if moving_at_start(log) else 0.01, **start)
+    times = np.unique(np.concatenate([log.torques.t] + [table.t for table, _ in events]))
+    times = times[times >= log.torques.t[0]]
+    cursor = {kind: 0 for _, kind in events}
+    out_x, out_sigma, out_b = np.empty((len(times), NX)), np.empty((len(times), 18)), np.empty((len(times), 6))
+    t_now = times[0]
+    for i, t in enumerate(times):
+        if t > t_now:
+            ekf.predict(log.torque_at(t_now), float(t - t_now))
+            t_now = t
+        u = log.torque_at(t)
+        for table, kind in events:
+            j = cursor[kind]
+            while j < len(table) and table.t[j] <= t:
+                if table.t[j] == t:
+                    row = table.data[j]
+                    if kind == "imu":
+                        ekf.update_imu(row, u)
+                    elif kind == "encoders":
+                        ekf.update_encoders(row)
+                    elif kind == "fixes":
+                        ekf.update_position(row[1:3])          # (t_measured, x, y)
+                    else:
+                        ekf.update_heading(float(row[0]))
+                j += 1
+            cursor[kind] = j
+        out_x[i], out_sigma[i], out_b[i] = ekf.x, ekf.sigma, ekf.biases
+        if progress is not None and i % 1000 == 0:
+            progress(i, len(times))
+    return Estimate(t=times, x=out_x, sigma=out_sigma, biases=out_b, counters=ekf.counters)
+
+
+def _tilt_and_heading(model, x, mount):
+    """Per state: the gravity direction in the IMU's body frame (n, 3) and the heading [rad] (n,)."""
+    from ..state import IDX_RP, IDX_RY
+    block = {"shell": IDX_RS, "yoke": IDX_RY, "pendulum": IDX_RP}[mount.body]
+    R = x[:, block].reshape(-1, 3, 3)
+    up = R[:, 2, :]                                               # R_Bᵀ e_z, rows of R_B's third row
+    psi = np.array([heading_of(model, xi, mount) for xi in x])
+    return up, psi
+
+
+def _velocity(params, x):
+    """The shell centre's velocity on the floor (n, 2): q̇ = r P R_S ω_S, P (v_y, −v_x)."""
+    R = x[:, IDX_RS].reshape(-1, 3, 3)
+    w = np.einsum("nij,nj->ni", R, x[:, IDX_WS])
+    return params.r * np.column_stack([w[:, 1], -w[:, 0]])
+
+
+def errors(log, result, params=None):
+    """The error metrics against the log's truth (None without one), from SETTLE_S on: RMS of the
+    position [m], heading [deg] (of the IMU's x axis), tilt [deg] (the angle between the estimated
+    and the true gravity direction in the IMU's body frame), forward speed [m/s] (along the true
+    heading), joint angles [deg]; and the share of samples whose true error lies within ±3σ, per
+    error coordinate of the position, heading (ξ_S,z) and joints."""
+    from ..params import Params
+    if log.truth is None:
+        return None
+    params = params if params is not None else (log.params() or Params.paper_simulation())
+    model = Model(params)
+    truth = log.truth_states()
+    i = np.clip(np.searchsorted(log.truth.t, result.t), 0, len(log.truth.t) - 1)
+    keep = (np.abs(log.truth.t[i] - result.t) < 1e-9) & (result.t >= min(SETTLE_S, result.t[-1] / 2))
+    est, tru, sig = result.x[keep], truth[i[keep]], result.sigma[keep]
+    mount = log.sensors.imu.mount
+    up_e, psi_e = _tilt_and_heading(model, est, mount)
+    up_t, psi_t = _tilt_and_heading(model, tru, mount)
+    tilt = np.degrees(np.arccos(np.clip(np.einsum("ni,ni->n", up_e, up_t), -1.0, 1.0)))
+    dpsi = np.degrees(np.angle(np.exp(1j * (psi_e - psi_t))))
+    dq = est[:, IDX_Q][:, :2] - tru[:, IDX_Q][:, :2]
+    direction = np.column_stack([np.cos(psi_t), np.sin(psi_t)])
+    v_e, v_t = _velocity(params, est), _velocity(params, tru)
+    speed = np.einsum("ni,ni->n", v_e - v_t, direction)
+    from ..state import yoke_angle, pendulum_angle
+    joints = np.degrees(np.column_stack([np.angle(np.exp(1j * (yoke_angle(est) - yoke_angle(tru)))),
+                                         np.angle(np.exp(1j * (pendulum_angle(est) - pendulum_angle(tru))))]))
+    rms = lambda e: float(np.sqrt(np.mean(np.square(e)))) if e.size else math.nan   # noqa: E731
+    inside = {"q_x": dq[:, 0], "q_y": dq[:, 1], "xi_S_z": np.radians(dpsi),
+              "theta_Y": np.radians(joints[:, 0]), "theta_P": np.radians(joints[:, 1])}
+    return {"scored_from_s": float(min(SETTLE_S, result.t[-1] / 2)), "samples": int(keep.sum()),
+            "position_rms_m": rms(np.linalg.norm(dq, axis=1)), "heading_rms_deg": rms(dpsi),
+            "tilt_rms_deg": rms(tilt), "forward_speed_rms_m_s": rms(speed),
+            "theta_Y_rms_deg": rms(joints[:, 0]), "theta_P_rms_deg": rms(joints[:, 1]),
+            "within_3_sigma": {name: float(np.mean(np.abs(e) <= 3 * sig[:, ERROR_NAMES.index(name)]))
+                               for name, e in inside.items()}}
+
+
+def table(result):
+    """estimate.csv's rows (n, 1 + 35 + 18 + 6) and header: t, the state as trajectory.csv names it,
+    sigma_<error coordinate>, the biases."""
+    header = ("t", *STATE_COLUMNS, *(f"sigma_{n}" for n in ERROR_NAMES), *ERROR_NAMES[12:])
+    return header, np.column_stack([result.t, result.x[:, COLUMN_INDEX], result.sigma, result.biases])
+
+
+def figure(log, result, path):
+    """estimate.png: position, heading, tilt and speed errors with ±3σ against the truth (or the
+    estimate alone without truth)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
+    t = result.t
+    if log.truth is not None:
+        truth = log.truth_states()
+        i = np.clip(np.searchsorted(log.truth.t, t), 0, len(log.truth.t) - 1)
+        for ax, k, name in ((axes[0], 0, "q_x"), (axes[1], 1, "q_y")):
+            ax.plot(t, result.x[:, IDX_Q][:, k] - truth[i][:, IDX_Q][:, k], label=f"{name} error")
+            s = 3 * result.sigma[:, ERROR_NAMES.index(name)]
+            ax.fill_between(t, -s, s, alpha=0.25, label="±3σ")
+            ax.set_ylabel("m")
+            ax.legend(loc="upper right")
+    else:
+        axes[0].plot(result.x[:, IDX_Q][:, 0], result.x[:, IDX_Q][:, 1])
+        axes[0].set_ylabel("q_y (m)")
+    axes[2].semilogy(t, 3 * result.sigma[:, ERROR_NAMES.index("xi_S_z")], label="3σ heading (rad)")
+    axes[2].semilogy(t, 3 * result.sigma[:, ERROR_NAMES.index("xi_S_x")], label="3σ tilt x (rad)")
+    axes[2].legend(loc="upper right")
+    axes[2].set_xlabel("t (s)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+# -- python -m runtime estimate --------------------------------------------------------------------
+def build_parser():
+    """The argument parser of `python -m runtime estimate`."""
+    import argparse
+    import pathlib
+
+    def degrees(value):
+        try:
+            number = float(value)
+        except ValueError:
+            number = math.nan
+        if not math.isfinite(number):
+            raise argparse.ArgumentTypeError(f"expected a finite angle in degrees, got {value!r}")
+        return number
+
+    parser = argparse.ArgumentParser(
+        prog="python -m runtime estimate",
+        description="Run the error-state EKF over a sensor log and write estimate.csv (the state with "
+                    "trajectory.csv's columns, the standard deviations, the biases), estimate.png and "
+                    "summary.json (the error metrics when the log has truth) into OUT (docs/estimation.md).")
+    parser.add_argument("log", type=pathlib.Path, help="a log folder (python -m runtime sense writes one)")
+    parser.add_argument("--out", required=True, type=pathlib.Path, help="the output folder (created if missing)")
+    parser.add_argument("--sensors", metavar="FILE", help="a sensors file or shipped set (default: the log's)")
+    parser.add_argument("--heading", type=degrees, metavar="DEG",
+                        help="the IMU's heading at the start, known to 10 deg (default: the log's, else 0)")
+    parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    return parser
+
+
+def main(argv):
+    """`python -m runtime estimate`: exit status 2 on a bad argument, log or file."""
+    import json
+    import sys
+
+    from ..atomic import atomic_path, write_text
+    from ..errors import KernelError
+    from ..sensor_set import load_sensor_set
+    from .logs import read_log
+    args = build_parser().parse_args(argv)
+    try:
+        if args.out.exists() and not args.out.is_dir():
+            raise ValueError(f"{args.out}: is a file, expected a folder")
+        sensors = load_sensor_set(args.sensors) if args.sensors else None
+        log = read_log(args.log, sensors=sensors)
+        try:
+            result = estimate_log(log, heading=None if args.heading is None else math.radians(args.heading))
+        except KernelError as exc:
+            raise ValueError(f"{args.log}: the filter failed: {exc}") from None
+        metrics = errors(log, result)
+        args.out.mkdir(parents=True, exist_ok=True)
+        header, rows = table(result)
+        with atomic_path(args.out / "estimate.csv") as path:
+            np.savetxt(path, rows, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
+        with atomic_path(args.out / "estimate.png") as path:
+            figure(log, result, path)
+        summary = {"log": str(args.log), "samples": int(len(result.t)), "counters": result.counters,
+                   "skipped": log.skipped, "gaps": len(log.gaps), "errors": metrics}
+        write_text(args.out / "summary.json", json.dumps(summary, indent=2) + "\n")
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    if not args.quiet:
+        print(json.dumps(metrics if metrics is not None else result.counters, indent=2))
+    return 0
