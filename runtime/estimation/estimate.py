@@ -161,8 +161,8 @@ def _velocity(params, x):
 def errors(log, result, params=None):
     """The error metrics against the log's truth (None without one), from SETTLE_S on: RMS of the
     position [m], heading [deg] (of the IMU's x axis), tilt [deg] (the angle between the estimated
-    and the true gravity direction in the IMU's body frame), forward speed [m/s] (along the true
-    heading), joint angles [deg]; and the share of samples whose true error lies within ±3σ, per
+    and the true gravity direction in the IMU's body frame), forward speed [m/s] (the shell
+    centre's speed on the floor), joint angles [deg]; and the share of samples whose true error lies within ±3σ, per
     error coordinate of the position, heading (ξ_S,z) and joints."""
     from ..params import Params
     if log.truth is None:
@@ -179,9 +179,7 @@ def errors(log, result, params=None):
     tilt = np.degrees(np.arccos(np.clip(np.einsum("ni,ni->n", up_e, up_t), -1.0, 1.0)))
     dpsi = np.degrees(np.angle(np.exp(1j * (psi_e - psi_t))))
     dq = est[:, IDX_Q][:, :2] - tru[:, IDX_Q][:, :2]
-    direction = np.column_stack([np.cos(psi_t), np.sin(psi_t)])
-    v_e, v_t = _velocity(params, est), _velocity(params, tru)
-    speed = np.einsum("ni,ni->n", v_e - v_t, direction)
+    speed = np.linalg.norm(_velocity(params, est), axis=1) - np.linalg.norm(_velocity(params, tru), axis=1)
     from ..state import yoke_angle, pendulum_angle
     joints = np.degrees(np.column_stack([np.angle(np.exp(1j * (yoke_angle(est) - yoke_angle(tru)))),
                                          np.angle(np.exp(1j * (pendulum_angle(est) - pendulum_angle(tru))))]))
