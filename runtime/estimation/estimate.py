@@ -21,7 +21,9 @@ from ..ekf import EkfNoise, start_from_measurements
 from ..model import Model
 from ..sensors import heading as heading_of
 from ..sensors import imu_partials
-from ..state import COLUMN_INDEX, IDX_Q, IDX_RS, IDX_WS, NX, STATE_COLUMNS, initial_state
+from ..params import Params
+from ..state import (COLUMN_INDEX, IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WS, NX, STATE_COLUMNS, initial_state,
+                     pendulum_angle, yoke_angle)
 
 #: The error state's names (the 12 error coordinates of Model.retract, then the IMU's biases), the
 #: columns `sigma_<name>` of estimate.csv.
@@ -67,6 +69,11 @@ class Estimate:
     counters: dict
 
 
+def claimed_params(log):
+    """The robot a log claims (log.json), else the paper's simulation robot."""
+    return log.params() or Params.paper_simulation()
+
+
 def start_heading(log):
     """The operator's knowledge of the IMU's heading at the start [rad] when a log does not say
     (log.json's "start_heading"): the truth's, when the log has truth, else 0."""
@@ -74,8 +81,7 @@ def start_heading(log):
         return float(log.meta["start_heading"])
     if log.truth is None:
         return 0.0
-    from ..params import Params
-    model = Model(log.params() or Params.paper_simulation())
+    model = Model(claimed_params(log))
     return heading_of(model, log.truth_states()[0], log.sensors.imu.mount)
 
 
@@ -94,8 +100,7 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
     log has them; the heading known to 10° around `heading` [rad], None: `start_heading`).  A robot
     already moving at the start (`moving_at_start`) starts with speeds of σ MOVING_RATE_SIGMA
     instead of at rest.  `progress(done, total)` is called every 1000 times."""
-    from ..params import Params
-    params = params if params is not None else (log.params() or Params.paper_simulation())
+    params = params if params is not None else claimed_params(log)
     model = Model(params)
     sensors = log.sensors
     noise = noise if noise is not None else ekf_noise(sensors, params)
@@ -143,12 +148,15 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
 
 def _tilt_and_heading(model, x, mount):
     """Per state: the gravity direction in the IMU's body frame (n, 3) and the heading [rad] (n,)."""
-    from ..state import IDX_RP, IDX_RY
     block = {"shell": IDX_RS, "yoke": IDX_RY, "pendulum": IDX_RP}[mount.body]
     R = x[:, block].reshape(-1, 3, 3)
     up = R[:, 2, :]                                               # R_Bᵀ e_z, rows of R_B's third row
     psi = np.array([heading_of(model, xi, mount) for xi in x])
     return up, psi
+
+
+def _rms(e):
+    return float(np.sqrt(np.mean(np.square(e)))) if e.size else math.nan
 
 
 def _velocity(params, x):
@@ -164,10 +172,9 @@ def errors(log, result, params=None):
     and the true gravity direction in the IMU's body frame), forward speed [m/s] (the shell
     centre's speed on the floor), joint angles [deg]; and the share of samples whose true error lies within ±3σ, per
     error coordinate of the position, heading (ξ_S,z) and joints."""
-    from ..params import Params
     if log.truth is None:
         return None
-    params = params if params is not None else (log.params() or Params.paper_simulation())
+    params = params if params is not None else claimed_params(log)
     model = Model(params)
     truth = log.truth_states()
     i = np.clip(np.searchsorted(log.truth.t, result.t), 0, len(log.truth.t) - 1)
@@ -180,16 +187,14 @@ def errors(log, result, params=None):
     dpsi = np.degrees(np.angle(np.exp(1j * (psi_e - psi_t))))
     dq = est[:, IDX_Q][:, :2] - tru[:, IDX_Q][:, :2]
     speed = np.linalg.norm(_velocity(params, est), axis=1) - np.linalg.norm(_velocity(params, tru), axis=1)
-    from ..state import yoke_angle, pendulum_angle
     joints = np.degrees(np.column_stack([np.angle(np.exp(1j * (yoke_angle(est) - yoke_angle(tru)))),
                                          np.angle(np.exp(1j * (pendulum_angle(est) - pendulum_angle(tru))))]))
-    rms = lambda e: float(np.sqrt(np.mean(np.square(e)))) if e.size else math.nan   # noqa: E731
     inside = {"q_x": dq[:, 0], "q_y": dq[:, 1], "xi_S_z": np.radians(dpsi),
               "theta_Y": np.radians(joints[:, 0]), "theta_P": np.radians(joints[:, 1])}
     return {"scored_from_s": float(min(SETTLE_S, result.t[-1] / 2)), "samples": int(keep.sum()),
-            "position_rms_m": rms(np.linalg.norm(dq, axis=1)), "heading_rms_deg": rms(dpsi),
-            "tilt_rms_deg": rms(tilt), "forward_speed_rms_m_s": rms(speed),
-            "theta_Y_rms_deg": rms(joints[:, 0]), "theta_P_rms_deg": rms(joints[:, 1]),
+            "position_rms_m": _rms(np.linalg.norm(dq, axis=1)), "heading_rms_deg": _rms(dpsi),
+            "tilt_rms_deg": _rms(tilt), "forward_speed_rms_m_s": _rms(speed),
+            "theta_Y_rms_deg": _rms(joints[:, 0]), "theta_P_rms_deg": _rms(joints[:, 1]),
             "within_3_sigma": {name: float(np.mean(np.abs(e) <= 3 * sig[:, ERROR_NAMES.index(name)]))
                                for name, e in inside.items()}}
 

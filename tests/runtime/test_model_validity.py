@@ -8,7 +8,7 @@ import re
 
 import numpy as np
 import pytest
-from bindings._sr import ffi, lib
+from bindings._sr import lib
 
 from runtime import Model, Params, initial_state
 from runtime.errors import KernelError

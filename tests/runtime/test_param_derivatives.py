@@ -7,7 +7,7 @@ import pytest
 from runtime import Model, Params
 from runtime.param_derivatives import (NPARAM, NPI, PARAMETER_NAMES, PI_NAMES, base_parameters, inertial_parameters,
                                       trajectory_sensitivities)
-from runtime.state import IDX_Q, NE, NV, NX
+from runtime.state import IDX_Q, NE, NV
 from runtime.verification.sampling import random_general_params, random_inputs, random_state
 
 RNG = np.random.default_rng(38)
