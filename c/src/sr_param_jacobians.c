@@ -29,17 +29,23 @@
 typedef sr_real tangent_p[SR_NT][NP];   /* d(13-vector)/dp */
 typedef sr_real error_p[SR_NE][NP];     /* d(state error)/dp */
 
-/* nu' and d(nu')/dp at a state the caller checked (u not NULL); J row-major SR_NV x NP. */
-static int accel_param_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                                sr_real a[SR_NV], sr_real J[SR_NV][NP])
+/* The general kernels' constants of any robot: the model's own for a general one; the paper's
+ * kernels fold parameters into constants, so for its robot they are computed (once per call of an
+ * entry point: a step's stages share them). */
+static const sr_real *general_constants(const sr_model *model, sr_real cg[SR_GEN_GENERAL_NCONST])
 {
-    sr_real cg[SR_GEN_GENERAL_NCONST], Mu[15], f[SR_NV], L[SR_NV * SR_NV], inv[SR_NV], dR[SR_NV * NP];
-    const sr_real *constants = model->cg;
+    if (model->general) return model->cg;
+    sr_gen_general_constants(model->p, cg);
+    return cg;
+}
+
+/* nu' and d(nu')/dp at a state the caller checked (u not NULL), the general kernels' constants
+ * given; J row-major SR_NV x NP. */
+static int accel_param_jacobian(const sr_model *model, const sr_real *constants, const sr_real x[SR_NX],
+                                const sr_real u[SR_NU], sr_real a[SR_NV], sr_real J[SR_NV][NP])
+{
+    sr_real Mu[15], f[SR_NV], L[SR_NV * SR_NV], inv[SR_NV], dR[SR_NV * NP];
     int i, k, c, status;
-    if (!model->general) {   /* the paper's kernels fold parameters into constants: take the general ones */
-        sr_gen_general_constants(model->p, cg);
-        constants = cg;
-    }
     status = sr_gen_general_system(constants, x, u, Mu, f);
     if (status == SR_OK) status = sr_internal_cholesky(Mu, L, inv);
     if (status != SR_OK) return status;
@@ -72,13 +78,13 @@ static int accel_param_jacobian(const sr_model *model, const sr_real x[SR_NX], c
 int sr_accel_param_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                             sr_real J[SR_NV * SR_NPARAM])
 {
-    sr_real a[SR_NV], j[SR_NV][NP];
+    sr_real a[SR_NV], j[SR_NV][NP], cg[SR_GEN_GENERAL_NCONST];
     int status = arg_model(model, READS(WHOLE));
     if (status != SR_OK) return status;
     if (!x || !J) return SR_ERR_NULL;
     status = sr_internal_check_state(model, x);
     if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
-    if (status == SR_OK) status = accel_param_jacobian(model, x, u ? u : sr_zero_u, a, j);
+    if (status == SR_OK) status = accel_param_jacobian(model, general_constants(model, cg), x, u ? u : sr_zero_u, a, j);
     if (status != SR_OK) return status;
     if (!all_finite_long(&j[0][0], SR_NV * NP)) return SR_ERR_NONFINITE;
     memcpy(J, j, sizeof j);
@@ -122,14 +128,14 @@ static void action_rows(const sr_real th[SR_NT], const tangent_p dth, error_p dy
 }
 
 /* The vector field f at y and df = J_f(y) dy + df/dp(y) (dy NULL: y is the step's start, dy = 0). */
-static int field_rows(const sr_model *model, const sr_real y[SR_NX], const sr_real u[SR_NU], const error_p dy,
-                      sr_real f[SR_NT], tangent_p df)
+static int field_rows(const sr_model *model, const sr_real *constants, const sr_real y[SR_NX],
+                      const sr_real u[SR_NU], const error_p dy, sr_real f[SR_NT], tangent_p df)
 {
     const sr_real *R = y + SR_X_R_S, *w = y + SR_X_w_S, r = model->p[SR_P_r];
     sr_real a[SR_NV], Jp[SR_NV][NP], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], p[2][3], wxp[2][3];
     int i, j, c, status;
     sr_internal_kinematics(model, y, f);
-    status = accel_param_jacobian(model, y, u, f + SR_T_V, Jp);
+    status = accel_param_jacobian(model, constants, y, u, f + SR_T_V, Jp);
     if (status == SR_OK && dy) status = sr_internal_accel_jacobian(model, y, u, a, Ja, Jb);
     /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
     if (status != SR_OK) return status == SR_ERR_SINGULAR && !all_finite(y, SR_NX) ? SR_ERR_NONFINITE : status;
@@ -162,25 +168,30 @@ static int field_rows(const sr_model *model, const sr_real y[SR_NX], const sr_re
 }
 
 /* RKMK4 with the state held: K1 = f(x), K_s = dexp^-1(th_s, f(x . exp(th_s))), th_s = a_s h K_(s-1),
- * x_new = x . exp(sum_k b_k K_k); dy the error of x_new along p. */
+ * x_new = x . exp(sum_k b_k K_k); dy the error of x_new along p.  Only the last stage's dK is kept
+ * and the combination sum_k b_k dK_k is summed as the stages go (in the combine's order): a
+ * quarter of the stack, which keeps the working set in L1. */
 static int rkmk4_param(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
                        error_p dy)
 {
     static const sr_real a_diag[3] = {SR_C(0.5), SR_C(0.5), SR_C(1.0)};
     const sr_real b[4] = {h / 6, h / 3, h / 3, h / 6};
-    sr_real K[4][SR_NT], th[SR_NT], D[9], y[SR_NX];
-    tangent_p dK[4], dth;
+    sr_real K[4][SR_NT], th[SR_NT], D[9], y[SR_NX], cg[SR_GEN_GENERAL_NCONST];
+    const sr_real *constants = general_constants(model, cg);
+    tangent_p dK, dth, dsum;
     error_p dstage;
-    int s, i, c, status = field_rows(model, x, u, NULL, K[0], dK[0]);
+    int s, i, c, status = field_rows(model, constants, x, u, NULL, K[0], dK);
+    for (i = 0; i < SR_NT; ++i)
+        for (c = 0; c < NP; ++c) dsum[i][c] = b[0] * dK[i][c];
     for (s = 1; s < 4 && status == SR_OK; ++s) {
         const sr_real hs = a_diag[s - 1] * h;
         for (i = 0; i < SR_NT; ++i) th[i] = hs * K[s - 1][i];
         for (i = 0; i < SR_NT; ++i)
-            for (c = 0; c < NP; ++c) dth[i][c] = hs * dK[s - 1][i][c];
+            for (c = 0; c < NP; ++c) dth[i][c] = hs * dK[i][c];
         so3_exp_minus_identity(th + SR_T_S, D);
         act_increment(x, D, th, NULL, y);   /* the stepper's stage state */
         action_rows(th, (const sr_real(*)[NP])dth, dstage);
-        status = field_rows(model, y, u, (const sr_real(*)[NP])dstage, K[s], dK[s]);
+        status = field_rows(model, constants, y, u, (const sr_real(*)[NP])dstage, K[s], dK);
         if (status == SR_OK) {   /* k_S = dexp^-1(th, f_S): dk_S = P df_S + Q dth_S */
             sr_real P[9], Q[9], kS[3], dS[3][NP];
             int j;
@@ -188,24 +199,22 @@ static int rkmk4_param(const sr_model *model, const sr_real x[SR_NX], const sr_r
             for (i = 0; i < 3; ++i)
                 for (c = 0; c < NP; ++c) {
                     dS[i][c] = 0;
-                    for (j = 0; j < 3; ++j) dS[i][c] += P[3 * i + j] * dK[s][SR_T_S + j][c] + Q[3 * i + j] * dth[SR_T_S + j][c];
+                    for (j = 0; j < 3; ++j) dS[i][c] += P[3 * i + j] * dK[SR_T_S + j][c] + Q[3 * i + j] * dth[SR_T_S + j][c];
                 }
             for (i = 0; i < 3; ++i) {
                 K[s][SR_T_S + i] = kS[i];
-                memcpy(dK[s][SR_T_S + i], dS[i], sizeof dS[0]);
+                memcpy(dK[SR_T_S + i], dS[i], sizeof dS[0]);
             }
+            for (i = 0; i < SR_NT; ++i)
+                for (c = 0; c < NP; ++c) dsum[i][c] += b[s] * dK[i][c];
         }
     }
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NT; ++i) {   /* as the stepper's combine */
         th[i] = 0;
         for (s = 0; s < 4; ++s) th[i] += b[s] * K[s][i];
-        for (c = 0; c < NP; ++c) {
-            dth[i][c] = 0;
-            for (s = 0; s < 4; ++s) dth[i][c] += b[s] * dK[s][i][c];
-        }
     }
-    action_rows(th, (const sr_real(*)[NP])dth, dy);
+    action_rows(th, (const sr_real(*)[NP])dsum, dy);
     return SR_OK;
 }
 
@@ -213,9 +222,9 @@ static int rkmk4_param(const sr_model *model, const sr_real x[SR_NX], const sr_r
 static int lie_euler_param(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real h,
                            error_p dy)
 {
-    sr_real f[SR_NT], th[SR_NT];
+    sr_real f[SR_NT], th[SR_NT], cg[SR_GEN_GENERAL_NCONST];
     tangent_p df;
-    int i, c, status = field_rows(model, x, u, NULL, f, df);
+    int i, c, status = field_rows(model, general_constants(model, cg), x, u, NULL, f, df);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NT; ++i) {
         th[i] = h * f[i];
