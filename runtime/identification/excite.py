@@ -29,6 +29,7 @@ import dataclasses
 import math
 import os
 import pathlib
+import time
 
 import numpy as np
 
@@ -310,7 +311,11 @@ def design_program(params, design, seed=0, max_iterations=10):
 
     best = start.ravel()
     if max_iterations > 0:
-        best = minimize(objective, best, method="L-BFGS-B", options={"maxiter": max_iterations, "eps": 1e-3}).x
+        # The peak scaling and the envelope's penalty have kinks where line searches can stall: the
+        # evaluations are capped at what max_iterations gradients and a few line-search steps need.
+        budget = (best.size + 1) * (max_iterations + 2)
+        best = minimize(objective, best, method="L-BFGS-B",
+                        options={"maxiter": max_iterations, "maxfun": budget, "eps": 1e-3}).x
     naive = {}
     amplitude, u, info, lean = _within_envelope(model, design, start)
     naive["random multisine"] = (*criterion(info), lean, amplitude)
@@ -397,11 +402,13 @@ def main(argv):
                         harmonics=args.harmonics, f_high=args.f_high)
         if not (isinstance(args.iterations, int) and args.iterations >= 1):
             raise ValueError(f"iterations: expected a whole number >= 1, got {args.iterations}")
+        started = time.perf_counter()
         result = design_program(params, design, seed=args.seed, max_iterations=args.iterations)
     except ValueError as exc:
         parser.exit(2, f"python -m runtime excite: error: {exc}\n")
     write_text(args.out, scenario_text(result, args.robot, args.out))
     print(report(result))
+    print(f"designed in {time.perf_counter() - started:.1f} s")
     print(f"wrote {args.out}")
     return 0
 

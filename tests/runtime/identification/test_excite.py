@@ -18,7 +18,7 @@ NAMES = "k_S,k_Y,k_P"
 
 
 def design(**changes):
-    return excite.Design(NAMES, 2.0, **{"harmonics": 2, "f_high": 1.5, **changes})
+    return excite.Design(NAMES, 2.0, **{"harmonics": 2, "f_high": 1.5, "sample": 0.05, **changes})
 
 
 @pytest.fixture(scope="module")
