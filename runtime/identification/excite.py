@@ -245,6 +245,15 @@ def criterion(info):
     return (float(logdet) if sign > 0 else -math.inf), (float(s[0] / s[-1]) if s[-1] > 0 else math.inf)
 
 
+def worst_sigma(info):
+    """The largest Cramér–Rao standard deviation of the relative parameters, max sqrt(diag I⁻¹):
+    what the least well determined parameter's relative error would be (inf when I is singular)."""
+    try:
+        return float(np.sqrt(np.max(np.diag(np.linalg.inv(info)))))
+    except np.linalg.LinAlgError:
+        return math.inf
+
+
 def _within_envelope(model, design, coefficients):
     """The largest amplitude in (0, 1] (halving, then bisection to 1 %) whose program keeps the
     pendulum inside max_lean; its torques, information and lean."""
@@ -273,7 +282,9 @@ def _within_envelope(model, design, coefficients):
 class Result:
     """A designed program and what it is compared against: torques (steps, 2), its amplitude
     (fraction of u_max after the envelope), its information's log det and condition number, its
-    peak lean, and the same numbers of the naive programs (name -> (log det, condition, lean))."""
+    peak lean, the number of evaluations of the information, its worst relative standard deviation
+    (`worst_sigma`), and the same numbers of the naive programs (name -> (log det, condition, lean,
+    amplitude, worst sigma))."""
     design: Design
     torques: np.ndarray
     amplitude: float
@@ -282,6 +293,7 @@ class Result:
     lean: float
     naive: dict
     evaluations: int
+    sigma: float = math.nan
 
 
 def design_program(params, design, seed=0, max_iterations=10):
@@ -318,19 +330,19 @@ def design_program(params, design, seed=0, max_iterations=10):
                         options={"maxiter": max_iterations, "maxfun": budget, "eps": 1e-3}).x
     naive = {}
     amplitude, u, info, lean = _within_envelope(model, design, start)
-    naive["random multisine"] = (*criterion(info), lean, amplitude)
+    naive["random multisine"] = (*criterion(info), lean, amplitude, worst_sigma(info))
     chirp_u = chirp(design)
     for scale in (1.0, 0.5, 0.25, 0.125):
         info_c, lean_c = information(model, design, scale * chirp_u)
         if lean_c <= design.max_lean:
-            naive["chirp"] = (*criterion(info_c), lean_c, scale)
+            naive["chirp"] = (*criterion(info_c), lean_c, scale, worst_sigma(info_c))
             break
     amplitude, u, info, lean = _within_envelope(model, design, best)
     logdet, condition = criterion(info)
     if logdet < naive["random multisine"][0]:     # the search may only improve on where it started
         amplitude, u, info, lean = _within_envelope(model, design, start)
         logdet, condition = criterion(info)
-    return Result(design, u, amplitude, logdet, condition, lean, naive, count[0])
+    return Result(design, u, amplitude, logdet, condition, lean, naive, count[0], worst_sigma(info))
 
 
 # -- the scenario file ------------------------------------------------------------------------------
@@ -370,12 +382,13 @@ def _toml_string(text):
 
 def report(result):
     """The comparison as text: the designed program's log det and condition against the naive ones."""
-    rows = [("D-optimal multisine", result.logdet, result.condition, result.lean, result.amplitude)]
+    rows = [("D-optimal multisine", result.logdet, result.condition, result.lean, result.amplitude, result.sigma)]
     rows += [(name, *values) for name, values in result.naive.items()]
     lines = [f"parameters: {', '.join(result.design.names)} (relative to their nominal values); "
              f"{result.design.duration:g} s, |u| <= {result.design.u_max:g} N m, lean <= {result.design.max_lean:.4g} rad",
-             f"{'program':<22} {'log det I':>10} {'cond I':>10} {'peak lean':>10} {'amplitude':>10}"]
-    lines += [f"{name:<22} {logdet:>10.3f} {cond:>10.3g} {lean:>10.3f} {amp:>10.3g}" for name, logdet, cond, lean, amp in rows]
+             f"{'program':<22} {'log det I':>10} {'cond I':>10} {'peak lean':>10} {'amplitude':>10} {'worst sigma':>12}"]
+    lines += [f"{name:<22} {logdet:>10.3f} {cond:>10.3g} {lean:>10.3f} {amp:>10.3g} {sig:>12.3g}"
+              for name, logdet, cond, lean, amp, sig in rows]
     lines.append(f"({result.evaluations} evaluations of the information)")
     return "\n".join(lines)
 
@@ -413,5 +426,5 @@ def main(argv):
     return 0
 
 
-__all__ = ["Design", "Result", "design_program", "information", "criterion", "torques", "chirp",
+__all__ = ["Design", "Result", "design_program", "information", "criterion", "worst_sigma", "torques", "chirp",
            "random_coefficients", "parameter_names", "scenario_text", "report", "main"]
