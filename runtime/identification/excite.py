@@ -413,8 +413,10 @@ def main(argv):
         params = load_robot(args.robot) if args.robot else Params.paper_simulation()
         design = Design(args.params, args.duration, u_max=args.u_max, max_lean=args.max_lean,
                         harmonics=args.harmonics, f_high=args.f_high)
-        if not (isinstance(args.iterations, int) and args.iterations >= 1):
+        if args.iterations < 1:
             raise ValueError(f"iterations: expected a whole number >= 1, got {args.iterations}")
+        if args.seed < 0:
+            raise ValueError(f"seed: expected a whole number >= 0, got {args.seed}")
         started = time.perf_counter()
         result = design_program(params, design, seed=args.seed, max_iterations=args.iterations)
     except ValueError as exc:

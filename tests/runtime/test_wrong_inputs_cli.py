@@ -43,6 +43,10 @@ OPTIONS = {
                                                    "--duration": NOT_A_NUMBER + NOT_POSITIVE}),
     "export": (["mjcf", "--out", "{tmp}/robot.xml"], {"--u-max": NOT_A_NUMBER + NOT_POSITIVE}),
     "compare-mujoco": (["tilted-yoke", "--out", "{tmp}"], {"--timesteps": NOT_A_NUMBER + NOT_POSITIVE + ["0.5", "1e-3,"]}),
+    "excite": (["--params", "k_S", "--duration", "2", "--out", "{tmp}/p.toml"],
+               {"--duration": NOT_A_NUMBER + NOT_POSITIVE, "--harmonics": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER,
+                "--iterations": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER,
+                "--seed": NOT_A_NUMBER + ["-1", "-5"] + NOT_AN_INTEGER, "--params": ["", ",", "k_X", "k_S,k_S"]}),
     "sweep-bench": ([], {"--samples": NOT_A_NUMBER + NOT_POSITIVE, "--samples-per-task": NOT_A_NUMBER + NOT_POSITIVE,
                          "--noop-tasks": NOT_A_NUMBER + NOT_POSITIVE, "--rounds": NOT_A_NUMBER + NOT_POSITIVE}),
 }
