@@ -9,9 +9,9 @@
   float build stays within the accuracy documented in docs/embedding.md;
 * CMake builds it stand-alone and through add_subdirectory.
 
-Every build goes to a fresh directory under pytest's tmp (c/Makefile's BUILD=...)
-rather than c/build, so that concurrent test runs in one checkout cannot race
-on the same objects.  No Python is involved in building the C.
+The plain builds go to one BUILD directory that the tests share under a lock
+(tests/c_build.py), the others to fresh directories under pytest's tmp, never to
+c/build, so that concurrent test runs in one checkout cannot race on the same objects.  No Python is involved in building the C.
 """
 import json
 import os
@@ -23,6 +23,7 @@ import sys
 import numpy as np
 import pytest
 
+from c_build import make_shared
 from conftest import ROOT
 
 C_DIR = ROOT / "c"
@@ -57,9 +58,11 @@ def make(build, *targets, env=None):
 
 @pytest.fixture(scope="module")
 def build(tmp_path_factory):
-    """c/Makefile's default target (libraries, example, C tests) plus the tools, in a fresh BUILD."""
-    out = tmp_path_factory.mktemp("c-build")
-    make(out, "all", "tools")
+    """c/Makefile's default target (libraries, example, C tests) plus the tools, in the BUILD the tests
+    share (tests/c_build.py); nothing may write into it but c/Makefile."""
+    out, result = make_shared(tmp_path_factory, "all", "tools")
+    if result.returncode != 0:
+        pytest.fail(f"make all tools failed:\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}")
     return out
 
 
@@ -101,16 +104,19 @@ def test_c_tests_pass(build, program, scalar):
     assert passed_line(out) >= 30
 
 
-def test_c_tests_pass_under_address_and_undefined_behaviour_sanitizers(build, tmp_path):
+def test_c_tests_pass_under_address_and_undefined_behaviour_sanitizers(tmp_path_factory, tmp_path):
     probe = tmp_path / "probe.c"
     probe.write_text("int main(void) { return 0; }\n")
     if run([CC, "-fsanitize=address,undefined", str(probe), "-o", str(tmp_path / "probe")],
            check=False).returncode != 0:
         pytest.skip("the C compiler has no AddressSanitizer/UBSan")
     env = dict(os.environ, ASAN_OPTIONS="detect_leaks=0")  # no heap in the library; LSan needs ptrace
-    out = make(build, "sanitize", env=env).stdout
-    counts = [int(n) for n in re.findall(r"^(\d+) passed, 0 failed$", out, flags=re.M)]
-    assert len(counts) == 2 and min(counts) >= 30, out
+    # `make sanitize`'s two programs, built in the shared BUILD and run outside its lock.
+    build, made = make_shared(tmp_path_factory, "{build}/sr_tests_asan", "{build}/sr_tests_asan_f")
+    assert made.returncode == 0, made.stdout[-3000:] + made.stderr[-3000:]
+    for program in ("sr_tests_asan", "sr_tests_asan_f"):
+        out = run([build / program], env=env).stdout
+        assert passed_line(out) >= 30, out
 
 
 # ---- symbols: no allocation, no mutable globals ------------------------------------------

@@ -16,6 +16,7 @@ import sys
 
 import pytest
 
+from c_build import make_shared
 from conftest import ROOT
 from runtime.bench import headline
 
@@ -71,9 +72,8 @@ def c_include_dirs():
 
 
 @pytest.mark.skipif(not (MAKE and CC), reason="needs make and a C compiler")
-def test_c_quick_start_compiles_without_warnings_and_runs(tmp_path):
-    build = tmp_path / "c-build"
-    made = subprocess.run([MAKE, "-s", "-C", str(ROOT / "c"), f"BUILD={build}", "lib"], capture_output=True, text=True)
+def test_c_quick_start_compiles_without_warnings_and_runs(tmp_path_factory, tmp_path):
+    build, made = make_shared(tmp_path_factory, "lib")
     assert made.returncode == 0, made.stderr[-3000:]
     source = tmp_path / "quickstart.c"
     source.write_text(fenced_block(readme(), "quickstart:c", "c") + "\n")

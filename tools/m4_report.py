@@ -22,6 +22,8 @@ Exit status 1 if a build or run fails or a double routine is linked.  The 8 KB f
 stack targets are reported, met or not, but do not fail the run.
 """
 import argparse
+import concurrent.futures
+import os
 import pathlib
 import re
 import subprocess
@@ -97,11 +99,13 @@ def link_firmware(tools, build, opt):
     flags = [*CPU_FLAGS, opt, "-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-ffp-contract=off",
              "-DSR_USE_FLOAT", "-Wdouble-promotion", "-Wfloat-conversion", "-ffunction-sections",
              "-fdata-sections", f"-I{size_report.INCLUDE}", f"-I{size_report.ROOT / 'generated'}"]
-    objs = []
-    for src in [*size_report.sources(), CROSS / "lie_euler_firmware.c", CROSS / "startup.c"]:
+    def compile_one(src):
         obj = out / (src.stem + ".o")
         run([tools["cc"], *flags, "-c", str(src), "-o", str(obj)])
-        objs.append(obj)
+        return obj
+    with concurrent.futures.ThreadPoolExecutor(os.cpu_count() or 1) as pool:
+        objs = list(pool.map(compile_one, [*size_report.sources(), CROSS / "lie_euler_firmware.c",
+                                            CROSS / "startup.c"]))
     elf, mapfile = out / "lie_euler_firmware.elf", out / "lie_euler_firmware.map"
     run([tools["cc"], *CPU_FLAGS, opt, *map(str, objs), f"-L{CROSS}", "-T", str(CROSS / "mps2-an386.ld"),
          "--specs=rdimon.specs", "-nostartfiles", "-Wl,--gc-sections", f"-Wl,-Map={mapfile}", "-lm",

@@ -30,6 +30,7 @@ Method.  Every library source (generated/*.c, c/src/*.c) is compiled at -Os and 
 """
 import argparse
 import collections
+import concurrent.futures
 import os
 import pathlib
 import re
@@ -58,9 +59,9 @@ def sources():
 
 
 def compile_variant(cc, cflags, opt, use_float, out_dir):
-    """Compile every source; return the object paths (the .su/.ci files sit next to them)."""
-    objs = []
-    for src in sources():
+    """Compile every source, one compiler per core; return the object paths (the .su/.ci files sit
+    next to them)."""
+    def compile_one(src):
         obj = out_dir / (src.stem + ".o")
         cmd = [cc, "-std=c99", opt, "-ffp-contract=off", "-ffunction-sections", "-fstack-usage",
                "-fcallgraph-info=su", f"-I{INCLUDE}", f"-I{ROOT / 'generated'}", *cflags, "-c", str(src),
@@ -68,8 +69,9 @@ def compile_variant(cc, cflags, opt, use_float, out_dir):
         if use_float:
             cmd.insert(1, "-DSR_USE_FLOAT")
         subprocess.run(cmd, check=True, cwd=out_dir)
-        objs.append(obj)
-    return objs
+        return obj
+    with concurrent.futures.ThreadPoolExecutor(os.cpu_count() or 1) as pool:
+        return list(pool.map(compile_one, sources()))
 
 
 def symbol_sizes(nm, obj):

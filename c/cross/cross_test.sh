@@ -27,6 +27,7 @@ MAKE=${MAKE:-make}
 M4_CPU_FLAGS=${M4_CPU_FLAGS:--mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard}
 M7_CPU_FLAGS=${M7_CPU_FLAGS:--mcpu=cortex-m7 -mthumb -mfpu=fpv5-d16 -mfloat-abi=hard}
 CC_CROSS=${CROSS_PREFIX}gcc
+JOBS=${CROSS_JOBS:-$(nproc 2>/dev/null || echo 2)}   # parallel compiles: the builds are most of the time
 QEMU_TIMEOUT=${QEMU_TIMEOUT:-900}   # seconds per emulated program; the slowest takes ~1 min
 
 failures=0
@@ -62,7 +63,7 @@ cross_make() {
     shift 3
     mkdir -p "$dir" &&
         "$CC_CROSS" $cpu -O2 -std=c99 -Wall -Wextra -Wpedantic -Werror -c cross/startup.c -o "$dir/startup.o" &&
-        $MAKE --no-print-directory CC="$CC_CROSS" AR="${CROSS_PREFIX}ar" CFLAGS="$cpu -O2" \
+        $MAKE -j"$JOBS" --no-print-directory CC="$CC_CROSS" AR="${CROSS_PREFIX}ar" CFLAGS="$cpu -O2" \
             LDFLAGS="-Lcross -T cross/$script --specs=rdimon.specs -nostartfiles $dir/startup.o" \
             BUILD="$dir" "$@"
 }
@@ -74,7 +75,7 @@ soft_double_symbols() {
 
 # ---- 2.-3. builds -------------------------------------------------------------------------------
 step "host builds (double and float)"
-$MAKE --no-print-directory BUILD="$HOST_DIR" "$HOST_DIR/firmware_tshape" "$HOST_DIR/firmware_tshape_f" \
+$MAKE -j"$JOBS" --no-print-directory BUILD="$HOST_DIR" "$HOST_DIR/firmware_tshape" "$HOST_DIR/firmware_tshape_f" \
     "$HOST_DIR/firmware_lqr" "$HOST_DIR/firmware_lqr_f" "$HOST_DIR/sr_tests" "$HOST_DIR/sr_tests_f" || fail "host build"
 step "Cortex-M4F build (float): $M4_CPU_FLAGS -O2"
 cross_make "$M4_DIR" "$M4_CPU_FLAGS" mps2-an386.ld "$M4_DIR/firmware_tshape_f" "$M4_DIR/firmware_lqr_f" "$M4_DIR/sr_tests_f" ||
@@ -85,7 +86,7 @@ cross_make "$M7_DIR" "$M7_CPU_FLAGS" mps2-an500.ld "$M7_DIR/firmware_tshape" "$M
 
 # ---- 4. no double arithmetic in the float build ---------------------------------------------------
 step "float library for the M4 under -Wdouble-promotion -Wfloat-conversion -Werror; no __aeabi_d*"
-if $MAKE --no-print-directory CC="$CC_CROSS" AR="${CROSS_PREFIX}ar" BUILD="$OUT/m4-strict" \
+if $MAKE -j"$JOBS" --no-print-directory CC="$CC_CROSS" AR="${CROSS_PREFIX}ar" BUILD="$OUT/m4-strict" \
         CFLAGS="$M4_CPU_FLAGS -O2 -Wdouble-promotion -Wfloat-conversion" "$OUT/m4-strict/libsphericalrobot_f.a"; then
     found=$(soft_double_symbols "$OUT/m4-strict/libsphericalrobot_f.a")
     [ -z "$found" ] && echo "  no software double routine referenced" || fail "float library uses$found"
@@ -166,7 +167,7 @@ cmake_build() {
     dir=$OUT/cmake-$1-$2
     step "CMake, toolchain file cmake/arm-none-eabi.cmake, SR_CPU=$1, SR_USE_FLOAT=$2"
     if cmake -S . -B "$dir" -DCMAKE_TOOLCHAIN_FILE=cmake/arm-none-eabi.cmake -DSR_CPU="$1" \
-            -DSR_USE_FLOAT="$2" -DSR_BUILD_TESTS=OFF >"$dir.log" 2>&1 && cmake --build "$dir" -j 2 >>"$dir.log" 2>&1; then
+            -DSR_USE_FLOAT="$2" -DSR_BUILD_TESTS=OFF >"$dir.log" 2>&1 && cmake --build "$dir" -j "$JOBS" >>"$dir.log" 2>&1; then
         lib=$(ls "$dir"/libsphericalrobot*.a)
         attrs=$("${CROSS_PREFIX}readelf" -A "$lib" | sort -u | grep -E 'Tag_CPU_name|Tag_FP_arch|Tag_ABI_VFP_args' | tr -s ' \n' ' ')
         echo "  $lib:$attrs"

@@ -21,6 +21,8 @@ from .report import format_markdown, format_report, write_results
 from .timing import cpu_name, pin_to_one_core
 
 RESULTS = ROOT / "bench" / "results"
+#: Parts of the C benchmarks that --skip can leave out (each has its own test).
+SKIPPABLE = ("step-anatomy", "ekf")
 
 
 def main(argv=None):
@@ -34,6 +36,8 @@ def main(argv=None):
     parser.add_argument("--no-kane", action="store_true", help="skip the sympy.physics.mechanics baseline")
     parser.add_argument("--loop-steps", type=int, default=10_000,
                         help="steps of the alternatives' t-shape run in a Python Lie-Euler loop (<= 10,000)")
+    parser.add_argument("--skip", action="append", default=[], choices=SKIPPABLE,
+                        help="leave out a part of the C benchmarks (repeatable; the result says which)")
     parser.add_argument("--out", type=pathlib.Path, default=RESULTS)
     parser.add_argument("--markdown", type=pathlib.Path, metavar="RESULT.json",
                         help="print a stored run's tables as Markdown (for the README) and exit")
@@ -73,7 +77,8 @@ def run(args, core, progress):
     model = Model(params)
     X, U = random_states(rng, args.states, params), random_inputs(rng, args.states)
     result = {"date": datetime.datetime.now().isoformat(timespec="seconds"), "cpu": cpu_name(),
-              "pinned_core": core, "states": args.states, "params": "Params.paper_simulation()"}
+              "pinned_core": core, "states": args.states, "params": "Params.paper_simulation()",
+              "skipped": sorted(set(args.skip))}
     try:
         with tempfile.TemporaryDirectory() as tmp:
             build = pathlib.Path(tmp)
@@ -86,10 +91,12 @@ def run(args, core, progress):
             exe = build_harness(build, native=False, with_casadi=True, kane=kane)
             result["c_loop"] = run_harness(exe, params, X, U, args.repeats, kane_inputs)
             check_harness(result["c_loop"], model, X, U)
-            progress("the anatomy of a fourth-order step (its accelerations and everything else)")
-            result["step_anatomy"] = step_anatomy(build, exe.parent / "input.bin", max(1, args.repeats // 4))
-            progress("one 200 Hz sample of the EKF: predict, an IMU and an encoder update")
-            result["ekf_sample"] = ekf_sample(build)
+            if "step-anatomy" not in args.skip:
+                progress("the anatomy of a fourth-order step (its accelerations and everything else)")
+                result["step_anatomy"] = step_anatomy(build, exe.parent / "input.bin", max(1, args.repeats // 4))
+            if "ekf" not in args.skip:
+                progress("one 200 Hz sample of the EKF: predict, an IMU and an encoder update")
+                result["ekf_sample"] = ekf_sample(build)
             if args.native:
                 exe = build_harness(build, native=True, with_casadi=False)
                 result["c_loop_native"] = run_harness(exe, params, X, U, args.repeats)
