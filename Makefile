@@ -51,9 +51,11 @@ sweep-bench: $(STAMP)
 figures: $(STAMP)
 	$(PY) -m runtime figures
 
-# Every controller on every benchmark task: out/control/table.md, table.csv, a folder per run (docs/control.md).
+# Every controller on every benchmark task: out/control/table.md, table.csv, a folder per run; then the
+# offset table (out/control/offsets.md, .csv: docs/control.md, "Offset-free tracking").
 control: $(STAMP)
 	$(PY) -m runtime control --out out/control
+	$(PY) -m runtime control --offsets --out out/control
 
 # The envelope of docs/control.md (prints its numbers, rewrites docs/figures/control-envelope.png).
 envelope: $(STAMP)

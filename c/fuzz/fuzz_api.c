@@ -216,7 +216,7 @@ static void fuzz_controller(reader *r, const sr_model *model, const sr_real x[SR
     lqr.period = pick(r, 0.01);
     lqr.u_max = pick(r, 2.0);
     lqr.kappa_rate = pick(r, 1.0);
-    lqr.integral_zone = pick(r, 0.5);
+    lqr.steady_rate = pick(r, 0.005);
     target.speed = pick(r, 0.5 * unit(r));
     target.heading = pick(r, 3.2 * unit(r));
     target.curvature = pick(r, unit(r));
@@ -345,8 +345,9 @@ static void fuzz_nmpc(reader *r, const sr_model *model, const sr_real x[SR_NX])
     design.u_max = pick(r, 0.5);
     design.r = pick(r, 4.0);
     design.r_step = pick(r, 100.0);
-    design.integral_zone = pick(r, 0.02);
+    design.steady_rate = pick(r, 0.02);
     design.heading_jump = pick(r, 0.3);
+    design.disturbance_gain = pick(r, 0.2);
     design.n_speeds = design.n_curvatures = 1;
     design.speeds[0] = pick(r, 0.3);
     for (i = 0; i < SR_NMPC_NZ; ++i) {
@@ -475,7 +476,7 @@ static void fuzz_model_validity(reader *r, const sr_model *valid, const sr_real 
     lqr.n_speeds = lqr.n_curvatures = 1;
     lqr.period = SR_C(0.02);
     lqr.u_max = SR_C(0.5);
-    lqr.integral_zone = SR_C(0.2);
+    lqr.steady_rate = SR_C(0.005);
 
     ON_BOTH_MODELS("sr_check_state (model)", 0, (arm(&g, 0), sr_check_state(M, x)));
     ON_BOTH_MODELS("sr_check_state_batch (model)", 0, (arm(&g, 0), sr_check_state_batch(M, 2, x2, &row)));

@@ -634,10 +634,17 @@ int sr_regressor_batch(const sr_model *model, long n, const sr_real *x, const sr
  * (runtime/control/lqr_design.py: Newton on the reduced dynamics, their linearisation, a
  * discrete Riccati equation at the controller's period; docs/control.md).  K_path is used for
  * path references, K_heading (whose e_y columns are zero) for speed and heading references.
- * The torques are clipped to +-u_max; the integrators advance by one period only when neither
- * torque was clipped (conditional anti-windup), and the cross-track integral only while
- * |e_y| <= integral_zone (a large initial offset, such as a line's, winds nothing up).  The curvature of the operating point follows
- * the reference's at most kappa_rate per second (a figure eight's switch of turn direction). */
+ * The torques are clipped to +-u_max.  The integrators (z[10], z[11]) act at any error: each
+ * advances by one period's step unless that step would push a clipped torque further past its
+ * limit (conditional integration against the torque limits: with the interpolated gain K, the
+ * step s_i of integrator i changes torque k by -K[k][10 + i] s_i; it is skipped when that change
+ * has the sign of the torque's excess over u_max).  The cross-track integral also holds while the
+ * error moves faster than steady_rate (|de_y/dt| > steady_rate, de_y/dt the contact point's
+ * velocity along the path's normal): such an error, a line's initial offset or the first lean
+ * into a circle, is a transient the loop is already removing, and integrating it would force an
+ * overshoot of the same area.  So a steady offset of any size is integrated away, and nothing winds up
+ * while a torque is held at its limit.  The curvature of the operating point follows the
+ * reference's at most kappa_rate per second (a figure eight's switch of turn direction). */
 /** @{ */
 #define SR_LQR_NZ 12               /**< entries of the error coordinates z */
 #ifndef SR_LQR_MAX_SPEEDS
@@ -673,7 +680,7 @@ typedef struct sr_lqr {
     sr_real period;                                 /**< the controller's sampling period [s], > 0 */
     sr_real u_max;                                  /**< torque limit on both motors [N m], > 0 */
     sr_real kappa_rate;                             /**< [1/(m s)], >= 0 */
-    sr_real integral_zone;                          /**< [m], > 0 */
+    sr_real steady_rate;                           /**< [m/s], >= 0: the integral of e_y advances only while |de_y/dt| <= this */
 } sr_lqr;
 
 /** What to track at this sample (from the reference). */
@@ -693,8 +700,8 @@ typedef struct sr_lqr_memory {
     int saturated;         /**< out: the last sample clipped a torque */
 } sr_lqr_memory;
 
-/** Checks a schedule: sizes in range, grids strictly increasing, every entry finite, period,
- * u_max and integral_zone > 0, kappa_rate >= 0.  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
+/** Checks a schedule: sizes in range, grids strictly increasing, every entry finite, period
+ * and u_max > 0, kappa_rate and steady_rate >= 0.  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
 int sr_lqr_check(const sr_lqr *lqr);
 
 /** Zeroes the memory.  Returns SR_OK or SR_ERR_NULL. */

@@ -12,6 +12,14 @@
  * to the error coordinates against the path (a circle of the node's curvature through the foot
  * point); its sensitivities are sr_step_jacobian's, chained through the lift and that projection.
  *
+ * Offset-free: the plant is modelled as the model driven by u + d, d a constant offset of the two
+ * torques estimated online from the model's one-period prediction error (the last sample's z and
+ * torques, with d, predicted by one node of one period against the measured z, on the pendulum
+ * and the rates: d += disturbance_gain * the least-squares torque step that explains the
+ * difference, clipped to +-u_max).  Every node adds d to its torques and the reference torques
+ * are u* - d.  The cross-track integral acts at any offset; it holds while a torque is at its
+ * bound (anti-windup) and while the error moves faster than steady_rate (a transient).
+ *
  * Self-contained C99: no dynamic allocation, no mutable globals.  Every buffer is sized by the
  * compile-time maximums below (SR_NMPC_MAX_HORIZON), so that sizeof(sr_nmpc_memory) is the
  * controller's whole workspace; every function returns a status code of spherical_robot.h.
@@ -94,7 +102,8 @@ typedef struct sr_nmpc {
     sr_real u_max;                  /**< torque limit on both motors [N m], > 0 */
     sr_real r;                      /**< weight of the torques' distance from u* [1/(N m)^2], > 0 */
     sr_real r_step;                 /**< weight of a torque's change from node to node, >= 0 */
-    sr_real integral_zone;          /**< the cross-track integral advances only within this [m], > 0 */
+    sr_real steady_rate;           /**< the cross-track integral advances only while |de_y/dt| <= this [m/s], >= 0 */
+    sr_real disturbance_gain;       /**< the share of the torque offset's one-sample update taken, 0 .. 1 (0: no estimate) */
     sr_real heading_jump;           /**< a jump of the reference's heading beyond this [rad] drops the guess, > 0 */
     sr_real q_path[SR_NMPC_NZ];     /**< weights of z on path references, >= 0 */
     sr_real q_heading[SR_NMPC_NZ];  /**< weights of z on speed and heading references, >= 0 */
@@ -127,6 +136,11 @@ typedef struct sr_nmpc_memory {
     sr_real u_last[SR_NU];          /**< the first torques of the last solution */
     sr_real heading;                /**< the last sample's reference heading [rad] */
     sr_real integral;               /**< the cross-track integral [m s] */
+    sr_real disturbance[SR_NU];     /**< the estimated torque offset d [N m] */
+    sr_real z_last[SR_NMPC_NZ];     /**< the last sample's error coordinates (what d is estimated from) */
+    sr_real v_last;                 /**< the last sample's reference speed [m/s] */
+    sr_real kappa_last;             /**< the last sample's curvature at the foot point [1/m] */
+    int have_last;                  /**< z_last, v_last, kappa_last and u_last are those of a solved sample */
     long samples;                   /**< samples since the reset */
     long restarts;                  /**< samples whose warm start failed and were solved afresh */
     long failures;                  /**< samples with no solution at all (the torques u* held) */
@@ -162,7 +176,7 @@ long sr_nmpc_memory_bytes(void);
  * above.  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
 int sr_nmpc_check(const sr_nmpc *design);
 
-/** Forgets the warm start, the heading, the integral and the counters.  Returns SR_OK or SR_ERR_NULL. */
+/** Forgets the warm start, the heading, the integral, the torque offset and the counters.  Returns SR_OK or SR_ERR_NULL. */
 int sr_nmpc_reset(sr_nmpc_memory *memory);
 
 /** One node of the prediction model: from the error coordinates z (reference speed v, the path's
@@ -174,8 +188,8 @@ int sr_nmpc_node(const sr_model *model, const sr_real z[SR_NMPC_NZ], const sr_re
                  sr_real kappa, sr_real dt, sr_real z_next[SR_NMPC_NZ], sr_real *A, sr_real *B);
 
 /** One sample: the torques u for the next period from the measured state x and the target (the
- * real-time iteration: shift the last solution when a node has passed, linearise the nodes,
- * condense, solve the torque-limited QP, advance the integral).  A sample whose iterations fail
+ * real-time iteration: update the torque offset, shift the last solution when a node has passed,
+ * linearise the nodes, condense, solve the torque-limited QP, advance the integral).  A sample whose iterations fail
  * from the warm start is solved afresh from the reference (memory->restarts); one that fails
  * from there too returns the reference's torques u*_0 (memory->failures) and SR_OK.  Checks the
  * design (sr_nmpc_check: SR_ERR_ARG, SR_ERR_NONFINITE), x in full (sr_check_state), the target's

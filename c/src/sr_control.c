@@ -4,6 +4,7 @@
  * docs/control.md; the schedule comes from runtime/control/lqr_design.py.
  */
 #include "sr_checks.h"
+#include "sr_control.h"
 #include "sr_so3.h"
 #include "sr_argcheck.h"
 
@@ -13,7 +14,7 @@ static int valid_sizes(const sr_lqr *lqr)
 {
     return lqr->n_speeds >= 1 && lqr->n_speeds <= SR_LQR_MAX_SPEEDS && lqr->n_curvatures >= 1
         && lqr->n_curvatures <= SR_LQR_MAX_CURVATURES && lqr->period > 0 && lqr->u_max > 0
-        && lqr->kappa_rate >= 0 && lqr->integral_zone > 0;
+        && lqr->kappa_rate >= 0 && lqr->steady_rate >= 0;
 }
 
 int sr_lqr_check(const sr_lqr *lqr)
@@ -21,7 +22,7 @@ int sr_lqr_check(const sr_lqr *lqr)
     int i, n;
     if (!lqr) return SR_ERR_NULL;
     if (!all_finite(&lqr->period, 1) || !all_finite(&lqr->u_max, 1) || !all_finite(&lqr->kappa_rate, 1)
-        || !all_finite(&lqr->integral_zone, 1))
+        || !all_finite(&lqr->steady_rate, 1))
         return SR_ERR_NONFINITE;
     if (!valid_sizes(lqr)) return SR_ERR_ARG;
     n = lqr->n_speeds * lqr->n_curvatures;
@@ -114,7 +115,7 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
                    sr_real u_raw[SR_NU])
 {
     sr_real z[SR_LQR_NZ], dz[SR_LQR_NZ], out[SR_NU], raw[SR_NU], kappa, step, wv, wk;
-    sr_real weight[4];
+    sr_real weight[4], k_int[SR_NU][2], step_int[2];
     int status = arg_model(model, READS(STATE)), i0, i1, j0, j1, k, j, n, point[4], clipped = 0;
     if (status != SR_OK) return status;
     if (!lqr || !x || !target || !memory || !u) return SR_ERR_NULL;
@@ -145,11 +146,14 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
                         + weight[2] * lqr->z_star[point[2]][j] + weight[3] * lqr->z_star[point[3]][j]);
     for (k = 0; k < SR_NU; ++k) {
         sr_real acc = 0;
+        k_int[k][0] = k_int[k][1] = 0;
         for (i0 = 0; i0 < 4; ++i0) {
             const sr_real *K = (target->path ? lqr->K_path : lqr->K_heading)[point[i0]] + k * SR_LQR_NZ;
             sr_real kdz = 0;
             for (j = 0; j < SR_LQR_NZ; ++j) kdz += K[j] * dz[j];
             acc += weight[i0] * (lqr->u_star[point[i0]][k] - kdz);
+            k_int[k][0] += weight[i0] * K[10];
+            k_int[k][1] += weight[i0] * K[11];
         }
         raw[k] = acc;
         out[k] = acc > lqr->u_max ? lqr->u_max : (acc < -lqr->u_max ? -lqr->u_max : acc);
@@ -157,9 +161,18 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
     }
     if (!all_finite(raw, SR_NU)) return SR_ERR_NONFINITE;
 
-    if (!clipped) {
-        if (target->path && SR_FABS(dz[9]) <= lqr->integral_zone) memory->integrals[0] += lqr->period * dz[9];
-        memory->integrals[1] += lqr->period * dz[4];
+    /* Conditional integration: an integrator advances at any error unless its step would push a
+     * clipped torque further past its limit (the step s_i changes u[k] by -K[k][10 + i] s_i), and
+     * the cross-track integral only while the error is steady, |de_y/dt| <= steady_rate: an error
+     * that moves is a transient (a start off the path, the first lean into a turn) that the loop
+     * is already removing, and integrating it would force an overshoot of equal area later. */
+    step_int[0] = target->path ? lqr->period * dz[9] : 0;
+    step_int[1] = lqr->period * dz[4];
+    for (j = 0; j < 2; ++j) {
+        int advance = j == 1 || SR_FABS(cross_track_rate(model, x, target->heading)) <= lqr->steady_rate;
+        for (k = 0; k < SR_NU; ++k)
+            if (out[k] != raw[k] && -k_int[k][j] * step_int[j] * (raw[k] - out[k]) > 0) advance = 0;
+        if (advance) memory->integrals[j] += step_int[j];
     }
     memory->kappa = kappa;
     memory->started = 1;

@@ -4,6 +4,7 @@
  */
 #include "sr_nmpc.h"
 #include "sr_checks.h"
+#include "sr_control.h"
 #include "sr_so3.h"
 #include "sr_argcheck.h"
 
@@ -24,7 +25,8 @@ static int valid_sizes(const sr_nmpc *d)
     return d->horizon >= 1 && d->horizon <= SR_NMPC_MAX_HORIZON && d->node_periods >= 1 && d->cold_iterations >= 1
         && d->iterations >= 1 && d->qp_max_iterations >= 1 && d->n_speeds >= 1 && d->n_speeds <= SR_LQR_MAX_SPEEDS
         && d->n_curvatures >= 1 && d->n_curvatures <= SR_LQR_MAX_CURVATURES && d->period > 0 && d->u_max > 0
-        && d->r > 0 && d->r_step >= 0 && d->integral_zone > 0 && d->heading_jump > 0;
+        && d->r > 0 && d->r_step >= 0 && d->steady_rate >= 0 && d->heading_jump > 0 && d->disturbance_gain >= 0
+        && d->disturbance_gain <= 1;
 }
 
 int sr_nmpc_check(const sr_nmpc *d)
@@ -32,7 +34,7 @@ int sr_nmpc_check(const sr_nmpc *d)
     int i, n;
     if (!d) return SR_ERR_NULL;
     if (!all_finite(&d->period, 1) || !all_finite(&d->u_max, 1) || !all_finite(&d->r, 1) || !all_finite(&d->r_step, 1)
-        || !all_finite(&d->integral_zone, 1) || !all_finite(&d->heading_jump, 1) || !all_finite(d->q_path, NZ)
+        || !all_finite(&d->steady_rate, 1) || !all_finite(&d->heading_jump, 1) || !all_finite(&d->disturbance_gain, 1) || !all_finite(d->q_path, NZ)
         || !all_finite(d->q_heading, NZ))
         return SR_ERR_NONFINITE;
     if (!valid_sizes(d)) return SR_ERR_ARG;
@@ -59,6 +61,8 @@ int sr_nmpc_reset(sr_nmpc_memory *memory)
     memory->samples = memory->restarts = memory->failures = 0;
     memory->qp_iterations = memory->saturated = 0;
     memory->u_last[0] = memory->u_last[1] = 0;
+    memory->disturbance[0] = memory->disturbance[1] = 0;
+    memory->have_last = 0;
     return SR_OK;
 }
 
@@ -319,9 +323,12 @@ static int iteration(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model,
     const int N = d->horizon, nq = SR_NU * N;
     const sr_real T = d->period * (sr_real)d->node_periods;
     sr_real zp[NZ], tmp[NZ * NZ], w[NZ], w2[NZ], M[SR_NU][NZ], M2[SR_NU][NZ];
+    sr_real ud[SR_NU];
     int i, j, k, a, b, status;
     for (k = 0; k < N; ++k) {
-        if (node(model, m->Z + k * NZ, m->U + k * SR_NU, v, m->kappa[k], T, zp, m->A[k], m->B[k]) != SR_OK) return 1;
+        ud[0] = m->U[k * SR_NU] + m->disturbance[0];
+        ud[1] = m->U[k * SR_NU + 1] + m->disturbance[1];
+        if (node(model, m->Z + k * NZ, ud, v, m->kappa[k], T, zp, m->A[k], m->B[k]) != SR_OK) return 1;
         for (j = 0; j < NZ; ++j) m->gap[k * NZ + j] = zp[j] - m->Z[(k + 1) * NZ + j];
     }
     /* The free response c (delta U = 0): c_0 = z0 - Z_0, c_{k+1} = A_k c_k + gap_k. */
@@ -449,6 +456,42 @@ static int iterate(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, c
     return 0;
 }
 
+/* The rows of z the torque offset is estimated from: the pendulum and the rates (3 .. 8), which do
+ * not depend on where the reference's nearest point falls. */
+#define D_FIRST 3
+#define D_LAST 8
+
+/* d += gain * argmin |B1 delta - (z - Phi_1(z_last, u_last + d))| over rows D_FIRST .. D_LAST: the
+ * last sample predicted over one period against the measured z, B1 the prediction's torque
+ * Jacobian; clipped to +-u_max.  Leaves d as it is when the prediction fails. */
+static void estimate_disturbance(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, const sr_real z[NZ])
+{
+    sr_real ud[SR_NU], zp[NZ], BtB[3] = {0, 0, 0}, Btr[2] = {0, 0}, det, step[2];
+    const sr_real *B = m->B[0];
+    int i, j;
+    ud[0] = m->u_last[0] + m->disturbance[0];
+    ud[1] = m->u_last[1] + m->disturbance[1];
+    /* A[0], B[0] are scratch here: the iteration overwrites them. */
+    if (node(model, m->z_last, ud, m->v_last, m->kappa_last, d->period, zp, m->A[0], m->B[0]) != SR_OK) return;
+    for (i = D_FIRST; i <= D_LAST; ++i) {
+        const sr_real res = z[i] - zp[i], b0 = B[i * SR_NU], b1 = B[i * SR_NU + 1];
+        BtB[0] += b0 * b0;
+        BtB[1] += b0 * b1;
+        BtB[2] += b1 * b1;
+        Btr[0] += b0 * res;
+        Btr[1] += b1 * res;
+    }
+    det = BtB[0] * BtB[2] - BtB[1] * BtB[1];
+    if (!(det > 0) || !all_finite(&det, 1)) return;
+    step[0] = (BtB[2] * Btr[0] - BtB[1] * Btr[1]) / det;
+    step[1] = (BtB[0] * Btr[1] - BtB[1] * Btr[0]) / det;
+    if (!all_finite(step, SR_NU)) return;
+    for (j = 0; j < SR_NU; ++j) {
+        const sr_real dj = m->disturbance[j] + d->disturbance_gain * step[j];
+        m->disturbance[j] = dj > d->u_max ? d->u_max : (dj < -d->u_max ? -d->u_max : dj);
+    }
+}
+
 static sr_real wrap(sr_real angle)
 {
     /* into [-pi, pi): the heading jump test needs only the magnitude */
@@ -463,7 +506,7 @@ int sr_nmpc_step(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, con
     sr_lqr_target lt;
     sr_real z[SR_LQR_NZ], integrals[2], v, heading_change;
     const sr_real *q, *P;
-    int status = arg_model(model, READS(WHOLE)), N, k, j, cold, path, failed;
+    int status = arg_model(model, READS(WHOLE)), N, k, j, cold, path, failed, jumped;
     if (status != SR_OK) return status;
     if (!d || !m || !x || !target || !u) return SR_ERR_NULL;
     /* The whole design, every sample (a few microseconds): a corrupt entry never reaches the torques. */
@@ -487,12 +530,16 @@ int sr_nmpc_step(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, con
     status = sr_lqr_error(model, x, &lt, integrals, z);
     if (status != SR_OK) return status;
     v = target->speed;
+    heading_change = wrap(target->heading - m->heading);
+    jumped = SR_FABS(heading_change) > d->heading_jump;
+    if (m->have_last && !jumped && d->disturbance_gain > 0) estimate_disturbance(d, m, model, z);
     for (k = 0; k <= N; ++k)
         m->kappa[k] = !path ? 0 : (target->curvature_ahead ? target->curvature_ahead[k] : target->curvature);
     references(d, m, v);
+    /* The torques that hold the reference on a plant driven by u + d. */
+    for (k = 0; k < N * SR_NU; ++k) m->us[k] -= m->disturbance[k % SR_NU];
 
-    heading_change = wrap(target->heading - m->heading);
-    if (m->have_guess && SR_FABS(heading_change) > d->heading_jump) m->have_guess = 0;
+    if (m->have_guess && jumped) m->have_guess = 0;
     m->heading = target->heading;
     cold = !m->have_guess;
     if (cold) {
@@ -517,7 +564,7 @@ int sr_nmpc_step(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, con
     m->samples++;
     if (failed) { /* no prediction at all: hold the reference's torques */
         m->failures++;
-        m->have_guess = 0;
+        m->have_guess = m->have_last = 0;
         for (j = 0; j < SR_NU; ++j) u[j] = m->us[j] > d->u_max ? d->u_max : (m->us[j] < -d->u_max ? -d->u_max : m->us[j]);
         m->saturated = SR_FABS(u[0]) >= d->u_max || SR_FABS(u[1]) >= d->u_max;
         return SR_OK;
@@ -526,9 +573,14 @@ int sr_nmpc_step(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, con
     m->have_u_last = 1;
     m->u_last[0] = m->U[0];
     m->u_last[1] = m->U[1];
-    /* The integral advances near the path while the torques are free (conditional anti-windup). */
-    if (path && SR_FABS(target->cross_track) <= d->integral_zone && SR_FABS(m->U[0]) < d->u_max * FREE_SHARE
-        && SR_FABS(m->U[1]) < d->u_max * FREE_SHARE)
+    memcpy(m->z_last, z, sizeof m->z_last);
+    m->v_last = v;
+    m->kappa_last = m->kappa[0];
+    m->have_last = 1;
+    /* The integral advances at any offset unless a torque is at its bound (anti-windup) or the
+     * error moves faster than steady_rate (a transient the loop is removing). */
+    if (path && SR_FABS(m->U[0]) < d->u_max * FREE_SHARE && SR_FABS(m->U[1]) < d->u_max * FREE_SHARE
+        && SR_FABS(cross_track_rate(model, x, target->heading)) <= d->steady_rate)
         m->integral += d->period * target->cross_track;
     for (j = 0; j < SR_NU; ++j) u[j] = m->U[j] > d->u_max ? d->u_max : (m->U[j] < -d->u_max ? -d->u_max : m->U[j]);
     m->saturated = SR_FABS(u[0]) >= d->u_max || SR_FABS(u[1]) >= d->u_max;

@@ -1,7 +1,7 @@
 /*
  * test_control.c -- the LQR controller (c/src/sr_control.c) on hand-made schedules: the error
  * coordinates at and near the reference, the law at a grid point and between points, clipping
- * with anti-windup, the curvature's rate limit, and status codes with untouched outputs.
+ * with conditional integration at any offset, the curvature's rate limit, and status codes with untouched outputs.
  */
 #include "sr_test.h"
 
@@ -31,7 +31,7 @@ static void empty_schedule(sr_lqr *lqr, int n_speeds)
     lqr->period = SR_C(0.02);
     lqr->u_max = SR_C(0.5);
     lqr->kappa_rate = SR_C(0.3);
-    lqr->integral_zone = SR_C(0.2);
+    lqr->steady_rate = SR_C(0.005);
 }
 
 static void test_error_coordinates_vanish_at_the_reference_and_read_each_deviation(void)
@@ -128,33 +128,59 @@ static void test_between_two_speeds_the_law_interpolates_linearly_and_clamps_out
     CHECK_NEAR(u[0], SR_C(0.3), 0);
 }
 
-static void test_clipped_torques_and_large_offsets_hold_the_integrators(void)
+static void test_the_cross_track_integral_acts_at_any_offset_and_holds_only_against_a_clipped_torque(void)
 {
     sr_model m;
     sr_lqr lqr;
     sr_lqr_memory mem;
     sr_real x[SR_NX], u[SR_NU], raw[SR_NU];
-    const sr_lqr_target t = {SR_C(0.2), 0, 0, SR_C(0.1), 1};
+    const sr_lqr_target far = {SR_C(0.2), 0, 0, SR_C(0.3), 1};
     paper_simulation_model(&m);
     empty_schedule(&lqr, 1);
-    lqr.K_path[0][9] = SR_C(-10.0);             /* u_Y = 10 e_y = 1 N m: clipped to 0.5 */
+    lqr.steady_rate = SR_C(0.01);
+    lqr.K_path[0][9] = SR_C(-1.0);              /* u_Y = e_y + I = 0.3 N m: free */
+    lqr.K_path[0][10] = SR_C(-1.0);
     sr_lqr_reset(&mem);
     reference_state(0.2, 0.0, 0.3, x);
-    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &t, &mem, u, raw), SR_OK);
-    CHECK_NEAR(raw[0], 1.0, 8 * TEST_EPS);
-    CHECK(u[0] == SR_C(0.5) && mem.saturated == 1);
-    CHECK(mem.integrals[0] == 0 && mem.integrals[1] == 0);
-    lqr.K_path[0][9] = SR_C(-1.0);              /* 0.1 N m: not clipped, the integral moves */
-    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &t, &mem, u, raw), SR_OK);
+    /* 0.3 m off the path, rolling along it, torques free: the integral advances. */
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &far, &mem, u, raw), SR_OK);
     CHECK(mem.saturated == 0);
-    CHECK_NEAR(mem.integrals[0], 0.02 * 0.1, 8 * TEST_EPS);
-    /* Outside the integral zone (|e_y| = 0.3 > 0.2 m) the cross-track integral holds. */
-    {
-        const sr_lqr_target far = {SR_C(0.2), 0, 0, SR_C(0.3), 1};
-        const sr_real before = mem.integrals[0];
-        CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &far, &mem, u, raw), SR_OK);
-        CHECK(mem.saturated == 0 && mem.integrals[0] == before);
-    }
+    CHECK_NEAR(mem.integrals[0], 0.02 * 0.3, 8 * TEST_EPS);
+    /* u_Y = 10 e_y + I = 3 N m, clipped to 0.5: the integral's step (+) would push it further: held. */
+    lqr.K_path[0][9] = SR_C(-10.0);
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &far, &mem, u, raw), SR_OK);
+    CHECK(u[0] == SR_C(0.5) && mem.saturated == 1);
+    CHECK_NEAR(mem.integrals[0], 0.02 * 0.3, 8 * TEST_EPS);
+    /* The same excess with the integral's gain reversed: its step pulls u_Y back, so it advances. */
+    lqr.K_path[0][10] = SR_C(1.0);
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &far, &mem, u, raw), SR_OK);
+    CHECK(mem.saturated == 1);
+    CHECK_NEAR(mem.integrals[0], 2 * 0.02 * 0.3, 8 * TEST_EPS);
+}
+
+static void test_the_cross_track_integral_holds_while_the_error_moves(void)
+{
+    sr_model m;
+    sr_lqr lqr;
+    sr_lqr_memory mem;
+    sr_real x[SR_NX], u[SR_NU];
+    /* The path heads 0.2 rad left of the robot, which rolls at 0.2 m/s: the error moves at
+     * 0.2 sin 0.2 = 0.04 m/s (towards the path from its left; away from it from its right). */
+    sr_lqr_target t = {SR_C(0.2), SR_C(0.2), 0, SR_C(0.3), 1};
+    paper_simulation_model(&m);
+    empty_schedule(&lqr, 1);
+    lqr.steady_rate = SR_C(0.01);
+    sr_lqr_reset(&mem);
+    reference_state(0.2, 0.0, 0.3, x);
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &t, &mem, u, NULL), SR_OK);
+    CHECK(mem.integrals[0] == 0);
+    t.cross_track = SR_C(-0.3);
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &t, &mem, u, NULL), SR_OK);
+    CHECK(mem.integrals[0] == 0);
+    /* Moving more slowly than steady_rate: integrated. */
+    lqr.steady_rate = SR_C(0.05);
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &t, &mem, u, NULL), SR_OK);
+    CHECK_NEAR(mem.integrals[0], -0.02 * 0.3, 8 * TEST_EPS);
 }
 
 static void test_the_operating_curvature_follows_a_jump_at_its_rate(void)
@@ -227,7 +253,8 @@ void suite_control(void)
     RUN_TEST(test_error_coordinates_vanish_at_the_reference_and_read_each_deviation);
     RUN_TEST(test_the_law_at_a_grid_point_is_u_star_minus_K_dz);
     RUN_TEST(test_between_two_speeds_the_law_interpolates_linearly_and_clamps_outside);
-    RUN_TEST(test_clipped_torques_and_large_offsets_hold_the_integrators);
+    RUN_TEST(test_the_cross_track_integral_acts_at_any_offset_and_holds_only_against_a_clipped_torque);
+    RUN_TEST(test_the_cross_track_integral_holds_while_the_error_moves);
     RUN_TEST(test_the_operating_curvature_follows_a_jump_at_its_rate);
     RUN_TEST(test_bad_input_gives_status_and_leaves_outputs_untouched);
 }

@@ -104,7 +104,7 @@ static void valid_arguments(double r)
     LQR.n_speeds = LQR.n_curvatures = 1;
     LQR.period = SR_C(0.02);
     LQR.u_max = SR_C(0.5);
-    LQR.integral_zone = SR_C(0.2);
+    LQR.steady_rate = SR_C(0.005);
 }
 
 static const sr_lqr_target TARGET = {SR_C(0.3), SR_C(0.5), SR_C(0.2), SR_C(0.05), 1};

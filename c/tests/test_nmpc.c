@@ -213,7 +213,8 @@ static void small_design(sr_nmpc *d)
     d->u_max = SR_C(0.5);
     d->r = 4;
     d->r_step = 100;
-    d->integral_zone = SR_C(0.02);
+    d->steady_rate = SR_C(0.005);
+    d->disturbance_gain = SR_C(0.2);
     d->heading_jump = SR_C(0.3);
     for (i = 0; i < SR_NMPC_NZ; ++i) d->q_path[i] = d->q_heading[i] = 1;
     d->n_speeds = d->n_curvatures = 1;

@@ -3,8 +3,12 @@ a folder per run with summary.json (metrics under `tracking`, the contact force'
 and figures.
 
     python -m runtime control [--out out/control] [--tasks circle,line] [--duration S]
+    python -m runtime control --offsets [--only TEXT] [--out out/control] [--duration S]
 
-`--duration` cuts every task short (a smoke run; the table then says so).
+`--duration` cuts every task short (a smoke run; the table then says so).  `--offsets` runs the
+offset table instead (runtime/control/offsets.py): the LQR and the NMPC on the circle and the line
+against a plant with one constant mismatch or on an unmodelled slope, out/control/offsets.md and
+.csv; `--only` keeps the cases whose "task plant controller" contains TEXT.
 """
 import argparse
 import csv
@@ -22,6 +26,7 @@ from ..contact import contact_summary
 from ..model import Model
 from .closed_loop import simulate_closed_loop
 from .metrics import tracking_metrics
+from .offsets import OFFSET_CONTROLLERS, offset_cases, with_controller
 from .plots import plot_run
 from .task import load_task, shipped_tasks
 
@@ -70,10 +75,26 @@ def main(argv=()):
     parser.add_argument("--tasks", default=",".join(shipped_tasks()),
                         help="comma-separated tasks: each a shipped name, or a path to a task file")
     parser.add_argument("--duration", type=float, default=None, help="cut every task to this many seconds")
+    parser.add_argument("--offsets", action="store_true", help="the offset table instead: the LQR and the NMPC on "
+                        "the circle and the line against one constant mismatch or a slope at a time")
+    parser.add_argument("--only", default="", help="with --offsets: the cases whose 'task plant controller' "
+                        "contains this text")
+    parser.add_argument("--controllers", default=",".join(OFFSET_CONTROLLERS),
+                        help="with --offsets: comma-separated controller kinds")
     args = parser.parse_args(list(argv))
     if args.duration is not None and not args.duration > 0:
         parser.error(f"--duration: must be > 0 s, got {args.duration:g}")
     out = pathlib.Path(args.out)
+    if args.offsets:
+        try:
+            out.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            parser.error(f"--out: cannot create the folder {out} ({exc.strerror})")
+        kinds = tuple(args.controllers.split(","))
+        unknown = sorted(set(kinds) - set(OFFSET_CONTROLLERS))
+        if unknown:
+            parser.error(f"--controllers: {unknown[0]!r} is not one of {', '.join(OFFSET_CONTROLLERS)}")
+        return offset_table(out, args.duration, args.only, kinds)
     try:
         tasks = [load_task(name) for name in args.tasks.split(",")]
     except ValueError as exc:
@@ -118,6 +139,48 @@ def main(argv=()):
     table = "\n".join(lines) + f"\n\nCPU: {cpu_name()}.{cut}\n"
     write_text(out / "table.md", table)
     with atomic_path(out / "table.csv") as tmp, open(tmp, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=header)
+        writer.writeheader()
+        writer.writerows(rows)
+    print(table)
+    return 0
+
+
+def _cut(task, duration):
+    if duration is None:
+        return task
+    return dataclasses.replace(task, scenario=dataclasses.replace(
+        task.scenario, steps=max(1, round(min(duration, task.duration) / task.scenario.dt))))
+
+
+def offset_table(out, duration=None, only="", kinds=OFFSET_CONTROLLERS):
+    """The offset cases (runtime/control/offsets.py) of the circle and the line for each controller of
+    `kinds`, those whose "task plant controller" contains `only`: out/offsets.md, .csv."""
+    circle, line = load_task("circle"), load_task("line")
+    runs = [(kind, case) for kind in kinds
+            for case in offset_cases(_cut(with_controller(circle, kind), duration),
+                                     _cut(with_controller(line, kind), duration))
+            if only in f"{case.name} {case.change} {kind}"]
+    if not runs:
+        print(f"error: --only: no offset case contains {only!r}", file=sys.stderr)
+        return 2
+    rows = []
+    for kind, case in tqdm(runs, unit="run"):
+        _, _, metrics = run_task(case.task)
+        rms = metrics["cross_track_rms_m"]
+        rows.append({"task": case.name, "plant": case.change, "controller": kind, "cross_track_rms_m": rms,
+                     "cross_track_max_m": metrics["cross_track_max_m"], "target_m": case.target_m,
+                     "met": rms <= case.target_m})
+    header = list(rows[0])
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join([r["task"], r["plant"], r["controller"], _fmt(r["cross_track_rms_m"]),
+                                 _fmt(r["cross_track_max_m"]), _fmt(r["target_m"]), "yes" if r["met"] else "**no**"]) + " |"
+              for r in rows]
+    met = sum(r["met"] for r in rows)
+    cut = "" if duration is None else f" Every task cut to at most {duration:g} s (smoke run)."
+    table = "\n".join(lines) + f"\n\n{met} of {len(rows)} runs meet their target. CPU: {cpu_name()}.{cut}\n"
+    write_text(out / "offsets.md", table)
+    with atomic_path(out / "offsets.csv") as tmp, open(tmp, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=header)
         writer.writeheader()
         writer.writerows(rows)

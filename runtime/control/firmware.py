@@ -90,8 +90,8 @@ def header(task, controller):
         "    /* u_star */ {" + ",\n     ".join(_array(s.u_star[i, j]) for i, j in points) + "},",
         "    /* K_path */ {" + ",\n     ".join(_array(s.K_path[i, j]) for i, j in points) + "},",
         "    /* K_heading */ {" + ",\n     ".join(_array(s.K_heading[i, j]) for i, j in points) + "},",
-        f"    /* period, u_max, kappa_rate, integral_zone */ {_real(controller.period)}, "
-        f"{_real(controller.u_max)}, {_real(controller.gains.kappa_rate)}, {_real(controller.gains.integral_zone_m)}",
+        f"    /* period, u_max, kappa_rate, steady_rate */ {_real(controller.period)}, "
+        f"{_real(controller.u_max)}, {_real(controller.gains.kappa_rate)}, {_real(controller.gains.steady_rate_m_s)}",
         "};",
         "",
         "#endif /* LQR_TASK_H */",

@@ -43,6 +43,13 @@ def planar_velocity(x, r):
     return r * np.stack([w[..., 1], -w[..., 0]], axis=-1)
 
 
+def cross_track_rate(x, r, psi):
+    """ė_y [m/s]: q̇ along the left normal (−sin ψ, cos ψ) of a path heading ψ (the rate of the
+    signed cross-track error, left positive)."""
+    v = planar_velocity(x, r)
+    return -v[..., 0] * np.sin(psi) + v[..., 1] * np.cos(psi)
+
+
 def forward_speed(x, r):
     """Speed along the forward direction f [m/s] (negative when rolling backwards)."""
     psi = heading(x)

@@ -3,8 +3,9 @@
 At every sample: the error coordinates z of the measured state against the reference (speed v_ref,
 heading ψ_ref, curvature κ, cross-track error e_y), the operating point (z*, u*) and gain K
 interpolated bilinearly in (v_ref, κ) over the design grid, u = u* − K (z − z*), then the
-integrators (∫e_y, ∫ of the rolling-rate error) advance by one period unless a torque was clipped
-(conditional anti-windup).
+integrators (∫e_y, ∫ of the rolling-rate error) advance by one period at any error, each unless its
+step would push a clipped torque further past its limit (conditional integration: the anti-windup),
+and ∫e_y only while the error is steady, |ė_y| ≤ `steady_rate_m_s` (a moving error is a transient).
 """
 import dataclasses
 import typing
@@ -35,7 +36,7 @@ class LqrGains:
     rate_rad_s: float = 0.5           # Ω_y, Ω_z
     joint_rate_rad_s: float = 2.0     # ω_Y, ω_P
     cross_track_m: float = 0.15       # e_y
-    cross_track_integral_m_s: float = 20.0   # ∫e_y dt (large: a slow integrator, no overshoot on a line)
+    cross_track_integral_m_s: float = 2.0    # ∫e_y dt: removes a steady offset within about 20 s
     speed_integral_rad: float = 0.5   # ∫(Ω_x − Ω_x*) dt
     v_min: float = 0.1                # the design grid's speeds [m/s]: v_min .. v_max in n_speeds
     v_max: float = 0.5
@@ -45,7 +46,7 @@ class LqrGains:
     kappa_rate: float = 0.3           # how fast the operating point follows the path's curvature [1/(m s)]
     preview_m: float = 0.3            # the path's curvature is averaged over preview_m ± smoothing_m [m]
     smoothing_m: float = 0.5          # ... along the path from the nearest point (0: the curvature there)
-    integral_zone_m: float = 0.1      # ∫e_y advances only while |e_y| ≤ this [m]
+    steady_rate_m_s: float = 0.002   # ∫e_y advances only while |ė_y| ≤ this [m/s]
     #: The ranges of the settings (runtime/control/ranges.py: those of a task file's keys).
     RANGES: typing.ClassVar[dict] = LQR_RANGES
 
@@ -132,7 +133,7 @@ def _design(params, rate, u_max, gains):
     return Schedule(speeds, curvatures, z_star, u_star, K_path, K_heading)
 
 
-def to_c(schedule, period, u_max, kappa_rate, integral_zone):
+def to_c(schedule, period, u_max, kappa_rate, steady_rate):
     """The schedule as the C struct `sr_lqr` (cffi), checked by `sr_lqr_check`."""
     nv, nk = len(schedule.speeds), len(schedule.curvatures)
     if nv > lib.SR_LQR_MAX_SPEEDS or nk > lib.SR_LQR_MAX_CURVATURES:
@@ -149,7 +150,7 @@ def to_c(schedule, period, u_max, kappa_rate, integral_zone):
             c.u_star[n][0:2] = schedule.u_star[i, j].tolist()
             c.K_path[n][0:2 * design.NZ] = schedule.K_path[i, j].ravel().tolist()
             c.K_heading[n][0:2 * design.NZ] = schedule.K_heading[i, j].ravel().tolist()
-    c.period, c.u_max, c.kappa_rate, c.integral_zone = period, u_max, kappa_rate, integral_zone
+    c.period, c.u_max, c.kappa_rate, c.steady_rate = period, u_max, kappa_rate, steady_rate
     status = lib.sr_lqr_check(c)
     if status != lib.SR_OK:
         raise ValueError(f"controller: the LQR schedule is not valid for the C controller "
@@ -175,7 +176,7 @@ class Lqr(Controller):
         super().__init__(params, rate, u_max)
         self.gains = gains
         self.schedule = schedule if schedule is not None else design_schedule(params, rate, u_max, gains)
-        self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate, gains.integral_zone_m)
+        self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate, gains.steady_rate_m_s)
         self._model = Model(params)
         self._memory = ffi.new("sr_lqr_memory *")
         self._u, self._raw = np.zeros(2), np.zeros(2)

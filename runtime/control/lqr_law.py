@@ -2,15 +2,17 @@
 the benchmark check `sr_lqr_control` against (runtime/control/lqr_design.py holds the coordinates).
 
 One sample: the operating point's curvature follows the reference's at `kappa_rate`, (z*, u*, K)
-interpolated bilinearly in (v_ref, κ) (Schedule.at), u = u* − K (z − z*), clipped to ±u_max; when
-neither torque was clipped the integrals advance (∫e_y only while |e_y| ≤ zone).
+interpolated bilinearly in (v_ref, κ) (Schedule.at), u = u* − K (z − z*), clipped to ±u_max; each
+integral advances at any error unless its step would push a clipped torque further past its limit,
+and ∫e_y only while the error is steady (|ė_y| ≤ `steady_rate`).
 """
 import numpy as np
 
 from . import lqr_design as design
+from .geometry import cross_track_rate
 
 
-def numpy_law(schedule, r, x, target, integrals, kappa_before, period, u_max, kappa_rate, zone):
+def numpy_law(schedule, r, x, target, integrals, kappa_before, period, u_max, kappa_rate, steady_rate):
     """(u_raw, u, integrals after, κ of the operating point) of one sample."""
     path = target.cross_track is not None
     kappa = target.curvature if path else 0.0
@@ -21,10 +23,13 @@ def numpy_law(schedule, r, x, target, integrals, kappa_before, period, u_max, ka
     z = design.error_coordinates(x, r, target.speed, target.heading, target.cross_track if path else 0.0,
                                  integrals)
     dz = z - z_star
-    raw = u_star - (K_path if path else K_heading) @ dz
+    K = K_path if path else K_heading
+    raw = u_star - K @ dz
     u = np.clip(raw, -u_max, u_max)
-    if np.all(u == raw):
-        in_zone = path and abs(dz[design.Z_EY]) <= zone
-        integrals = np.asarray(integrals) + period * np.array([dz[design.Z_EY] if in_zone else 0.0,
-                                                               dz[design.Z_OM_X]])
-    return raw, u, integrals, kappa
+    e_y = dz[design.Z_EY]
+    steps = period * np.array([e_y if path else 0.0, dz[design.Z_OM_X]])
+    # A step that changes a clipped torque (by −K[:, 10 + i] s_i) in the direction of its excess is skipped.
+    pushes = np.any(-K[:, design.Z_IY:] * steps * (raw - u)[:, None] > 0, axis=0)
+    moving = abs(cross_track_rate(x, r, target.heading)) > steady_rate
+    advance = ~pushes & np.array([not moving, True])
+    return raw, u, np.asarray(integrals, dtype=float) + np.where(advance, steps, 0.0), kappa

@@ -33,6 +33,7 @@ import numpy as np
 
 from ..casadi_model import load, parameter_vector
 from .controller import DEFAULT_U_MAX, Controller
+from .geometry import cross_track_rate
 from . import lqr_design as design
 from .lqr import LqrGains, design_schedule
 from .ranges import NMPC_RANGES
@@ -41,6 +42,9 @@ from .ranges import NMPC_RANGES
 #: (offset-free tracking of a robot heavier than the model); the speed's integrator is left out.
 NZ_N = design.Z_IY + 1
 Z_E = design.Z_E
+#: The coordinates the torque offset is estimated from: the pendulum and the rates, which do not
+#: depend on where the reference's nearest point falls (the attitude and e_y do, by its quantisation).
+DISTURBANCE_ROWS = slice(design.Z_TH_P, design.Z_WP + 1)
 
 
 def _casadi():
@@ -153,7 +157,8 @@ class NmpcGains(LqrGains):
     operating points are the horizon's reference), and the horizon."""
     torque_step_n_m: float = 0.1      # a change of torque from one node to the next worth the full cost
     cross_track_integral_m_s: float = 2.0    # ∫e_y: faster than the LQR's (the horizon sees its overshoot)
-    integral_zone_m: float = 0.02     # ... and advancing only this near the path (no windup while converging)
+    steady_rate_m_s: float = 0.005    # ∫e_y advances only while |ė_y| ≤ this [m/s] (the horizon sees the overshoot)
+    disturbance_gain: float = 0.0     # the share of the torque offset's one-sample update taken (0: no estimate)
     horizon: float = 30               # N nodes
     node_periods: float = 2           # controller periods per node: the horizon is N × node_periods / rate
     iterations: float = 1             # real-time iterations per sample
@@ -213,6 +218,10 @@ class Nmpc(Controller):
         if key not in _NODES:
             _NODES[key] = compiled(node_function(self.node_period).map(self.n))
         self._nodes = _NODES[key]
+        # One period of the prediction, for the torque offset's estimate (compiled only when used).
+        if self.gains.disturbance_gain > 0 and (self.period, 1) not in _NODES:
+            _NODES[self.period, 1] = compiled(node_function(self.period))
+        self._one_period = _NODES.get((self.period, 1))
         n2 = 2 * self.n
         self._qp = ca.conic("nmpc_qp", "daqp", {"h": ca.Sparsity.dense(n2, n2), "a": ca.Sparsity(0, n2)},
                             {"error_on_fail": False})
@@ -243,10 +252,12 @@ class Nmpc(Controller):
         return P_path, P_heading
 
     def reset(self, x0):
-        """Starts a run at x0: forgets the warm start, the heading and the integral."""
+        """Starts a run at x0: forgets the warm start, the heading, the integral and the torque offset."""
         super().reset(x0)
         self._guess, self._heading, self._u_last = None, 0.0, None
         self.integral = 0.0                     # ∫e_y dt [m s], the controller's own state
+        self.disturbance = np.zeros(2)          # d̂ [N m]: the estimated constant offset of the torques
+        self._last = None                       # (z, u, v, κ) of the last sample: what d̂ is estimated from
         self.restarts = 0
 
     def preview_distances(self, target):
@@ -286,6 +297,11 @@ class Nmpc(Controller):
                                       (self.integral if path else 0.0, 0.0))[:NZ_N]
         zs, us = self._references(v, kappas)
         jumped = abs(_wrap(target.heading - self._heading)) > HEADING_JUMP_RAD
+        if not jumped:
+            self._estimate_disturbance(z0)
+        # The plant is modelled as the model driven by u + d̂: the torques that hold the reference
+        # are u* − d̂, and every node of the prediction adds d̂ to its torques.
+        us = us - self.disturbance
         if self._guess is not None and jumped:
             self._guess = None                  # a corner: the last solution is in another frame
         self._heading = target.heading
@@ -308,14 +324,34 @@ class Nmpc(Controller):
             try:
                 Z, U = self._iterate(z0, zs.copy(), us.copy(), zs, us, v, kappas, q, P, cold=True)
             except _Diverged:                    # no prediction at all: hold the reference's torques
-                self._guess = None
-                return us[0]
+                self._guess, self._last = None, None
+                return np.clip(us[0], -self.u_max, self.u_max)
         self._guess, self._u_last = (Z, U), U[0].copy()
-        # The integral advances while the robot is near the path and the torques are free
-        # (conditional anti-windup, as the LQR's).
-        if path and abs(target.cross_track) <= self.gains.integral_zone_m and np.all(np.abs(U[0]) < self.u_max * 0.999):
-            self.integral += self.period * target.cross_track
+        self._last = (z0, U[0].copy(), v, float(kappas[0]))
+        # The integral advances at any offset unless a torque is held at its bound (anti-windup) or
+        # the error moves faster than steady_rate_m_s (a transient the loop is removing:
+        # integrating it would force an overshoot of equal area), as the LQR's.
+        e_y = target.cross_track
+        if (path and np.all(np.abs(U[0]) < self.u_max * 0.999)
+                and abs(cross_track_rate(x, self.params.r, target.heading)) <= self.gains.steady_rate_m_s):
+            self.integral += self.period * e_y
         return U[0]
+
+    def _estimate_disturbance(self, z):
+        """d̂ += gain · argmin_δ ‖B₁ δ − (z − Φ₁(z⁻, u⁻ + d̂))‖ over DISTURBANCE_ROWS: the last
+        sample's z⁻ and torques u⁻ predicted over one period by the model with the offset, against
+        the measured z; B₁ the prediction's torque Jacobian.  Clipped to ±u_max."""
+        gain = self.gains.disturbance_gain
+        if self._last is None or gain == 0:
+            return
+        z_prev, u_prev, v, kappa = self._last
+        z_pred, _, B = (out.full() for out in self._one_period(z_prev, u_prev + self.disturbance, v, kappa, self._p))
+        residual = z[DISTURBANCE_ROWS] - z_pred[DISTURBANCE_ROWS, 0]
+        B = B[DISTURBANCE_ROWS]
+        if not (np.all(np.isfinite(residual)) and np.all(np.isfinite(B))):
+            return
+        step = np.linalg.solve(B.T @ B, B.T @ residual)
+        self.disturbance = np.clip(self.disturbance + gain * step, -self.u_max, self.u_max)
 
     def _iterate(self, z0, Z, U, zs, us, v, kappas, q, P, cold):
         # Cold start: iterate to convergence once (RTI's usual initialisation), then one per sample.
@@ -327,7 +363,8 @@ class Nmpc(Controller):
         """One Gauss–Newton QP around the nodes (Z (N+1, NZ_N), U (N, 2)); the new nodes.
         Raises _Diverged when the prediction overflows or the QP fails."""
         n, nz = self.n, NZ_N
-        z_next, A, B = (out.full() for out in self._nodes(Z[:n].T, U.T, v, kappas[:n].reshape(1, n), self._p))
+        z_next, A, B = (out.full() for out in self._nodes(Z[:n].T, (U + self.disturbance).T, v,
+                                                          kappas[:n].reshape(1, n), self._p))
         if not (np.all(np.isfinite(z_next)) and np.all(np.isfinite(A)) and np.all(np.isfinite(B))):
             raise _Diverged
         z_next = z_next.T
@@ -392,7 +429,8 @@ class NmpcC(Nmpc):
         c.cold_iterations, c.iterations = COLD_START_ITERATIONS, int(self.gains.iterations)
         c.qp_max_iterations = QP_MAX_ITERATIONS_PER_UNKNOWN * 2 * self.n
         c.period, c.u_max, c.r, c.r_step = self.period, self.u_max, self._r, self._r_step
-        c.integral_zone, c.heading_jump = self.gains.integral_zone_m, HEADING_JUMP_RAD
+        c.steady_rate, c.heading_jump = self.gains.steady_rate_m_s, HEADING_JUMP_RAD
+        c.disturbance_gain = self.gains.disturbance_gain
         c.q_path[0:NZ_N] = self._q_path.tolist()
         c.q_heading[0:NZ_N] = self._q_heading.tolist()
         c.n_speeds, c.n_curvatures = nv, nk
@@ -416,7 +454,8 @@ class NmpcC(Nmpc):
         self._u = np.zeros(2)
 
     def reset(self, x0):
-        """Starts a run at x0: forgets the warm start, the heading and the integral (sr_nmpc_reset)."""
+        """Starts a run at x0: forgets the warm start, the heading, the integral and the torque offset
+        (sr_nmpc_reset)."""
         super().reset(x0)
         self._lib.sr_nmpc_reset(self._memory)
 
@@ -447,4 +486,5 @@ class NmpcC(Nmpc):
             raise ValueError(f"controller {self.kind}: {ffi.string(lib.sr_status_string(status)).decode()} "
                              f"at t = {t:g} s")
         self.integral, self.restarts = self._memory.integral, self._memory.restarts
+        self.disturbance = np.array(list(self._memory.disturbance))
         return self._u.copy()

@@ -26,7 +26,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 #: The fields of `sr_nmpc` that are numbers or arrays, in the header's order.
 _INT_FIELDS = ("horizon", "node_periods", "cold_iterations", "iterations", "qp_max_iterations", "n_speeds",
                "n_curvatures")
-_REAL_FIELDS = ("period", "u_max", "r", "r_step", "integral_zone", "heading_jump")
+_REAL_FIELDS = ("period", "u_max", "r", "r_step", "steady_rate", "heading_jump", "disturbance_gain")
 
 
 def _real(v):

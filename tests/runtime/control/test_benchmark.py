@@ -23,6 +23,21 @@ def test_the_benchmark_writes_one_table_row_and_one_summary_per_task_and_control
         assert (tmp_path / run / "tracking.png").stat().st_size > 0
 
 
+def test_the_offset_table_writes_one_row_per_chosen_case_with_its_target(tmp_path):
+    assert main(["control", "--offsets", "--controllers", "lqr", "--only", "slope", "--duration", "0.5",
+                 "--out", str(tmp_path)]) == 0
+    rows = list(csv.DictReader(open(tmp_path / "offsets.csv")))
+    assert [r["task"] for r in rows] == ["circle", "line", "line", "line"]
+    assert [float(r["target_m"]) for r in rows] == [0.01, 0.005, 0.005, 0.005]
+    assert " of 4 runs meet their target" in (tmp_path / "offsets.md").read_text()
+
+
+def test_the_offset_table_names_an_unknown_controller(tmp_path, capsys):
+    with pytest.raises(SystemExit):
+        main(["control", "--offsets", "--controllers", "pid", "--out", str(tmp_path)])
+    assert "--controllers" in capsys.readouterr().err
+
+
 PID_ONLY_TASK = """
 dt = 0.005
 duration = 1.0

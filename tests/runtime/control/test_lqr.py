@@ -50,7 +50,7 @@ def c_error(x, target, integrals=(0.0, 0.0)):
 def python_law(sched, x, target, integrals, kappa_before):
     gains = lqr.LqrGains()
     return numpy_law(sched, PARAMS.r, x, target, integrals, kappa_before, 1 / RATE, U_MAX, gains.kappa_rate,
-                     gains.integral_zone_m)
+                     gains.steady_rate_m_s)
 
 
 @pytest.mark.parametrize("path", [False, True])

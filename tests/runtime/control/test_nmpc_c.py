@@ -120,5 +120,5 @@ def test_the_design_header_holds_the_c_design():
     text = design_initializer(controller)
     assert f".horizon = {controller.n}," in text
     assert f".r = SR_C({controller._r!r})," in text
-    assert text.count("SR_C(") == 6 + 2 * nmpc.NZ_N + controller._c.n_speeds + controller._c.n_curvatures + \
+    assert text.count("SR_C(") == 7 + 2 * nmpc.NZ_N + controller._c.n_speeds + controller._c.n_curvatures + \
         controller._c.n_speeds * controller._c.n_curvatures * (nmpc.NZ_N + 2 + 2 * nmpc.NZ_N ** 2)
