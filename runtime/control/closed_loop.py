@@ -52,7 +52,8 @@ class ClosedLoopResult:
     solve_s: np.ndarray         # (k,) [s] the controller's computation time per sample
     wall_time_s: float
     estimates: np.ndarray | None = None   # (k, 35): what the controller was given, when an estimator ran
-    samples: list | None = None           # on sensors: (arrival [s], kind, reading) in the order applied
+    samples: list | None = None           # on sensors: (time [s], kind, reading) in the order applied, the
+    #                                       controller's samples among them as (t, "tick", None)
 
 
 def _measure(x, r, noise, rng):
@@ -109,6 +110,7 @@ def simulate_on_sensors(plant_params, controller, reference, x0, duration, dt, e
     for k in tqdm(range(samples), disable=not progress or None, unit="sample", leave=False):
         t = k * controller.period
         y = estimates[k] = estimator.at(t, u)
+        applied.append((t, "tick", None))
         u = controller.update(t, y, _target(reference, controller, t, y))
         torques[k * per:(k + 1) * per] = u
         for s in range(k * per, (k + 1) * per):

@@ -107,6 +107,7 @@ class SensorEkf:
         sigma[IDX_E_Q] = START_POSITION_M
         sigma[IDX_E_NU] = START_RATE_RAD_S
         sigma[NE:NE + 3], sigma[NE + 3:] = noise.gyro_bias, noise.accel_bias
+        self.sigma0 = sigma                 # the start's standard deviations (the firmware example's too)
         self.filter = CEkf(Model(params), x0, sigma=sigma, noise=noise, mount=sensors.imu.mount, method=method)
         self.t = 0.0
 

@@ -75,7 +75,8 @@ def test_the_filter_gets_every_sample_the_sensors_declare(on_sensors):
     kinds = [kind for _, kind, _ in result.samples]
     assert kinds.count("imu") == kinds.count("encoders") == round(DURATION * 200)
     assert kinds.count("fixes") == round(DURATION * 2)
-    arrivals = [t for t, _, _ in result.samples]
+    assert kinds.count("tick") == len(result.control_time)
+    arrivals = [t for t, kind, _ in result.samples if kind != "tick"]
     assert arrivals == sorted(arrivals)
 
 
