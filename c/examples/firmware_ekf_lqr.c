@@ -17,7 +17,7 @@
  *
  * Every event first predicts the filter from its last time to t under the torques held since the
  * last tick; a tick then runs the LQR on the estimate and holds its torques until the next tick.
- * Output (stdout): one CSV row per tick, t, the 35 estimated state entries (spherical_robot.h's
+ * Output (stdout): CSV, a header line (as firmware_lqr.c's) then one row per tick: t, the 35 estimated state entries (spherical_robot.h's
  * order) and the torques u_Y, u_P, %.17g.  In the double build the rows equal, bit for bit, the
  * Python closed loop on the estimator of the same task fed the same samples
  * (runtime.control.closed_loop.simulate_on_sensors, tests/runtime/control/test_firmware.py).
@@ -35,6 +35,17 @@
 
 /* The numbers after the kind and the time on a line of each kind. */
 static const int WIDTH[5] = {0, SR_NIMU, 2, 2, 1};
+
+static void print_header(void)
+{
+    static const char *const blocks[] = {"RS", "RY", "RP"};
+    int b, i, j;
+    printf("t");
+    for (b = 0; b < 3; ++b)
+        for (i = 0; i < 3; ++i)
+            for (j = 0; j < 3; ++j) printf(",%s_%d%d", blocks[b], i, j);
+    printf(",q_x,q_y,q_z,w_Sx,w_Sy,w_Sz,w_Y,w_P,u_Y,u_P\n");
+}
 
 static void print_row(double t, const sr_real x[SR_NX], const sr_real u[SR_NU])
 {
@@ -86,6 +97,7 @@ int main(void)
         fprintf(stderr, "firmware_ekf_lqr: setup failed: %s\n", sr_status_string(status));
         return 1;
     }
+    print_header();
     while (fgets(line, sizeof line, stdin) != NULL) {
         ++n;
         if (!parse(line, &kind, &t, v)) {

@@ -171,6 +171,7 @@ def write_ekf_headers(folder, name=EKF_TASK):
     if task.sensors is None:
         raise ValueError(f"{task.source}: sensors: the example runs on sensors; the task has no [sensors]")
     folder = pathlib.Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
     write_text(folder / "lqr_task.h", header(task, task.controller()))
     write_text(folder / "ekf_task.h", ekf_header(task, task.make_estimator()))
     return task
@@ -182,3 +183,13 @@ def sample_events(result):
     return "".join(" ".join([str(EVENT_CODES[kind]), repr(float(t)), *(repr(float(v)) for v in
                                                                        (() if row is None else row))]) + "\n"
                    for t, kind, row in result.samples)
+
+
+def write_ekf_vector(folder, duration=1.0, name=EKF_TASK):
+    """The firmware example's recorded input for the cross builds (c/examples/ekf_lqr_vector/):
+    its two headers and events.txt, the first `duration` s of the Python run of `name` on sensors."""
+    from .benchmark import run_task
+    task = write_ekf_headers(folder, name)
+    task = dataclasses.replace(task, scenario=task.scenario.with_overrides(steps=round(duration / task.scenario.dt)))
+    write_text(pathlib.Path(folder) / "events.txt", sample_events(run_task(task)[0]))
+    return task

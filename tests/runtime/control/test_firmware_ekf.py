@@ -19,7 +19,7 @@ pytestmark = pytest.mark.skipif(not (MAKE and shutil.which("cc")), reason="needs
 
 def run_firmware(exe, events):
     out = subprocess.run([str(exe)], input=events, check=True, capture_output=True, text=True).stdout
-    return np.loadtxt(out.splitlines(), delimiter=",")
+    return np.loadtxt(out.splitlines()[1:], delimiter=",")
 
 
 @pytest.fixture(scope="module")
