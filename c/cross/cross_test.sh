@@ -14,6 +14,8 @@
 #     (tools/compare_runs.py: double identical; float within 1e-4 m at 10 s): the open-loop t-shape and
 #     the closed loop (the LQR at 100 Hz, c/examples/firmware_lqr.c); the double t-shape again
 #     with -ffp-contract=fast must be caught, and its difference is printed (also the float one);
+#     the loop on the estimator (c/examples/firmware_ekf_lqr.c on the recorded samples of
+#     examples/ekf_lqr_vector) against the host build of its precision;
 #  7. the CMake toolchain file (c/cmake/arm-none-eabi.cmake): both libraries configured and built
 #     for the two CPUs, and checked like the Makefile's;
 #  8. the M4 sizes and stacks (tools/m4_report.py): a Lie-Euler-only firmware linked and run under QEMU,
@@ -144,6 +146,26 @@ run_qemu mps2-an386 "$M4_DIR/firmware_lqr_f" "$OUT/lqr_f.m4.csv" || fail "Cortex
 python3 ../tools/compare_runs.py double-libm "$OUT/lqr.host.csv" "$OUT/lqr.m7.csv" || fail "Cortex-M7 closed loop"
 python3 ../tools/compare_runs.py float "$OUT/lqr_f.host.csv" "$OUT/lqr_f.m4.csv" "$OUT/lqr.host.csv" ||
     fail "Cortex-M4F closed loop"
+
+step "firmware example on the estimator (sensor samples in, EKF, LQR; examples/ekf_lqr_vector, 1 s) under QEMU"
+EKF_VECTOR=examples/ekf_lqr_vector
+$MAKE --no-print-directory BUILD="$HOST_DIR" CPPFLAGS="-I$EKF_VECTOR" "$HOST_DIR/firmware_ekf_lqr" \
+    "$HOST_DIR/firmware_ekf_lqr_f" || fail "host build of the example on the estimator"
+cross_make "$M4_DIR" "$M4_CPU_FLAGS" mps2-an386.ld CPPFLAGS="-I$EKF_VECTOR" "$M4_DIR/firmware_ekf_lqr_f" ||
+    fail "Cortex-M4F build of the example on the estimator"
+cross_make "$M7_DIR" "$M7_CPU_FLAGS" mps2-an500.ld CPPFLAGS="-I$EKF_VECTOR" "$M7_DIR/firmware_ekf_lqr" ||
+    fail "Cortex-M7 build of the example on the estimator"
+"$HOST_DIR/firmware_ekf_lqr" <"$EKF_VECTOR/events.txt" >"$OUT/ekf.host.csv" || fail "host double, on the estimator"
+"$HOST_DIR/firmware_ekf_lqr_f" <"$EKF_VECTOR/events.txt" >"$OUT/ekf_f.host.csv" || fail "host float, on the estimator"
+run_qemu mps2-an500 "$M7_DIR/firmware_ekf_lqr" "$OUT/ekf.m7.csv" <"$EKF_VECTOR/events.txt" ||
+    fail "Cortex-M7 example on the estimator exited with $?"
+run_qemu mps2-an386 "$M4_DIR/firmware_ekf_lqr_f" "$OUT/ekf_f.m4.csv" <"$EKF_VECTOR/events.txt" ||
+    fail "Cortex-M4F example on the estimator exited with $?"
+# Both against the host build of their precision: identical, or within 1e-12 relative where newlib's
+# and glibc's atan2, sin and cos round an argument differently.
+python3 ../tools/compare_runs.py double-libm "$OUT/ekf.host.csv" "$OUT/ekf.m7.csv" || fail "Cortex-M7, on the estimator"
+python3 ../tools/compare_runs.py double-libm "$OUT/ekf_f.host.csv" "$OUT/ekf_f.m4.csv" || fail "Cortex-M4F, on the estimator"
+"${CROSS_PREFIX}size" "$M4_DIR/firmware_ekf_lqr_f" "$M7_DIR/firmware_ekf_lqr"
 
 # A slightly different kernel must be caught: the same double build with fused multiply-adds
 # (-ffp-contract=fast; the M7's FPU has VFMA).  Its distance from the host is what contraction

@@ -2,13 +2,15 @@
 a folder per run with summary.json (metrics under `tracking`, the contact force's extremes under `contact`)
 and figures.
 
-    python -m runtime control [--out out/control] [--tasks circle,line] [--duration S]
+    python -m runtime control [--out out/control] [--tasks circle,line] [--duration S] [--sensors FILE]
     python -m runtime control --offsets [--only TEXT] [--out out/control] [--duration S]
 
-`--duration` cuts every task short (a smoke run; the table then says so).  `--offsets` runs the
-offset table instead (runtime/control/offsets.py): the LQR and the NMPC on the circle and the line
-against a plant with one constant mismatch or on an unmodelled slope, out/control/offsets.md and
-.csv; `--only` keeps the cases whose "task plant controller" contains TEXT.
+`--duration` cuts every task short (a smoke run; the table then says so).  `--sensors` runs every
+task on the C EKF of these sensors (a shipped set or a sensors file) instead of its own measurement;
+a task's `[sensors]` does so for that task.  `--offsets` runs the offset table instead
+(runtime/control/offsets.py): the LQR and the NMPC on the circle and the line against a plant with
+one constant mismatch or on an unmodelled slope, out/control/offsets.md and .csv; `--only` keeps the
+cases whose "task plant controller" contains TEXT.
 """
 import argparse
 import csv
@@ -19,15 +21,19 @@ import subprocess
 import pathlib
 import sys
 
+import numpy as np
 from tqdm.auto import tqdm
 
 from ..atomic import atomic_path, write_text
 from ..contact import contact_summary
 from ..model import Model
-from .closed_loop import simulate_closed_loop
+from ..sensor_set import load_sensor_set
+from ..state import IDX_Q
+from .closed_loop import simulate_closed_loop, simulate_on_sensors
+from .geometry import heading, wrap_angle
 from .metrics import tracking_metrics
 from .offsets import OFFSET_CONTROLLERS, offset_cases, with_controller
-from .plots import plot_run
+from .plots import plot_estimate, plot_run
 from .task import load_task, shipped_tasks
 
 COLUMNS = ("cross_track_rms_m", "cross_track_max_m", "heading_settle_s", "speed_settle_s", "overshoot",
@@ -48,9 +54,14 @@ def run_task(task, progress=False):
     before anything is built if the run would not fit the memory budget."""
     task.check_memory()
     reference = task.reference()
-    result = simulate_closed_loop(task.plant_params, task.controller(), reference, task.scenario.x0,
-                                  task.duration, task.scenario.dt, task.scenario.method, task.noise, progress,
-                                  task.make_estimator())
+    if task.sensors is not None:
+        result = simulate_on_sensors(task.plant_params, task.controller(), reference, task.scenario.x0,
+                                     task.duration, task.scenario.dt, task.make_estimator(), task.sensors,
+                                     task.scenario.method, task.noise.seed, progress)
+    else:
+        result = simulate_closed_loop(task.plant_params, task.controller(), reference, task.scenario.x0,
+                                      task.duration, task.scenario.dt, task.scenario.method, task.noise, progress,
+                                      task.make_estimator())
     every = max(1, round(1 / (task.rate * task.scenario.dt)))
     return result, reference, tracking_metrics(result, reference, task.reference_spec["kind"],
                                                task.plant_params.r, sample_every=every)
@@ -60,6 +71,17 @@ def run_contact(task, result):
     """The contact force's extremes and flags (runtime.contact) along a run of `task`, on its plant."""
     forces = Model(task.plant_params).contact_force(result.trajectory, result.torques)
     return contact_summary(result.time, forces, task.scenario.friction)
+
+
+def estimate_errors(result):
+    """RMS and largest errors of the estimate the controller read against the plant's state at its
+    samples: position [m] and heading [deg]."""
+    per = round((len(result.time) - 1) / len(result.control_time))
+    true, est = result.trajectory[:-1:per], result.estimates
+    dq = np.linalg.norm(est[:, IDX_Q][:, :2] - true[:, IDX_Q][:, :2], axis=1)
+    dpsi = np.degrees(wrap_angle(heading(est) - heading(true)))
+    return {"position_rms_m": float(np.sqrt(np.mean(dq ** 2))), "position_max_m": float(dq.max()),
+            "heading_rms_deg": float(np.sqrt(np.mean(dpsi ** 2))), "heading_max_deg": float(np.abs(dpsi).max())}
 
 
 def _fmt(value):
@@ -81,6 +103,8 @@ def main(argv=()):
                         "contains this text")
     parser.add_argument("--controllers", default=",".join(OFFSET_CONTROLLERS),
                         help="with --offsets: comma-separated controller kinds")
+    parser.add_argument("--sensors", metavar="FILE", default=None,
+                        help="run every task on the C EKF of these sensors (a shipped set or a sensors file)")
     args = parser.parse_args(list(argv))
     if args.duration is not None and not args.duration > 0:
         parser.error(f"--duration: must be > 0 s, got {args.duration:g}")
@@ -97,6 +121,9 @@ def main(argv=()):
         return offset_table(out, args.duration, args.only, kinds)
     try:
         tasks = [load_task(name) for name in args.tasks.split(",")]
+        if args.sensors is not None:
+            sensors = load_sensor_set(args.sensors)
+            tasks = [task.with_sensors(sensors) for task in tasks]
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -129,8 +156,12 @@ def main(argv=()):
         summary = {"task": name, "controller": task.controller_kind, "rate_hz": task.rate, "u_max": task.u_max,
                    "duration_s": task.duration, "cpu": cpu_name(), "tracking": metrics,
                    "contact": run_contact(task, result)}
+        if task.sensors is not None:
+            summary["estimate"] = estimate_errors(result)
         write_text(folder / "summary.json", json.dumps(summary, indent=2) + "\n")
         plot_run(result, reference, task, folder / "tracking.png")
+        if task.sensors is not None:
+            plot_estimate(result, reference, task, folder / "estimate.png")
         rows.append({"task": name, "controller": task.controller_kind, **metrics})
     header = ["task", "controller", *COLUMNS]
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]

@@ -5,14 +5,23 @@ noise if asked) or, with an estimator (`[estimator]` in a task file), the estima
 after that measurement; its torques are held constant, and the plant advances by
 `Model.simulate` (the guarded C loop) for the period's steps.  The plant may have other
 parameters than the controller's model (`[plant]` in a task file).
+
+On sensors (`simulate_on_sensors`, a task's `[sensors]`), the controller never sees the plant's
+state: the plant steps one step at a time under the set's process noise while runtime/sensor_sim.py
+reads its sensors, every sample goes to the C EKF (`estimator.SensorEkf`) when it arrives, and the
+controller reads the filter's estimate predicted to its sample time.  A sample taken at a
+controller's sample time is read under that sample's new torques, so it reaches the filter just
+after the controller has used the estimate: the firmware's order (estimate, control, then read).
 """
 import dataclasses
+import heapq
 import time
 
 import numpy as np
 from tqdm.auto import tqdm
 
 from ..model import Model
+from ..sensor_sim import KINDS, SensorSimulation
 from ..state import IDX_Q, NU
 from ..validation import project_state
 from .geometry import heading
@@ -43,6 +52,8 @@ class ClosedLoopResult:
     solve_s: np.ndarray         # (k,) [s] the controller's computation time per sample
     wall_time_s: float
     estimates: np.ndarray | None = None   # (k, 35): what the controller was given, when an estimator ran
+    samples: list | None = None           # on sensors: (time [s], kind, reading) in the order applied, the
+    #                                       controller's samples among them as (t, "tick", None)
 
 
 def _measure(x, r, noise, rng):
@@ -59,6 +70,66 @@ def _measure(x, r, noise, rng):
     return project_state(y, r)
 
 
+def _period_steps(controller, dt):
+    per = round(controller.period / dt)
+    if per < 1 or abs(per * dt - controller.period) > 1e-9 * controller.period:
+        raise ValueError(f"controller.rate: the period 1/{controller.rate:g} s is not a whole number of "
+                         f"plant steps dt = {dt:g} s")
+    return per
+
+
+def _target(reference, controller, t, y):
+    target = reference.target(t, y[IDX_Q], float(heading(y)))
+    if getattr(reference, "is_path", False) and hasattr(controller, "preview_distances"):
+        target = dataclasses.replace(target, curvature_ahead=reference.curvature_ahead(
+            controller.preview_distances(target)))
+    return target
+
+
+def simulate_on_sensors(plant_params, controller, reference, x0, duration, dt, estimator, sensors, method="rkmk4",
+                        seed=0, progress=False):
+    """Run `controller` on `reference` from x0 for `duration` s on the estimate of `estimator`
+    (an `estimator.SensorEkf`) from the sensors `sensors` (a runtime.sensor_set.SensorSet) of the
+    plant, seeded by `seed`; the plant steps by `dt`, the controller's period a whole number of steps."""
+    per = _period_steps(controller, dt)
+    samples = round(duration / controller.period)
+    if samples < 1:
+        raise ValueError(f"duration: {duration:g} s is shorter than one controller period")
+    steps = samples * per
+    sim = SensorSimulation(Model(plant_params), sensors, dt, steps, method, seed)
+    traj = np.empty((steps + 1, x0.size))
+    torques = np.empty((steps + 1, NU))
+    estimates = np.empty((samples, x0.size))
+    applied, pending = [], []
+    traj[0] = x = x0
+    u = np.zeros(NU)
+    controller.reset(estimator.at(0.0, u))
+    if hasattr(reference, "reset"):
+        reference.reset()
+    started = time.perf_counter()
+    for k in tqdm(range(samples), disable=not progress or None, unit="sample", leave=False):
+        t = k * controller.period
+        y = estimates[k] = estimator.at(t, u)
+        applied.append((t, "tick", None))
+        u = controller.update(t, y, _target(reference, controller, t, y))
+        torques[k * per:(k + 1) * per] = u
+        for s in range(k * per, (k + 1) * per):
+            x, new = sim.advance(s, x, u)
+            traj[s + 1] = x
+            for kind, i in new:
+                heapq.heappush(pending, (sim.arrival(kind, i), KINDS.index(kind), i, kind))
+            while pending and pending[0][0] < (s + 1) * dt - 1e-9 * dt:
+                arrival, _, i, kind = heapq.heappop(pending)
+                estimator.sample(kind, arrival, sim.readings[kind][i], u)
+                applied.append((arrival, kind, sim.readings[kind][i]))
+    torques[-1] = torques[-2]
+    return ClosedLoopResult(time=np.arange(len(traj)) * dt, trajectory=traj, torques=torques,
+                            control_time=np.arange(samples) * controller.period,
+                            saturated_fraction=controller.saturated_fraction,
+                            solve_s=np.asarray(controller.solve_s), wall_time_s=time.perf_counter() - started,
+                            estimates=estimates, samples=applied)
+
+
 def simulate_closed_loop(plant_params, controller, reference, x0, duration, dt, method="rkmk4",
                          noise=Noise(), progress=False, estimator=None):
     """Run `controller` on `reference` from x0 for `duration` s; the plant steps by `dt`.
@@ -70,10 +141,7 @@ def simulate_closed_loop(plant_params, controller, reference, x0, duration, dt, 
     reads the sensors at that rate, between the controller's samples too, as a filter on a
     faster sensor bus would; without one it runs once per controller sample.
     """
-    per = round(controller.period / dt)
-    if per < 1 or abs(per * dt - controller.period) > 1e-9 * controller.period:
-        raise ValueError(f"controller.rate: the period 1/{controller.rate:g} s is not a whole number of "
-                         f"plant steps dt = {dt:g} s")
+    per = _period_steps(controller, dt)
     sub = 1                     # estimator samples per controller sample
     if estimator is not None and getattr(estimator, "rate", 0):
         sub = round(controller.period * estimator.rate)
@@ -103,11 +171,7 @@ def simulate_closed_loop(plant_params, controller, reference, x0, duration, dt, 
         if estimator is not None:
             y = estimator.reset(y) if k == 0 else estimator.update(y, u, period_e)
             estimates[k] = y
-        target = reference.target(k * controller.period, y[IDX_Q], float(heading(y)))
-        if getattr(reference, "is_path", False) and hasattr(controller, "preview_distances"):
-            target = dataclasses.replace(target, curvature_ahead=reference.curvature_ahead(
-                controller.preview_distances(target)))
-        u = controller.update(k * controller.period, y, target)
+        u = controller.update(k * controller.period, y, _target(reference, controller, k * controller.period, y))
         torques[k * per:(k + 1) * per] = u
         for j in range(sub):    # the estimator's samples between the controller's, u held
             at = k * per + j * per_e

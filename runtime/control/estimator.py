@@ -15,13 +15,19 @@ the shell's attitude, the joint encoders, the rates), so its Jacobian is the ide
 coordinates.  The process noise Σ_w is a white acceleration on the five rates (model mismatch:
 a heavier robot, other dampings); G_w puts it on ν.  The model is the controller's (its nominal
 parameters), never the plant's.
+
+`SensorEkf` is the robot's own filter instead: the C EKF (runtime/ekf.py) on an IMU, the encoders
+and optional fixes and heading (a task's `[sensors]`), which never sees the state itself.
 """
 import dataclasses
 
 import numpy as np
 
+from ..ekf import Ekf as CEkf
 from ..model import Model
 from ..schema import check_arguments
+from ..sensor_sim import ekf_noise
+from ..sensors import NEB
 from .ranges import ESTIMATOR_RANGES
 from ..state import IDX_E_NU, IDX_E_Q, IDX_E_TH_P, IDX_E_TH_Y, IDX_E_XI_S, NE
 
@@ -79,3 +85,47 @@ class Ekf:
         I_K = np.eye(NE) - K
         self.P = I_K @ P @ I_K.T + K @ self.R @ K.T          # Joseph form: stays symmetric positive
         return self.x
+
+
+#: The start's standard deviations of the filter on sensors: the robot placed where its task says to
+#: within 1 cm and 0.01 rad per axis, its rates known to 0.05 rad/s (it may start rolling).
+START_POSITION_M, START_ATTITUDE_RAD, START_RATE_RAD_S = 0.01, 0.01, 0.05
+
+
+class SensorEkf:
+    """The C EKF (runtime.ekf) on the samples of a sensor set, on the controller's model (`params`),
+    started at x0 (the task's initial state) with the START_* standard deviations and the set's
+    biases' spread.  `sample(kind, t, row, u)` applies one sample at time t (the filter predicted
+    there under the held torques u first); `at(t, u)` -> the estimate predicted to t."""
+    kind = "sensors"
+
+    def __init__(self, params, sensors, x0, method="rkmk4"):
+        noise = ekf_noise(sensors, params)
+        sigma = np.empty(NEB)
+        sigma[IDX_E_XI_S] = START_ATTITUDE_RAD
+        sigma[IDX_E_TH_Y] = sigma[IDX_E_TH_P] = noise.encoder
+        sigma[IDX_E_Q] = START_POSITION_M
+        sigma[IDX_E_NU] = START_RATE_RAD_S
+        sigma[NE:NE + 3], sigma[NE + 3:] = noise.gyro_bias, noise.accel_bias
+        self.sigma0 = sigma                 # the start's standard deviations (the firmware example's too)
+        self.filter = CEkf(Model(params), x0, sigma=sigma, noise=noise, mount=sensors.imu.mount, method=method)
+        self.t = 0.0
+
+    def at(self, t, u):
+        """The state estimate (35,) at t [s] >= the last sample's time, predicted under u."""
+        if t > self.t:
+            self.filter.predict(u, t - self.t)
+            self.t = t
+        return self.filter.x
+
+    def sample(self, kind, t, row, u):
+        """Apply one sample of `kind` ("imu", "encoders", "fixes", "heading") taken at t [s] while u acts."""
+        self.at(t, u)
+        if kind == "imu":
+            self.filter.update_imu(row, u)
+        elif kind == "encoders":
+            self.filter.update_encoders(row)
+        elif kind == "fixes":
+            self.filter.update_position(row)
+        else:
+            self.filter.update_heading(float(row[0]))

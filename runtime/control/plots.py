@@ -36,3 +36,33 @@ def plot_run(result, reference, task, path):
     fig.tight_layout()
     fig.savefig(path, dpi=80)
     plt.close(fig)
+
+
+def plot_estimate(result, reference, task, path):
+    """Draws a run on sensors: the cross-track error the controller believed (on the estimate)
+    against the true one (or, without a path, the estimated path against the true one), and the
+    estimate's position and heading errors; saves it to `path`."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    per = round((len(result.time) - 1) / len(result.control_time))
+    true, est, t = result.trajectory[:-1:per], result.estimates, result.control_time
+    fig, (a, b) = plt.subplots(1, 2, figsize=(12, 4.5))
+    if reference.is_path:
+        a.plot(t, reference.cross_track(true[:, IDX_Q][:, :2]), label="true")
+        a.plot(t, reference.cross_track(est[:, IDX_Q][:, :2]), lw=1, label="on the estimate")
+        a.set_xlabel("t [s]"), a.set_ylabel("cross-track [m]")
+    else:
+        a.plot(true[:, IDX_Q][:, 0], true[:, IDX_Q][:, 1], label="true path")
+        a.plot(est[:, IDX_Q][:, 0], est[:, IDX_Q][:, 1], lw=1, label="estimated path")
+        a.set_aspect("equal"), a.set_xlabel("x [m]"), a.set_ylabel("y [m]")
+    a.legend(), a.set_title(f"{task.name} ({task.controller_kind})")
+    b.plot(t, np.linalg.norm(est[:, IDX_Q][:, :2] - true[:, IDX_Q][:, :2], axis=1), label="position [m]")
+    b.set_xlabel("t [s]"), b.set_ylabel("m"), b.set_title("estimate − truth")
+    c = b.twinx()
+    c.plot(t, np.degrees(np.abs(wrap_angle(heading(est) - heading(true)))), color="C1", lw=1, label="heading [deg]")
+    c.set_ylabel("deg")
+    b.legend(handles=b.lines + c.lines)
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)

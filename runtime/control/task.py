@@ -30,7 +30,7 @@ from .nmpc import GAIN_NAMES as NMPC_GAIN_NAMES
 from .nmpc import NZ_N as NMPC_NZ
 from .nmpc import Nmpc, NmpcC, NmpcGains
 from .estimator import SETTING_NAMES as ESTIMATOR_SETTINGS
-from .estimator import Ekf, EkfSettings
+from .estimator import Ekf, EkfSettings, SensorEkf
 from .pid import GAIN_NAMES, Pid, PidGains
 from .ranges import CONTROLLER_RANGES, ESTIMATOR_RANGES, LQR_RANGES, NMPC_RANGES, PID_RANGES
 from .reference import KINDS, SpeedHeading, path_points, circle_path, figure8_path, line_path, waypoints_path
@@ -129,8 +129,17 @@ class Task:
         return cls(self.scenario.params, rate=self.rate, u_max=self.u_max, gains=self.gains)
 
     def make_estimator(self):
-        """The `[estimator]` on the controller's model (never the plant's), or None."""
+        """The filter on the controller's model (never the plant's): on the `[sensors]` a
+        `SensorEkf`, else the `[estimator]`'s `Ekf`, else None."""
+        if self.sensors is not None:
+            return SensorEkf(self.scenario.params, self.sensors, self.scenario.x0, self.scenario.method)
         return None if self.estimator is None else Ekf(self.scenario.params, self.estimator)
+
+    def with_sensors(self, sensors):
+        """The task on these sensors (runtime.sensor_set.SensorSet; None: on the state), instead of its
+        own `[sensors]`, `[estimator]` and measurement noise."""
+        return dataclasses.replace(self, scenario=dataclasses.replace(self.scenario, sensors=sensors),
+                                   estimator=None, noise=Noise(seed=self.noise.seed))
 
     def path_length(self):
         """The length [m] of path a run needs: the distance at the reference speed and 2 m more."""
@@ -147,8 +156,13 @@ class Task:
                              x0[IDX_Q][:2], spec.get("points"))
         if points is not None:
             parts["path table"] = points * PATH_ROW_BYTES
-        if self.estimator is not None:
+        if self.estimator is not None or self.sensors is not None:
             parts["estimates"] = (steps + 1) * memory.STATE_ROW_BYTES
+        if self.sensors is not None:
+            rate = sum(getattr(self.sensors, kind).rate for kind in ("imu", "encoders", "fixes", "heading")
+                       if getattr(self.sensors, kind) is not None)
+            # each sample: its reading's row and, in the closed loop's record, a tuple and a view of it
+            parts["sensor samples"] = (math.floor(self.duration * rate) + 4) * 256
         nmpc = [c for c in self.controllers if c.kind == "nmpc"]
         if nmpc:
             n = max(int(c.gains.horizon) for c in nmpc)
@@ -226,6 +240,9 @@ def parse_task(data, source="<task>", name="task"):
         controllers.append(spec)
     plant, noise = _parse_plant(data.get("plant", {}), scenario.params, source)
     estimator = _parse_estimator(data["estimator"], source) if "estimator" in data else None
+    if scenario.sensors is not None and (estimator is not None or noise.active):
+        raise ValueError(f"{source}: sensors: a task on sensors is estimated by the filter on them; "
+                         f"[estimator] and [plant]'s noise_* (the full state measured) do not apply")
     return Task(name=name, source=source, scenario=scenario, reference_spec=reference,
                 controllers=tuple(controllers), plant_params=plant, noise=noise, estimator=estimator)
 

@@ -17,12 +17,12 @@ import math
 
 import numpy as np
 
-from ..ekf import EkfNoise, start_from_measurements
+from ..ekf import start_from_measurements
 from ..model import Model
 from ..sensors import heading as heading_of
-from ..sensors import imu_partials
+from ..sensor_sim import ekf_noise
 from ..params import Params
-from ..state import (COLUMN_INDEX, IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WS, NX, STATE_COLUMNS, initial_state,
+from ..state import (COLUMN_INDEX, IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WS, NX, STATE_COLUMNS,
                      pendulum_angle, yoke_angle)
 
 #: The error state's names (the 12 error coordinates of Model.retract, then the IMU's biases), the
@@ -35,26 +35,6 @@ SETTLE_S = 10.0
 START_SAMPLES = 20
 #: The speeds' standard deviation [rad/s] at the start of a robot that already moves.
 MOVING_RATE_SIGMA = 2.0
-
-
-def ekf_noise(sensors, params, x0=None):
-    """The EkfNoise a log's sensor set declares.  The accelerometer's standard deviation adds to its
-    white noise what the process noise puts into its reading at the IMU's rate (the largest axis,
-    at x0: the robot at rest by default), because the filter's measurement model sees the applied
-    torques only."""
-    model = Model(params)
-    x0 = initial_state(r=params.r) if x0 is None else x0
-    imu = sensors.imu
-    _, _, Hn = imu_partials(model, x0, np.zeros(5), mount=imu.mount)
-    Minv = np.linalg.inv(model.inertia(x0))
-    q2 = sensors.process.generalized() ** 2 * imu.rate             # (q/√dt)² at the IMU's period
-    cov = Hn[3:] @ Minv @ np.diag(q2) @ Minv.T @ Hn[3:].T
-    return EkfNoise(gyro=imu.gyro_noise, accel=math.sqrt(imu.accel_noise ** 2 + float(np.max(np.diag(cov)))),
-                    gyro_bias=imu.gyro_bias, accel_bias=imu.accel_bias,
-                    encoder=sensors.encoders.step / math.sqrt(12),
-                    position=sensors.fixes.noise if sensors.fixes is not None else EkfNoise.position,
-                    heading=sensors.heading.noise if sensors.heading is not None else EkfNoise.heading,
-                    torque_psd=float(np.max(sensors.process.generalized())))
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

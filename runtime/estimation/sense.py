@@ -6,14 +6,9 @@ noise driving the truth (docs/estimation.md, "Simulated logs").
     write_log(log, "out/t-shape-log")
 
 The truth is the verified model on the C steppers (the scenario's integrator and dt) under the
-applied torques and a white torque disturbance w on the shell (three axes) and both joints, of
-spectral densities q (`ProcessNoise`): over each step dt, w is a constant generalized force of
-standard deviation q/√dt on ν = (ω_S, ω_Y, ω_P).  Its velocity change M⁻¹ w τ after a time τ into the
-step is added to the step's state (the first-order effect of the force), and the accelerometer
-reads its acceleration M⁻¹ w.  Every sensor samples at k/rate (k = 0, 1, ...) up to the end of
-the run; between steps the state is the stepper's over the partial step.  Readings: runtime.sensors
-(the truth's robot), plus per-run biases, white noise, the IMU's saturation at its full scale,
-the encoders' quantisation, the fixes' latency.  Seeded: one seed gives the same log.
+applied torques and the set's white torque disturbance, read by runtime/sensor_sim.py (the same
+simulation the closed loop on the estimator runs): per-run biases, white noise, the IMU's
+saturation, the encoders' quantisation, the fixes' latency.  Seeded: one seed gives the same log.
 """
 import dataclasses
 import math
@@ -25,17 +20,12 @@ from .. import memory
 from ..model import Model
 from ..scenario import Scenario
 from ..sensor_set import SensorSet
-from ..sensors import encoders, heading, imu, position
-from ..state import COLUMN_INDEX, IDX_NU, IDX_Q
+from ..sensor_sim import SensorSimulation
+from ..state import COLUMN_INDEX, IDX_Q
 from .logs import COLUMNS, Log, samples
 
 #: `plant_mismatch`: the truth's masses and inertias times this, its dampings times DAMPING_FACTOR.
 MASS_FACTOR, DAMPING_FACTOR = 1.1, 0.8
-#: The random streams of a run, each its own child of the seed: changing one sensor's rate or noise
-#: leaves the others' draws alone.
-STREAMS = ("process", "bias", "imu", "encoders", "fixes", "heading")
-#: The numbers of one reading of each sensor.
-_WIDTH = {"imu": 6, "encoders": 2, "fixes": 2, "heading": 1}
 
 
 def mismatched(params):
@@ -48,12 +38,6 @@ def mismatched(params):
     heavier = {k: getattr(params, k) * MASS_FACTOR for k in ("m_S", "m_Y", "m_P", "j_S")}
     heavier.update({k: tuple(map(tuple, np.asarray(getattr(params, k)) * MASS_FACTOR)) for k in ("J_Y", "J_P")})
     return params.replace(**heavier, **damping)
-
-
-def sample_times(rate, duration):
-    """k / rate for k = 0, 1, ... up to `duration` (with a 1e-9 relative allowance)."""
-    n = math.floor(duration * rate * (1 + 1e-12) + 1e-9) + 1
-    return np.arange(n) / rate
 
 
 def memory_estimate(steps, duration, sensors):
@@ -123,62 +107,18 @@ def simulate_log(run, sensors=None, seed=0, plant_mismatch=False, progress=None,
     memory.check(scenario.source, memory_estimate(steps, duration, sensors))
     torque = _OpenLoop(scenario) if isinstance(run, Scenario) else _ClosedLoop(run)
     started = time.perf_counter()
-    plant = Model(truth_params)
-    rng = dict(zip(STREAMS, map(np.random.default_rng, np.random.SeedSequence(seed).spawn(len(STREAMS)))))
-    imu_spec, mount = sensors.imu, sensors.imu.mount
-    bias = np.concatenate([rng["bias"].normal(0.0, imu_spec.gyro_bias, 3),
-                           rng["bias"].normal(0.0, imu_spec.accel_bias, 3)])
-    q_std = sensors.process.generalized() / math.sqrt(dt)
-    fix_latency = sensors.fixes.latency if sensors.fixes is not None else 0.0
-    times = {kind: sample_times(getattr(sensors, kind).rate, duration)
-             for kind in ("imu", "encoders", "fixes", "heading") if getattr(sensors, kind) is not None}
-    if "fixes" in times:                     # measured at k/rate, logged on arrival within the run
-        times["fixes"] = times["fixes"][times["fixes"] + fix_latency <= duration * (1 + 1e-12) + 1e-9]
-    readings = {kind: np.empty((len(t), _WIDTH[kind])) for kind, t in times.items()}
-    cursor = dict.fromkeys(times, 0)
+    sim = SensorSimulation(Model(truth_params), sensors, dt, steps, method, seed, disturbance_in_accel)
     truth = np.empty((steps + 1, len(COLUMN_INDEX)))
     applied = np.empty((steps + 1, 2))
     x = scenario.x0.copy()
-
-    def read(kind, i, xs, u, nu_dot_w):
-        if kind == "imu":
-            a = plant.accel(xs, u) + (nu_dot_w if disturbance_in_accel else 0.0)
-            y = imu(plant, xs, a, mount=mount, bias=bias)
-            y += rng["imu"].normal(0.0, 1.0, 6) * np.repeat([imu_spec.gyro_noise, imu_spec.accel_noise], 3)
-            limits = np.repeat([imu_spec.gyro_range, imu_spec.accel_range], 3)
-            readings[kind][i] = np.clip(y, -limits, limits)
-        elif kind == "encoders":
-            step = sensors.encoders.step
-            readings[kind][i] = np.round(encoders(plant, xs) / step) * step
-        elif kind == "fixes":
-            readings[kind][i] = position(plant, xs) + rng["fixes"].normal(0.0, sensors.fixes.noise, 2)
-        else:
-            psi = heading(plant, xs, mount) + rng["heading"].normal(0.0, sensors.heading.noise)
-            readings[kind][i] = math.remainder(psi, 2 * math.pi)
-
     for k in range(steps + 1):
-        t_k = k * dt
         truth[k] = x[COLUMN_INDEX]
         u = torque(k, x) if k < steps else applied[k - 1]    # the last row starts no step: held
         applied[k] = u
-        w = rng["process"].normal(0.0, 1.0, 5) * q_std if k < steps else np.zeros(5)
-        nu_dot_w = np.linalg.solve(plant.inertia(x), w)
-        end = t_k + dt if k < steps else math.inf
-        for kind, t in times.items():
-            while cursor[kind] < len(t) and t[cursor[kind]] < end - 1e-9 * dt:
-                tau = t[cursor[kind]] - t_k
-                if tau <= 1e-9 * dt:
-                    xs = x
-                else:
-                    xs = plant.step(x, u, tau, method=method)
-                    xs[IDX_NU] += nu_dot_w * tau
-                read(kind, cursor[kind], xs, u, nu_dot_w)
-                cursor[kind] += 1
-        if k < steps:
-            x = plant.step(x, u, dt, method=method)
-            x[IDX_NU] += nu_dot_w * dt
+        x, _ = sim.advance(k, x, u, last=k == steps)
         if progress is not None and k % 1000 == 0:
             progress(k, steps)
+    times, readings, bias, fix_latency = sim.times, sim.readings, sim.bias, sim.latency
     fixes = None
     if "fixes" in times:
         fixes = samples("fixes", times["fixes"] + fix_latency, np.column_stack([times["fixes"], readings["fixes"]]))

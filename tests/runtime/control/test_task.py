@@ -2,6 +2,7 @@
 import pytest
 
 from runtime.control.task import load_task, parse_task, shipped_tasks
+from runtime.sensor_set import SensorSet
 
 BASE = {"dt": 0.005, "duration": 1.0, "params": {"preset": "paper_simulation"},
         "reference": {"kind": "speed", "speed": 0.3}, "controller": {"kind": "pid", "rate": 50.0}}
@@ -16,8 +17,18 @@ def with_(section, **values):
 def test_the_six_tasks_of_issue_20_ship():
     assert set(shipped_tasks()) >= {"speed-step", "heading-step", "line", "circle", "figure8", "square"}
     for name in shipped_tasks():
+        if load_task(name).sensors is not None:
+            continue                    # on the estimator: the LQR and the C NMPC (test_on_sensors.py)
         assert load_task(name).controller_kinds == ("pid", "lqr", "nmpc")
         assert load_task(name).with_controller("nmpc").rate == 20.0
+
+
+def test_the_tasks_on_sensors_run_the_lqr_and_the_c_nmpc_on_the_default_set():
+    on_sensors = [name for name in shipped_tasks() if load_task(name).sensors is not None]
+    assert sorted(on_sensors) == ["circle-sensors", "heading-step-sensors", "line-sensors"]
+    for name in on_sensors:
+        assert load_task(name).controller_kinds == ("lqr", "nmpc-c")
+        assert load_task(name).sensors == SensorSet.default()
 
 
 @pytest.mark.parametrize("section, values, named", [

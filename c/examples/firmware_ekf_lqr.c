@@ -1,0 +1,138 @@
+/*
+ * firmware_ekf_lqr.c -- a closed-loop firmware example on the robot's own sensors: sensor samples
+ * in, the error-state EKF (sr_ekf_*), the LQR (sr_lqr_control) on its estimate, torques out; no
+ * Python, no heap.
+ *
+ * The task comes from two headers on the include path, written by runtime/control/firmware.py
+ * (`write_ekf_headers`): lqr_task.h (the LQR's schedule, the initial state, the constant target,
+ * the controller's rate) and ekf_task.h (the filter's start, noise, IMU mount and gates).  On a
+ * robot the samples come from the sensor drivers; here they come from stdin, one event a line,
+ * in the order they reach the filter (times in s, numbers as %.17g prints them):
+ *
+ *   0 t                    a controller tick at t
+ *   1 t g_x g_y g_z a_x a_y a_z   an IMU sample (gyroscope [rad/s], accelerometer [m/s^2])
+ *   2 t theta_Y theta_P    an encoder sample [rad]
+ *   3 t q_x q_y            a position fix [m], at its arrival
+ *   4 t psi                a heading [rad]
+ *
+ * Every event first predicts the filter from its last time to t under the torques held since the
+ * last tick; a tick then runs the LQR on the estimate and holds its torques until the next tick.
+ * Output (stdout): CSV, a header line (as firmware_lqr.c's) then one row per tick: t, the 35 estimated state entries (spherical_robot.h's
+ * order) and the torques u_Y, u_P, %.17g.  In the double build the rows equal, bit for bit, the
+ * Python closed loop on the estimator of the same task fed the same samples
+ * (runtime.control.closed_loop.simulate_on_sensors, tests/runtime/control/test_firmware.py).
+ * Exit status 0 on success; on an error, a message on stderr and 1.
+ */
+#include <stdio.h>
+#include <stdlib.h>
+
+#include <ekf_task.h>
+#include <lqr_task.h>
+#include "sr_ekf.h"
+#include "spherical_robot.h"
+
+#define MAX_LINE 1024
+
+/* The numbers after the kind and the time on a line of each kind. */
+static const int WIDTH[5] = {0, SR_NIMU, 2, 2, 1};
+
+static void print_header(void)
+{
+    static const char *const blocks[] = {"RS", "RY", "RP"};
+    int b, i, j;
+    printf("t");
+    for (b = 0; b < 3; ++b)
+        for (i = 0; i < 3; ++i)
+            for (j = 0; j < 3; ++j) printf(",%s_%d%d", blocks[b], i, j);
+    printf(",q_x,q_y,q_z,w_Sx,w_Sy,w_Sz,w_Y,w_P,u_Y,u_P\n");
+}
+
+static void print_row(double t, const sr_real x[SR_NX], const sr_real u[SR_NU])
+{
+    int i;
+    printf("%.17g", t);
+    for (i = 0; i < SR_NX; ++i) printf(",%.17g", (double)x[i]);
+    printf(",%.17g,%.17g\n", (double)u[0], (double)u[1]);
+}
+
+/* One event line: its kind, time and numbers; 0 when it is not a whole event. */
+static int parse(const char *line, int *kind, double *t, sr_real v[SR_NIMU])
+{
+    char *end;
+    int i;
+    long k = strtol(line, &end, 10);
+    if (end == line || k < 0 || k > 4) return 0;
+    *kind = (int)k;
+    line = end;
+    *t = strtod(line, &end);
+    if (end == line) return 0;
+    for (i = 0; i < WIDTH[*kind]; ++i) {
+        line = end;
+        v[i] = (sr_real)strtod(line, &end);
+        if (end == line) return 0;
+    }
+    return 1;
+}
+
+int main(void)
+{
+    static const sr_real zero_bias[SR_NBIAS] = {0};
+    const sr_lqr_target target = {LQR_TASK_SPEED, LQR_TASK_HEADING, 0, 0, 0};
+    const sr_ekf_process process = {{EKF_TASK_TORQUE_PSD, EKF_TASK_TORQUE_PSD, EKF_TASK_TORQUE_PSD},
+                                    EKF_TASK_GYRO_BIAS_RW, EKF_TASK_ACCEL_BIAS_RW};
+    sr_model model;
+    sr_lqr_memory memory;
+    sr_ekf ekf;
+    sr_real u[SR_NU] = {0, 0}, v[SR_NIMU];
+    double t_now = 0.0, t;
+    char line[MAX_LINE];
+    long n = 0;
+    int kind, status;
+
+    status = sr_model_init(&model, LQR_TASK_PARAMS);
+    if (status == SR_OK) status = sr_lqr_check(&LQR_TASK_SCHEDULE);
+    if (status == SR_OK) status = sr_lqr_reset(&memory);
+    if (status == SR_OK) status = sr_ekf_init_diagonal(&ekf, &model, LQR_TASK_X0, zero_bias, EKF_TASK_SIGMA);
+    if (status != SR_OK) {
+        fprintf(stderr, "firmware_ekf_lqr: setup failed: %s\n", sr_status_string(status));
+        return 1;
+    }
+    print_header();
+    while (fgets(line, sizeof line, stdin) != NULL) {
+        ++n;
+        if (!parse(line, &kind, &t, v)) {
+            fprintf(stderr, "firmware_ekf_lqr: line %ld: not an event\n", n);
+            return 1;
+        }
+        status = SR_OK;
+        if (t > t_now) { /* the filter's time, as the Python loop's: predicted only forward */
+            status = sr_ekf_predict(&ekf, &model, EKF_TASK_METHOD, u, (sr_real)(t - t_now), &process);
+            t_now = t;
+        }
+        if (status == SR_OK) switch (kind) {
+        case 0:
+            status = sr_lqr_control(&LQR_TASK_SCHEDULE, &model, ekf.x, &target, &memory, u, NULL);
+            if (status == SR_OK) print_row(t, ekf.x, u);
+            break;
+        case 1:
+            status = sr_ekf_update_imu(&ekf, &model, v, u, EKF_TASK_BODY, EKF_TASK_MOUNT, EKF_TASK_GYRO,
+                                       EKF_TASK_ACCEL, EKF_TASK_GATE_IMU);
+            break;
+        case 2:
+            status = sr_ekf_update_encoders(&ekf, &model, v, EKF_TASK_ENCODER, EKF_TASK_GATE_ENCODERS);
+            break;
+        case 3:
+            status = sr_ekf_update_position(&ekf, &model, v, EKF_TASK_POSITION, EKF_TASK_GATE_POSITION);
+            break;
+        default:
+            status = sr_ekf_update_heading(&ekf, &model, v[0], EKF_TASK_BODY, EKF_TASK_MOUNT, EKF_TASK_HEADING,
+                                           EKF_TASK_GATE_HEADING);
+            break;
+        }
+        if (status != SR_OK) {
+            fprintf(stderr, "firmware_ekf_lqr: line %ld failed: %s\n", n, sr_status_string(status));
+            return 1;
+        }
+    }
+    return 0;
+}

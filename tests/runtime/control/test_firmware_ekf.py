@@ -1,0 +1,62 @@
+"""The firmware example on the estimator (c/examples/firmware_ekf_lqr.c: sensor samples in, the C EKF,
+the LQR, torques out) equals the Python closed loop on the estimator bit for bit (double build, host)."""
+import dataclasses
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import ROOT
+from runtime.control.benchmark import run_task
+from runtime.control.firmware import sample_events, write_ekf_headers
+
+C_DIR = ROOT / "c"
+DURATION = 4.0
+MAKE = shutil.which("make")
+pytestmark = pytest.mark.skipif(not (MAKE and shutil.which("cc")), reason="needs make and a C compiler")
+
+
+def run_firmware(exe, events):
+    out = subprocess.run([str(exe)], input=events, check=True, capture_output=True, text=True).stdout
+    return np.loadtxt(out.splitlines()[1:], delimiter=",")
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """(firmware executable, the Python run's events, its result, the controller's steps per sample)."""
+    tmp = tmp_path_factory.mktemp("firmware-ekf")
+    task = write_ekf_headers(tmp)
+    task = dataclasses.replace(task, scenario=task.scenario.with_overrides(steps=round(DURATION / task.scenario.dt)))
+    exe = tmp / "build" / "firmware_ekf_lqr"
+    subprocess.run([MAKE, "-s", "-C", str(C_DIR), f"BUILD={tmp / 'build'}", f"CPPFLAGS=-I{tmp}", str(exe)],
+                   check=True, capture_output=True, text=True)
+    result = run_task(task)[0]
+    return exe, sample_events(result), result, round(1 / (task.rate * task.scenario.dt))
+
+
+def same_run(rows, result, per):
+    return (rows.shape == (len(result.control_time), 38) and np.array_equal(rows[:, 0], result.control_time)
+            and np.array_equal(rows[:, 1:36], result.estimates)
+            and np.array_equal(rows[:, 36:38], result.torques[:-1:per]))
+
+
+def test_the_firmware_on_the_estimator_equals_the_python_closed_loop_bit_for_bit(runs):
+    exe, events, result, per = runs
+    assert same_run(run_firmware(exe, events), result, per)
+
+
+def test_the_bit_for_bit_check_fails_for_one_imu_reading_changed_in_its_last_digit(runs):
+    exe, events, result, per = runs
+    lines = events.splitlines(keepends=True)
+    at = next(i for i, line in enumerate(lines) if line.startswith("1 ") and float(line.split()[1]) > 1.0)
+    fields = lines[at].split()
+    fields[-1] = repr(float(np.nextafter(float(fields[-1]), np.inf)))
+    lines[at] = " ".join(fields) + "\n"
+    assert not same_run(run_firmware(exe, "".join(lines)), result, per)
+
+
+def test_the_firmware_refuses_a_line_that_is_not_an_event(runs):
+    exe = runs[0]
+    done = subprocess.run([str(exe)], input="0 0.0\n7 0.1\n", capture_output=True, text=True)
+    assert done.returncode == 1 and "line 2: not an event" in done.stderr

@@ -1,0 +1,98 @@
+"""The closed loop on the estimator: the controller reads the C EKF's estimate from simulated sensors,
+never the plant's state, and tracks as it does on the state."""
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+from runtime.control.benchmark import estimate_errors, main, run_task
+from runtime.control.closed_loop import simulate_on_sensors
+from runtime.control.estimator import SensorEkf
+from runtime.control.task import load_task, parse_task
+from runtime.sensor_set import SensorSet
+from runtime.state import IDX_Q
+
+DURATION = 5.0
+
+
+def short(name, sensors=None):
+    task = load_task(name).with_controller("lqr")
+    task = dataclasses.replace(task, scenario=dataclasses.replace(task.scenario,
+                                                                  steps=round(DURATION / task.scenario.dt)))
+    return task if sensors is None else task.with_sensors(sensors)
+
+
+class ShiftedEkf(SensorEkf):
+    """A wrong estimate: the filter's, 0.2 m further left of the circle's centre than it is."""
+
+    def at(self, t, u):
+        x = super().at(t, u)
+        x[IDX_Q.start] -= 0.2
+        return x
+
+
+def run_on(task, estimator):
+    return simulate_on_sensors(task.plant_params, task.controller(), task.reference(), task.scenario.x0,
+                               task.duration, task.scenario.dt, estimator, task.sensors, task.scenario.method)
+
+
+@pytest.fixture(scope="module")
+def on_state():
+    return run_task(short("circle"))[0]
+
+
+@pytest.fixture(scope="module")
+def on_sensors():
+    task = short("circle", SensorSet.default())
+    return task, run_on(task, task.make_estimator())
+
+
+def assert_tracks_as_on_the_state(result, on_state):
+    gap = np.linalg.norm(result.trajectory[:, IDX_Q][:, :2] - on_state.trajectory[:, IDX_Q][:, :2], axis=1)
+    assert gap.max() < 0.03, f"the true path strays {gap.max():.3f} m from the run on the state"
+
+
+def test_the_true_path_on_the_estimate_stays_with_the_path_on_the_state(on_sensors, on_state):
+    assert_tracks_as_on_the_state(on_sensors[1], on_state)
+
+
+def test_a_wrong_estimate_takes_the_robot_off_the_path(on_sensors, on_state):
+    task = on_sensors[0]
+    wrong = run_on(task, ShiftedEkf(task.scenario.params, task.sensors, task.scenario.x0))
+    with pytest.raises(AssertionError):
+        assert_tracks_as_on_the_state(wrong, on_state)
+
+
+def test_the_controller_reads_an_estimate_not_the_state(on_sensors):
+    errors = estimate_errors(on_sensors[1])
+    assert 0 < errors["position_rms_m"] < 0.02
+    assert 0 < errors["heading_rms_deg"] < 2.0
+
+
+def test_the_filter_gets_every_sample_the_sensors_declare(on_sensors):
+    task, result = on_sensors
+    kinds = [kind for _, kind, _ in result.samples]
+    assert kinds.count("imu") == kinds.count("encoders") == round(DURATION * 200)
+    assert kinds.count("fixes") == round(DURATION * 2)
+    assert kinds.count("tick") == len(result.control_time)
+    arrivals = [t for t, kind, _ in result.samples if kind != "tick"]
+    assert arrivals == sorted(arrivals)
+
+
+def test_a_task_on_sensors_refuses_an_estimator_of_the_state():
+    data = {"dt": 0.005, "duration": 1.0, "reference": {"kind": "speed", "speed": 0.3},
+            "controller": {"kind": "pid", "rate": 50.0}, "sensors": {},
+            "estimator": {"kind": "ekf"}}
+    with pytest.raises(ValueError, match="sensors: a task on sensors"):
+        parse_task(data)
+    del data["estimator"]
+    assert parse_task(data).make_estimator().kind == "sensors"
+
+
+def test_the_control_command_runs_every_task_on_the_sensors_it_is_given(tmp_path):
+    assert main(["--tasks", "line", "--sensors", "imu-encoders", "--duration", "0.2", "--out", str(tmp_path)]) == 0
+    for kind in ("pid", "lqr", "nmpc"):
+        summary = json.loads((tmp_path / f"line-{kind}" / "summary.json").read_text())
+        assert summary["estimate"]["position_rms_m"] >= 0
+        assert (tmp_path / f"line-{kind}" / "estimate.png").is_file()
