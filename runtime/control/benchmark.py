@@ -4,7 +4,9 @@ and figures.
 
     python -m runtime control [--out out/control] [--tasks circle,line] [--duration S]
 
-`--duration` cuts every task short (a smoke run; the table then says so).
+`--duration` cuts every task short (a smoke run; the table then says so).  A task with the NMPC
+(kind nmpc) also runs the C NMPC (kind nmpc-c) on the same settings, in the row after it, unless it
+lists nmpc-c itself or its horizon exceeds the C NMPC's capacity.
 """
 import argparse
 import csv
@@ -23,6 +25,7 @@ from ..model import Model
 from .closed_loop import simulate_closed_loop
 from .metrics import tracking_metrics
 from .plots import plot_run
+from .ranges import NMPC_C_RANGES
 from .task import load_task, shipped_tasks
 
 COLUMNS = ("cross_track_rms_m", "cross_track_max_m", "heading_settle_s", "speed_settle_s", "overshoot",
@@ -36,6 +39,19 @@ def cpu_name():
         return next(line.split(":", 1)[1].strip() for line in out.splitlines() if line.startswith("Model name"))
     except (OSError, subprocess.CalledProcessError, StopIteration):
         return platform.processor() or "unknown CPU"
+
+
+def controller_runs(task):
+    """The task with each of its controllers in turn; after the NMPC, the C NMPC on its settings
+    (see the module)."""
+    runs = []
+    for kind in task.controller_kinds:
+        runs.append(task.with_controller(kind))
+        spec = runs[-1].controllers[0]
+        if kind == "nmpc" and "nmpc-c" not in task.controller_kinds and \
+                spec.gains.horizon <= NMPC_C_RANGES["horizon"].high:
+            runs.append(dataclasses.replace(runs[-1], controllers=(dataclasses.replace(spec, kind="nmpc-c"),)))
+    return runs
 
 
 def run_task(task, progress=False):
@@ -90,7 +106,7 @@ def main(argv=()):
     except OSError as exc:
         parser.error(f"--out: cannot create the folder {out} ({exc.strerror})")
     rows = []
-    runs = [(task.name, task.with_controller(kind)) for task in tasks for kind in task.controller_kinds]
+    runs = [(task.name, run) for task in tasks for run in controller_runs(task)]
     if args.duration is not None:
         runs = [(name, dataclasses.replace(task, scenario=dataclasses.replace(
             task.scenario, steps=max(1, round(min(args.duration, task.duration) / task.scenario.dt)))))
