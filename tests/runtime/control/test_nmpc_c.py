@@ -12,7 +12,7 @@ from runtime.casadi_model import parameter_vector
 from runtime.control import nmpc
 from runtime.control.benchmark import run_task
 from conftest import ROOT
-from runtime.control.nmpc_c import daqp_solution, design_initializer, recorded_qps, task_header
+from runtime.control.nmpc_c import daqp_solution, design_initializer, main, ratio_line, recorded_qps, task_header
 from runtime.control.task import load_task
 from runtime.params import Params
 
@@ -155,3 +155,15 @@ def test_the_shipped_design_check_fails_for_one_number_changed_in_its_sixth_digi
     value = _NUMBER.match(text, j).group()
     changed = text[:j] + repr(float(value) * (1 + 1e-6) + 1e-6) + text[j + len(value):]
     assert not same_design(changed, fresh_header)
+
+
+def test_the_bench_line_gives_the_python_to_c_ratio_of_each_percentile():
+    line = "samples 1200 p50_us 200.0 p99_us 400.0 max_us 900.0 cpu_p50_us 190.0"
+    out = ratio_line(line, (2.0, 8.0))
+    assert "C NMPC p50 0.200 ms, p99 0.400 ms" in out
+    assert "Python / C: 10 (p50), 20 (p99)" in out
+
+
+def test_a_negative_python_timing_span_is_a_named_error(capsys):
+    assert main(["--timing", "--against-python", "-1"]) == 2
+    assert "--against-python: must be >= 0 s" in capsys.readouterr().err
