@@ -24,8 +24,8 @@ run: $(STAMP)
 	$(PY) -m runtime run all --out out --force
 
 # The SymPy-emitted kernels (byte-reproducible), the extension rebuilt on them, then the firmware
-# example's gain table (generated/lqr_task.h: an LQR design through LAPACK, whose last bits vary
-# with the CPU; tests/runtime/control/test_firmware.py holds it to a fresh design within 1e-7).
+# examples' designs (generated/lqr_task.h and nmpc_task.h: designs through LAPACK, whose last bits vary
+# with the CPU; tests/runtime/control/test_firmware.py and test_nmpc_c.py hold them to fresh designs within 1e-7).
 # derive/ needs only SymPy and CasADi (the `derive` extra), not the compiled extension, so it runs
 # before the package is rebuilt: a C change that needs a newly emitted symbol then builds.
 DERIVE_DEPS = $(shell $(PYTHON) -c "import tomllib; print(' '.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['optional-dependencies']['derive']))")
@@ -35,12 +35,14 @@ generate:
 	$(PY) -m derive
 	$(MAKE) install
 	$(PY) -m runtime firmware-table --out generated/lqr_task.h
+	$(PY) -m runtime nmpc-c --header generated/nmpc_task.h
 
 verify: $(STAMP)
 	$(PY) -m runtime verify
 
 bench: $(STAMP)
 	$(PY) -m runtime bench --native
+	$(PY) -m runtime nmpc-c --timing --against-python 20
 	$(MAKE) sweep-bench
 
 # Sweep throughput on Dask (1 and 2 workers), overhead against the C batch, per-task cost, bytes

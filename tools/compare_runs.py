@@ -7,14 +7,14 @@
         differing entries and the largest relative difference (relative to the larger of the two
         values and of the column's largest magnitude over the run) are printed, with whether it
         is within RELATIVE_TOL, the tolerance allowed for contraction; it still fails.
-    compare_runs.py double-libm HOST.csv TARGET.csv
+    compare_runs.py double-libm HOST.csv TARGET.csv [TOL]
         the same, for a program whose results pass through functions that newlib and glibc round
         differently (the closed loop: atan2 in the controller's Log and pendulum angle, sin and cos
-        of the heading): holds when identical or within RELATIVE_TOL.
+        of the heading): holds when identical or within TOL (default RELATIVE_TOL).
     compare_runs.py float HOST_F.csv TARGET_F.csv HOST_D.csv
         the float build on the Cortex-M4F against the host float build: the position q after
-        10 s (row t = 10) within Q_TOL metres; the distance of both from the host double build
-        is reported, at 10 s and at the end.
+        10 s (row t = 10, or the last row of a shorter run) within Q_TOL metres; the distance of
+        both from the host double build is reported, then and at the end.
 
 Each comparison is then repeated on a copy of the target's output with one entry perturbed (by
 one unit in the last place in double, by 1.5 Q_TOL in float), which must fail: the check is
@@ -55,15 +55,21 @@ def worst_relative(host, target):
     return worst
 
 
+def first_difference(host, target):
+    """The first row where the two runs differ."""
+    return next((i for i, (h, t) in enumerate(zip(host, target)) if h != t), min(len(host), len(target)))
+
+
 def double_holds(host, target, label, tol=0.0):
     if host == target:
         print(f"  {label}: identical ({len(target)} rows x {len(target[0])} entries)")
         return True
     rel, row, col = worst_relative(host, target)
     differing = sum(a != b for h, t in zip(host, target) for a, b in zip(h, t))
-    print(f"  {label}: NOT identical: {differing} entries differ, largest relative difference "
-          f"{rel:.3g} (row {row}, column {col}), {'within' if rel <= RELATIVE_TOL else 'beyond'} "
-          f"{RELATIVE_TOL:g}")
+    bound = max(tol, RELATIVE_TOL)
+    print(f"  {label}: NOT identical: {differing} entries differ (the first in row "
+          f"{first_difference(host, target)}), largest relative difference {rel:.3g} (row {row}, column {col}), "
+          f"{'within' if rel <= bound else 'beyond'} {bound:g}")
     return rel <= tol
 
 
@@ -78,13 +84,18 @@ def distance(a, b):
     return sum((x - y) ** 2 for x, y in zip(a[Q_COLUMNS], b[Q_COLUMNS])) ** 0.5
 
 
+def check_time(rows):
+    """T_CHECK, or the last row's time of a shorter run."""
+    return min(T_CHECK, rows[-1][0])
+
+
 def float_holds(host_f, target_f, host_d, label):
-    t_end = target_f[-1][0]
-    d_host = distance(row_at(target_f, T_CHECK), row_at(host_f, T_CHECK))
+    t_end, t_check = target_f[-1][0], check_time(host_f)
+    d_host = distance(row_at(target_f, t_check), row_at(host_f, t_check))
     ok = len(target_f) == len(host_f) and d_host <= Q_TOL
-    print(f"  {label}: |q_target - q_host_float| at t = {T_CHECK:g} s: {d_host:.3g} m "
+    print(f"  {label}: |q_target - q_host_float| at t = {t_check:g} s: {d_host:.3g} m "
           f"(tolerance {Q_TOL:g}): {'ok' if ok else 'MISMATCH'}")
-    for t in (T_CHECK, t_end):
+    for t in sorted({t_check, t_end}):
         print(f"    t = {t:g} s: |q_target - q_host_float| = {distance(row_at(target_f, t), row_at(host_f, t)):.3g} m, "
               f"|q_target - q_host_double| = {distance(row_at(target_f, t), row_at(host_d, t)):.3g} m, "
               f"|q_host_float - q_host_double| = {distance(row_at(host_f, t), row_at(host_d, t)):.3g} m")
@@ -105,18 +116,19 @@ def main(argv):
         row, col = len(target) - 1, Q_COLUMNS.start
         caught = not double_holds(host, perturbed(target, row, col, math.ulp(target[row][col])),
                                   "self-check, q_x at the end moved by one ulp")
-    elif len(argv) == 4 and argv[1] == "double-libm":
+    elif len(argv) in (4, 5) and argv[1] == "double-libm":
         host, target = read_csv(argv[2]), read_csv(argv[3])
-        ok = double_holds(host, target, "double, Cortex-M7 vs host (libm may round differently)", RELATIVE_TOL)
+        tol = float(argv[4]) if len(argv) == 5 else RELATIVE_TOL
+        ok = double_holds(host, target, "double, Cortex-M7 vs host (libm may round differently)", tol)
         row, col = len(target) - 1, Q_COLUMNS.start
-        caught = not double_holds(host, perturbed(target, row, col, 10 * RELATIVE_TOL * abs(target[row][col])),
-                                  "self-check, q_x at the end moved by 1e-11 relative", RELATIVE_TOL)
+        caught = not double_holds(host, perturbed(target, row, col, 10 * tol * abs(target[row][col])),
+                                  f"self-check, q_x at the end moved by {10 * tol:g} relative", tol)
     elif len(argv) == 5 and argv[1] == "float":
         host_f, target_f, host_d = read_csv(argv[2]), read_csv(argv[3]), read_csv(argv[4])
         ok = float_holds(host_f, target_f, host_d, "float, Cortex-M4F vs host")
-        row = next(i for i, r in enumerate(target_f) if abs(r[0] - T_CHECK) < 1e-9)
+        row = next(i for i, r in enumerate(target_f) if abs(r[0] - check_time(host_f)) < 1e-9)
         caught = not float_holds(host_f, perturbed(target_f, row, Q_COLUMNS.start, 1.5 * Q_TOL), host_d,
-                                 "self-check, q_x at 10 s moved by 1.5e-4 m")
+                                 f"self-check, q_x at {check_time(host_f):g} s moved by 1.5e-4 m")
     else:
         sys.exit(__doc__)
     if not caught:

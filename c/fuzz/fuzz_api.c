@@ -386,6 +386,7 @@ static void fuzz_nmpc(reader *r, const sr_model *model, const sr_real x[SR_NX])
             fail("sr_nmpc_step", status, "changed the memory on error");
         }
     }
+    if (sr_nmpc_memory_bytes() != (long)sizeof(sr_nmpc_memory)) fail("sr_nmpc_memory_bytes", SR_OK, "not the memory's size");
     EXPECT_STATUS("sr_nmpc_step(NULL)", sr_nmpc_step(&design, NULL, model, x, &target, arm(&gu, SR_NU)), SR_ERR_NULL);
 }
 
@@ -446,6 +447,9 @@ static void fuzz_model_validity(reader *r, const sr_model *valid, const sr_real 
     static const sr_real mount_nu_dot[SR_NV] = {SR_C(0.1), SR_C(-0.2), SR_C(0.3), SR_C(0.4), SR_C(-0.5)};
     static const sr_lqr_target target = {SR_C(0.3), SR_C(0.5), SR_C(0.2), SR_C(0.05), 1};
     static const sr_real d[SR_NE];
+    static const sr_real nmpc_z[SR_NMPC_NZ] = {SR_C(0.02), SR_C(-0.03), SR_C(0.05), SR_C(0.1), SR_C(0.05), SR_C(-0.02),
+                                               SR_C(0.03), SR_C(-0.1), SR_C(0.2), SR_C(0.01), SR_C(0.003)};
+    static const sr_real nmpc_u[SR_NU] = {SR_C(0.1), SR_C(-0.05)};
     sr_real x2[2 * SR_NX];
     const sr_lqr_memory fresh = {{0, 0}, 0, 0, 0};
     sr_lqr_memory memory = fresh;
@@ -521,6 +525,7 @@ static void fuzz_model_validity(reader *r, const sr_model *valid, const sr_real 
     ON_BOTH_MODELS("sr_step_param_jacobian_batch (model)", SR_NE * SR_NPARAM, sr_step_param_jacobian_batch(M, SR_LIE_EULER, 1, x, u, dt, arm(&g, SR_NE * SR_NPARAM), &row));
     ON_BOTH_MODELS("sr_regressor (model)", SR_NV * SR_NPI, sr_regressor(M, x, mount_nu_dot, arm(&g, SR_NV * SR_NPI)));
     ON_BOTH_MODELS("sr_regressor_batch (model)", SR_NV * SR_NPI, sr_regressor_batch(M, 1, x, mount_nu_dot, arm(&g, SR_NV * SR_NPI), &row));
+    ON_BOTH_MODELS("sr_nmpc_node (model)", SR_NMPC_NZ, sr_nmpc_node(M, nmpc_z, nmpc_u, SR_C(0.3), SR_C(0.5), dt, arm(&g, SR_NMPC_NZ), arm(&g2, SR_NMPC_NZ * SR_NMPC_NZ), arm(&g3, SR_NMPC_NZ * SR_NU)));
 
     /* the sensors (sr_sensors.h), on a valid mount: a lever arm along the body's -z, its axes */
     ON_BOTH_MODELS("sr_imu_measure (model)", SR_NIMU, sr_imu_measure(M, x, mount_nu_dot, SR_BODY_yoke, mount, NULL, arm(&g, SR_NIMU)));

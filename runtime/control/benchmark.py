@@ -10,7 +10,9 @@ task on the C EKF of these sensors (a shipped set or a sensors file) instead of 
 a task's `[sensors]` does so for that task.  `--offsets` runs the offset table instead
 (runtime/control/offsets.py): the LQR and the NMPC on the circle and the line against a plant with
 one constant mismatch or on an unmodelled slope, out/control/offsets.md and .csv; `--only` keeps the
-cases whose "task plant controller" contains TEXT.
+cases whose "task plant controller" contains TEXT.  A task with the NMPC (kind nmpc) also runs the
+C NMPC (kind nmpc-c) on the same settings, in the row after it, unless it lists nmpc-c itself or its
+horizon exceeds the C NMPC's capacity.
 """
 import argparse
 import csv
@@ -34,6 +36,7 @@ from .geometry import heading, wrap_angle
 from .metrics import tracking_metrics
 from .offsets import OFFSET_CONTROLLERS, offset_cases, with_controller
 from .plots import plot_estimate, plot_run
+from .ranges import NMPC_C_RANGES
 from .task import load_task, shipped_tasks
 
 COLUMNS = ("cross_track_rms_m", "cross_track_max_m", "heading_settle_s", "speed_settle_s", "overshoot",
@@ -47,6 +50,19 @@ def cpu_name():
         return next(line.split(":", 1)[1].strip() for line in out.splitlines() if line.startswith("Model name"))
     except (OSError, subprocess.CalledProcessError, StopIteration):
         return platform.processor() or "unknown CPU"
+
+
+def controller_runs(task):
+    """The task with each of its controllers in turn; after the NMPC, the C NMPC on its settings
+    (see the module)."""
+    runs = []
+    for kind in task.controller_kinds:
+        runs.append(task.with_controller(kind))
+        spec = runs[-1].controllers[0]
+        if kind == "nmpc" and "nmpc-c" not in task.controller_kinds and \
+                spec.gains.horizon <= NMPC_C_RANGES["horizon"].high:
+            runs.append(dataclasses.replace(runs[-1], controllers=(dataclasses.replace(spec, kind="nmpc-c"),)))
+    return runs
 
 
 def run_task(task, progress=False):
@@ -138,7 +154,7 @@ def main(argv=()):
     except OSError as exc:
         parser.error(f"--out: cannot create the folder {out} ({exc.strerror})")
     rows = []
-    runs = [(task.name, task.with_controller(kind)) for task in tasks for kind in task.controller_kinds]
+    runs = [(task.name, run) for task in tasks for run in controller_runs(task)]
     if args.duration is not None:
         runs = [(name, dataclasses.replace(task, scenario=dataclasses.replace(
             task.scenario, steps=max(1, round(min(args.duration, task.duration) / task.scenario.dt)))))

@@ -3,6 +3,7 @@ timing in a C driver, and its QPs against DAQP.
 
     python -m runtime nmpc-c --header PATH [--task circle]   the task's design and scenario as C (nmpc_task.h)
     python -m runtime nmpc-c --timing [--task circle]        builds c/examples/nmpc_loop.c on it and runs it
+        [--against-python S]                                 and times the Python NMPC over S s of the task: the ratio
     python -m runtime nmpc-c --qp-samples 1000 [--tasks ...] the C QP solution against DAQP's on recorded QPs
 
 The header is what c/examples/nmpc_loop.c (and a firmware) compiles against: an `sr_nmpc`
@@ -88,6 +89,7 @@ def task_header(task_name="circle"):
         f"#define NMPC_TASK_RADIUS {float(spec['radius'])!r}",
         f"#define NMPC_TASK_SPEED SR_C({float(spec['speed'])!r})",
         f"#define NMPC_TASK_DT SR_C({float(task.scenario.dt)!r})",
+        f"#define NMPC_TASK_DT_SECONDS {float(task.scenario.dt)!r}",
         f"#define NMPC_TASK_STEPS_PER_SAMPLE {per}",
         f"#define NMPC_TASK_SAMPLES {samples}",
         design_initializer(controller), "#endif", ""])
@@ -106,6 +108,28 @@ def timing(task_name="circle", cc="cc"):
                         str(ROOT / "c" / "examples" / "nmpc_loop.c"), *(str(ROOT / s) for s in SOURCES), "-lm",
                         "-o", exe], check=True)
         return subprocess.run([exe], check=True, capture_output=True, text=True).stdout.strip()
+
+
+def python_timing(task_name, seconds):
+    """(p50, p99) [ms] of the Python NMPC's samples over the first `seconds` of the task's closed loop."""
+    import dataclasses
+    from .benchmark import run_task
+    from .task import load_task
+    task = load_task(task_name).with_controller("nmpc")
+    task = dataclasses.replace(task, scenario=dataclasses.replace(task.scenario,
+                                                                  steps=max(1, round(seconds / task.scenario.dt))))
+    metrics = run_task(task)[2]
+    return metrics["solve_ms_p50"], metrics["solve_ms_p99"]
+
+
+def ratio_line(c_line, python_ms):
+    """The C and Python NMPC's p50 and p99 per sample and their ratio, from nmpc_loop's output line and
+    python_timing's."""
+    fields = c_line.split()
+    c_ms = [float(fields[fields.index(key) + 1]) / 1e3 for key in ("p50_us", "p99_us")]
+    return (f"per sample: C NMPC p50 {c_ms[0]:.3f} ms, p99 {c_ms[1]:.3f} ms; Python NMPC p50 {python_ms[0]:.3f} ms, "
+            f"p99 {python_ms[1]:.3f} ms; Python / C: {python_ms[0] / c_ms[0]:.3g} (p50), "
+            f"{python_ms[1] / c_ms[1]:.3g} (p99)")
 
 
 def recorded_qps(task, samples):
@@ -147,6 +171,8 @@ def main(argv=()):
     parser.add_argument("--task", default="circle", help="the circle task of --header and --timing")
     parser.add_argument("--header", default=None, help="write the task's design and scenario as C to this file")
     parser.add_argument("--timing", action="store_true", help="build and run the C closed loop, print its timing")
+    parser.add_argument("--against-python", type=float, default=0, metavar="S",
+                        help="with --timing: also time the Python NMPC over S s of the task's closed loop, print the ratio")
     parser.add_argument("--qp-samples", type=int, default=0, help="compare this many recorded QPs with DAQP's")
     parser.add_argument("--tasks", default="circle,line,figure8,heading-step,speed-step",
                         help="tasks whose QPs are recorded (comma-separated), in turn until --qp-samples")
@@ -154,8 +180,13 @@ def main(argv=()):
     try:
         if args.header:
             write_text(pathlib.Path(args.header), task_header(args.task))
+        if args.against_python < 0:
+            raise ValueError(f"--against-python: must be >= 0 s, got {args.against_python:g}")
         if args.timing:
-            print(timing(args.task))
+            line = timing(args.task)
+            print(line)
+            if args.against_python > 0:
+                print(ratio_line(line, python_timing(args.task, args.against_python)))
         if args.qp_samples > 0:
             worst, count, active = 0.0, 0, 0
             names = args.tasks.split(",")

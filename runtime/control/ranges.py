@@ -48,6 +48,13 @@ NMPC_RANGES = {
     "iterations": Range(1, 100, "", "real-time iterations per sample: each solves a QP", whole=True),
 }
 
+#: `NmpcGains` of the C NMPC (kind nmpc-c): its horizon within the capacity of its buffers.
+NMPC_C_RANGES = {
+    **NMPC_RANGES,
+    "horizon": Range(1, lib.SR_NMPC_MAX_HORIZON, "", "nodes of the horizon: the C NMPC's buffers hold "
+                     "SR_NMPC_MAX_HORIZON (c/include/sr_nmpc.h; set at build time)", whole=True),
+}
+
 #: `EkfSettings`.
 ESTIMATOR_RANGES = {
     "position_m": Range(1e-9, 1e3, "m", "a standard deviation"),

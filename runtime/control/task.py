@@ -32,7 +32,7 @@ from .nmpc import Nmpc, NmpcC, NmpcGains
 from .estimator import SETTING_NAMES as ESTIMATOR_SETTINGS
 from .estimator import Ekf, EkfSettings, SensorEkf
 from .pid import GAIN_NAMES, Pid, PidGains
-from .ranges import CONTROLLER_RANGES, ESTIMATOR_RANGES, LQR_RANGES, NMPC_RANGES, PID_RANGES
+from .ranges import CONTROLLER_RANGES, ESTIMATOR_RANGES, LQR_RANGES, NMPC_C_RANGES, NMPC_RANGES, PID_RANGES
 from .reference import KINDS, SpeedHeading, path_points, circle_path, figure8_path, line_path, waypoints_path
 from ..state import IDX_Q
 
@@ -66,8 +66,8 @@ TASK_RANGES = {
               "noise_rate_rad_s": Range(0, 1e3, "rad/s", "a standard deviation"),
               "noise_seed": Range(0, 2**63 - 1, "", "a seed of NumPy's generator", whole=True)},
 }
-# The C NMPC takes the NMPC's settings (its horizon is at most SR_NMPC_MAX_HORIZON, checked when it is built).
-TASK_RANGES["controller.nmpc-c"] = TASK_RANGES["controller.nmpc"]
+# The C NMPC takes the NMPC's settings, its horizon at most SR_NMPC_MAX_HORIZON.
+TASK_RANGES["controller.nmpc-c"] = NMPC_C_RANGES
 #: Bytes per sample of a path table: points (2), arc length, tangent, curvature, and the
 #: differences, segment lengths and turns that build them.
 PATH_ROW_BYTES = 12 * 8

@@ -1,22 +1,26 @@
 """`python -m runtime control`: one table for every task, a summary.json with `tracking` and `contact` per run."""
 import csv
+import dataclasses
 import json
 
 import pytest
 
+from bindings._sr import lib
 from runtime.__main__ import main
-from runtime.control.benchmark import COLUMNS
+from runtime.control.benchmark import COLUMNS, controller_runs
+from runtime.control.task import load_task
 
 
 def test_the_benchmark_writes_one_table_row_and_one_summary_per_task_and_controller(tmp_path):
     assert main(["control", "--out", str(tmp_path), "--tasks", "speed-step,circle", "--duration", "1"]) == 0
     rows = list(csv.DictReader(open(tmp_path / "table.csv")))
     assert [(r["task"], r["controller"]) for r in rows] == [
-        ("speed-step", "pid"), ("speed-step", "lqr"), ("speed-step", "nmpc"),
-        ("circle", "pid"), ("circle", "lqr"), ("circle", "nmpc")]
+        ("speed-step", "pid"), ("speed-step", "lqr"), ("speed-step", "nmpc"), ("speed-step", "nmpc-c"),
+        ("circle", "pid"), ("circle", "lqr"), ("circle", "nmpc"), ("circle", "nmpc-c")]
     table = (tmp_path / "table.md").read_text()
     assert "smoke run" in table and "CPU:" in table
-    for run in ("speed-step-pid", "speed-step-lqr", "speed-step-nmpc", "circle-pid", "circle-lqr", "circle-nmpc"):
+    for run in ("speed-step-pid", "speed-step-lqr", "speed-step-nmpc", "speed-step-nmpc-c", "circle-pid", "circle-lqr",
+                "circle-nmpc", "circle-nmpc-c"):
         summary = json.loads((tmp_path / run / "summary.json").read_text())
         assert set(summary["tracking"]) == set(COLUMNS)
         assert summary["contact"]["least_normal_force_N"] > 0 and summary["contact"]["largest_friction_ratio"] > 0
@@ -36,6 +40,19 @@ def test_the_offset_table_names_an_unknown_controller(tmp_path, capsys):
     with pytest.raises(SystemExit):
         main(["control", "--offsets", "--controllers", "pid", "--out", str(tmp_path)])
     assert "--controllers" in capsys.readouterr().err
+def test_a_task_with_the_nmpc_also_runs_the_c_nmpc_on_its_settings():
+    runs = controller_runs(load_task("circle"))
+    assert [r.controller_kind for r in runs] == ["pid", "lqr", "nmpc", "nmpc-c"]
+    assert runs[3].controllers[0] == dataclasses.replace(runs[2].controllers[0], kind="nmpc-c")
+
+
+def test_the_c_nmpc_is_left_out_where_the_horizon_exceeds_its_capacity():
+    task = load_task("circle").with_controller("nmpc")
+    spec = task.controllers[0]
+    for horizon, kinds in ((lib.SR_NMPC_MAX_HORIZON, ["nmpc", "nmpc-c"]), (lib.SR_NMPC_MAX_HORIZON + 1, ["nmpc"])):
+        gains = dataclasses.replace(spec.gains, horizon=horizon)
+        longer = dataclasses.replace(task, controllers=(dataclasses.replace(spec, gains=gains),))
+        assert [r.controller_kind for r in controller_runs(longer)] == kinds
 
 
 PID_ONLY_TASK = """

@@ -2,6 +2,7 @@
 random and recorded QPs, its prediction node equals the Python NMPC's to the integrators' error,
 and a short closed loop tracks as the Python NMPC does."""
 import dataclasses
+import re
 
 import numpy as np
 import pytest
@@ -10,7 +11,8 @@ from bindings._sr import ffi, lib
 from runtime.casadi_model import parameter_vector
 from runtime.control import nmpc
 from runtime.control.benchmark import run_task
-from runtime.control.nmpc_c import daqp_solution, design_initializer, recorded_qps
+from conftest import ROOT
+from runtime.control.nmpc_c import daqp_solution, design_initializer, main, ratio_line, recorded_qps, task_header
 from runtime.control.task import load_task
 from runtime.params import Params
 
@@ -122,3 +124,46 @@ def test_the_design_header_holds_the_c_design():
     assert f".r = SR_C({controller._r!r})," in text
     assert text.count("SR_C(") == 7 + 2 * nmpc.NZ_N + controller._c.n_speeds + controller._c.n_curvatures + \
         controller._c.n_speeds * controller._c.n_curvatures * (nmpc.NZ_N + 2 + 2 * nmpc.NZ_N ** 2)
+
+
+#: The firmware example's design (c/examples/firmware_nmpc.c), written by `make generate`.
+SHIPPED_HEADER = ROOT / "generated" / "nmpc_task.h"
+_NUMBER = re.compile(r"(?<![\w.])-?\d+\.?\d*(?:e[-+]?\d+)?")
+
+
+def same_design(text, other):
+    """The two headers are the same text but for their numbers, and those agree within the spread of
+    LAPACK builds (the Riccati cost-to-go's last bits vary with the CPU)."""
+    a, b = [np.array([float(v) for v in _NUMBER.findall(t)]) for t in (text, other)]
+    return _NUMBER.sub("#", text) == _NUMBER.sub("#", other) and a.shape == b.shape and \
+        np.allclose(a, b, rtol=1e-7, atol=1e-10)
+
+
+@pytest.fixture(scope="module")
+def fresh_header():
+    return task_header("circle")
+
+
+def test_the_shipped_firmware_design_is_the_current_design(fresh_header):
+    assert same_design(SHIPPED_HEADER.read_text(), fresh_header), "stale: rerun make generate"
+
+
+def test_the_shipped_design_check_fails_for_one_number_changed_in_its_sixth_digit(fresh_header):
+    text = SHIPPED_HEADER.read_text()
+    i = text.index("P_path")
+    j = i + _NUMBER.search(text[i:]).start()
+    value = _NUMBER.match(text, j).group()
+    changed = text[:j] + repr(float(value) * (1 + 1e-6) + 1e-6) + text[j + len(value):]
+    assert not same_design(changed, fresh_header)
+
+
+def test_the_bench_line_gives_the_python_to_c_ratio_of_each_percentile():
+    line = "samples 1200 p50_us 200.0 p99_us 400.0 max_us 900.0 cpu_p50_us 190.0"
+    out = ratio_line(line, (2.0, 8.0))
+    assert "C NMPC p50 0.200 ms, p99 0.400 ms" in out
+    assert "Python / C: 10 (p50), 20 (p99)" in out
+
+
+def test_a_negative_python_timing_span_is_a_named_error(capsys):
+    assert main(["--timing", "--against-python", "-1"]) == 2
+    assert "--against-python: must be >= 0 s" in capsys.readouterr().err
