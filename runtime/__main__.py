@@ -26,6 +26,7 @@ COMMANDS = {
     "sense": ("runtime.estimation.sense", "simulate the sensors along a scenario or task: a log and its truth"),
     "estimate": ("runtime.estimation.estimate", "run the EKF over a sensor log: the estimate, its sigmas, the errors"),
     "base-parameters": ("runtime.identification.base_parameters", "the identifiable combinations of the inertial parameters (docs/identification.md)"),
+    "identify": ("runtime.identification.identify", "fit a robot's parameters to a log: estimates, intervals, identifiability, a robot file"),
 }
 
 
