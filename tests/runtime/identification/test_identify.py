@@ -145,3 +145,16 @@ def test_the_command_exits_2_naming_a_bad_parameter(state_log, tmp_path, capsys)
     write_log(state_log, tmp_path / "log", formats=("csv",))
     assert cli.main([str(tmp_path / "log"), "--params", "m_Q", "--out", str(tmp_path / "fit"), "--quiet"]) == 2
     assert "'m_Q' is not a parameter" in capsys.readouterr().err
+
+
+def test_the_coverage_command_counts_the_fits_whose_interval_holds_the_truth(tmp_path):
+    from runtime.identification import coverage
+    out = tmp_path / "coverage.json"
+    assert coverage.main(["--params", "k_Y,m_P", "--fits", "2", "--duration", "1", "--full-state",
+                          "--out", str(out)]) == 0
+    result = json.loads(out.read_text())
+    inside = np.array([t["inside"] for t in result["trials"]], dtype=float)
+    assert result["coverage"] == inside.mean(axis=0).tolist() and len(result["trials"]) == 2
+    first = result["trials"][0]
+    assert first["inside"] == (np.abs(np.subtract(first["estimate"], first["truth"]))
+                               <= 1.959964 * np.array(first["sigma"])).tolist()
