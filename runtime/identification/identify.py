@@ -149,6 +149,11 @@ def build_parser():
             raise argparse.ArgumentTypeError(f"expected a number > 0, got {value!r}")
         return number
 
+    def count(value):
+        if not value.isdigit() or int(value) < 1:
+            raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {value!r}")
+        return int(value)
+
     parser = argparse.ArgumentParser(
         prog="python -m runtime identify",
         description="Fit the named parameters of a robot, with the initial state and the IMU's biases, to a sensor "
@@ -164,7 +169,7 @@ def build_parser():
     parser.add_argument("--out", required=True, type=pathlib.Path, help="the output folder (created if missing)")
     parser.add_argument("--full-state", action="store_true", help="fit to the log's truth table (a full-state log)")
     parser.add_argument("--segment", type=positive, default=0.5, help="multiple-shooting segment length [s] (0.5)")
-    parser.add_argument("--max-evaluations", type=int, default=20, help="the solver's evaluation budget (20)")
+    parser.add_argument("--max-evaluations", type=count, default=20, help="the solver's evaluation budget (20)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar, print nothing but errors")
     return parser
 
