@@ -34,7 +34,7 @@ import scipy.stats
 from ..model import Model
 from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_parameters
 from ..params import SHAPES, Params, flat_names
-from ..sensors import IDX_ACCEL, imu_partials
+from ..sensors import imu_partials
 from ..state import IDX_E_NU, IDX_E_Q, IDX_E_TH_P, IDX_E_TH_Y, IDX_NU, IDX_Q, NE, NV, pendulum_angle, yoke_angle
 
 #: Parameters a builder knows and the fit never frees: the shell's radius, the gear ratios, gravity, the slope.
@@ -60,7 +60,7 @@ class IdentifyError(ValueError):
     """A log or a parameter set that cannot be identified: the message names what is wrong."""
 
 
-def free_parameters(names, params):
+def free_parameters(names):
     """The entries of the C parameter vector (`PARAMETER_NAMES`) that `names` frees: a field name
     (m_P, c_P, J_P) frees all its entries, an entry name (c_P_z, J_P_yy) one.  IdentifyError for an
     empty list, an unknown name, a repeated entry or a parameter the builder knows (KNOWN)."""
@@ -82,7 +82,6 @@ def free_parameters(names, params):
             if entry in out:
                 raise IdentifyError(f"params: {entry!r} named twice")
             out.append(entry)
-    del params
     return tuple(out)
 
 
@@ -573,7 +572,7 @@ def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, 
     EKF's start guess.  `progress()` is called once per evaluation.  Returns a `Fit`."""
     if not isinstance(params, Params):
         raise IdentifyError(f"robot: expected a runtime.Params, got {type(params).__name__}")
-    free = free_parameters(names, params)
+    free = free_parameters(names)
     check_log(log, full_state)
     if not (isinstance(segment, (int, float)) and math.isfinite(segment) and segment > 0):
         raise IdentifyError(f"segment: expected a length > 0 in s, got {segment!r}")

@@ -194,13 +194,13 @@ def main(argv):
             params = log.params() or Params.paper_simulation()
             source = "the log's robot" if log.params() is not None else "Params.paper_simulation()"
         bar = tqdm(desc="identify", unit=" evaluations", disable=args.quiet, file=sys.stderr)
-        started = time.perf_counter()
+        started, cpu = time.perf_counter(), time.process_time()
         try:
             fit = identify(log, params, args.params, segment=args.segment, full_state=args.full_state,
                            max_nfev=args.max_evaluations, progress=lambda: bar.update(1))
         finally:
             bar.close()
-        wall = time.perf_counter() - started
+        wall, cpu = time.perf_counter() - started, time.process_time() - cpu
         args.out.mkdir(parents=True, exist_ok=True)
         write_text(args.out / "estimates.csv", estimates_csv(fit))
         write_text(args.out / "correlation.csv", correlation_csv(fit))
@@ -210,7 +210,8 @@ def main(argv):
             fit.params, f"Identified from {args.log} ({', '.join(fit.names)} fitted; the rest from {source}).\n"
                         f"Residual check {'passed' if fit.residual_check['passed'] else 'FAILED'}: RMS "
                         f"{fit.residual_check['rms']:.3f}.  Intervals: estimates.csv."))
-        write_text(args.out / "summary.json", json.dumps(summary(fit, wall, args.log, source), indent=2) + "\n")
+        write_text(args.out / "summary.json",
+                   json.dumps({**summary(fit, wall, args.log, source), "cpu_time_s": cpu}, indent=2) + "\n")
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -108,11 +108,11 @@ def test_a_fit_that_ends_on_a_bound_says_so(state_log, monkeypatch):
 ])
 def test_impossible_parameter_sets_are_named(names, message):
     with pytest.raises(IdentifyError, match=message):
-        free_parameters(names, NOMINAL)
+        free_parameters(names)
 
 
 def test_field_names_free_all_their_entries():
-    assert free_parameters("c_P,k_Y", NOMINAL) == ("c_P_x", "c_P_y", "c_P_z", "k_Y")
+    assert free_parameters("c_P,k_Y") == ("c_P_x", "c_P_y", "c_P_z", "k_Y")
 
 
 def test_bad_logs_are_named(short_log):
