@@ -489,15 +489,18 @@ class _Problem:
         return lo, hi
 
     def residual_series(self, z):
-        """{kind: (t, whitened-by-noise residuals (n, m))} along the log (each sensor's own noise)."""
+        """{kind: (t, whitened residuals (n, m))} along the log: each segment's residuals whitened by
+        their covariance (the Cholesky factor's order: each reading's innovation given the earlier
+        readings of its segment), so that a right model leaves unit white noise."""
         blocks = self.assemble(z)[2]
         out = {"imu": ([], []), "encoders": ([], []), "fixes": ([], [])}
-        for blk in blocks:
+        for s, blk in enumerate(blocks):
+            w = scipy.linalg.solve_triangular(self.chol[s], blk["r"], lower=True)
             row = 0
             for kind, k, Hx, _ in blk["meta"]:
                 m = Hx.shape[0]
                 out[kind][0].append(self.data.t[k])
-                out[kind][1].append(blk["r"][row:row + m])
+                out[kind][1].append(w[row:row + m])
                 row += m
         return {k: (np.array(t), np.array(v)) for k, (t, v) in out.items() if t}
 

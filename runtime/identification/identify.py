@@ -99,7 +99,8 @@ def report_md(fit, log_path):
 
 
 def residual_figure(fit, path):
-    """The whitened residuals against time, one panel per sensor, with their RMS."""
+    """The whitened residuals against time (unit white noise when the model is right), one panel per
+    sensor, with their RMS."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -110,7 +111,7 @@ def residual_figure(fit, path):
         ax.plot(t, r, lw=0.4)
         ax.axhline(2, color="k", lw=0.5, ls=":")
         ax.axhline(-2, color="k", lw=0.5, ls=":")
-        ax.set_ylabel(f"{kind}\n[noise σ]")
+        ax.set_ylabel(f"{kind}\n[whitened]")
         ax.set_title(f"{kind}: RMS {math.sqrt(float(np.mean(r ** 2))):.3f}", fontsize=9)
     axes[-1, 0].set_xlabel("t [s]")
     fig.tight_layout()
