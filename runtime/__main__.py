@@ -27,6 +27,8 @@ COMMANDS = {
     "estimate": ("runtime.estimation.estimate", "run the EKF over a sensor log: the estimate, its sigmas, the errors"),
     "base-parameters": ("runtime.identification.base_parameters", "the identifiable combinations of the inertial parameters (docs/identification.md)"),
     "excite": ("runtime.identification.excite", "a D-optimal torque program for identifying named parameters, as a scenario"),
+    "identify": ("runtime.identification.identify", "fit a robot's parameters to a log: estimates, intervals, identifiability, a robot file"),
+    "identify-coverage": ("runtime.identification.coverage", "seeded fits: how often the 95 % intervals hold the truth"),
 }
 
 

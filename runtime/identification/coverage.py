@@ -1,0 +1,109 @@
+"""`python -m runtime identify-coverage`: are the fit's 95 % intervals honest?  Seeded logs of a
+robot whose parameters differ from the nominal ones, each fitted; the fraction of fits whose
+interval holds the truth, per parameter (docs/identification.md, "Measured").
+
+The robot is robots/battery-geared.toml; the truth scales the named entries by factors drawn
+uniformly in [1 − spread, 1 + spread] per fit (the entries not named held at their true values); the
+torques are piecewise constant, uniform within ±0.3 N m (yoke) and ±0.15 N m (pendulum), new every
+0.25 s: a rich program while the excitation design is not in use.
+"""
+import dataclasses
+import json
+import time
+
+import numpy as np
+
+from ..atomic import write_text
+from ..estimation.sense import simulate_log
+from ..param_derivatives import PARAMETER_NAMES
+from ..params import Params
+from ..scenario import TorqueWindow, load_scenario
+from ..sensor_set import SensorSet
+from .fit import free_parameters, identify
+
+
+def random_torques(duration, rng, period=0.25, yoke=0.3, pendulum=0.15):
+    """Piecewise-constant torques, uniform within ±yoke and ±pendulum [N m], new every `period` s."""
+    n = int(round(duration / period))
+    return tuple(TorqueWindow(i * period, (i + 1) * period, float(rng.uniform(-yoke, yoke)),
+                              float(rng.uniform(-pendulum, pendulum))) for i in range(n))
+
+
+def planted(nominal, names, rng, spread):
+    """`nominal` with each free entry of `names` scaled by a factor in [1 − spread, 1 + spread]; a
+    draw that is not a physical robot is drawn again."""
+    entries = free_parameters(names)
+    for _ in range(100):
+        p = nominal.as_array()
+        for e in entries:
+            p[PARAMETER_NAMES.index(e)] *= rng.uniform(1 - spread, 1 + spread)
+        try:
+            return Params.from_array(p)
+        except ValueError:
+            continue
+    raise ValueError(f"params: no physical robot within ±{spread:g} of the nominal one for {names}")
+
+
+def trial(names, duration, seed, spread=0.3, full_state=False, segment=0.5, max_nfev=20):
+    """One seeded fit: {"names", "truth", "estimate", "sigma", "inside", "rms", "wall_time_s", "cpu_time_s"}."""
+    rng = np.random.default_rng(seed)
+    scenario = load_scenario("battery-geared")
+    nominal = scenario.params
+    truth = planted(nominal, names, rng, spread)
+    run = dataclasses.replace(scenario, params=truth, torques=random_torques(duration, rng),
+                              steps=int(round(duration / scenario.dt)))
+    log = simulate_log(run, SensorSet.default(), seed=seed)
+    started, cpu = time.perf_counter(), time.process_time()
+    fit = identify(log, nominal, names, segment=segment, full_state=full_state, max_nfev=max_nfev)
+    wall, cpu = time.perf_counter() - started, time.process_time() - cpu
+    true = np.array([truth.as_array()[PARAMETER_NAMES.index(n)] for n in fit.names])
+    return {"names": list(fit.names), "truth": true.tolist(), "estimate": fit.estimate.tolist(),
+            "sigma": fit.sigma.tolist(), "inside": (np.abs(fit.estimate - true) <= 1.959964 * fit.sigma).tolist(),
+            "rms": fit.residual_check["rms"], "wall_time_s": wall, "cpu_time_s": cpu}
+
+
+def coverage(names, duration, fits, seed=0, **options):
+    """`fits` trials with seeds seed, seed + 1, ...: the trials and, per entry, the fraction inside."""
+    trials = [trial(names, duration, seed + i, **options) for i in range(fits)]
+    inside = np.array([t["inside"] for t in trials], dtype=float)
+    return {"names": trials[0]["names"], "coverage": inside.mean(axis=0).tolist(), "trials": trials}
+
+
+def main(argv):
+    """`python -m runtime identify-coverage --params NAMES [--fits N] [--duration S] [--full-state] --out FILE`."""
+    import argparse
+    import pathlib
+    import sys
+    import math
+
+    def count(value, low=1):
+        if not value.isdigit() or int(value) < low:
+            raise argparse.ArgumentTypeError(f"expected a whole number >= {low}, got {value!r}")
+        return int(value)
+
+    def duration(value):
+        try:
+            number = float(value)
+        except ValueError:
+            number = math.nan
+        if not (math.isfinite(number) and number > 0):
+            raise argparse.ArgumentTypeError(f"expected a duration > 0 in s, got {value!r}")
+        return number
+
+    parser = argparse.ArgumentParser(prog="python -m runtime identify-coverage", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--params", required=True, help="comma-separated entries to plant and fit")
+    parser.add_argument("--fits", type=count, default=20, help="number of seeded fits (20)")
+    parser.add_argument("--duration", type=duration, default=30.0, help="each log's length [s] (30)")
+    parser.add_argument("--seed", type=lambda v: count(v, 0), default=0, help="the first seed (0)")
+    parser.add_argument("--full-state", action="store_true", help="fit the logs' truth (a full-state log)")
+    parser.add_argument("--out", required=True, type=pathlib.Path, help="the JSON file of the results")
+    args = parser.parse_args(argv)
+    try:
+        result = coverage(args.params, args.duration, args.fits, args.seed, full_state=args.full_state)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    write_text(args.out, json.dumps(result, indent=1) + "\n")
+    for name, c in zip(result["names"], result["coverage"]):
+        print(f"{name}: truth inside the 95 % interval in {100 * c:.0f} % of {args.fits} fits")
+    return 0

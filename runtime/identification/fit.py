@@ -1,0 +1,743 @@
+"""Identification of a robot's parameters from a log: a multiple-shooting least-squares fit
+(docs/identification.md, "Identifying a robot from a log").
+
+    log = read_log("out/geared-log")
+    fit = identify(log, Params.paper_simulation(), ["k_S", "k_Y", "k_P", "m_P"])
+    fit.estimate, fit.sigma, fit.information, fit.residual_check
+
+A sensor log is cut into segments of `segment` seconds on the IMU's sample grid.  The unknowns are
+the named parameters θ, the IMU's biases b and the state at the start of every segment (12 error
+coordinates about a start guess from the EKF); each segment is simulated from its start state
+under the logged torques, its predicted IMU, encoder and fix readings are compared with the log,
+and its end state with the next segment's start.  The differences are whitened by their
+covariance: the sensors' declared noise plus what the process noise (the sensor set's torque
+disturbance) does to the readings and to the end state inside the segment, linearised along the
+segment.  SciPy's `least_squares` (trust-region reflective, bounds) minimises the whitened sum of
+squares with the analytic Jacobian: the step and parameter Jacobians of the C library chained along
+each segment, and the sensors' Jacobians.  A full-state log (its truth table) is fitted by the
+one-step prediction error of the velocities instead, whitened by the process noise.
+
+The Fisher information JᵀJ of the whitened residuals at the optimum, with the start states and the
+biases eliminated (Schur complement), gives the parameters' covariance and 95 % intervals; its
+eigenvalues the rank and conditioning; the base parameters (runtime.param_derivatives) name the
+combinations a rank-deficient fit still determines.
+"""
+import dataclasses
+import math
+
+import numpy as np
+import scipy.linalg
+import scipy.optimize
+import scipy.sparse
+import scipy.stats
+
+from ..model import Model
+from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_parameters
+from ..params import SHAPES, Params, flat_names
+from ..sensors import imu_partials
+from ..state import IDX_E_NU, IDX_E_Q, IDX_E_TH_P, IDX_E_TH_Y, IDX_NU, IDX_Q, NE, NV, pendulum_angle, yoke_angle
+
+#: Parameters a builder knows and the fit never frees: the shell's radius, the gear ratios, gravity, the slope.
+KNOWN = ("r", "n_Y", "n_P", "g", "slope")
+#: The shortest log [s] a fit accepts: two segments of the shortest length.
+MIN_DURATION = 0.5
+#: A whitened residual RMS within this of 1 passes the residual check.
+RESIDUAL_TOLERANCE = 0.15
+#: Eigenvalues of the scaled information below this fraction of the largest count as zero (not identified).
+RANK_RTOL = 1e-9
+#: Two-sided 95 % quantile of the normal distribution.
+Z95 = float(scipy.stats.norm.ppf(0.975))
+#: Standard deviation [rad, m, rad/s] of the weak prior on the first segment's start state: it fixes
+#: what no sensor sees (the position without fixes, the heading without fixes or a magnetometer).
+GAUGE_SIGMA = 10.0
+#: Largest Jacobian (entries) solved densely; beyond it the trust-region steps use LSMR.
+DENSE_LIMIT = 2e7
+#: Smallest standard deviation of an end-state difference, for a sensor set without process noise.
+DEFECT_FLOOR = 1e-7
+
+
+class IdentifyError(ValueError):
+    """A log or a parameter set that cannot be identified: the message names what is wrong."""
+
+
+def free_parameters(names):
+    """The entries of the C parameter vector (`PARAMETER_NAMES`) that `names` frees: a field name
+    (m_P, c_P, J_P) frees all its entries, an entry name (c_P_z, J_P_yy) one.  IdentifyError for an
+    empty list, an unknown name, a repeated entry or a parameter the builder knows (KNOWN)."""
+    if isinstance(names, str):
+        names = [n.strip() for n in names.split(",") if n.strip()]
+    if not names:
+        raise IdentifyError("params: name at least one parameter to identify")
+    out = []
+    for name in names:
+        base = name if name in SHAPES else next((f for f in SHAPES if name in flat_names(f, SHAPES[f])), None)
+        if base is None:
+            raise IdentifyError(f"params: {name!r} is not a parameter of the robot (fields: {', '.join(SHAPES)}; "
+                                f"entries such as c_P_z, J_P_yy)")
+        if base in KNOWN:
+            raise IdentifyError(f"params: {name!r} is a constant of the robot's kind that the fit takes as known "
+                                f"({', '.join(KNOWN)}), not one it identifies")
+        entries = flat_names(base, SHAPES[base]) if name == base else (name,)
+        for entry in entries:
+            if entry in out:
+                raise IdentifyError(f"params: {entry!r} named twice")
+            out.append(entry)
+    return tuple(out)
+
+
+def bounds_of(entry, params, free=()):
+    """(low, high) of one free entry: masses > 0, inertias and dampings >= 0, each coordinate of a
+    centre of mass within the shell's radius; a tensor's diagonal entry within the triangle rule of
+    a physical tensor (|J_a − J_b| <= J_c <= J_a + J_b) when the other two diagonal entries are held
+    (`free`: all free entries), else >= 0.  The full rules (|c| < r, the tensor positive
+    semidefinite) are C's checks of every candidate."""
+    if entry in ("m_S", "m_Y", "m_P"):
+        return 1e-9, math.inf
+    if entry in ("j_S", "k_S", "k_Y", "k_P", "j_mY", "j_mP"):
+        return 0.0, math.inf
+    if entry.startswith("c_"):
+        return -params.r, params.r
+    if entry[-2] == entry[-1]:              # J_*_xx, J_*_yy, J_*_zz
+        body, axis = entry[2], "xyz".index(entry[-1])
+        others = [i for i in range(3) if i != axis]
+        if any(f"J_{body}_{'xyz'[i] * 2}" in free for i in others):
+            return 0.0, math.inf
+        J = np.asarray(getattr(params, f"J_{body}"))
+        a, b = J[others[0], others[0]], J[others[1], others[1]]
+        return abs(a - b), a + b
+    return -math.inf, math.inf
+
+
+def _wrap(a):
+    return np.remainder(a + np.pi, 2 * np.pi) - np.pi
+
+
+@dataclasses.dataclass
+class _Data:
+    """The log on the fit's node grid."""
+    t: np.ndarray            # (n,) node times
+    h: float                 # node spacing
+    u: np.ndarray            # (n, 2) torques held from each node
+    imu_row: np.ndarray      # (n,) IMU sample index or -1
+    enc_row: np.ndarray
+    fix_row: np.ndarray
+    interval: np.ndarray     # (n,) index of the process-noise interval (torque period) of each node
+    tau: float               # the torque period
+    skipped: int             # samples off the node grid
+
+
+def _grid(log):
+    """Node times on the IMU's grid and the samples of each kind at them."""
+    imu = log.imu
+    h = 1.0 / log.sensors.imu.rate
+    t0 = float(imu.t[0])
+    n = int(round((imu.t[-1] - t0) / h)) + 1
+    t = t0 + h * np.arange(n)
+    skipped = 0
+
+    def rows(times):
+        nonlocal skipped
+        out = np.full(n, -1)
+        k = np.round((np.asarray(times) - t0) / h).astype(int)
+        ok = (k >= 0) & (k < n) & (np.abs(times - (t0 + k * h)) <= 1e-6 * h)
+        skipped += int((~ok).sum())
+        out[k[ok]] = np.flatnonzero(ok)
+        return out
+
+    fix_times = log.fixes["t_measured"] if log.fixes is not None and len(log.fixes) else np.empty(0)
+    dts = np.diff(log.torques.t)
+    tau = float(np.median(dts)) if len(dts) else h
+    interval = np.floor((t - float(log.torques.t[0])) / tau + 1e-6).astype(int)
+    return _Data(t=t, h=h, u=log.torque_at(t), imu_row=rows(imu.t), enc_row=rows(log.encoders.t),
+                 fix_row=rows(fix_times), interval=interval, tau=tau, skipped=skipped)
+
+
+def check_log(log, full_state=False):
+    """IdentifyError for a log no fit can use: shorter than MIN_DURATION, torques all zero, or (full
+    state) without a truth table."""
+    duration = float(log.imu.t[-1] - log.imu.t[0])
+    if duration < MIN_DURATION:
+        raise IdentifyError(f"log: {duration:g} s of IMU samples; an identification needs at least {MIN_DURATION:g} s")
+    if not np.any(log.torques.data != 0):
+        raise IdentifyError("log: torques: every torque is zero; a robot that is not driven shows nothing of "
+                            "its inertias")
+    if full_state and (log.truth is None or len(log.truth) < 3):
+        raise IdentifyError("log: a full-state fit needs the log's truth table (truth.csv / truth.parquet)")
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Fit:
+    """The result of `identify`: the free entries `names`, their `nominal` and `estimate`, the
+    standard deviations `sigma` (NaN where not identified) and 95 % intervals `low`, `high`; the
+    marginal Fisher information `information` of the named parameters (n, n), `correlation`;
+    `rank`, `condition` (of the information scaled by the nominal values), `identified` (n,) bool,
+    `on_bound` {name: "lower"/"upper"}; `combinations`: [{"name", "value", "sigma", "identified"}]
+    for the base parameters the free entries enter; `null_directions`: [{name: weight}] the
+    combinations the log cannot separate; `biases` (6,) and their sigma; `residual_check`: {"rms",
+    "chi2", "dof", "p_value", "passed"}; `residuals` {kind: (t, whitened residuals)} for plots;
+    `params` the estimated robot; `nfev`, `status`, `message` of the solver."""
+    names: tuple
+    nominal: np.ndarray
+    estimate: np.ndarray
+    sigma: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    information: np.ndarray
+    correlation: np.ndarray
+    rank: int
+    condition: float
+    identified: np.ndarray
+    on_bound: dict
+    combinations: list
+    null_directions: list
+    biases: np.ndarray
+    bias_sigma: np.ndarray
+    residual_check: dict
+    residuals: dict
+    params: Params
+    nfev: int
+    status: int
+    message: str
+    mode: str
+
+
+class _Problem:
+    """The multiple-shooting problem of a sensor log."""
+
+    def __init__(self, log, params, free, segment, method, x_guess, bias_guess):
+        self.log, self.params, self.free, self.method = log, params, free, method
+        self.idx = [PARAMETER_NAMES.index(n) for n in free]
+        self.nf = len(free)
+        self.data = d = _grid(log)
+        n = len(d.t)
+        per = max(2, int(round(segment / d.h)))
+        starts = list(range(0, n - 1, per))
+        if len(starts) > 1 and n - 1 - starts[-1] < per // 2:     # a short tail joins the segment before
+            starts.pop()
+        self.starts = np.array(starts)
+        self.ends = np.append(self.starts[1:], n - 1)
+        self.S = len(self.starts)
+        self.xref = np.array(x_guess[self.starts])
+        self.b0 = np.asarray(bias_guess, dtype=float)
+        self.mount = log.sensors.imu.mount
+        sensors = log.sensors
+        self.sig_imu = np.repeat([sensors.imu.gyro_noise, sensors.imu.accel_noise], 3)
+        self.sig_enc = sensors.encoders.step / math.sqrt(12)
+        self.sig_fix = sensors.fixes.noise if sensors.fixes is not None else 1.0
+        self.fix_xy = log.fixes.select("x", "y") if log.fixes is not None else np.empty((0, 2))
+        self.q2 = sensors.process.generalized() ** 2
+        self.ncols = self.nf + 6 + NE * self.S
+        self.chol = None
+        self._cache = (None, None)
+        self.nfev = 0
+        self.progress = None
+
+    # -- the unknowns ---------------------------------------------------------------------------
+    def split(self, z):
+        return z[:self.nf], z[self.nf:self.nf + 6], z[self.nf + 6:].reshape(self.S, NE)
+
+    def model(self, theta):
+        p = self.params.as_array()
+        p[self.idx] = theta
+        try:
+            return Model(Params.from_array(p))
+        except ValueError as exc:
+            raise IdentifyError(f"the fit reached a robot the model refuses ({exc}); the named parameters may not be "
+                                f"identifiable from this log, or the nominal robot is too far from the truth") from None
+
+    def _dretract(self, model, x, d):
+        """∂ local(retract(x, d), retract(x, d + δ)) / ∂δ (12, 12) by central differences of the
+        group maps (exact maps, no dynamics); the start-state unknowns are offsets about a fixed guess."""
+        x0 = model.retract(x, d)
+        e = 1e-6
+        D = np.empty((NE, NE))
+        for i in range(NE):
+            dp, dm = d.copy(), d.copy()
+            dp[i] += e
+            dm[i] -= e
+            D[:, i] = (model.local(x0, model.retract(x, dp)) - model.local(x0, model.retract(x, dm))) / (2 * e)
+        return x0, D
+
+    def _dlocal(self, model, a, b):
+        """(∂ local(a ⊕ δ, b)/∂δ, ∂ local(a, b ⊕ δ)/∂δ) at δ = 0, central differences."""
+        e = 1e-6
+        A, B = np.empty((NE, NE)), np.empty((NE, NE))
+        for i in range(NE):
+            di = np.zeros(NE)
+            di[i] = e
+            A[:, i] = (model.local(model.retract(a, di), b) - model.local(model.retract(a, -di), b)) / (2 * e)
+            B[:, i] = (model.local(a, model.retract(b, di)) - model.local(a, model.retract(b, -di))) / (2 * e)
+        return A, B
+
+    # -- one evaluation -------------------------------------------------------------------------
+    def segment_blocks(self, z):
+        """Per segment: raw residuals r (noise-scaled readings, then the end-state difference), their
+        Jacobian blocks (theta, bias, own start, next start), and what the whitening needs."""
+        theta, b, Dz = self.split(z)
+        model = self.model(theta)
+        starts = [self._dretract(model, self.xref[s], Dz[s]) for s in range(self.S)]
+        out = []
+        for s in range(self.S):
+            nxt = starts[s + 1] if s + 1 < self.S else None
+            out.append(self.segment_block(model, s, starts[s], nxt, b))
+        return out
+
+    def segment_block(self, model, s, start, nxt, b):
+        """One segment's block: simulated from start = (x0, D) under the logged torques; the
+        end-state difference to nxt = (x0 of the next segment, its D) unless nxt is None."""
+        d = self.data
+        x0, D = start
+        k0, k1 = self.starts[s], self.ends[s]
+        steps = k1 - k0
+        X = model.simulate(x0, d.h, steps, u=d.u[k0:k1], method=self.method, energy_tol=None)
+        F, _ = model.step_jacobian(X[:-1], d.u[k0:k1], d.h, self.method)
+        Jp = model.step_param_jacobian(X[:-1], d.u[k0:k1], d.h, self.method)[:, :, self.idx]
+        last = s == self.S - 1
+        nodes = np.arange(k0, k1 + 1 if last else k1)
+        Xn = X[:len(nodes)]
+        nudot = model.accel(Xn, d.u[nodes])
+        Ja, _ = model.accel_jacobian(Xn, d.u[nodes])
+        Jpa = model.param_jacobian(Xn, d.u[nodes])[:, :, self.idx]
+        Phi = np.empty((steps + 1, NE, NE))
+        Sens = np.empty((steps + 1, NE, self.nf))
+        Phi[0], Sens[0] = np.eye(NE), 0.0
+        for k in range(steps):
+            Phi[k + 1] = F[k] @ Phi[k]
+            Sens[k + 1] = F[k] @ Sens[k] + Jp[k]
+        rows_r, rows_th, rows_b, rows_x, meta = [], [], [], [], []
+        enc_H = np.zeros((2, NE))
+        enc_H[0, IDX_E_TH_Y] = enc_H[1, IDX_E_TH_P] = 1.0
+        fix_H = np.zeros((2, NE))
+        fix_H[:, IDX_E_Q] = np.eye(2)
+        for i, k in enumerate(nodes):
+            j = d.imu_row[k]
+            if j >= 0:
+                y, H, Hn = imu_partials(model, Xn[i], nudot[i], mount=self.mount, bias=b)
+                Hx = H[:, :NE] + Hn @ Ja[i]
+                rows_r.append((self.log.imu.data[j] - y) / self.sig_imu)
+                rows_th.append(-(Hx @ Sens[i] + Hn @ Jpa[i]) / self.sig_imu[:, None])
+                rows_b.append(-H[:, NE:] / self.sig_imu[:, None])
+                rows_x.append(-(Hx @ Phi[i]) / self.sig_imu[:, None])
+                meta.append(("imu", k, Hx, Hn))
+            for kind, row, H, sig, pred in (
+                    ("encoders", d.enc_row[k], enc_H, self.sig_enc, None),
+                    ("fixes", d.fix_row[k], fix_H, self.sig_fix, None)):
+                if row < 0:
+                    continue
+                if kind == "encoders":
+                    e = _wrap(self.log.encoders.data[row] - np.array([yoke_angle(Xn[i]), pendulum_angle(Xn[i])]))
+                else:
+                    e = self.fix_xy[row] - Xn[i][IDX_Q][:2]
+                rows_r.append(e / sig)
+                rows_th.append(-(H @ Sens[i]) / sig)
+                rows_b.append(np.zeros((2, 6)))
+                rows_x.append(-(H @ Phi[i]) / sig)
+                meta.append((kind, k, H, None))
+        block = {"r": np.concatenate(rows_r), "th": np.vstack(rows_th), "b": np.vstack(rows_b),
+                 "x": np.vstack(rows_x) @ D, "next": None, "meta": meta, "X": X, "Phi": Phi,
+                 "nodes": nodes, "model": model, "n_out": len(np.concatenate(rows_r))}
+        if nxt is not None:
+            A, B = self._dlocal(model, X[-1], nxt[0])
+            defect = model.local(X[-1], nxt[0])
+            block["r"] = np.concatenate([block["r"], defect])
+            block["th"] = np.vstack([block["th"], A @ Sens[-1]])
+            block["b"] = np.vstack([block["b"], np.zeros((NE, 6))])
+            block["x"] = np.vstack([block["x"], A @ Phi[-1] @ D])
+            block["next"] = np.vstack([np.zeros((len(block["r"]) - NE, NE)), B @ nxt[1]])
+        return block
+
+    def fit_starts(self, z):
+        """The segments' start states one after the other (the parameters and biases held): each
+        from its own readings and, after the first, from the previous segment's end (weighed by the
+        process noise between them), a small Levenberg–Marquardt fit; the guesses then move there
+        (the fit's offsets start at zero)."""
+        theta, b, _ = self.split(z)
+        model = self.model(theta)
+        prior = None
+        for s in range(self.S):
+            x_ref = self.xref[s]
+            if prior is not None:       # start from the previous segment's end
+                x_ref = prior[0]
+            cache = {}
+
+            def evaluate(dv, x_ref=x_ref, prior=prior, s=s):
+                key = dv.tobytes()
+                if key not in cache:
+                    cache.clear()
+                    start = self._dretract(model, x_ref, dv)
+                    blk = self.segment_block(model, s, start, None, b)
+                    r, J = blk["r"], blk["x"]
+                    if prior is not None:
+                        e = model.local(prior[0], start[0])
+                        _, Bd = self._dlocal(model, prior[0], start[0])
+                        r = np.concatenate([r, scipy.linalg.solve_triangular(prior[1], e, lower=True)])
+                        J = np.vstack([J, scipy.linalg.solve_triangular(prior[1], Bd @ start[1], lower=True)])
+                    cache[key] = (r, J, blk)
+                return cache[key]
+
+            sol = scipy.optimize.least_squares(lambda dv: evaluate(dv)[0], np.zeros(NE),
+                                               jac=lambda dv: evaluate(dv)[1], method="lm", max_nfev=20)
+            self.xref[s] = model.retract(x_ref, sol.x)
+            blk = evaluate(sol.x)[2]
+            prior = (blk["X"][-1], np.linalg.cholesky(self.end_covariance(s, blk)))
+        self._cache = (None, None)
+
+    def noise_map(self, s, blk):
+        """(A, Q): the effect on the segment's noise-scaled readings and on its end state (the last
+        12 rows) of the process noise's forces w_j, one per torque period and held over it (the
+        accelerometer reads M⁻¹ w_j, the velocities jump by M⁻¹ w_j τ at its end), w_j of
+        covariance diag(Q)."""
+        d = self.data
+        model, X, Phi = blk["model"], blk["X"], blk["Phi"]
+        k0, last_node = self.starts[s], self.ends[s]
+        js = np.unique(d.interval[k0:last_node + 1])
+        col = {j: c for c, j in enumerate(js)}
+        A = np.zeros((blk["n_out"] + NE, 5 * len(js)))
+        P = np.zeros((NE, 5 * len(js)))
+        enters = np.full(len(js), np.iinfo(int).max)
+        for c, j in enumerate(js):
+            after = np.flatnonzero(d.interval[k0 + 1:last_node + 1] > j)
+            if after.size:
+                kappa = after[0] + 1
+                Bk = np.zeros((NE, 5))
+                Bk[IDX_E_NU] = np.linalg.inv(model.inertia(X[kappa - 1])) * d.tau
+                P[:, 5 * c:5 * c + 5] = np.linalg.solve(Phi[kappa], Bk)
+                enters[c] = kappa
+        row = 0
+        sig = {"imu": self.sig_imu, "encoders": self.sig_enc, "fixes": self.sig_fix}
+        for kind, k, Hx, Hn in blk["meta"]:
+            i = k - k0
+            m = Hx.shape[0]
+            scale = np.broadcast_to(np.asarray(sig[kind], dtype=float), (m,))[:, None]
+            A[row:row + m] = (Hx @ Phi[i] @ P) / scale * np.repeat(enters <= i, 5)
+            if kind == "imu":
+                c = col[d.interval[k]]
+                A[row:row + m, 5 * c:5 * c + 5] += Hn @ np.linalg.inv(model.inertia(X[i])) / scale
+            row += m
+        A[row:] = (Phi[-1] @ P) * np.repeat(enters <= len(Phi) - 1, 5)
+        return A, np.tile(self.q2 / d.tau, len(js))
+
+    def end_covariance(self, s, blk):
+        """The covariance (12, 12) of a segment's end state from the process noise inside it."""
+        A, Q = self.noise_map(s, blk)
+        E = A[blk["n_out"]:]
+        return (E * Q) @ E.T + DEFECT_FLOOR ** 2 * np.eye(NE)
+
+    def covariances(self, blocks):
+        """Cholesky factors of each segment's residual covariance, in units of the sensor noise:
+        I + A Q Aᵀ (`noise_map`) for the readings and their end-state difference."""
+        out = []
+        for s, blk in enumerate(blocks):
+            A, Q = self.noise_map(s, blk)
+            nrow, row = len(blk["r"]), blk["n_out"]
+            A = A[:nrow]
+            C = (A * Q) @ A.T
+            C[np.arange(row), np.arange(row)] += 1.0
+            C[np.arange(row, nrow), np.arange(row, nrow)] += DEFECT_FLOOR ** 2
+            out.append(scipy.linalg.cholesky(C, lower=True))
+        return out
+
+    def assemble(self, z):
+        """(whitened residuals, sparse Jacobian) at z."""
+        if self._cache[0] is not None and np.array_equal(self._cache[0], z):
+            return self._cache[1]
+        blocks = self.segment_blocks(z)
+        if self.chol is None:
+            self.chol = self.covariances(blocks)
+        rs, data, ri, ci = [], [], [], []
+        row0 = 0
+        cols_g = np.arange(self.nf + 6)
+        for s, blk in enumerate(blocks):
+            L = self.chol[s]
+            w = scipy.linalg.solve_triangular
+            r = w(L, blk["r"], lower=True)
+            parts = [(np.hstack([blk["th"], blk["b"]]), cols_g),
+                     (blk["x"], self.nf + 6 + NE * s + np.arange(NE))]
+            if blk["next"] is not None:
+                parts.append((blk["next"], self.nf + 6 + NE * (s + 1) + np.arange(NE)))
+            for M, cols in parts:
+                Mw = w(L, M, lower=True)
+                rr, cc = np.meshgrid(row0 + np.arange(len(r)), cols, indexing="ij")
+                data.append(Mw.ravel())
+                ri.append(rr.ravel())
+                ci.append(cc.ravel())
+            rs.append(r)
+            row0 += len(r)
+        # the weak prior on the first start state (the gauge no sensor fixes)
+        _, _, Dz = self.split(z)
+        rs.append(Dz[0] / GAUGE_SIGMA)
+        data.append(np.full(NE, 1.0 / GAUGE_SIGMA))
+        ri.append(row0 + np.arange(NE))
+        ci.append(self.nf + 6 + np.arange(NE))
+        r = np.concatenate(rs)
+        J = scipy.sparse.csr_matrix((np.concatenate(data), (np.concatenate(ri), np.concatenate(ci))),
+                                    shape=(len(r), self.ncols))
+        self._cache = (z.copy(), (r, J, blocks))
+        self.nfev += 1
+        if self.progress is not None:
+            self.progress()
+        return self._cache[1]
+
+    def z0(self):
+        return np.concatenate([self.params.as_array()[self.idx], self.b0, np.zeros(NE * self.S)])
+
+    def bounds(self):
+        lo = np.full(self.ncols, -np.inf)
+        hi = np.full(self.ncols, np.inf)
+        for i, name in enumerate(self.free):
+            lo[i], hi[i] = bounds_of(name, self.params, self.free)
+        return lo, hi
+
+    def residual_series(self, z):
+        """{kind: (t, whitened residuals (n, m))} along the log: each segment's residuals whitened by
+        their covariance (the Cholesky factor's order: each reading's innovation given the earlier
+        readings of its segment), so that a right model leaves unit white noise."""
+        blocks = self.assemble(z)[2]
+        out = {"imu": ([], []), "encoders": ([], []), "fixes": ([], [])}
+        for s, blk in enumerate(blocks):
+            w = scipy.linalg.solve_triangular(self.chol[s], blk["r"], lower=True)
+            row = 0
+            for kind, k, Hx, _ in blk["meta"]:
+                m = Hx.shape[0]
+                out[kind][0].append(self.data.t[k])
+                out[kind][1].append(w[row:row + m])
+                row += m
+        return {k: (np.array(t), np.array(v)) for k, (t, v) in out.items() if t}
+
+
+class _FullState:
+    """The one-step prediction-error problem of a full-state log: the velocities at row k + 1 against
+    one step of the model from row k, whitened by the process noise's velocity jump."""
+
+    def __init__(self, log, params, free, method):
+        self.params, self.free, self.method = params, free, method
+        self.idx = [PARAMETER_NAMES.index(n) for n in free]
+        self.nf = len(free)
+        self.X = log.truth_states()
+        self.t = log.truth.t
+        self.h = float(np.median(np.diff(self.t)))
+        self.u = log.torque_at(self.t[:-1])
+        q2 = log.sensors.process.generalized() ** 2
+        if not np.all(q2 > 0):
+            raise IdentifyError("sensors.process: a full-state fit weighs the velocities by the process noise; "
+                                "the sensor set declares none on some axis")
+        model = Model(params)
+        self.chol = []
+        for x in self.X[:-1]:
+            Minv = np.linalg.inv(model.inertia(x))
+            self.chol.append(np.linalg.cholesky(Minv @ np.diag(q2 * self.h) @ Minv.T))
+        self.chol = np.array(self.chol)
+        self.ncols = self.nf
+        self._cache = (None, None)
+        self.nfev = 0
+        self.progress = None
+
+    model = _Problem.model
+
+    def assemble(self, z):
+        if self._cache[0] is not None and np.array_equal(self._cache[0], z):
+            return self._cache[1]
+        model = self.model(z)
+        pred = np.array([model.step(x, u, self.h, self.method) for x, u in zip(self.X[:-1], self.u)])
+        e = self.X[1:, IDX_NU] - pred[:, IDX_NU]
+        Jp = model.step_param_jacobian(self.X[:-1], self.u, self.h, self.method)[:, IDX_E_NU][:, :, self.idx]
+        r = np.linalg.solve(self.chol, e[..., None])[..., 0]
+        J = -np.linalg.solve(self.chol, Jp)
+        self._cache = (z.copy(), (r.ravel(), scipy.sparse.csr_matrix(J.reshape(-1, self.nf)), None))
+        self.nfev += 1
+        if self.progress is not None:
+            self.progress()
+        return self._cache[1]
+
+    def z0(self):
+        return self.params.as_array()[self.idx]
+
+    def bounds(self):
+        lo, hi = zip(*(bounds_of(n, self.params, self.free) for n in self.free))
+        return np.array(lo), np.array(hi)
+
+
+def _start_guess(log, params):
+    """The EKF's estimate at every IMU time and its final biases (the fit's starting point)."""
+    from ..estimation.estimate import estimate_log
+    est = estimate_log(log, params)
+    k = np.searchsorted(est.t, log.imu.t)
+    k = np.clip(k, 0, len(est.t) - 1)
+    return est.x[k], est.biases[-1]
+
+
+def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, max_nfev=20, progress=None,
+             x_guess=None, bias_guess=None):
+    """Fit the parameters `names` (see `free_parameters`) of the robot `params` (the others held) to
+    `log` (runtime.estimation.logs.Log), with the IMU's biases and each segment's start state; or,
+    `full_state`, to the log's truth by the one-step prediction error.  `segment` [s]: the
+    multiple-shooting segments' length; `x_guess` (n_imu, 35) and `bias_guess` (6,) replace the
+    EKF's start guess.  `progress()` is called once per evaluation.  Returns a `Fit`."""
+    if not isinstance(params, Params):
+        raise IdentifyError(f"robot: expected a runtime.Params, got {type(params).__name__}")
+    free = free_parameters(names)
+    check_log(log, full_state)
+    if not (isinstance(segment, (int, float)) and math.isfinite(segment) and segment > 0):
+        raise IdentifyError(f"segment: expected a length > 0 in s, got {segment!r}")
+    if full_state:
+        prob = _FullState(log, params, free, method)
+    else:
+        if x_guess is None:
+            x_guess, guess_b = _start_guess(log, params)
+            bias_guess = guess_b if bias_guess is None else bias_guess
+        prob = _Problem(log, params, free, segment, method, np.asarray(x_guess), np.zeros(6) if bias_guess is None
+                        else bias_guess)
+    prob.progress = progress
+    if not full_state:
+        prob.fit_starts(prob.z0())
+    lo, hi = prob.bounds()
+    with np.errstate(invalid="ignore"):
+        z0 = np.clip(prob.z0(), np.where(np.isfinite(lo), lo + 1e-12 * np.maximum(1, abs(lo)), lo),
+                     np.where(np.isfinite(hi), hi - 1e-12 * np.maximum(1, abs(hi)), hi))
+
+    def fun(z):
+        return prob.assemble(z)[0]
+
+    # a dense trust-region solve while J is small, LSMR on the sparse J beyond
+    dense = full_state or prob.ncols * (prob.ncols + 8 * len(prob.data.t)) <= DENSE_LIMIT
+
+    def jac(z):
+        return prob.assemble(z)[1].toarray() if dense else prob.assemble(z)[1]
+
+    opts = dict(jac=jac, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=max_nfev,
+                xtol=1e-8, ftol=1e-8, gtol=1e-10)
+    if not dense:
+        opts.update(tr_solver="lsmr", tr_options={"atol": 1e-12, "btol": 1e-12, "maxiter": 2000})
+    sol = scipy.optimize.least_squares(fun, z0, **opts)
+    if not full_state:              # the covariance at the optimum, then a short refinement
+        prob.chol = None
+        prob._cache = (None, None)
+        sol = scipy.optimize.least_squares(fun, sol.x, **{**opts, "max_nfev": max(3, max_nfev // 2)})
+    return _report(prob, sol, free, params, full_state)
+
+
+def _report(prob, sol, free, params, full_state):
+    r, J, _ = prob.assemble(sol.x)
+    nf = len(free)
+    I = (J.T @ J).toarray()
+    if full_state:
+        info = I
+    else:                           # eliminate the start states and the biases
+        g, l = slice(0, nf), slice(nf, None)
+        Ill = I[l, l]
+        info = I[g, g] - I[g, l] @ np.linalg.solve(Ill, I[l, g])
+        gb = slice(0, nf + 6)
+        lx = slice(nf + 6, None)
+        info_gb = I[gb, gb] - I[gb, lx] @ np.linalg.solve(I[lx, lx], I[lx, gb])
+    info = 0.5 * (info + info.T)
+    theta = sol.x[:nf]
+    nominal = params.as_array()[prob.idx]
+    scale = np.where(np.abs(nominal) > 0, np.abs(nominal), 1e-3 * max(1.0, float(np.abs(nominal).max())))
+    scaled = info * np.outer(scale, scale)
+    evals, evecs = np.linalg.eigh(scaled)
+    top = max(float(evals[-1]), 1e-300)
+    keep = evals > RANK_RTOL * top
+    rank = int(keep.sum())
+    condition = float(top / evals[keep][0]) if rank else math.inf
+    null = evecs[:, ~keep]
+    identified = np.array([np.linalg.norm(null[i]) < 1e-3 for i in range(nf)]) if null.size else np.ones(nf, bool)
+    cov_scaled = (evecs[:, keep] / evals[keep]) @ evecs[:, keep].T
+    cov = cov_scaled * np.outer(scale, scale)
+    sigma = np.sqrt(np.clip(np.diag(cov), 0, None))
+    sigma[~identified] = np.nan
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(np.sqrt(np.diag(cov)), np.sqrt(np.diag(cov)))
+    lo, hi = prob.bounds()
+    lo, hi = lo[:nf], hi[:nf]
+    on_bound = {}
+    for i, n in enumerate(free):
+        tol = 1e-6 * max(abs(theta[i]), scale[i])
+        if np.isfinite(lo[i]) and theta[i] - lo[i] <= tol:
+            on_bound[n] = "lower"
+        elif np.isfinite(hi[i]) and hi[i] - theta[i] <= tol:
+            on_bound[n] = "upper"
+    p = params.as_array()
+    p[prob.idx] = theta
+    estimated = Params.from_array(p)
+    combos = _combinations(params, estimated, prob.idx, cov, null, scale)
+    nulls = [{free[i]: float(v[i]) for i in np.argsort(-np.abs(v)) if abs(v[i]) > 1e-3} for v in null.T]
+    n_data = len(r) - (0 if full_state else NE)
+    chi2 = float(np.sum(r[:n_data] ** 2))
+    dof = max(n_data - (nf if full_state else prob.ncols), 1)
+    rms = math.sqrt(chi2 / dof)
+    check = {"rms": rms, "chi2": chi2, "dof": dof, "p_value": float(scipy.stats.chi2.sf(chi2, dof)),
+             "tolerance": RESIDUAL_TOLERANCE, "passed": bool(abs(rms - 1) <= RESIDUAL_TOLERANCE)}
+    if full_state:
+        biases, bsig = np.full(6, np.nan), np.full(6, np.nan)
+        series = {"velocities": (prob.t[1:], r.reshape(-1, NV))}
+    else:
+        biases = sol.x[nf:nf + 6]
+        ev, V = np.linalg.eigh(0.5 * (info_gb + info_gb.T))
+        ok = ev > RANK_RTOL * ev[-1]
+        cgb = (V[:, ok] / ev[ok]) @ V[:, ok].T
+        bsig = np.sqrt(np.clip(np.diag(cgb)[nf:], 0, None))
+        series = prob.residual_series(sol.x)
+    return Fit(names=free, nominal=nominal, estimate=theta, sigma=sigma, low=theta - Z95 * sigma,
+               high=theta + Z95 * sigma, information=info, correlation=corr, rank=rank, condition=condition,
+               identified=identified, on_bound=on_bound, combinations=combos, null_directions=nulls,
+               biases=biases, bias_sigma=bsig, residual_check=check, residuals=series, params=estimated,
+               nfev=int(prob.nfev), status=int(sol.status), message=str(sol.message),
+               mode="full-state" if full_state else "sensors")
+
+
+def _dpi(params, idx):
+    """∂π/∂θ (27, n) by central differences of the exact polynomial π(p)."""
+    p = params.as_array()
+    out = np.empty((len(inertial_parameters(params)), len(idx)))
+    for c, i in enumerate(idx):
+        e = 1e-6 * max(abs(p[i]), 1e-3)
+        hi, lo = p.copy(), p.copy()
+        hi[i] += e
+        lo[i] -= e
+        out[:, c] = (_pi_of(hi) - _pi_of(lo)) / (2 * e)
+    return out
+
+
+def _pi_of(p):
+    """π of a parameter vector that need not pass the physical checks (a difference step may not)."""
+    values = dict(zip(PARAMETER_NAMES, p))
+    fields = {}
+    for body in ("Y", "P"):
+        c = np.array([values[f"c_{body}_{a}"] for a in "xyz"])
+        J = np.array([[values[f"J_{body}_{''.join(sorted(a + b, key='xyz'.index))}"] for b in "xyz"] for a in "xyz"])
+        fields[body] = (values[f"m_{body}"], c, J)
+    proxy = type("P", (), {})()
+    for k in ("m_S", "j_S", "k_S", "k_Y", "k_P", "j_mY", "j_mP"):
+        setattr(proxy, k, values[k])
+    for body, (m, c, J) in fields.items():
+        setattr(proxy, f"m_{body}", m)
+        setattr(proxy, f"c_{body}", c)
+        setattr(proxy, f"J_{body}", J)
+    return inertial_parameters(proxy)
+
+
+def _combinations(nominal, estimated, idx, cov, null, scale):
+    """The base parameters (runtime.param_derivatives.base_parameters of the robot) that the free
+    entries enter, with their value at the estimate, a sigma by the delta method and whether the
+    log determines them (their gradient orthogonal to the information's null space)."""
+    base = base_parameters(Model(estimated))
+    G = np.zeros((base.rank, len(inertial_parameters(estimated))))
+    for k, i in enumerate(base.independent):
+        G[k, i] = 1.0
+        G[k, list(base.dependent)] = base.combination[k]
+    dpi = _dpi(estimated, idx)
+    values = base.values(inertial_parameters(estimated))
+    nominal_values = base.values(inertial_parameters(nominal))
+    out = []
+    grads = G @ dpi * scale
+    largest = np.abs(grads).max()
+    for k, name in enumerate(base.names(4)):
+        g = G[k] @ dpi
+        if np.abs(grads[k]).max() <= 1e-9 * largest:
+            continue
+        gs = g * scale
+        determined = bool(null.size == 0 or np.abs(null.T @ gs).max() <= 1e-3 * np.linalg.norm(gs))
+        sigma = float(math.sqrt(max(g @ cov @ g, 0.0))) if determined else math.nan
+        out.append({"name": name, "value": float(values[k]), "nominal": float(nominal_values[k]),
+                    "sigma": sigma, "identified": determined})
+    return out
