@@ -95,6 +95,22 @@ static void test_predict_leaves_the_bias_block_alone_and_moves_the_cross_terms(v
     CHECK(nonzero > 0);
 }
 
+static void test_the_bias_variances_grow_by_their_random_walk_over_dt(void)
+{
+    /* P_bb <- P_bb + dt diag(rw^2): the biases do not enter the step, only their random walk. */
+    sr_ekf ekf;
+    sr_model m;
+    const sr_ekf_process q = {{SR_C(0.01), SR_C(0.01), SR_C(0.01)}, SR_C(0.02), SR_C(0.3)};
+    const double dt = 0.005, p = 1e-4;
+    int i;
+    start(&ekf, &m, sqrt(p));
+    CHECK_STATUS(sr_ekf_predict(&ekf, &m, SR_RKMK4, NULL, (sr_real)dt, &q), SR_OK);
+    for (i = 0; i < 3; ++i) {
+        CHECK_NEAR(ekf.P[SR_NEB * (SR_EB_b_g + i) + SR_EB_b_g + i], p + dt * 0.02 * 0.02, 8 * TEST_EPS);
+        CHECK_NEAR(ekf.P[SR_NEB * (SR_EB_b_a + i) + SR_EB_b_a + i], p + dt * 0.3 * 0.3, 8 * TEST_EPS);
+    }
+}
+
 static void test_a_constant_gyro_offset_at_rest_is_learnt_as_the_gyro_bias(void)
 {
     sr_ekf ekf;
@@ -216,6 +232,7 @@ void suite_ekf(void)
     RUN_TEST(test_an_outlier_is_gated_counted_and_not_applied);
     RUN_TEST(test_encoder_innovations_wrap_around_pi);
     RUN_TEST(test_predict_leaves_the_bias_block_alone_and_moves_the_cross_terms);
+    RUN_TEST(test_the_bias_variances_grow_by_their_random_walk_over_dt);
     RUN_TEST(test_a_constant_gyro_offset_at_rest_is_learnt_as_the_gyro_bias);
     RUN_TEST(test_a_fix_marked_and_applied_at_once_is_the_plain_fix);
     RUN_TEST(test_a_late_fix_corrects_the_estimate_by_what_it_said_when_it_measured);
