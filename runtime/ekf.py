@@ -12,6 +12,10 @@ from an IMU, the joint encoders, position fixes and a heading (docs/estimation.m
         ekf.update_position((q_x, q_y))
     ekf.x, ekf.biases, ekf.sigma, ekf.counters
 
+A fix that arrives `latency` after the instant it measures: `ekf.mark_position(slot)` at that
+instant (after the predict to it), `ekf.update_position_delayed(slot, (q_x, q_y))` on arrival;
+up to DELAYED_SLOTS fixes may wait at once.
+
 Every call is one C call on a caller-owned `sr_ekf`; the arguments are checked here first (a
 ValueError names the one that is wrong).  Each update returns True when the sample was applied,
 False when the chi-square gate refused it (counted in `counters`).
@@ -37,6 +41,8 @@ KINDS = ("imu", "encoders", "position", "heading")
 METHODS = {"lie-euler": lib.SR_LIE_EULER, "rkmk4": lib.SR_RKMK4, "cf4": lib.SR_CF4}
 #: The size of each kind's sample (the degrees of freedom of its gate).
 SAMPLE_SIZES = {"imu": lib.SR_NIMU, "encoders": 2, "position": 2, "heading": 1}
+#: How many delayed fixes may wait at once (the slots of `Ekf.mark_position`).
+DELAYED_SLOTS = lib.SR_EKF_NDELAYED
 #: The bias blocks of the error state.
 IDX_EB_BG = slice(lib.SR_EB_b_g, lib.SR_EB_b_g + 3)
 IDX_EB_BA = slice(lib.SR_EB_b_a, lib.SR_EB_b_a + 3)
@@ -176,6 +182,27 @@ class Ekf:
                                             self.gate["position"])
         return self._applied("position", status, "the innovation covariance is not positive definite")
 
+    def mark_position(self, slot):
+        """The instant a fix is measured that arrives later: what its update needs is kept in
+        `slot` (0 ≤ slot < DELAYED_SLOTS; a slot still waiting forgets its fix)."""
+        slot = _slot(slot)
+        _check(lib.sr_ekf_mark_position(self._ekf, self.model._model, slot), "x")
+
+    def update_position_delayed(self, slot, y):
+        """The fix (q_x, q_y) [m] measured when `slot` was marked (the slot is free afterwards)."""
+        slot = _slot(slot)
+        if not self._ekf.delayed[slot].marked:
+            raise ValueError(f"slot: {slot} waits for no fix (mark_position first)")
+        y = _vector(y, "y", 2)
+        self._before = self._ekf.accepted[2]
+        status = lib.sr_ekf_update_position_delayed(self._ekf, self.model._model, slot, _ptr(y), self.noise.position,
+                                                    self.gate["position"])
+        return self._applied("position", status, "the innovation covariance is not positive definite")
+
+    def waiting(self):
+        """The slots whose fixes have not arrived yet."""
+        return [k for k in range(DELAYED_SLOTS) if self._ekf.delayed[k].marked]
+
     def update_heading(self, y):
         """One heading sample [rad] of the heading sensor's x axis."""
         value = float(_vector([y], "y", 1)[0]) if np.ndim(y) == 0 else None
@@ -224,6 +251,12 @@ def _mount(mount, name):
     if not isinstance(mount, Mount):
         raise ValueError(f"{name}: expected a runtime.sensors.Mount, got {type(mount).__name__}")
     return mount
+
+
+def _slot(slot):
+    if not (isinstance(slot, (int, np.integer)) and not isinstance(slot, bool) and 0 <= slot < DELAYED_SLOTS):
+        raise ValueError(f"slot: expected an integer in [0, {DELAYED_SLOTS}), got {slot!r}")
+    return int(slot)
 
 
 def _check(status, field):

@@ -306,7 +306,7 @@ def test_size_report_covers_every_public_function(tmp_path):
         pytest.skip("the C compiler has no -fcallgraph-info (GCC >= 10 needed)")
     out = run([sys.executable, str(ROOT / "tools" / "size_report.py"), "--cc", CC]).stdout
     header = "".join(re.sub(r"/\*.*?\*/", "", (INCLUDE / h).read_text(), flags=re.S)
-                     for h in ("spherical_robot.h", "sr_sensors.h"))
+                     for h in ("spherical_robot.h", "sr_sensors.h", "sr_ekf.h"))
     for name in re.findall(r"^[A-Za-z_][\w \t\*]*?\b(sr_\w+)\s*\(", header, flags=re.M):
         assert out.count(f"| `{name}` |") == 2, name  # one row per scalar type
 

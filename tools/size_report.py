@@ -42,7 +42,7 @@ import tempfile
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 C_DIR = ROOT / "c"
 INCLUDE = C_DIR / "include"
-HEADERS = (INCLUDE / "spherical_robot.h", INCLUDE / "sr_sensors.h")
+HEADERS = (INCLUDE / "spherical_robot.h", INCLUDE / "sr_sensors.h", INCLUDE / "sr_ekf.h")
 BEGIN, END = "<!-- size-report:begin -->", "<!-- size-report:end -->"
 
 Node = collections.namedtuple("Node", "title symbol obj frame qualifier")

@@ -4,7 +4,8 @@
  * LLVMFuzzerTestOneInput turns the input bytes into parameters, a state, torques, a time
  * step, a method and small step counts, calls every function of spherical_robot.h (the
  * controller's sr_lqr_* with a fuzzed gain schedule, target and memory) and of sr_sensors.h
- * (a fuzzed body, mount, nu_dot and biases) and of sr_nmpc.h (a fuzzed box QP; a fuzzed NMPC design
+ * (a fuzzed body, mount, nu_dot and biases) and of sr_ekf.h (a fuzzed start, process noise,
+ * samples, noise levels, gates and delayed-fix slots) and of sr_nmpc.h (a fuzzed box QP; a fuzzed NMPC design
  * of a short horizon, target and curvatures ahead) and checks their
  * contract (abort() on a violation, so libFuzzer and the plain driver both report it with the
  * input that caused it):
@@ -25,6 +26,7 @@
  */
 #include "spherical_robot.h"
 #include "sr_sensors.h"
+#include "sr_ekf.h"
 #include "sr_nmpc.h"
 
 #include <math.h>
@@ -609,6 +611,115 @@ static void fuzz_sensors(reader *r, const sr_model *model, const sr_real x[SR_NX
     expect("sr_position_measure", status, &g, status == SR_OK ? 2 : 0, 1);
 }
 
+/* The filter: every sr_ekf_* entry point gives a documented status; on error the filter is byte for
+ * byte what it was, on SR_OK its x, biases and P are finite. */
+static void check_ekf(const char *fn, int status, const sr_ekf *ekf, const sr_ekf *before)
+{
+    int i;
+    if (status != SR_OK) {
+        if (memcmp(ekf, before, sizeof *ekf) != 0) fail(fn, status, "changed the filter on error");
+        return;
+    }
+    for (i = 0; i < SR_NX; ++i)
+        if (!isfinite(ekf->x[i])) fail(fn, status, "non-finite state with SR_OK");
+    for (i = 0; i < SR_NBIAS; ++i)
+        if (!isfinite(ekf->bias[i])) fail(fn, status, "non-finite bias with SR_OK");
+    for (i = 0; i < SR_NEB * SR_NEB; ++i)
+        if (!isfinite(ekf->P[i])) fail(fn, status, "non-finite covariance with SR_OK");
+}
+
+static void fuzz_ekf(reader *r, const sr_model *model, const sr_real x[SR_NX], const sr_real *u)
+{
+    static sr_ekf ekf, before;
+    static sr_real P0[SR_NEB * SR_NEB];
+    sr_real sigma[SR_NEB], bias[SR_NBIAS], mount[SR_NMOUNT], y[SR_NIMU], dt, noise, gate;
+    sr_ekf_process q;
+    const sr_real gates[4] = {SR_C(13.8), SR_C(1.0), (sr_real)INFINITY, SR_C(-1.0)};
+    int i, k, status, slot;
+    const unsigned b = read_u8(r);
+    const int body = b % 16 == 15 ? (int)(b / 16) - 8 : (int)(b % SR_NBODY);
+
+    for (i = 0; i < SR_NEB; ++i) sigma[i] = pick(r, 0.001 + 0.1 * fabs(unit(r)));
+    for (i = 0; i < SR_NBIAS; ++i) bias[i] = pick(r, 0.05 * unit(r));
+    memset(&ekf, CANARY, sizeof ekf);
+    memcpy(&before, &ekf, sizeof ekf);
+    status = sr_ekf_init_diagonal(&ekf, model, x, read_u8(r) % 4 == 3 ? NULL : bias, sigma);
+    EXPECT_STATUS("sr_ekf_init_diagonal", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                  SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
+    check_ekf("sr_ekf_init_diagonal", status, &ekf, &before);
+    /* sr_ekf_init with a covariance perturbed in one entry (asymmetric, indefinite or not finite) */
+    memset(P0, 0, sizeof P0);
+    for (i = 0; i < SR_NEB; ++i) P0[SR_NEB * i + i] = SR_C(1e-4);
+    i = (int)(read_u8(r) % (SR_NEB * SR_NEB));
+    P0[i] = pick(r, (double)P0[i]);
+    memcpy(&before, &ekf, sizeof ekf);
+    status = sr_ekf_init(&ekf, model, x, bias, P0);
+    EXPECT_STATUS("sr_ekf_init", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT,
+                  SR_ERR_SINGULAR);
+    check_ekf("sr_ekf_init", status, &ekf, &before);
+    EXPECT_STATUS("sr_ekf_init(NULL)", sr_ekf_init(NULL, model, x, bias, P0), SR_ERR_NULL);
+    if (status != SR_OK) return;
+
+    for (k = 0; k < 3; ++k) {
+        const unsigned what = read_u8(r);
+        int method = (int)(read_u8(r) % 3);
+        if (what % 32 == 31) method = 9; /* an unknown method */
+        dt = pick(r, 0.002 + 0.02 * fabs(unit(r)));
+        for (i = 0; i < 3; ++i) q.torque_psd[i] = pick(r, 0.01);
+        q.gyro_bias_rw = pick(r, 1e-4);
+        q.accel_bias_rw = pick(r, 1e-3);
+        memcpy(&before, &ekf, sizeof ekf);
+        status = sr_ekf_predict(&ekf, model, method, u, dt, &q);
+        EXPECT_STATUS("sr_ekf_predict", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
+        check_ekf("sr_ekf_predict", status, &ekf, &before);
+
+        slot = (int)(read_u8(r) % (SR_EKF_NDELAYED + 2)) - 1; /* -1 .. SR_EKF_NDELAYED */
+        memcpy(&before, &ekf, sizeof ekf);
+        status = sr_ekf_mark_position(&ekf, model, slot);
+        EXPECT_STATUS("sr_ekf_mark_position", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT);
+        check_ekf("sr_ekf_mark_position", status, &ekf, &before);
+
+        for (i = 0; i < 3; ++i) mount[SR_MOUNT_lever + i] = pick(r, 0.05 * unit(r));
+        for (i = 0; i < 9; ++i) mount[SR_MOUNT_R_m + i] = pick(r, i % 4 == 0 ? 1.0 : 0.0);
+        for (i = 0; i < SR_NIMU; ++i) y[i] = pick(r, (i == SR_NIMU - 1 ? 9.81 : 0.0) + 0.5 * unit(r));
+        noise = pick(r, 0.01 + 0.1 * fabs(unit(r)));
+        gate = gates[read_u8(r) % 4];
+        if (read_u8(r) % 8 == 7) gate = (sr_real)NAN;
+        memcpy(&before, &ekf, sizeof ekf);
+        status = sr_ekf_update_imu(&ekf, model, y, u, body, mount, noise, noise, gate);
+        EXPECT_STATUS("sr_ekf_update_imu", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
+        check_ekf("sr_ekf_update_imu", status, &ekf, &before);
+        memcpy(&before, &ekf, sizeof ekf);
+        status = sr_ekf_update_encoders(&ekf, model, y, noise, gate);
+        EXPECT_STATUS("sr_ekf_update_encoders", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
+        check_ekf("sr_ekf_update_encoders", status, &ekf, &before);
+        memcpy(&before, &ekf, sizeof ekf);
+        status = sr_ekf_update_position(&ekf, model, y + 2, noise, gate);
+        EXPECT_STATUS("sr_ekf_update_position", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
+        check_ekf("sr_ekf_update_position", status, &ekf, &before);
+        memcpy(&before, &ekf, sizeof ekf);
+        status = sr_ekf_update_heading(&ekf, model, y[0], body, mount, noise, gate);
+        EXPECT_STATUS("sr_ekf_update_heading", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
+        check_ekf("sr_ekf_update_heading", status, &ekf, &before);
+        slot = (int)(read_u8(r) % (SR_EKF_NDELAYED + 2)) - 1;
+        memcpy(&before, &ekf, sizeof ekf);
+        status = sr_ekf_update_position_delayed(&ekf, model, slot, y + 3, noise, gate);
+        EXPECT_STATUS("sr_ekf_update_position_delayed", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE,
+                      SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
+        check_ekf("sr_ekf_update_position_delayed", status, &ekf, &before);
+    }
+    EXPECT_STATUS("sr_ekf_predict(NULL)", sr_ekf_predict(&ekf, model, SR_RKMK4, u, SR_C(0.005), NULL), SR_ERR_NULL);
+    EXPECT_STATUS("sr_ekf_mark_position(NULL)", sr_ekf_mark_position(NULL, model, 0), SR_ERR_NULL);
+    EXPECT_STATUS("sr_ekf_update_position_delayed(NULL)",
+                  sr_ekf_update_position_delayed(&ekf, model, 0, NULL, SR_C(0.01), SR_C(1.0)), SR_ERR_NULL);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -924,6 +1035,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     /* The sensors; read last, for the same reason. */
     fuzz_sensors(&rd, &model, x, u_or_null);
+    fuzz_ekf(&rd, &model, x, u_or_null);
 
     /* NULL pointers */
     EXPECT_STATUS("sr_accel(NULL)", sr_accel(&model, x, u, NULL), SR_ERR_NULL);

@@ -27,6 +27,26 @@
  * gate: the caller's threshold on the NIS, e.g. the 99.9 % quantile of chi-square with m degrees
  * of freedom (10.83, 13.82, 22.46 for m = 1, 2, 6); +INFINITY accepts every sample.
  *
+ * Delayed fixes (a position fix that arrives some time after the instant it measures; Larsen's
+ * method with the cross-covariance carried already projected onto the fix):
+ *   at the instant s the fix is measured, sr_ekf_mark_position keeps in a slot the prediction
+ *   yh = h(x_s) and C = P_s H^T = Cov(e, z), z = H e_s (H of a fix is constant: it reads q);
+ *   every later predict and update moves C as it moves the error: C <- Phi C (Phi = diag(F, I)),
+ *   C <- C - K Cov(r, z) for an applied sample (Cov(r, z) = H C), then the reset's G;
+ *   on arrival, sr_ekf_update_position_delayed applies r = y - yh with S = H P_s H^T + R and the
+ *   cross-covariance C in place of P H^T: K = C S^-1, P <- P - K C^T - (C - K S) K^T, the
+ *   injection and the reset as above.
+ * In a linear filter C is exactly the covariance of the current error with z, so the update is
+ * the best one of the form x + K r and P stays the covariance of its error (not the smoother's
+ * optimum: the samples applied meanwhile do not revise z).  Several fixes may wait at once: each
+ * slot also keeps Cov(z_i, z_j) with every other waiting slot (taken when the later is marked),
+ * because applying one moves the others' C by -K Cov(z_i, z_j).  A fix that arrives when it is
+ * measured (no latency) is simply sr_ekf_update_position.
+ * Cost: SR_EKF_NDELAYED slots of 2 + 2 SR_NEB + 4 SR_EKF_NDELAYED numbers and an int in the
+ * sr_ekf (the default 4: 216 numbers, 1.7 kB in double, 0.9 kB in float), instead of a history of
+ * states and covariances to re-run; per waiting slot and predict one
+ * 12 x 12 by 12 x 2 product, per update an m x 2 and an SR_NEB x 2 product.
+ *
  * Checks, in the library's order (docs/robustness.md): the model (SR_ERR_NULL, SR_ERR_MODEL), the
  * other pointers (SR_ERR_NULL), the arguments (SR_ERR_ARG: method, dt, a standard deviation or a
  * noise density not finite and > 0 (>= 0 for the process noise), gate not > 0 or NaN, body; the
@@ -53,6 +73,14 @@ extern "C" {
 #define sr_ekf_update_encoders sr_ekf_update_encoders_f
 #define sr_ekf_update_position sr_ekf_update_position_f
 #define sr_ekf_update_heading sr_ekf_update_heading_f
+#define sr_ekf_mark_position sr_ekf_mark_position_f
+#define sr_ekf_update_position_delayed sr_ekf_update_position_delayed_f
+#endif
+
+#ifndef SR_EKF_NDELAYED
+/** How many delayed position fixes may wait at once (slots of sr_ekf_mark_position); a build may
+ * set its own (>= 1) with -DSR_EKF_NDELAYED=n, the library and its callers alike. */
+#define SR_EKF_NDELAYED 4
 #endif
 
 /** @name Sensor kinds: the index of each update's counters and last NIS */
@@ -64,6 +92,14 @@ extern "C" {
 #define SR_EKF_NKINDS 4        /**< the number of sensor kinds */
 /** @} */
 
+/** A position fix measured and not yet arrived (sr_ekf_mark_position; see the file's description). */
+typedef struct sr_ekf_delayed {
+    sr_real yh[2];                        /**< the fix predicted at the instant it measures, h(x_s) [m] */
+    sr_real C[SR_NEB * 2];                /**< Cov(e, z) of the current error with z = H e_s, SR_NEB x 2 row-major */
+    sr_real Z[SR_EKF_NDELAYED * 4];       /**< Cov(z, z_j) per slot j (2 x 2 row-major at 4 j); its own: H P_s H^T */
+    int marked;                           /**< 1 while the slot waits for its fix */
+} sr_ekf_delayed;
+
 /** The filter's state, owned by the caller; fill it with sr_ekf_init or sr_ekf_init_diagonal. */
 typedef struct sr_ekf {
     sr_real x[SR_NX];                 /**< the state estimate (layout of spherical_robot.h) */
@@ -72,6 +108,7 @@ typedef struct sr_ekf {
     long accepted[SR_EKF_NKINDS];     /**< samples applied, per kind (SR_EKF_*) */
     long gated[SR_EKF_NKINDS];        /**< samples refused by the gate, per kind */
     sr_real nis[SR_EKF_NKINDS];       /**< the last sample's r^T S^-1 r, per kind (applied or gated) */
+    sr_ekf_delayed delayed[SR_EKF_NDELAYED]; /**< the delayed fixes waiting, by slot */
 } sr_ekf;
 
 /** The process noise of sr_ekf_predict (all >= 0 and finite). */
@@ -112,6 +149,18 @@ int sr_ekf_update_encoders(sr_ekf *ekf, const sr_model *model, const sr_real y[2
 
 /** One position fix y = (q_x, q_y) [m], standard deviation sigma each, gated at gate. */
 int sr_ekf_update_position(sr_ekf *ekf, const sr_model *model, const sr_real y[2], sr_real sigma, sr_real gate);
+
+/** The instant a position fix is measured that will arrive later: keeps in slot (0 <=
+ * slot < SR_EKF_NDELAYED, else SR_ERR_ARG) what its update will need (see the file's
+ * description); a slot still waiting is overwritten (its fix is forgotten).  Call it after the
+ * predict to that instant; the samples of the same instant may be applied before or after. */
+int sr_ekf_mark_position(sr_ekf *ekf, const sr_model *model, int slot);
+
+/** The fix y = (q_x, q_y) [m] measured at the instant slot was marked (SR_ERR_ARG if slot is out
+ * of range or waits for no fix), standard deviation sigma each, gated at gate; counted as a
+ * position fix.  Applied or gated, the slot is free afterwards. */
+int sr_ekf_update_position_delayed(sr_ekf *ekf, const sr_model *model, int slot, const sr_real y[2], sr_real sigma,
+                                   sr_real gate);
 
 /** One heading sample [rad] of the sensor on body at mount (sr_heading_measure), standard deviation
  * sigma, gated at gate; the innovation is wrapped into (-pi, pi].  SR_ERR_SINGULAR where the

@@ -200,42 +200,36 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
     if (!all_finite(Pn, NB * NB)) return SR_ERR_NONFINITE;
     memcpy(ekf->x, xn, sizeof xn);
     memcpy(ekf->P, Pn, sizeof Pn);
+    /* The waiting fixes' cross-covariances: C <- diag(F, I) C (the process noise is independent). */
+    for (k = 0; k < SR_EKF_NDELAYED; ++k) {
+        sr_real *Ck = ekf->delayed[k].C, t[NE * 2];
+        if (!ekf->delayed[k].marked) continue;
+        for (i = 0; i < NE; ++i) {
+            sr_real s0 = 0, s1 = 0;
+            for (j = 0; j < NE; ++j) {
+                s0 += F[NE * i + j] * Ck[2 * j];
+                s1 += F[NE * i + j] * Ck[2 * j + 1];
+            }
+            t[2 * i] = s0;
+            t[2 * i + 1] = s1;
+        }
+        memcpy(Ck, t, sizeof t);
+    }
     return SR_OK;
 }
 
-/* The update of sr_ekf.h for an m-entry sample with innovation r, Jacobian H (m x NB) and noise
- * variances Rd: gate, gain, Joseph form, injection, reset; the filter is written only on SR_OK. */
-static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_real *r, const sr_real *H,
-                  const sr_real *Rd, sr_real gate)
+/* Applies an m-entry sample with innovation r, cross-covariance C = Cov(e, r) (NB x m, row stride
+ * MAXM) and innovation covariance S (m x m, stride m): gate, gain, the covariance update, injection,
+ * reset; W[j] (m x 2, stride 2, at MAXM * 2 j) is Cov(r, z_j) for every waiting slot j (not
+ * `released`, the slot this sample comes from, freed whether applied or gated).  The filter is
+ * written only on SR_OK. */
+static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_real *r, const sr_real *C,
+                 const sr_real *S, sr_real gate, const sr_real *W, int released)
 {
-    sr_real C[NB * MAXM], S[MAXM * MAXM] = {0}, L[MAXM * MAXM], K[NB * MAXM], D[NB * MAXM], Pn[NB * NB];
-    sr_real Hc[MAXM * NB], Pc[NB], z[MAXM], e[NB], xn[SR_NX], Jr[9], T[3 * NB], nis = 0;
-    int cols[NB], nc = 0, a, b, i, j, k, status;
+    sr_real L[MAXM * MAXM], K[NB * MAXM], D[NB * MAXM], Pn[NB * NB];
+    sr_real z[MAXM], e[NB], xn[SR_NX], Jr[9], T[3 * NB], nis = 0;
+    int a, b, i, j, status;
 
-    /* H is sparse (the encoders and the fix read two columns, the heading four): its nonzero
-     * columns are gathered, Hc (m x nc), and only they enter C = P H^T and S = H C + R. */
-    for (k = 0; k < NB; ++k)
-        for (i = 0; i < m; ++i)
-            if (H[NB * i + k] != 0) {
-                for (j = 0; j < m; ++j) Hc[NB * j + nc] = H[NB * j + k];
-                cols[nc++] = k;
-                break;
-            }
-    for (a = 0; a < NB; ++a) {
-        const sr_real *Pa = ekf->P + NB * a;
-        for (k = 0; k < nc; ++k) Pc[k] = Pa[cols[k]];
-        for (i = 0; i < m; ++i) {
-            sr_real s = 0;
-            for (k = 0; k < nc; ++k) s += Pc[k] * Hc[NB * i + k];
-            C[MAXM * a + i] = s;
-        }
-    }
-    for (i = 0; i < m; ++i)
-        for (j = i; j < m; ++j) {
-            sr_real s = i == j ? Rd[i] : 0;
-            for (k = 0; k < nc; ++k) s += Hc[NB * i + k] * C[MAXM * cols[k] + j];
-            S[m * i + j] = S[m * j + i] = s;
-        }
     status = cholesky(m, S, L);
     if (status != SR_OK) return status;
     for (i = 0; i < m; ++i) z[i] = r[i];
@@ -245,6 +239,7 @@ static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_
     if (!(nis <= gate)) {
         ekf->gated[kind] += 1;
         ekf->nis[kind] = nis;
+        if (released >= 0) ekf->delayed[released].marked = 0;
         return SR_OK;
     }
 
@@ -261,7 +256,8 @@ static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_
     /* The Joseph form (I - K H) P (I - K H)^T + K R K^T, expanded with C = P H^T and S = H P H^T + R:
      * P - K C^T - C K^T + K S K^T = P - K C^T - (C - K S) K^T.  The same polynomial in K (exact
      * for any gain, so an error in K enters only to second order), in O(NB^2 m) on the upper
-     * triangle instead of the products of 18 x 18 matrices. */
+     * triangle instead of the products of 18 x 18 matrices.  For a delayed fix the same
+     * expression is the covariance of e - K r with C its cross-covariance. */
     for (a = 0; a < NB; ++a)
         for (i = 0; i < m; ++i) {
             sr_real s = C[MAXM * a + i];
@@ -296,7 +292,72 @@ static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_
     memcpy(ekf->P, Pn, sizeof Pn);
     ekf->accepted[kind] += 1;
     ekf->nis[kind] = nis;
+    if (released >= 0) ekf->delayed[released].marked = 0;
+
+    /* The waiting fixes' cross-covariances move with the error: e <- G (e - K r). */
+    for (j = 0; j < SR_EKF_NDELAYED; ++j) {
+        sr_real *Cj = ekf->delayed[j].C, t[6];
+        const sr_real *Wj = W + MAXM * 2 * j;
+        if (!ekf->delayed[j].marked) continue;
+        for (a = 0; a < NB; ++a)
+            for (b = 0; b < 2; ++b) {
+                sr_real s = Cj[2 * a + b];
+                for (i = 0; i < m; ++i) s -= K[MAXM * a + i] * Wj[2 * i + b];
+                Cj[2 * a + b] = s;
+            }
+        for (i = 0; i < 3; ++i)
+            for (b = 0; b < 2; ++b)
+                t[2 * i + b] = Jr[3 * i] * Cj[2 * SR_EB_xi_S + b] + Jr[3 * i + 1] * Cj[2 * (SR_EB_xi_S + 1) + b]
+                             + Jr[3 * i + 2] * Cj[2 * (SR_EB_xi_S + 2) + b];
+        memcpy(Cj + 2 * SR_EB_xi_S, t, sizeof t);
+    }
     return SR_OK;
+}
+
+/* The update of sr_ekf.h for an m-entry sample with innovation r, Jacobian H (m x NB) and noise
+ * variances Rd. */
+static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_real *r, const sr_real *H,
+                  const sr_real *Rd, sr_real gate)
+{
+    sr_real C[NB * MAXM], S[MAXM * MAXM] = {0}, Hc[MAXM * NB], Pc[NB], W[SR_EKF_NDELAYED * MAXM * 2];
+    int cols[NB], nc = 0, a, i, j, k;
+
+    /* H is sparse (the encoders and the fix read two columns, the heading four): its nonzero
+     * columns are gathered, Hc (m x nc), and only they enter C = P H^T and S = H C + R. */
+    for (k = 0; k < NB; ++k)
+        for (i = 0; i < m; ++i)
+            if (H[NB * i + k] != 0) {
+                for (j = 0; j < m; ++j) Hc[NB * j + nc] = H[NB * j + k];
+                cols[nc++] = k;
+                break;
+            }
+    for (a = 0; a < NB; ++a) {
+        const sr_real *Pa = ekf->P + NB * a;
+        for (k = 0; k < nc; ++k) Pc[k] = Pa[cols[k]];
+        for (i = 0; i < m; ++i) {
+            sr_real s = 0;
+            for (k = 0; k < nc; ++k) s += Pc[k] * Hc[NB * i + k];
+            C[MAXM * a + i] = s;
+        }
+    }
+    for (i = 0; i < m; ++i)
+        for (j = i; j < m; ++j) {
+            sr_real s = i == j ? Rd[i] : 0;
+            for (k = 0; k < nc; ++k) s += Hc[NB * i + k] * C[MAXM * cols[k] + j];
+            S[m * i + j] = S[m * j + i] = s;
+        }
+    /* Cov(r, z_j) = H C_j for every waiting fix. */
+    for (j = 0; j < SR_EKF_NDELAYED; ++j) {
+        const sr_real *Cj = ekf->delayed[j].C;
+        if (!ekf->delayed[j].marked) continue;
+        for (i = 0; i < m; ++i)
+            for (a = 0; a < 2; ++a) {
+                sr_real s = 0;
+                for (k = 0; k < nc; ++k) s += Hc[NB * i + k] * Cj[2 * cols[k] + a];
+                W[MAXM * 2 * j + 2 * i + a] = s;
+            }
+    }
+    return apply(ekf, model, kind, m, r, C, S, gate, W, -1);
 }
 
 int sr_ekf_update_imu(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
@@ -371,4 +432,76 @@ int sr_ekf_update_heading(sr_ekf *ekf, const sr_model *model, sr_real y, int bod
     r = angle_difference(y, yh);
     Rd = sigma * sigma;
     return update(ekf, model, SR_EKF_HEADING, 1, &r, H, &Rd, gate);
+}
+
+int sr_ekf_mark_position(sr_ekf *ekf, const sr_model *model, int slot)
+{
+    sr_real yh[2], H[2 * NB], C[NB * 2], Z[SR_EKF_NDELAYED * 4];
+    int status = arg_model(model, READS(WHOLE)), a, i, j, k;
+    sr_ekf_delayed *d;
+    if (status != SR_OK) return status;
+    if (!ekf) return SR_ERR_NULL;
+    if (slot < 0 || slot >= SR_EKF_NDELAYED) return SR_ERR_ARG;
+    status = check_filter(model, ekf);
+    if (status == SR_OK) status = sr_position_jacobian(model, ekf->x, yh, H);
+    if (status != SR_OK) return status;
+    for (a = 0; a < NB; ++a)
+        for (i = 0; i < 2; ++i) {
+            sr_real s = 0;
+            for (k = 0; k < NB; ++k) s += ekf->P[NB * a + k] * H[NB * i + k];
+            C[2 * a + i] = s;
+        }
+    /* Cov(z, z_j) = H C_j for every other waiting fix, H P H^T for its own. */
+    for (j = 0; j < SR_EKF_NDELAYED; ++j) {
+        const sr_real *Cj = j == slot ? C : ekf->delayed[j].C;
+        if (j != slot && !ekf->delayed[j].marked) continue;
+        for (i = 0; i < 2; ++i)
+            for (a = 0; a < 2; ++a) {
+                sr_real s = 0;
+                for (k = 0; k < NB; ++k) s += H[NB * i + k] * Cj[2 * k + a];
+                Z[4 * j + 2 * i + a] = s;
+            }
+    }
+    if (!all_finite(C, NB * 2) || !all_finite(Z + 4 * slot, 4)) return SR_ERR_NONFINITE;
+    d = &ekf->delayed[slot];
+    for (j = 0; j < SR_EKF_NDELAYED; ++j) {
+        if (j == slot || !ekf->delayed[j].marked) continue;
+        for (i = 0; i < 2; ++i)
+            for (a = 0; a < 2; ++a) {
+                d->Z[4 * j + 2 * i + a] = Z[4 * j + 2 * i + a];
+                ekf->delayed[j].Z[4 * slot + 2 * a + i] = Z[4 * j + 2 * i + a];
+            }
+    }
+    memcpy(d->Z + 4 * slot, Z + 4 * slot, 4 * sizeof(sr_real));
+    memcpy(d->yh, yh, sizeof yh);
+    memcpy(d->C, C, sizeof C);
+    d->marked = 1;
+    return SR_OK;
+}
+
+int sr_ekf_update_position_delayed(sr_ekf *ekf, const sr_model *model, int slot, const sr_real y[2], sr_real sigma,
+                                   sr_real gate)
+{
+    sr_real r[2], C[NB * MAXM], S[4], W[SR_EKF_NDELAYED * MAXM * 2];
+    const sr_ekf_delayed *d;
+    int status = arg_model(model, READS(WHOLE)), a, j;
+    if (status != SR_OK) return status;
+    if (!ekf || !y) return SR_ERR_NULL;
+    if (slot < 0 || slot >= SR_EKF_NDELAYED || !ekf->delayed[slot].marked) return SR_ERR_ARG;
+    status = check_simple(ekf, model, y, 2, sigma, gate);
+    if (status != SR_OK) return status;
+    d = &ekf->delayed[slot];
+    r[0] = y[0] - d->yh[0];
+    r[1] = y[1] - d->yh[1];
+    for (a = 0; a < NB; ++a) {
+        C[MAXM * a] = d->C[2 * a];
+        C[MAXM * a + 1] = d->C[2 * a + 1];
+    }
+    memcpy(S, d->Z + 4 * slot, sizeof S);
+    S[0] += sigma * sigma;
+    S[3] += sigma * sigma;
+    /* Cov(r, z_j) = Cov(z, z_j): the fix's noise is independent of the others. */
+    for (j = 0; j < SR_EKF_NDELAYED; ++j)
+        if (j != slot && ekf->delayed[j].marked) memcpy(W + MAXM * 2 * j, d->Z + 4 * j, 4 * sizeof(sr_real));
+    return apply(ekf, model, SR_EKF_POSITION, 2, r, C, S, gate, W, slot);
 }

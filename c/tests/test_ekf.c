@@ -95,6 +95,22 @@ static void test_predict_leaves_the_bias_block_alone_and_moves_the_cross_terms(v
     CHECK(nonzero > 0);
 }
 
+static void test_the_bias_variances_grow_by_their_random_walk_over_dt(void)
+{
+    /* P_bb <- P_bb + dt diag(rw^2): the biases do not enter the step, only their random walk. */
+    sr_ekf ekf;
+    sr_model m;
+    const sr_ekf_process q = {{SR_C(0.01), SR_C(0.01), SR_C(0.01)}, SR_C(0.02), SR_C(0.3)};
+    const double dt = 0.005, p = 1e-4;
+    int i;
+    start(&ekf, &m, sqrt(p));
+    CHECK_STATUS(sr_ekf_predict(&ekf, &m, SR_RKMK4, NULL, (sr_real)dt, &q), SR_OK);
+    for (i = 0; i < 3; ++i) {
+        CHECK_NEAR(ekf.P[SR_NEB * (SR_EB_b_g + i) + SR_EB_b_g + i], p + dt * 0.02 * 0.02, 8 * TEST_EPS);
+        CHECK_NEAR(ekf.P[SR_NEB * (SR_EB_b_a + i) + SR_EB_b_a + i], p + dt * 0.3 * 0.3, 8 * TEST_EPS);
+    }
+}
+
 static void test_a_constant_gyro_offset_at_rest_is_learnt_as_the_gyro_bias(void)
 {
     sr_ekf ekf;
@@ -117,6 +133,53 @@ static void test_a_constant_gyro_offset_at_rest_is_learnt_as_the_gyro_bias(void)
     }
     CHECK_NEAR(ekf.bias[SR_BIAS_b_g + 2], 0.02, 0.002);
     CHECK(sqrt((double)ekf.P[SR_NEB * (SR_EB_b_g + 2) + SR_EB_b_g + 2]) < 0.01);
+}
+
+static void test_a_fix_marked_and_applied_at_once_is_the_plain_fix(void)
+{
+    /* No time between the measuring instant and the arrival: the delayed update is the plain one. */
+    sr_ekf plain, late;
+    sr_model m;
+    const sr_real y[2] = {SR_C(0.03), SR_C(-0.01)};
+    int i;
+    start(&plain, &m, 0.02);
+    late = plain;
+    CHECK_STATUS(sr_ekf_update_position(&plain, &m, y, SR_C(0.01), chi2_2), SR_OK);
+    CHECK_STATUS(sr_ekf_mark_position(&late, &m, 2), SR_OK);
+    CHECK(late.delayed[2].marked == 1);
+    CHECK_STATUS(sr_ekf_update_position_delayed(&late, &m, 2, y, SR_C(0.01), chi2_2), SR_OK);
+    CHECK(late.delayed[2].marked == 0 && late.accepted[SR_EKF_POSITION] == 1);
+    for (i = 0; i < SR_NX; ++i) CHECK_NEAR(late.x[i], plain.x[i], 8 * TEST_EPS);
+    for (i = 0; i < SR_NEB * SR_NEB; ++i) CHECK_NEAR(late.P[i], plain.P[i], 8 * TEST_EPS);
+}
+
+static void test_a_late_fix_corrects_the_estimate_by_what_it_said_when_it_measured(void)
+{
+    /* The robot rolling (q_x moves about 1 cm in the 8 samples between the measuring instant and
+     * the arrival), P diagonal: the late fix corrects q by the scalar filter's gain times the fix
+     * minus q then, whatever q became; taken as fresh it would pull q back by the distance rolled. */
+    sr_ekf ekf, fresh;
+    sr_model m;
+    sr_ekf_process q = {{0, 0, 0}, 0, 0};
+    const double p = 0.04, s = 0.1, k = p / (p + s * s);
+    sr_real x[SR_NX], sigma[SR_NEB], y[2], before;
+    int i;
+    paper_simulation_model(&m);
+    make_state(x, 0, 0, (double)m.p[SR_P_r]);
+    x[SR_X_w_S + 1] = 1;
+    for (i = 0; i < SR_NEB; ++i) sigma[i] = (sr_real)sqrt(p);
+    CHECK_STATUS(sr_ekf_init_diagonal(&ekf, &m, x, NULL, sigma), SR_OK);
+    CHECK_STATUS(sr_ekf_mark_position(&ekf, &m, 1), SR_OK);
+    y[0] = ekf.x[SR_X_q] + SR_C(0.3);
+    y[1] = ekf.x[SR_X_q + 1];
+    for (i = 0; i < 8; ++i) CHECK_STATUS(sr_ekf_predict(&ekf, &m, SR_RKMK4, NULL, SR_C(0.005), &q), SR_OK);
+    CHECK(fabs((double)(ekf.x[SR_X_q] - x[SR_X_q])) > 0.01);
+    fresh = ekf;
+    before = ekf.x[SR_X_q];
+    CHECK_STATUS(sr_ekf_update_position_delayed(&ekf, &m, 1, y, (sr_real)s, chi2_2), SR_OK);
+    CHECK_NEAR(ekf.x[SR_X_q] - before, k * 0.3, 64 * TEST_EPS);
+    CHECK_STATUS(sr_ekf_update_position(&fresh, &m, y, (sr_real)s, (sr_real)INFINITY), SR_OK);
+    CHECK(fabs((double)(fresh.x[SR_X_q] - ekf.x[SR_X_q])) > 0.005);
 }
 
 static void test_bad_input_gives_a_status_and_writes_nothing(void)
@@ -147,6 +210,11 @@ static void test_bad_input_gives_a_status_and_writes_nothing(void)
     CHECK_STATUS(sr_ekf_update_imu(&ekf, &m, y, NULL, 5, mount, SR_C(0.003), SR_C(0.02), chi2_2), SR_ERR_ARG);
     CHECK_STATUS(sr_ekf_update_heading(&ekf, &m, (sr_real)NAN, SR_BODY_yoke, mount, SR_C(0.05), chi2_2),
                  SR_ERR_NONFINITE);
+    CHECK_STATUS(sr_ekf_mark_position(&ekf, &m, SR_EKF_NDELAYED), SR_ERR_ARG);
+    CHECK_STATUS(sr_ekf_mark_position(&ekf, &m, -1), SR_ERR_ARG);
+    CHECK_STATUS(sr_ekf_mark_position(NULL, &m, 0), SR_ERR_NULL);
+    CHECK_STATUS(sr_ekf_update_position_delayed(&ekf, &m, 0, fix, SR_C(0.1), chi2_2), SR_ERR_ARG); /* not marked */
+    CHECK_STATUS(sr_ekf_update_position_delayed(&ekf, &broken, 0, fix, SR_C(0.1), chi2_2), SR_ERR_MODEL);
     CHECK(memcmp(&ekf, &before, sizeof ekf) == 0);
     /* a covariance that is not symmetric, or not positive definite */
     memcpy(P0, ekf.P, sizeof P0);
@@ -164,6 +232,9 @@ void suite_ekf(void)
     RUN_TEST(test_an_outlier_is_gated_counted_and_not_applied);
     RUN_TEST(test_encoder_innovations_wrap_around_pi);
     RUN_TEST(test_predict_leaves_the_bias_block_alone_and_moves_the_cross_terms);
+    RUN_TEST(test_the_bias_variances_grow_by_their_random_walk_over_dt);
     RUN_TEST(test_a_constant_gyro_offset_at_rest_is_learnt_as_the_gyro_bias);
+    RUN_TEST(test_a_fix_marked_and_applied_at_once_is_the_plain_fix);
+    RUN_TEST(test_a_late_fix_corrects_the_estimate_by_what_it_said_when_it_measured);
     RUN_TEST(test_bad_input_gives_a_status_and_writes_nothing);
 }

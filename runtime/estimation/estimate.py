@@ -7,8 +7,8 @@
 The filter (runtime.ekf, C in c/src/sr_ekf.c) assumes what the log's sensor set declares
 (`ekf_noise`); between two samples it predicts under the torques the log says were applied (a
 torque row holds until the next); samples of one time are applied IMU first, then encoders,
-fixes and heading.  A fix is applied when it arrived, as if measured then (its latency is not
-modelled).  The IMU update runs while the filter's `accel` standard deviation includes what the
+fixes and heading.  A fix that arrives after the instant it measures (`t_measured` < `t`) is marked
+at that instant and applied on arrival as a delayed fix (runtime.ekf, `mark_position`).  The IMU update runs while the filter's `accel` standard deviation includes what the
 process noise adds to the accelerometer's reading (`ekf_noise`), since the filter's measurement
 model sees the applied torques only.
 """
@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from ..ekf import start_from_measurements
+from ..ekf import DELAYED_SLOTS, start_from_measurements
 from ..model import Model
 from ..sensors import heading as heading_of
 from ..sensor_sim import ekf_noise
@@ -95,15 +95,29 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
     ekf = start_from_measurements(model, noise=noise, mount=sensors.imu.mount, gate=gate,
                                   heading_prior=start_heading(log) if heading is None else heading,
                                   rate_sigma=MOVING_RATE_SIGMA if moving_at_start(log) else 0.01, **start)
-    times = np.unique(np.concatenate([log.torques.t] + [table.t for table, _ in events]))
+    late = []                                   # (t_measured, index) of the fixes that arrive late
+    if log.fixes is not None and len(log.fixes):
+        measured = log.fixes["t_measured"]
+        late = sorted((float(measured[j]), j) for j in range(len(log.fixes))
+                      if log.torques.t[0] <= measured[j] < log.fixes.t[j])
+    times = np.unique(np.concatenate([log.torques.t] + [table.t for table, _ in events] + [[m for m, _ in late]]))
     times = times[times >= log.torques.t[0]]
     cursor = {kind: 0 for _, kind in events}
+    slot_of, next_late = {}, 0
     out_x, out_sigma, out_b = np.empty((len(times), NX)), np.empty((len(times), 18)), np.empty((len(times), 6))
     t_now = times[0]
     for i, t in enumerate(times):
         if t > t_now:
             ekf.predict(log.torque_at(t_now), float(t - t_now))
             t_now = t
+        while next_late < len(late) and late[next_late][0] <= t:
+            free = sorted(set(range(DELAYED_SLOTS)) - set(slot_of.values()))
+            if not free:
+                raise ValueError(f"fixes: more than {DELAYED_SLOTS} fixes measured and not yet arrived at "
+                                 f"t = {t:g} s; the filter holds {DELAYED_SLOTS}")
+            slot_of[late[next_late][1]] = free[0]
+            ekf.mark_position(free[0])
+            next_late += 1
         u = log.torque_at(t)
         for table, kind in events:
             j = cursor[kind]
@@ -114,8 +128,10 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
                         ekf.update_imu(row, u)
                     elif kind == "encoders":
                         ekf.update_encoders(row)
+                    elif kind == "fixes" and j in slot_of:
+                        ekf.update_position_delayed(slot_of.pop(j), row[1:3])   # (t_measured, x, y)
                     elif kind == "fixes":
-                        ekf.update_position(row[1:3])          # (t_measured, x, y)
+                        ekf.update_position(row[1:3])
                     else:
                         ekf.update_heading(float(row[0]))
                 j += 1

@@ -7,6 +7,13 @@ retraction `Model.retract`) and writes the filter in its textbook form, without 
 shortcuts: the full 18 × 18 transition, the inverse of M, the gain through a solve with S, the
 Joseph form as the product (I − K H) P (I − K H)ᵀ + K R Kᵀ, the reset as G P Gᵀ with G the
 right Jacobian of SO(3) as its power series, angle innovations wrapped through the unit circle.
+
+Delayed fixes by stochastic cloning: marking a fix appends a copy of the whole error state (and
+of x) to the state, so the covariance grows to (18 (1 + n)) square; every equation is then a
+linear map T of that augmented error, P_aug ← T P_aug Tᵀ (+ the noise on the current block):
+the current block moves by Φ, I − K H and G, the clones stay.  On arrival the fix measures its
+clone, H_aug reads that clone's q; the gain changes the current error only (Larsen's update: the
+clones are not revised), then the clone is dropped.  Nothing of the C's projected bookkeeping.
 """
 import numpy as np
 
@@ -34,16 +41,53 @@ def wrapped(angle):
 
 
 class EkfReference:
-    """The filter's state (x, b, P) and its counters; one method per equation of sr_ekf.h."""
+    """The filter's state (x, b, P) and its counters; one method per equation of sr_ekf.h.
+    `P` is the current error's block of the augmented covariance `P_aug`; `clones` the marked
+    fixes' states by slot, in the order of their blocks."""
 
     def __init__(self, model, x0, bias, P0, method="rkmk4"):
         self.model, self.method = model, method
         self.x = np.array(x0, dtype=float)
         self.b = np.array(bias, dtype=float)
-        self.P = np.array(P0, dtype=float)
+        self.P_aug = np.array(P0, dtype=float)
+        self.clones = {}
         self.accepted = dict.fromkeys(KINDS, 0)
         self.gated = dict.fromkeys(KINDS, 0)
         self.nis = dict.fromkeys(KINDS, 0.0)
+
+    @property
+    def P(self):
+        """The covariance (18, 18) of the current error."""
+        return self.P_aug[:NB, :NB].copy()
+
+    @P.setter
+    def P(self, value):
+        self.P_aug[:NB, :NB] = value
+
+    def transform(self, A):
+        """The current error e ← A e with the clones kept: P_aug ← T P_aug Tᵀ, T = diag(A, I)
+        (the current block itself is set by the equation's own method)."""
+        T = np.eye(len(self.P_aug))
+        T[:NB, :NB] = A
+        P = self.P
+        self.P_aug = T @ self.P_aug @ T.T
+        self.P = P
+
+    def mark_position(self, slot):
+        """A fix measured now that arrives later: a clone of x and of the error."""
+        self.drop(slot)
+        n = len(self.P_aug)
+        T = np.vstack([np.eye(n), np.eye(NB, n)])
+        self.P_aug = T @ self.P_aug @ T.T
+        self.clones[slot] = self.x.copy()
+
+    def drop(self, slot):
+        """Forgets a clone (its rows and columns of P_aug)."""
+        if slot in self.clones:
+            k = NB * (1 + list(self.clones).index(slot))
+            keep = np.r_[0:k, k + NB:len(self.P_aug)]
+            self.P_aug = self.P_aug[np.ix_(keep, keep)]
+            del self.clones[slot]
 
     def process_noise(self, dt, torque_psd, gyro_bias_rw, accel_bias_rw):
         """Q (18, 18) over dt: white generalized torques on ν through M⁻¹, random-walk biases."""
@@ -68,7 +112,11 @@ class EkfReference:
         F, _ = self.model.casadi_step_jacobian(self.x, u, dt, self.method)
         Q = self.process_noise(dt, torque_psd, gyro_bias_rw, accel_bias_rw)
         self.x = self.model.step(self.x, u, dt, self.method)
-        self.P = self.propagate(F, Q)
+        P = self.propagate(F, Q)
+        Phi = np.eye(NB)
+        Phi[:NE, :NE] = F
+        self.transform(Phi)
+        self.P = P
 
     @staticmethod
     def accepts(nis, gate):
@@ -93,7 +141,9 @@ class EkfReference:
         """P ← G P Gᵀ, G = I but Jr(e_ξ) on the shell's block."""
         G = np.eye(NB)
         G[IDX_E_XI_S, IDX_E_XI_S] = right_jacobian(e[IDX_E_XI_S])
-        self.P = G @ self.P @ G.T
+        P = G @ self.P @ G.T
+        self.transform(G)
+        self.P = P
 
     def _update(self, kind, r, H, R, gate):
         S = H @ self.P @ H.T + R
@@ -104,7 +154,9 @@ class EkfReference:
             return False
         K = self.gain(H, S)
         e = K @ r
-        self.P = self.joseph(K, H, R)
+        P = self.joseph(K, H, R)
+        self.transform(np.eye(NB) - K @ H)
+        self.P = P
         self.inject(e)
         self.reset(e)
         self.accepted[kind] += 1
@@ -131,3 +183,32 @@ class EkfReference:
         """One heading sample."""
         yh, H = sensors.heading_jacobian(self.model, self.x, mount)
         return self._update("heading", np.array([wrapped(y - yh)]), H[None, :], np.array([[sigma ** 2]]), gate)
+
+    def update_position_delayed(self, slot, y, sigma, gate):
+        """The fix y measured when `slot` was marked: H_aug reads its clone; the gain moves the
+        current error alone, e ← e − K r, so P_aug ← T P_aug Tᵀ + K R Kᵀ with T = I but −K H in
+        the clone's columns."""
+        k = NB * (1 + list(self.clones).index(slot))
+        yh, H = sensors.position_jacobian(self.model, self.clones[slot])
+        R = sigma ** 2 * np.eye(2)
+        H_aug = np.zeros((2, len(self.P_aug)))
+        H_aug[:, k:k + NB] = H
+        S = H_aug @ self.P_aug @ H_aug.T + R
+        r = np.asarray(y) - yh
+        nis = float(r @ np.linalg.solve(S, r))
+        self.nis["position"] = nis
+        if not self.accepts(nis, gate):
+            self.gated["position"] += 1
+            self.drop(slot)
+            return False
+        K = np.linalg.solve(S, H_aug @ self.P_aug[:, :NB]).T
+        T = np.eye(len(self.P_aug))
+        T[:NB] -= K @ H_aug
+        self.P_aug = T @ self.P_aug @ T.T
+        self.P = self.P + K @ R @ K.T
+        e = K @ r
+        self.drop(slot)
+        self.inject(e)
+        self.reset(e)
+        self.accepted["position"] += 1
+        return True

@@ -1,7 +1,8 @@
 """The error-state EKF (runtime/ekf.py over c/include/sr_ekf.h): the C filter equals its NumPy
 reference (runtime/verification/ekf_reference.py) over a run with asynchronous sensors and
-outliers, and that comparison fails for a reference with any one equation broken; the start
-rule; gating counted; bad input named."""
+outliers, and over one whose fixes arrive late, and that comparison fails for a reference with any
+one equation broken; late fixes handled as such beat late fixes taken as fresh; the start rule;
+gating counted; bad input named."""
 import dataclasses
 import math
 
@@ -10,7 +11,8 @@ import pytest
 
 from runtime import Model, Params, initial_state, so3
 from runtime import sensors
-from runtime.ekf import Ekf, EkfNoise, gate_threshold, start_from_measurements
+from runtime.state import IDX_Q
+from runtime.ekf import DELAYED_SLOTS, Ekf, EkfNoise, gate_threshold, start_from_measurements
 from runtime.verification.ekf_reference import EkfReference
 
 DT = 0.005
@@ -24,10 +26,12 @@ def model():
     return Model(Params.paper_simulation())
 
 
-def make_run(model, seconds, seed=3):
+def make_run(model, seconds, seed=3, fix_every=100, latency=0, heading=True):
     """Truth rolling under varying torques, and the readings of every sample: the IMU at 200 Hz,
-    the encoders at 100 Hz, a heading at 10 Hz, position fixes at 2 Hz; two outliers."""
+    the encoders at 100 Hz, a heading at 10 Hz, position fixes every `fix_every` samples (2 Hz),
+    each arriving `latency` samples after it measures; two outliers."""
     rng = np.random.default_rng(seed)
+    arrivals = {}
     bias = rng.normal(0.0, [0.005] * 3 + [0.05] * 3)
     x = initial_state(r=model.params.r)
     samples = []
@@ -36,23 +40,33 @@ def make_run(model, seconds, seed=3):
         t = k * DT
         u = np.array([0.15 + 0.1 * math.sin(0.9 * t), 0.05 * math.cos(1.7 * t)])
         x = model.step(x, u, DT, "rkmk4")
-        sample = {"u": u, "imu": sensors.imu(model, x, u=u, bias=bias) + rng.normal(0.0, [0.003] * 3 + [0.02] * 3)}
+        sample = {"q": x[IDX_Q][:2], "u": u, "imu": sensors.imu(model, x, u=u, bias=bias) + rng.normal(0.0, [0.003] * 3 + [0.02] * 3)}
         if k == IMU_OUTLIER:
             sample["imu"][4] += 5.0
         if k % 2 == 1:
             sample["encoders"] = sensors.encoders(model, x) + rng.normal(0.0, NOISE.encoder, 2)
-        if k % 20 == 10:
+        if heading and k % 20 == 10:
             sample["heading"] = sensors.heading(model, x) + rng.normal(0.0, NOISE.heading)
-        if k % 100 == 99:
-            sample["fix"] = sensors.position(model, x) + rng.normal(0.0, 0.01, 2) + (1.0 if k == FIX_OUTLIER else 0.0)
+        if k % fix_every == fix_every - 1:
+            fix = sensors.position(model, x) + rng.normal(0.0, 0.01, 2) + (1.0 if k == FIX_OUTLIER else 0.0)
+            if latency:
+                sample["mark"] = k // fix_every % DELAYED_SLOTS
+                arrivals.setdefault(k + latency, []).append((sample["mark"], fix))
+            else:
+                sample["fix"] = fix
+        sample["arrive"] = arrivals.pop(k, [])
         samples.append(sample)
     return first, samples
 
 
-def run_c(ekf, samples):
+def run_c(ekf, samples, delayed=True):
+    """The C filter over the samples; late fixes marked and applied as such, or (`delayed` False)
+    applied on arrival as if fresh."""
     history = []
     for s in samples:
         ekf.predict(s["u"], DT)
+        if "mark" in s and delayed:
+            ekf.mark_position(s["mark"])
         ekf.update_imu(s["imu"], s["u"])
         if "encoders" in s:
             ekf.update_encoders(s["encoders"])
@@ -60,6 +74,8 @@ def run_c(ekf, samples):
             ekf.update_heading(s["heading"])
         if "fix" in s:
             ekf.update_position(s["fix"])
+        for slot, fix in s["arrive"]:
+            ekf.update_position_delayed(slot, fix) if delayed else ekf.update_position(fix)
         history.append((ekf.x, ekf.biases, ekf.P))
     return history
 
@@ -70,6 +86,8 @@ def run_reference(ref, samples, noise=NOISE, gate=0.999):
     history = []
     for s in samples:
         ref.predict(s["u"], DT, (noise.torque_psd,) * 3, noise.gyro_bias_rw, noise.accel_bias_rw)
+        if "mark" in s:
+            ref.mark_position(s["mark"])
         ref.update_imu(s["imu"], s["u"], mount, noise.gyro, noise.accel, g[6])
         if "encoders" in s:
             ref.update_encoders(s["encoders"], noise.encoder, g[2])
@@ -77,6 +95,8 @@ def run_reference(ref, samples, noise=NOISE, gate=0.999):
             ref.update_heading(s["heading"], mount, noise.heading, g[1])
         if "fix" in s:
             ref.update_position(s["fix"], noise.position, g[2])
+        for slot, fix in s["arrive"]:
+            ref.update_position_delayed(slot, fix, noise.position, g[2])
         history.append((ref.x.copy(), ref.b.copy(), ref.P.copy()))
     return history
 
@@ -117,6 +137,31 @@ def test_the_c_filter_equals_the_numpy_reference_over_a_5_s_run(model):
         assert (counts[kind]["accepted"], counts[kind]["gated"]) == (ref.accepted[kind], ref.gated[kind])
         assert counts[kind]["nis"] == pytest.approx(ref.nis[kind], rel=1e-9)
     assert counts["imu"]["accepted"] == 999 and counts["position"]["accepted"] == 9
+
+
+def test_the_c_filter_equals_the_numpy_reference_with_late_fixes_several_waiting_at_once(model):
+    # fixes at 10 Hz arriving 0.25 s late: three wait at a time; the 1 m outlier arrives late too
+    first, samples = make_run(model, 1.5, fix_every=20, latency=50)
+    ekf, ref = started(model, first)
+    c_history = run_c(ekf, samples)
+    ref_history = run_reference(ref, samples)
+    assert worst_relative_difference(c_history, ref_history) <= TOL
+    assert (ekf.counters["position"]["accepted"], ekf.counters["position"]["gated"]) == (11, 1)
+    assert (ref.accepted["position"], ref.gated["position"]) == (11, 1)
+    assert max(sum(1 for t in range(k - 49, k + 1) if "mark" in samples[t]) for k in range(49, len(samples))) == 3
+
+
+def test_late_fixes_handled_as_late_beat_late_fixes_taken_as_fresh(model):
+    # 2 Hz fixes arriving 0.2 s after they measure, on a robot rolling at about 0.3 m/s
+    first, samples = make_run(model, 10.0, latency=40, heading=False)
+    truth = np.array([s["q"] for s in samples[1000:]])
+    rms = {}
+    for delayed in (True, False):
+        ekf, _ = started(model, first)
+        estimate = np.array([x[IDX_Q][:2] for x, _, _ in run_c(ekf, samples, delayed=delayed)[1000:]])
+        rms[delayed] = float(np.sqrt(np.mean(np.sum((estimate - truth) ** 2, axis=1))))
+    assert rms[True] < 0.005
+    assert rms[False] > 3 * rms[True]
 
 
 def test_the_outliers_are_gated_and_counted(short_run):
@@ -218,6 +263,9 @@ def test_the_gate_probability_sets_the_chi_square_quantile():
     (lambda e: e.update_encoders((0.0, math.inf)), "y"),
     (lambda e: e.update_position("here"), "y"),
     (lambda e: e.update_heading((0.1, 0.2)), "y"),
+    (lambda e: e.mark_position(DELAYED_SLOTS), "slot"),
+    (lambda e: e.mark_position(1.0), "slot"),
+    (lambda e: e.update_position_delayed(0, (0.0, 0.0)), "slot"),
 ])
 def test_bad_input_is_a_value_error_naming_the_argument_and_changes_nothing(model, call, field):
     ekf = start_from_measurements(model, (0.0, 0.0, 9.81))
