@@ -101,8 +101,10 @@ def estimate_figure(log, result, path, title):
     sigma = np.sqrt(np.diagonal(T @ result.P[keep] @ np.transpose(T, (0, 2, 1)), axis1=-2, axis2=-1))
     panels = (("q_x", "q_y"), ("tilt_x", "tilt_y"), ("heading",), ("theta_Y", "theta_P"),
               ("w_S_x", "w_Y"), ("b_g_z", "b_a_x"))
+    units = ("m", "rad", "rad", "rad", "rad/s", "rad/s, m/s²")
     fig, axes = plt.subplots(len(panels), 1, figsize=(8, 1.8 * len(panels)), sharex=True)
-    for ax, names in zip(axes, panels):
+    for ax, names, unit in zip(axes, panels, units):
+        ax.set_ylabel(unit)
         for name, colour in zip(names, ("tab:blue", "tab:orange")):
             k = COMPONENTS.index(name)
             ax.plot(t, e[:, k], lw=0.7, color=colour, label=f"{name} error")
