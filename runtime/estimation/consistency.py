@@ -325,7 +325,10 @@ def main(argv):
         if args.out.exists() and not args.out.is_dir():
             raise ValueError(f"{args.out}: is a file, expected a folder")
         if args.scheduler is not None and args.scheduler != SERIAL:
-            scheduler_address(args.scheduler)
+            try:
+                scheduler_address(args.scheduler)
+            except ValueError as exc:
+                raise ValueError(f"--scheduler: {exc}") from None
         load_run(args.run)
         sensors = load_sensor_set(args.sensors)
         seeds = list(range(args.first_seed, args.first_seed + args.runs))
