@@ -41,12 +41,15 @@ MOVING_RATE_SIGMA = 2.0
 class Estimate:
     """The filter's output at every torque row and sample time `t` (n,): the state `x` (n, 35) and
     the error state's standard deviations `sigma` (n, 18) (ERROR_NAMES), the biases (n, 6), and the
-    filter's counters per sensor kind ({"accepted", "gated", "nis"})."""
+    filter's counters per sensor kind ({"accepted", "gated", "nis"}); with `covariance_every` = k,
+    the whole covariance `P` (m, 18, 18) at the rows `P_rows` (every k-th), else None."""
     t: np.ndarray
     x: np.ndarray
     sigma: np.ndarray
     biases: np.ndarray
     counters: dict
+    P: np.ndarray = None
+    P_rows: np.ndarray = None
 
 
 def claimed_params(log):
@@ -73,13 +76,17 @@ def moving_at_start(log):
     return bool(np.any(np.abs(gyro) > 5 * imu.gyro_noise / math.sqrt(START_SAMPLES) + 3 * imu.gyro_bias))
 
 
-def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progress=None):
+def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progress=None, covariance_every=None):
     """Run the filter over `log` (runtime.estimation.logs.Log) for the robot `params` (None: the one
     the log claims, else the paper's simulation robot), started by the start rule (the first
     START_SAMPLES accelerometer samples, the first encoder sample, the first fix and heading if the
     log has them; the heading known to 10° around `heading` [rad], None: `start_heading`).  A robot
     already moving at the start (`moving_at_start`) starts with speeds of σ MOVING_RATE_SIGMA
-    instead of at rest.  `progress(done, total)` is called every 1000 times."""
+    instead of at rest.  `progress(done, total)` is called every 1000 times.  `covariance_every` = k
+    (a whole number >= 1) keeps the whole covariance at every k-th row (`Estimate.P`)."""
+    if covariance_every is not None and (isinstance(covariance_every, bool) or not isinstance(
+            covariance_every, (int, np.integer)) or covariance_every < 1):
+        raise ValueError(f"covariance_every: expected a whole number >= 1, got {covariance_every!r}")
     params = params if params is not None else claimed_params(log)
     model = Model(params)
     sensors = log.sensors
@@ -105,6 +112,8 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
     cursor = {kind: 0 for _, kind in events}
     slot_of, next_late = {}, 0
     out_x, out_sigma, out_b = np.empty((len(times), NX)), np.empty((len(times), 18)), np.empty((len(times), 6))
+    P_rows = None if covariance_every is None else np.arange(0, len(times), covariance_every)
+    out_P = None if P_rows is None else np.empty((len(P_rows), 18, 18))
     t_now = times[0]
     for i, t in enumerate(times):
         if t > t_now:
@@ -137,16 +146,21 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
                 j += 1
             cursor[kind] = j
         out_x[i], out_sigma[i], out_b[i] = ekf.x, ekf.sigma, ekf.biases
+        if out_P is not None and i % covariance_every == 0:
+            out_P[i // covariance_every] = ekf.P
         if progress is not None and i % 1000 == 0:
             progress(i, len(times))
-    return Estimate(t=times, x=out_x, sigma=out_sigma, biases=out_b, counters=ekf.counters)
+    return Estimate(t=times, x=out_x, sigma=out_sigma, biases=out_b, counters=ekf.counters, P=out_P, P_rows=P_rows)
 
 
 def _tilt_and_heading(model, x, mount):
     """Per state: the gravity direction in the IMU's body frame (n, 3) and the heading [rad] (n,)."""
-    block = {"shell": IDX_RS, "yoke": IDX_RY, "pendulum": IDX_RP}[mount.body]
-    R = x[:, block].reshape(-1, 3, 3)
-    up = R[:, 2, :]                                               # R_Bᵀ e_z, rows of R_B's third row
+    R = x[:, IDX_RS].reshape(-1, 3, 3)
+    if mount.body in ("yoke", "pendulum"):                        # the joints' rotations are relative
+        R = R @ x[:, IDX_RY].reshape(-1, 3, 3)
+    if mount.body == "pendulum":
+        R = R @ x[:, IDX_RP].reshape(-1, 3, 3)
+    up = R[:, 2, :]                                               # R_Bᵀ e_z, R_B's third row
     psi = np.array([heading_of(model, xi, mount) for xi in x])
     return up, psi
 

@@ -12,7 +12,8 @@ from runtime.estimation.estimate import ERROR_NAMES, errors, estimate_log, main,
 from runtime.estimation.logs import write_log
 from runtime.estimation.sense import load_run, simulate_log
 from runtime.sensor_set import load_sensor_set
-from runtime.state import IDX_Q, STATE_COLUMNS
+from runtime.so3 import rot_x
+from runtime.state import IDX_Q, IDX_RS, STATE_COLUMNS
 
 SECONDS = 12.0          # scored over the second half
 
@@ -64,6 +65,14 @@ def test_the_metrics_see_a_position_off_by_two_centimetres(with_fixes):
     x = result.x.copy()
     x[:, IDX_Q.start] += 0.02
     assert errors(log, dataclasses.replace(result, x=x))["position_rms_m"] > 0.015
+
+
+def test_the_tilt_metric_sees_the_shell_tilted_by_one_degree(with_fixes):
+    log, result = with_fixes
+    x = result.x.copy()
+    R_S = x[:, IDX_RS].reshape(-1, 3, 3)
+    x[:, IDX_RS] = (rot_x(np.radians(1.0)) @ R_S).reshape(-1, 9)     # about the floor's x axis
+    assert errors(log, dataclasses.replace(result, x=x))["tilt_rms_deg"] == pytest.approx(1.0, abs=0.05)
 
 
 def test_a_log_without_truth_has_no_metrics(with_fixes):
