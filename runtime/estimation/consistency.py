@@ -269,21 +269,7 @@ def build_parser():
     import argparse
     import pathlib
 
-    def whole(low):
-        def parse(value):
-            if not value.isdigit() or int(value) < low:
-                raise argparse.ArgumentTypeError(f"expected a whole number >= {low}, got {value!r}")
-            return int(value)
-        return parse
-
-    def duration(value):
-        try:
-            number = float(value)
-        except ValueError:
-            number = math.nan
-        if not (math.isfinite(number) and number > 0):
-            raise argparse.ArgumentTypeError(f"expected a duration > 0 in s, got {value!r}")
-        return number
+    from ..cli_types import duration, whole_number as whole
 
     parser = argparse.ArgumentParser(
         prog="python -m runtime consistency",

@@ -176,19 +176,9 @@ def build_parser():
     import argparse
     import pathlib
 
-    def seed(value):
-        if not value.isdigit():
-            raise argparse.ArgumentTypeError(f"expected a whole number >= 0, got {value!r}")
-        return int(value)
+    from ..cli_types import duration, whole_number
 
-    def duration(value):
-        try:
-            number = float(value)
-        except ValueError:
-            number = math.nan
-        if not (math.isfinite(number) and number > 0):
-            raise argparse.ArgumentTypeError(f"expected a duration > 0 in s, got {value!r}")
-        return number
+    seed = whole_number(0)
 
     parser = argparse.ArgumentParser(
         prog="python -m runtime sense",

@@ -74,27 +74,14 @@ def main(argv):
     import argparse
     import pathlib
     import sys
-    import math
 
-    def count(value, low=1):
-        if not value.isdigit() or int(value) < low:
-            raise argparse.ArgumentTypeError(f"expected a whole number >= {low}, got {value!r}")
-        return int(value)
-
-    def duration(value):
-        try:
-            number = float(value)
-        except ValueError:
-            number = math.nan
-        if not (math.isfinite(number) and number > 0):
-            raise argparse.ArgumentTypeError(f"expected a duration > 0 in s, got {value!r}")
-        return number
+    from ..cli_types import duration, whole_number
 
     parser = argparse.ArgumentParser(prog="python -m runtime identify-coverage", description=__doc__.split("\n\n")[0])
     parser.add_argument("--params", required=True, help="comma-separated entries to plant and fit")
-    parser.add_argument("--fits", type=count, default=20, help="number of seeded fits (20)")
+    parser.add_argument("--fits", type=whole_number(1), default=20, help="number of seeded fits (20)")
     parser.add_argument("--duration", type=duration, default=30.0, help="each log's length [s] (30)")
-    parser.add_argument("--seed", type=lambda v: count(v, 0), default=0, help="the first seed (0)")
+    parser.add_argument("--seed", type=whole_number(0), default=0, help="the first seed (0)")
     parser.add_argument("--full-state", action="store_true", help="fit the logs' truth (a full-state log)")
     parser.add_argument("--out", required=True, type=pathlib.Path, help="the JSON file of the results")
     args = parser.parse_args(argv)

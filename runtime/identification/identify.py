@@ -141,19 +141,9 @@ def build_parser():
     """The argument parser of `python -m runtime identify`."""
     import argparse
 
-    def positive(value):
-        try:
-            number = float(value)
-        except ValueError:
-            number = math.nan
-        if not (math.isfinite(number) and number > 0):
-            raise argparse.ArgumentTypeError(f"expected a number > 0, got {value!r}")
-        return number
+    from ..cli_types import positive_number as positive, whole_number
 
-    def count(value):
-        if not value.isdigit() or int(value) < 1:
-            raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {value!r}")
-        return int(value)
+    count = whole_number(1)
 
     parser = argparse.ArgumentParser(
         prog="python -m runtime identify",
