@@ -35,6 +35,7 @@ generate:
 	$(PY) -m derive
 	$(MAKE) install
 	$(PY) -m runtime firmware-table --out generated/lqr_task.h
+	$(PY) -m runtime firmware-table --ekf-vector c/examples/ekf_lqr_vector
 	$(PY) -m runtime nmpc-c --header generated/nmpc_task.h
 
 verify: $(STAMP)

@@ -21,7 +21,7 @@ COMMANDS = {
     "envelope": ("runtime.control.envelope", "what the torque limits allow (make envelope)"),
     "climbing": ("runtime.control.climbing", "the climbing limit on a slope; writes docs/figures/climbing-limit.png"),
     "nmpc-c": ("runtime.control.nmpc_c", "the C NMPC: its design as C, its timing in a C loop, its QPs against DAQP"),
-    "firmware-table": ("runtime.control.firmware", "the firmware example's LQR gain table, generated/lqr_task.h (make generate)"),
+    "firmware-table": ("runtime.control.firmware", "the firmware examples' LQR gain table, generated/lqr_task.h, and the estimator example's vector (make generate)"),
     "sweep-bench": ("runtime.bench.sweep", "what a sweep costs (make sweep-bench)"),
     "sense": ("runtime.estimation.sense", "simulate the sensors along a scenario or task: a log and its truth"),
     "estimate": ("runtime.estimation.estimate", "run the EKF over a sensor log: the estimate, its sigmas, the errors"),

@@ -114,12 +114,18 @@ def main(argv=()):
     parser.add_argument("task", nargs="?", default=DEFAULT_TASK)
     parser.add_argument("--rate", type=float, default=DEFAULT_RATE, help="controller rate [Hz]")
     parser.add_argument("--out", default="generated/lqr_task.h")
+    parser.add_argument("--ekf-vector", metavar="FOLDER",
+                        help="instead: the estimator example's headers and recorded input into FOLDER "
+                             "(c/examples/ekf_lqr_vector; write_ekf_vector)")
     args = parser.parse_args(list(argv))
     try:
-        write_header(args.out, args.task, args.rate)
+        if args.ekf_vector:
+            write_ekf_vector(args.ekf_vector)
+        else:
+            write_header(args.out, args.task, args.rate)
     except ValueError as exc:
         parser.exit(2, f"{parser.prog}: {exc}\n")
-    print(f"written: {args.out}")
+    print(f"written: {args.ekf_vector or args.out}")
     return 0
 
 

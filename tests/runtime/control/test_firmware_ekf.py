@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from conftest import ROOT
+from runtime.__main__ import main
 from runtime.control.benchmark import run_task
 from runtime.control.firmware import sample_events, write_ekf_headers
 
@@ -60,3 +61,12 @@ def test_the_firmware_refuses_a_line_that_is_not_an_event(runs):
     exe = runs[0]
     done = subprocess.run([str(exe)], input="0 0.0\n7 0.1\n", capture_output=True, text=True)
     assert done.returncode == 1 and "line 2: not an event" in done.stderr
+
+
+def test_the_checked_in_vector_of_the_cross_builds_is_what_make_generate_writes_now(tmp_path):
+    """c/examples/ekf_lqr_vector/ (the cross-test's recorded input and headers) follows the control law
+    and the filter: a change of either must be regenerated (`make generate`), not left stale."""
+    assert main(["firmware-table", "--ekf-vector", str(tmp_path)]) == 0
+    vector = C_DIR / "examples" / "ekf_lqr_vector"
+    for name in ("lqr_task.h", "ekf_task.h", "events.txt"):
+        assert (tmp_path / name).read_bytes() == (vector / name).read_bytes(), f"{name} is stale: run make generate"
