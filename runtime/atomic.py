@@ -57,3 +57,25 @@ def output_file(value):
     if not os.access(folder, os.W_OK | os.X_OK):
         raise argparse.ArgumentTypeError(f"{value}: the folder {folder} is not writable")
     return path
+
+
+def write_new_file(folder, stem, suffix, text):
+    """Writes `text` to `<stem><suffix>` in `folder` (created if missing) without ever replacing a
+    file: when that name is taken, `<stem>-2<suffix>`, `-3`, ...  Written to a temporary file
+    first, then linked under its name (os.link fails rather than replace).  Returns the path
+    written.  For results that are all kept, one file a run."""
+    folder = pathlib.Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    tmp = folder / f".{stem}{suffix}.tmp"
+    tmp.write_text(text, encoding="utf-8")
+    try:
+        for n in range(1, 1000):
+            path = folder / (f"{stem}{suffix}" if n == 1 else f"{stem}-{n}{suffix}")
+            try:
+                os.link(tmp, path)
+                return path
+            except FileExistsError:
+                continue
+        raise FileExistsError(f"{folder}: 999 files for {stem}")
+    finally:
+        tmp.unlink()

@@ -1,8 +1,8 @@
 """The benchmark's report: the table on stdout, in families of like against like,
 with the targets, and the result file of the run."""
 import json
-import os
-import pathlib
+
+from ..atomic import write_new_file
 
 #: The C loop's baselines: key, label.  The first three are the Kane model as its users would ship it.
 C_BASELINES = [
@@ -228,20 +228,6 @@ def write_results(result, folder):
     """The run as JSON in its own file, `<date and time>.json` (every run is kept,
     so every figure the README quotes is in a stored file).  Never overwrites: a second run within
     the same second gets `-2`, `-3`, ...  Written to a temporary file first, then linked under its
-    name (os.link fails rather than replace an existing file).  Returns the path written."""
-    folder = pathlib.Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    stem = result_file_name(result["date"])[:-len(".json")]
-    tmp = folder / f".{stem}.json.tmp"
-    tmp.write_text(json.dumps(result, indent=1) + "\n")
-    try:
-        for n in range(1, 1000):
-            path = folder / (f"{stem}.json" if n == 1 else f"{stem}-{n}.json")
-            try:
-                os.link(tmp, path)
-                return path
-            except FileExistsError:
-                continue
-        raise FileExistsError(f"{folder}: 999 result files for {stem}")
-    finally:
-        tmp.unlink()
+    name (runtime.atomic.write_new_file).  Returns the path written."""
+    return write_new_file(folder, result_file_name(result["date"])[:-len(".json")], ".json",
+                          json.dumps(result, indent=1) + "\n")

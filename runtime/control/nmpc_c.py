@@ -11,6 +11,8 @@ initializer designed for the task's robot exactly as `NmpcC` builds it, the task
 the circle (centre, radius), dt and the rates.  Doubles are printed with %.17g.
 """
 import argparse
+import datetime
+import json
 import pathlib
 import subprocess
 import sys
@@ -18,8 +20,9 @@ import tempfile
 
 import numpy as np
 
-from ..atomic import write_text
+from ..atomic import write_new_file, write_text
 from ..state import IDX_Q
+from .benchmark import cpu_name
 from .geometry import heading
 from .nmpc import NZ_N
 
@@ -110,25 +113,27 @@ def timing(task_name="circle", cc="cc"):
         return subprocess.run([exe], check=True, capture_output=True, text=True).stdout.strip()
 
 
-def python_timing(task_name, seconds):
-    """(p50, p99) [ms] of the Python NMPC's samples over the first `seconds` of the task's closed loop."""
+def python_timing(task_name, seconds, kind="nmpc"):
+    """(p50, p99) [ms] of one controller sample as called from Python (the closed loop's own timing,
+    `solve_ms`), over the first `seconds` of the task's closed loop, for the controller `kind`
+    (nmpc: the Python NMPC; nmpc-c: the C NMPC through cffi)."""
     import dataclasses
     from .benchmark import run_task
     from .task import load_task
     task = load_task(task_name).with_controller("nmpc")
+    # The C NMPC on the NMPC's own settings, as make control runs it.
+    task = dataclasses.replace(task, controllers=(dataclasses.replace(task.controllers[0], kind=kind),))
     task = dataclasses.replace(task, scenario=dataclasses.replace(task.scenario,
                                                                   steps=max(1, round(seconds / task.scenario.dt))))
     metrics = run_task(task)[2]
     return metrics["solve_ms_p50"], metrics["solve_ms_p99"]
 
 
-def ratio_line(c_line, python_ms):
-    """The C and Python NMPC's p50 and p99 per sample and their ratio, from nmpc_loop's output line and
-    python_timing's."""
-    fields = c_line.split()
-    c_ms = [float(fields[fields.index(key) + 1]) / 1e3 for key in ("p50_us", "p99_us")]
-    return (f"per sample: C NMPC p50 {c_ms[0]:.3f} ms, p99 {c_ms[1]:.3f} ms; Python NMPC p50 {python_ms[0]:.3f} ms, "
-            f"p99 {python_ms[1]:.3f} ms; Python / C: {python_ms[0] / c_ms[0]:.3g} (p50), "
+def ratio_line(c_ms, python_ms):
+    """The C and the Python NMPC's p50 and p99 per sample, each called from Python (python_timing's
+    (p50, p99) of the kinds nmpc-c and nmpc), and their ratio: a Python call against a Python call."""
+    return (f"per sample, called from Python: C NMPC p50 {c_ms[0]:.3f} ms, p99 {c_ms[1]:.3f} ms; Python NMPC "
+            f"p50 {python_ms[0]:.3f} ms, p99 {python_ms[1]:.3f} ms; Python / C: {python_ms[0] / c_ms[0]:.3g} (p50), "
             f"{python_ms[1] / c_ms[1]:.3g} (p99)")
 
 
@@ -172,7 +177,11 @@ def main(argv=()):
     parser.add_argument("--header", default=None, help="write the task's design and scenario as C to this file")
     parser.add_argument("--timing", action="store_true", help="build and run the C closed loop, print its timing")
     parser.add_argument("--against-python", type=float, default=0, metavar="S",
-                        help="with --timing: also time the Python NMPC over S s of the task's closed loop, print the ratio")
+                        help="with --timing: also time the Python NMPC and the C NMPC, each called from Python, over "
+                             "S s of the task's closed loop, print their ratio")
+    parser.add_argument("--out", type=pathlib.Path, default=None, metavar="FOLDER",
+                        help="with --timing: keep the run's numbers in FOLDER as <date and time>.json (never "
+                             "overwritten)")
     parser.add_argument("--qp-samples", type=int, default=0, help="compare this many recorded QPs with DAQP's")
     parser.add_argument("--tasks", default="circle,line,figure8,heading-step,speed-step",
                         help="tasks whose QPs are recorded (comma-separated), in turn until --qp-samples")
@@ -185,8 +194,17 @@ def main(argv=()):
         if args.timing:
             line = timing(args.task)
             print(line)
+            result = {"date": datetime.datetime.now().isoformat(timespec="seconds"), "cpu": cpu_name(),
+                      "task": args.task, "c_loop": line}
             if args.against_python > 0:
-                print(ratio_line(line, python_timing(args.task, args.against_python)))
+                result["from_python_ms"] = {
+                    kind: dict(zip(("p50", "p99"), python_timing(args.task, args.against_python, kind)))
+                    for kind in ("nmpc", "nmpc-c")}
+                ms = {kind: (v["p50"], v["p99"]) for kind, v in result["from_python_ms"].items()}
+                print(ratio_line(ms["nmpc-c"], ms["nmpc"]))
+            if args.out is not None:
+                stem = result["date"].replace(":", "-")
+                print(f"written: {write_new_file(args.out, stem, '.json', json.dumps(result, indent=1) + chr(10))}")
         if args.qp_samples > 0:
             worst, count, active = 0.0, 0, 0
             names = args.tasks.split(",")

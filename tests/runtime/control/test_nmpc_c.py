@@ -158,9 +158,8 @@ def test_the_shipped_design_check_fails_for_one_number_changed_in_its_sixth_digi
 
 
 def test_the_bench_line_gives_the_python_to_c_ratio_of_each_percentile():
-    line = "samples 1200 p50_us 200.0 p99_us 400.0 max_us 900.0 cpu_p50_us 190.0"
-    out = ratio_line(line, (2.0, 8.0))
-    assert "C NMPC p50 0.200 ms, p99 0.400 ms" in out
+    out = ratio_line((0.2, 0.4), (2.0, 8.0))
+    assert "called from Python: C NMPC p50 0.200 ms, p99 0.400 ms" in out
     assert "Python / C: 10 (p50), 20 (p99)" in out
 
 
