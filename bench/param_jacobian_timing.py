@@ -4,9 +4,12 @@ Jacobian, the analytic step-parameter Jacobian and the batched finite-difference
 With --baseline REV the same program is also built with c/src/sr_param_jacobians.c as it was at
 the git revision REV, and the two run in turns (the same states, the same load): before and after.
 
-    .venv/bin/python bench/param_jacobian_timing.py [--repeats N] [--baseline REV] [--objects DIR]
+    .venv/bin/python bench/param_jacobian_timing.py [--repeats N] [--baseline REV] [--objects DIR] [--out DIR]
+
+Each run is kept, with the date and the CPU, as <date and time>.json in --out (bench/results/param-jacobian).
 """
 import argparse
+import datetime
 import json
 import pathlib
 import struct
@@ -19,9 +22,11 @@ import numpy as np
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from runtime.atomic import write_new_file  # noqa: E402
 from runtime.bench.harness import LIBRARY_FLAGS, _compiler, _library_sources, general_robot  # noqa: E402
 from runtime.param_derivatives import random_states  # noqa: E402
 from runtime.params import Params  # noqa: E402
+from runtime.bench.timing import cpu_name  # noqa: E402
 
 
 def main():
@@ -32,6 +37,8 @@ def main():
     parser.add_argument("--rounds", type=int, default=3, help="turns of the two builds (with --baseline)")
     parser.add_argument("--objects", type=pathlib.Path, default=None,
                         help="a folder to keep the library's objects in between runs (default: rebuilt each run)")
+    parser.add_argument("--out", type=pathlib.Path, default=ROOT / "bench" / "results" / "param-jacobian",
+                        help="the folder that keeps each run's result file")
     args = parser.parse_args()
     paper = Params.paper_simulation()
     rng = np.random.default_rng(0)
@@ -90,7 +97,10 @@ def main():
             for m in ("rkmk4", "lie_euler"):
                 row[f"ratio_to_step_jacobian_{m}"] = round(row[f"step_param_jacobian_{m}"] / row[f"step_jacobian_{m}"], 2)
                 row[f"fd_over_analytic_{m}"] = round(row[f"fd_batched_{m}"] / row[f"step_param_jacobian_{m}"], 1)
-    print(json.dumps(out, indent=1))
+    date = datetime.datetime.now().isoformat(timespec="seconds")
+    text = json.dumps({"date": date, "cpu": cpu_name(), "baseline": args.baseline, "robots": out}, indent=1)
+    print(text)
+    print(f"written: {write_new_file(args.out, date.replace(':', '-'), '.json', text + chr(10))}")
 
 
 if __name__ == "__main__":
