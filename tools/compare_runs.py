@@ -9,8 +9,9 @@
         is within RELATIVE_TOL, the tolerance allowed for contraction; it still fails.
     compare_runs.py double-libm HOST.csv TARGET.csv [TOL]
         the same, for a program whose results pass through functions that newlib and glibc round
-        differently (the closed loop: atan2 in the controller's Log and pendulum angle, sin and cos
-        of the heading): holds when identical or within TOL (default RELATIVE_TOL).
+        differently (the float build's closed loop on the estimator: libm's atan2f in the
+        controller's Log and pendulum angle; the double build uses the library's own and is
+        compared with `double`): holds when identical or within TOL (default RELATIVE_TOL).
     compare_runs.py float HOST_F.csv TARGET_F.csv HOST_D.csv
         the float build on the Cortex-M4F against the host float build: the position q after
         10 s (row t = 10, or the last row of a shorter run) within Q_TOL metres; the distance of

@@ -297,6 +297,12 @@ int sr_contact_force(const sr_model *model, const sr_real x[SR_NX], const sr_rea
 int sr_contact_force_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real *F,
                            long *failed_row);
 
+/** atan2(y, x) as the library computes it (its controllers' headings and pendulum angles): in
+ * double the library's own, the same bits on every platform (within 2 ulp of the exact value, with
+ * C99's values at zeros and infinities), so that a firmware computing its targets with it matches
+ * its host build bit for bit; in float libm's atan2f (or libm's atan2 with -DSR_LIBM_TRIG). */
+sr_real sr_atan2(sr_real y, sr_real x);
+
 /** R = Exp([[w]]) by Rodrigues' formula, with a series branch for |w| < 1e-4 rad.
  * SR_ERR_NONFINITE (R untouched) if w is not finite or |w|^2 overflows. */
 int sr_so3_exp(const sr_real w[3], sr_real R[9]);

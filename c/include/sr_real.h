@@ -11,10 +11,10 @@
  *                     -Wall -Wextra -Wpedantic -Werror (no double promotion).
  *   SR_GEN_SIN, SR_GEN_COS
  *                     the sine and cosine of sr_real (sr_gen_general_constants
- *                     takes those of the slope, once per model): libm's in
- *                     double, the library's own in float (c/src/sr_trig.c: no
- *                     4 KB libm reduction in a firmware; -DSR_LIBM_TRIG for
- *                     libm's sinf and cosf).
+ *                     takes those of the slope, once per model): the library's
+ *                     own (c/src/sr_trig.c: in double the same bits on every
+ *                     platform, which libm's are not; in float no 4 KB libm
+ *                     reduction in a firmware); -DSR_LIBM_TRIG for libm's.
  *   SR_GEN_PIVOT_TOL  relative pivot tolerance of the joint-first solve in
  *                     sr_gen_accel: each pivot of M (M_33, M_44, the leading
  *                     minors of the Schur complement) must exceed it times
@@ -71,8 +71,17 @@ float sr_internal_cosf(float x);
 typedef double sr_real;
 #define SR_C(v) ((sr_real)(v))
 #define SR_GEN_PIVOT_TOL SR_C(1e-13)
+#ifdef SR_LIBM_TRIG
 #define SR_GEN_SIN sin
 #define SR_GEN_COS cos
+#else
+#define SR_GEN_SIN sr_internal_sin
+#define SR_GEN_COS sr_internal_cos
+/* c/src/sr_trig.c (internal to the library); also its arctangent, sr_internal_atan2. */
+double sr_internal_sin(double x);
+double sr_internal_cos(double x);
+double sr_internal_atan2(double y, double x);
+#endif
 #endif
 
 #define SR_GEN_LANE_FINITE(v) ((v) - (v) == 0)

@@ -23,11 +23,15 @@
 #define SR_EPSILON FLT_EPSILON
 #else
 #define SR_SQRT sqrt
-#define SR_SIN sin
-#define SR_COS cos
+#define SR_SIN SR_GEN_SIN      /* c/src/sr_trig.c, or libm's with -DSR_LIBM_TRIG (sr_real.h) */
+#define SR_COS SR_GEN_COS
 #define SR_FABS fabs
 #define SR_POW pow
+#ifdef SR_LIBM_TRIG
 #define SR_ATAN2 atan2
+#else
+#define SR_ATAN2 sr_internal_atan2
+#endif
 #define SR_EPSILON DBL_EPSILON
 #endif
 
@@ -35,6 +39,9 @@
  * reduction's rounding growing as |x| 2^-24 beyond, NaN past SR_TRIG_MAX_ARG. */
 #define SR_TRIG_EXACT_RANGE 8192.0f
 #define SR_TRIG_MAX_ARG 16777216.0f
+/* c/src/sr_trig.c's double sine and cosine: within 1 ulp up to here (just below 2^20 pi/2, where
+ * the quadrant count times the first 33 bits of pi/2 stays exact), NaN beyond. */
+#define SR_TRIG_DOUBLE_MAX_ARG 1647099.0
 
 /* The generated kernels' status codes are the library's: their results pass through. */
 #if SR_GEN_OK != SR_OK || SR_GEN_NONFINITE != SR_ERR_NONFINITE || SR_GEN_SINGULAR != SR_ERR_SINGULAR
