@@ -4,9 +4,11 @@
  * `make -C c cross-test`, on the emulated Cortex-M7 (double) and Cortex-M4F (float).
  *
  * The design and the task come from generated/nmpc_task.h, written by `make generate`
- * (python -m runtime nmpc-c --header): an `sr_nmpc` initializer designed for the circle task's
- * robot as the controller kind nmpc-c builds it, the initial state, the circle (centre, radius),
- * dt and the rates.  Every controller sample finds the nearest point of the circle, computes the
+ * (python -m runtime nmpc-c --header --horizon 20 --node-periods 3): an `sr_nmpc` initializer
+ * designed for the circle task's robot as the controller kind nmpc-c builds it, on 20 nodes of 3
+ * periods (the tasks' 3 s horizon in nodes that keep every warm-started sample within 5 million
+ * instructions on the Cortex-M; the tasks' 30 nodes of 2 periods take up to 8.4 million), the
+ * initial state, the circle (centre, radius), dt and the rates.  Every controller sample finds the nearest point of the circle, computes the
  * torques and holds them for NMPC_TASK_STEPS_PER_SAMPLE plant steps (sr_step, RKMK4).  The run is
  * NMPC_FIRMWARE_SAMPLES samples (default 60: 3 s, a cold start and the warm-started samples after it).
  *
@@ -35,10 +37,8 @@
 #endif
 #define PER NMPC_TASK_STEPS_PER_SAMPLE
 #ifdef SR_USE_FLOAT
-#define ATAN2 atan2f
 #define SQRT sqrtf
 #else
-#define ATAN2 atan2
 #define SQRT sqrt
 #endif
 
@@ -128,7 +128,8 @@ int main(void)
 #ifdef HAVE_SYSTICK
         uint32_t start;
 #endif
-        target.heading = ATAN2(dy, dx) + half_pi;
+        /* The library's atan2, not libm's: the double build then matches its host build bit for bit. */
+        target.heading = sr_atan2(dy, dx) + half_pi;
         target.cross_track = (sr_real)NMPC_TASK_RADIUS - SQRT(dx * dx + dy * dy);
 #ifdef HAVE_SYSTICK
         start = SYST_CVR;

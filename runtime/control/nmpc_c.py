@@ -2,6 +2,7 @@
 timing in a C driver, and its QPs against DAQP.
 
     python -m runtime nmpc-c --header PATH [--task circle]   the task's design and scenario as C (nmpc_task.h)
+        [--horizon N --node-periods P]                       on another horizon than the task's
     python -m runtime nmpc-c --timing [--task circle]        builds c/examples/nmpc_loop.c on it and runs it
         [--against-python S]                                 and times the Python NMPC over S s of the task: the ratio
     python -m runtime nmpc-c --qp-samples 1000 [--tasks ...] the C QP solution against DAQP's on recorded QPs
@@ -27,6 +28,10 @@ from .geometry import heading
 from .nmpc import NZ_N
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
+#: The firmware example's horizon (generated/nmpc_task.h, `make generate`): 20 nodes of 3 periods,
+#: the tasks' 3 s horizon in nodes that keep every warm-started sample within 5 million instructions
+#: on the Cortex-M (30 nodes of 2 periods take up to 8.4 million; docs/embedding.md).
+FIRMWARE_HORIZON, FIRMWARE_NODE_PERIODS = 20, 3
 #: The fields of `sr_nmpc` that are numbers or arrays, in the header's order.
 _INT_FIELDS = ("horizon", "node_periods", "cold_iterations", "iterations", "qp_max_iterations", "n_speeds",
                "n_curvatures")
@@ -60,17 +65,24 @@ def design_initializer(controller, name="NMPC_DESIGN"):
     return "\n".join(lines) + "\n"
 
 
-def c_task(task_name):
-    """The task with its NMPC run by the C NMPC (kind nmpc-c, the same settings)."""
+def c_task(task_name, horizon=None, node_periods=None):
+    """The task with its NMPC run by the C NMPC (kind nmpc-c, the same settings), on `horizon` nodes
+    of `node_periods` controller periods where given (else the task's)."""
     import dataclasses
     from .task import load_task
     task = load_task(task_name).with_controller("nmpc")
-    return dataclasses.replace(task, controllers=(dataclasses.replace(task.controllers[0], kind="nmpc-c"),))
+    spec = task.controllers[0]
+    gains = spec.gains
+    if horizon is not None or node_periods is not None:
+        gains = dataclasses.replace(gains, horizon=gains.horizon if horizon is None else horizon,
+                                    node_periods=gains.node_periods if node_periods is None else node_periods)
+    return dataclasses.replace(task, controllers=(dataclasses.replace(spec, kind="nmpc-c", gains=gains),))
 
 
-def task_header(task_name="circle"):
-    """The header c/examples/nmpc_loop.c compiles against: the C NMPC designed for the task (a circle)."""
-    task = c_task(task_name)
+def task_header(task_name="circle", horizon=None, node_periods=None):
+    """The header c/examples/nmpc_loop.c and c/examples/firmware_nmpc.c compile against: the C NMPC
+    designed for the task (a circle), on `horizon` nodes of `node_periods` periods where given."""
+    task = c_task(task_name, horizon, node_periods)
     spec = task.reference_spec
     if spec["kind"] != "circle":
         raise ValueError(f"--task: the C driver follows a circle; {task_name!r} is a {spec['kind']!r} task")
@@ -175,6 +187,10 @@ def main(argv=()):
     parser = argparse.ArgumentParser(prog="python -m runtime nmpc-c")
     parser.add_argument("--task", default="circle", help="the circle task of --header and --timing")
     parser.add_argument("--header", default=None, help="write the task's design and scenario as C to this file")
+    parser.add_argument("--horizon", type=int, default=None, metavar="N",
+                        help="with --header: N nodes instead of the task's (1 to SR_NMPC_MAX_HORIZON)")
+    parser.add_argument("--node-periods", type=int, default=None, metavar="P",
+                        help="with --header: P controller periods per node instead of the task's (>= 1)")
     parser.add_argument("--timing", action="store_true", help="build and run the C closed loop, print its timing")
     parser.add_argument("--against-python", type=float, default=0, metavar="S",
                         help="with --timing: also time the Python NMPC and the C NMPC, each called from Python, over "
@@ -188,7 +204,7 @@ def main(argv=()):
     args = parser.parse_args(list(argv))
     try:
         if args.header:
-            write_text(pathlib.Path(args.header), task_header(args.task))
+            write_text(pathlib.Path(args.header), task_header(args.task, args.horizon, args.node_periods))
         if args.against_python < 0:
             raise ValueError(f"--against-python: must be >= 0 s, got {args.against_python:g}")
         if args.timing:

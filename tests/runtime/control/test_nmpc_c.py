@@ -12,7 +12,8 @@ from runtime.casadi_model import parameter_vector
 from runtime.control import nmpc
 from runtime.control.benchmark import run_task
 from conftest import ROOT
-from runtime.control.nmpc_c import daqp_solution, design_initializer, main, ratio_line, recorded_qps, task_header
+from runtime.control.nmpc_c import (FIRMWARE_HORIZON, FIRMWARE_NODE_PERIODS, daqp_solution, design_initializer, main,
+                                    ratio_line, recorded_qps, task_header)
 from runtime.control.task import load_task
 from runtime.params import Params
 
@@ -141,7 +142,7 @@ def same_design(text, other):
 
 @pytest.fixture(scope="module")
 def fresh_header():
-    return task_header("circle")
+    return task_header("circle", FIRMWARE_HORIZON, FIRMWARE_NODE_PERIODS)
 
 
 def test_the_shipped_firmware_design_is_the_current_design(fresh_header):
