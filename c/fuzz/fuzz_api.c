@@ -799,6 +799,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     status = sr_so3_exp(x + SR_X_w_S, arm(&g, 9));
     EXPECT_STATUS("sr_so3_exp", status, SR_OK, SR_ERR_NONFINITE);
     expect("sr_so3_exp", status, &g, status == SR_OK ? 9 : 0, 1);
+    {
+        /* the library's atan2: an angle in [-pi, pi] for any two non-NaN arguments, NaN otherwise */
+        const sr_real ay = pick(&rd, 0.3), ax = pick(&rd, -0.7), angle = sr_atan2(ay, ax);
+        const int nan_in = ay != ay || ax != ax;
+        if (nan_in ? angle == angle : !(angle >= -SR_C(3.1415927) && angle <= SR_C(3.1415927)))
+            fail("sr_atan2", SR_OK, nan_in ? "no NaN for a NaN argument" : "an angle outside [-pi, pi]");
+    }
 
     /* batches: two rows, the second a copy of x with one more perturbation */
     memcpy(x2, x, sizeof x);
