@@ -17,9 +17,9 @@
 #define SR_FMOD fmod
 #endif
 
-/* The products by pairs of columns (predict, apply) need even sizes and the dq pair at an odd
- * offset (it then straddles two pairs: SR_E_q - 1, SR_E_q and SR_E_q + 1, SR_E_nu). */
-typedef char pairs_fit[(NE % 2 == 0 && NB % 2 == 0 && SR_E_q % 2 == 1 && SR_E_nu == SR_E_q + 2) ? 1 : -1];
+/* The Joseph form by pairs of columns (apply) needs an even NB; the predict's skip of the dq
+ * columns, that they are the two before nu. */
+typedef char layout_fits[(NB % 2 == 0 && SR_E_nu == SR_E_q + 2) ? 1 : -1];
 
 static const sr_real pi_ = SR_C(3.14159265358979323846);
 
@@ -164,7 +164,7 @@ static int torque_noise(const sr_model *model, const sr_real x[SR_NX], const sr_
 int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real u[SR_NU], sr_real dt,
                    const sr_ekf_process *process)
 {
-    sr_real xn[SR_NX], F[NE * NE], G[NE * SR_NU], Qnu[SR_NV * SR_NV], T[NE * NB], Ft[NE * NE], Pn[NB * NB];
+    sr_real xn[SR_NX], F[NE * NE], G[NE * SR_NU], Qnu[SR_NV * SR_NV], T[NE * NB], Pn[NB * NB];
     int status = arg_model(model, READS(WHOLE)), i, j, k, k1, dq_identity = 1;
     if (status != SR_OK) return status;
     if (!ekf || !process) return SR_ERR_NULL;
@@ -179,8 +179,8 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
     /* F P F^T with F = [[F_d, 0], [0, I]] blockwise: T = F_d [P_dd P_db] (the cross terms F_d P_db come
      * with it), then F_d P_dd F_d^T = T_dd F_d^T on the upper triangle.  The steps' F_d has the
      * identity's dq columns (nothing in a step depends on where the robot stands,
-     * sr_step_jacobian): when it does, both products skip those two columns and take the dq
-     * entries as they are. */
+     * sr_step_jacobian): when it does, the first product skips those two columns and takes the
+     * dq rows of P as they are (the second, a twelfth of the work, multiplies by their 0 and 1). */
     for (k = 0; k < NE; ++k) {
         const int dq = k == SR_E_q || k == SR_E_q + 1;
         for (i = 0; i < NE && dq; ++i) dq_identity &= F[NE * i + k] == (i == k ? 1 : 0);
@@ -197,30 +197,12 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
             for (j = 0; j < NB; ++j) Ti[j] += f * Pk[j];
         }
     }
-    /* T_dd F_d^T by pairs of columns from the one that holds the diagonal, through F_d^T: two
-     * adjacent sums a statement, one vector operation (as in apply). */
     for (i = 0; i < NE; ++i)
-        for (j = 0; j < NE; ++j) Ft[NE * j + i] = F[NE * i + j];
-    for (i = 0; i < NE; ++i) {
-        const sr_real *Ti = T + NB * i;
-        for (j = i - i % 2; j < NE; j += 2) {
-            sr_real s0 = 0, s1 = 0;
-            if (dq_identity && j == SR_E_q - 1) s1 = Ti[SR_E_q];
-            if (dq_identity && j == SR_E_q + 1) s0 = Ti[SR_E_q + 1];
-            for (k = 0; k < SR_E_q; ++k) {
-                s0 += Ti[k] * Ft[NE * k + j];
-                s1 += Ti[k] * Ft[NE * k + j + 1];
-            }
-            for (k = k1; k < NE; ++k) {
-                s0 += Ti[k] * Ft[NE * k + j];
-                s1 += Ti[k] * Ft[NE * k + j + 1];
-            }
-            Pn[NB * i + j] = s0;
-            Pn[NB * i + j + 1] = s1;
+        for (j = i; j < NE; ++j) {
+            sr_real s = 0;
+            for (k = 0; k < NE; ++k) s += T[NB * i + k] * F[NE * j + k];
+            Pn[NB * i + j] = Pn[NB * j + i] = s;
         }
-    }
-    for (i = 0; i < NE; ++i)
-        for (j = i + 1; j < NE; ++j) Pn[NB * j + i] = Pn[NB * i + j];
     for (i = 0; i < SR_NV; ++i)
         for (j = 0; j < SR_NV; ++j) Pn[NB * (SR_EB_nu + i) + SR_EB_nu + j] += Qnu[SR_NV * i + j];
     /* The cross terms F P_db (in T already); the bias block only gains its random walk. */
