@@ -2,7 +2,10 @@
  * one prediction (RKMK4, its step Jacobian, the process noise), one IMU update on the yoke and one
  * encoder update, over a recorded run; and the prediction alone, and each update alone.
  *
- * usage: bench_ekf [SAMPLES]   (default 2000: 10 s at 200 Hz)
+ * usage: bench_ekf [SAMPLES [PARTS]]   (default 2000: 10 s at 200 Hz)
+ * With PARTS (a sum of 1 predict, 2 IMU update, 4 encoder update; 0 none) only those parts run,
+ * once over the samples: the program an instruction counter runs (bench/ekf_timing.py --callgrind
+ * subtracts the run of PARTS 0, the setup).
  * Build (portable -O2, as the bench's C loop), from the repository's root:
  *   make -C c lib && cc -O2 -std=c99 -ffp-contract=off -Ic/include -Igenerated bench/bench_ekf.c \
  *       c/build/libsphericalrobot.a -lm -o bench_ekf
@@ -76,9 +79,10 @@ int main(int argc, char **argv)
     const int parts[] = {7, 1, 2, 4};
     sr_real params[SR_NPARAM], x[SR_NX];
     sr_model m;
-    int n = argc > 1 ? atoi(argv[1]) : 2000, i, k, r;
+    int n = argc > 1 ? atoi(argv[1]) : 2000, only, i, k, r;
     if (n < 1 || n > NMAX) n = 2000;
     if (sr_paper_params(paper, params) != SR_OK || sr_model_init(&m, params) != SR_OK) return 1;
+    only = argc > 2 ? atoi(argv[2]) : -1;
     start_state(&m, x);
     for (i = 0; i < n; ++i) {
         U[i][0] = (sr_real)(0.2 + 0.1 * sin(0.7 * i * DT));
@@ -86,6 +90,12 @@ int main(int argc, char **argv)
         if (sr_imu_measure_u(&m, x, U[i], SR_BODY_yoke, MOUNT, NULL, IMU[i]) != SR_OK
             || sr_encoders_measure(&m, x, ENC[i]) != SR_OK || sr_step(&m, SR_RKMK4, x, U[i], DT, x) != SR_OK)
             return 1;
+    }
+    if (only >= 0) {
+        double ns = 0;
+        if (only > 7 || run(&m, n, only, &ns) != SR_OK) return 1;
+        printf("{\"samples\": %d, \"parts\": %d, \"ns\": %.1f}\n", n, only, ns);
+        return 0;
     }
     printf("{\"samples\": %d, \"dt\": %g", n, DT);
     for (k = 0; k < 4; ++k) {

@@ -296,6 +296,15 @@ def test_the_ekf_timing_driver_builds_warning_free_and_reports_every_part(build,
         assert out[f"{part}_ns"] > 0
 
 
+def test_the_ekf_timing_driver_runs_only_the_parts_asked_for(build, tmp_path):
+    """bench_ekf SAMPLES PARTS: those parts once, one time (what bench/ekf_timing.py --callgrind counts)."""
+    exe = tmp_path / "bench_ekf"
+    run([CC, "-std=c99", "-O2", f"-I{INCLUDE}", f"-I{ROOT / 'generated'}", str(ROOT / "bench" / "bench_ekf.c"),
+         str(build / "libsphericalrobot.a"), "-lm", "-o", str(exe)])
+    out = json.loads(run([str(exe), "5", "2"]).stdout)
+    assert set(out) == {"samples", "parts", "ns"} and out["parts"] == 2 and out["ns"] > 0
+
+
 # ---- documentation tools ------------------------------------------------------------------------
 
 def test_size_report_covers_every_public_function(tmp_path):

@@ -17,7 +17,9 @@
 #     printed, every warm-started sample held to NMPC_INSTRUCTION_BUDGET); the double t-shape again
 #     with -ffp-contract=fast must be caught, and its difference is printed (also the float one);
 #     the loop on the estimator (c/examples/firmware_ekf_lqr.c on the recorded samples of
-#     examples/ekf_lqr_vector) against the host build of its precision;
+#     examples/ekf_lqr_vector) against the host build of its precision, run with -icount shift=0:
+#     the filter's instructions per 200 Hz sample are printed, the M4F's median held to
+#     EKF_INSTRUCTION_BUDGET;
 #  7. the CMake toolchain file (c/cmake/arm-none-eabi.cmake): both libraries configured and built
 #     for the two CPUs, and checked like the Makefile's;
 #  8. the M4 sizes and stacks (tools/m4_report.py): a Lie-Euler-only firmware linked and run under QEMU,
@@ -36,6 +38,9 @@ QEMU_TIMEOUT=${QEMU_TIMEOUT:-900}   # seconds per emulated program; the slowest 
 # Instructions of any warm-started NMPC sample: a quarter of the 50 ms period of a 400 MHz
 # Cortex-M7 at one instruction a cycle.
 NMPC_INSTRUCTION_BUDGET=${NMPC_INSTRUCTION_BUDGET:-5000000}
+# Instructions of the median 200 Hz sample of the filter on the Cortex-M4F (float): a prediction
+# (RKMK4 step and its Jacobian), an IMU and an encoder update.
+EKF_INSTRUCTION_BUDGET=${EKF_INSTRUCTION_BUDGET:-300000}
 
 failures=0
 step() { printf '\n== %s\n' "$*"; }
@@ -166,10 +171,18 @@ cross_make "$M7_DIR" "$M7_CPU_FLAGS" mps2-an500.ld CPPFLAGS="-I$EKF_VECTOR" "$M7
     fail "Cortex-M7 build of the example on the estimator"
 "$HOST_DIR/firmware_ekf_lqr" <"$EKF_VECTOR/events.txt" >"$OUT/ekf.host.csv" || fail "host double, on the estimator"
 "$HOST_DIR/firmware_ekf_lqr_f" <"$EKF_VECTOR/events.txt" >"$OUT/ekf_f.host.csv" || fail "host float, on the estimator"
-run_qemu mps2-an500 "$M7_DIR/firmware_ekf_lqr" "$OUT/ekf.m7.csv" <"$EKF_VECTOR/events.txt" ||
-    fail "Cortex-M7 example on the estimator exited with $?"
-run_qemu mps2-an386 "$M4_DIR/firmware_ekf_lqr_f" "$OUT/ekf_f.m4.csv" <"$EKF_VECTOR/events.txt" ||
-    fail "Cortex-M4F example on the estimator exited with $?"
+# Under -icount shift=0 the firmware prints the instructions of the filter's 200 Hz samples
+# (SysTick, calibrated); the M4F's median is held to EKF_INSTRUCTION_BUDGET.
+run_qemu mps2-an500 "$M7_DIR/firmware_ekf_lqr" "$OUT/ekf.m7.csv" -icount shift=0 <"$EKF_VECTOR/events.txt" \
+    2>"$OUT/ekf.m7.txt" || fail "Cortex-M7 example on the estimator exited with $?"
+echo "  Cortex-M7 double: $(grep '^instructions per filter sample' "$OUT/ekf.m7.txt" || cat "$OUT/ekf.m7.txt")"
+run_qemu mps2-an386 "$M4_DIR/firmware_ekf_lqr_f" "$OUT/ekf_f.m4.csv" -icount shift=0 <"$EKF_VECTOR/events.txt" \
+    2>"$OUT/ekf_f.m4.txt" || fail "Cortex-M4F example on the estimator exited with $?"
+counts=$(grep '^instructions per filter sample' "$OUT/ekf_f.m4.txt")
+echo "  Cortex-M4F float: ${counts:-no instruction counts: $(cat "$OUT/ekf_f.m4.txt")}"
+median=$(echo "$counts" | sed -n 's/.* p50 \([0-9]*\),.*/\1/p')
+[ -n "$median" ] && [ "$median" -le "$EKF_INSTRUCTION_BUDGET" ] ||
+    fail "Cortex-M4F filter: the median sample beyond $EKF_INSTRUCTION_BUDGET instructions (${median:-none counted})"
 # Both against the host build of their precision: the double one identical (the library's own
 # trigonometry); the float one identical or within 1e-12 relative, where newlib's and glibc's atan2f
 # round an argument differently.

@@ -22,6 +22,11 @@
  * Python closed loop on the estimator of the same task fed the same samples
  * (runtime.control.closed_loop.simulate_on_sensors, tests/runtime/control/test_firmware.py).
  * Exit status 0 on success; on an error, a message on stderr and 1.
+ * On an Armv7-M part (SysTick) also one line on stderr: the instructions of the filter's 200 Hz
+ * samples (the prediction to the sample's time, the IMU and the encoder update; not the LQR, nor
+ * fixes and headings), as SysTick counts them converted to instructions by a calibration loop of
+ * known length; under QEMU with -icount shift=0 (one instruction per nanosecond of virtual time)
+ * that is the exact count.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,6 +37,73 @@
 #include "spherical_robot.h"
 
 #define MAX_LINE 1024
+
+#if defined(__ARM_ARCH_7M__) || defined(__ARM_ARCH_7EM__)
+#define HAVE_SYSTICK 1
+#include <stdint.h>
+/* SysTick (Armv7-M): a 24-bit down-counter of the processor clock, free-running, no interrupt. */
+#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
+#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
+#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
+#define SYSTICK_MASK 0xFFFFFFu
+#define MAX_SAMPLES 256   /* the samples counted (the recorded input has 200); a longer input's first ones */
+
+static void systick_start(void)
+{
+    SYST_RVR = SYSTICK_MASK;
+    SYST_CVR = 0;
+    SYST_CSR = 5u; /* enable, processor clock */
+}
+
+static uint32_t ticks_since(uint32_t start) { return (start - SYST_CVR) & SYSTICK_MASK; }
+
+/* Instructions per SysTick tick: a loop of 2^20 iterations of two instructions (subs, bne). */
+static double instructions_per_tick(void)
+{
+    uint32_t n = 1u << 20, start = SYST_CVR;
+    __asm__ volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(n)::"cc");
+    return 2.0 * (double)(1u << 20) / (double)ticks_since(start);
+}
+
+static int by_ticks(const void *a, const void *b)
+{
+    const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* The parts of a sample counted so far (1 prediction, 2 IMU, 4 encoders) and their ticks; a
+ * sample with all three is kept. */
+typedef struct sample_count {
+    uint32_t ticks[MAX_SAMPLES], current;
+    int parts, n;
+} sample_count;
+
+static void close_sample(sample_count *c)
+{
+    if (c->parts == 7 && c->n < MAX_SAMPLES) c->ticks[c->n++] = c->current;
+    c->parts = 0;
+    c->current = 0;
+}
+
+static void report(sample_count *c, double per_tick)
+{
+    double sum = 0;
+    int k;
+    close_sample(c);
+    if (c->n == 0) {
+        fprintf(stderr, "instructions per filter sample: no sample with a prediction, an IMU and an encoder update\n");
+        return;
+    }
+    for (k = 0; k < c->n; ++k) sum += per_tick * (double)c->ticks[k];
+    qsort(c->ticks, (size_t)c->n, sizeof c->ticks[0], by_ticks);
+    fprintf(stderr,
+            "instructions per filter sample (prediction, IMU and encoder updates), %d samples: mean %.0f, "
+            "p50 %.0f, max %.0f (%.3g instructions per SysTick tick)\n",
+            c->n, sum / c->n, per_tick * (double)c->ticks[c->n / 2], per_tick * (double)c->ticks[c->n - 1], per_tick);
+}
+
+static sample_count counts; /* 1 kB, not on the stack */
+#endif
 
 /* The numbers after the kind and the time on a line of each kind. */
 static const int WIDTH[5] = {0, SR_NIMU, 2, 2, 1};
@@ -88,6 +160,17 @@ int main(void)
     char line[MAX_LINE];
     long n = 0;
     int kind, status;
+#ifdef HAVE_SYSTICK
+    uint32_t start = 0;
+    double per_tick;
+    systick_start();
+    per_tick = instructions_per_tick();
+#define COUNT_FROM() (start = SYST_CVR)
+#define COUNT_PART(part) (counts.current += ticks_since(start), counts.parts |= (part))
+#else
+#define COUNT_FROM() ((void)0)
+#define COUNT_PART(part) ((void)0)
+#endif
 
     status = sr_model_init(&model, LQR_TASK_PARAMS);
     if (status == SR_OK) status = sr_lqr_check(&LQR_TASK_SCHEDULE);
@@ -106,7 +189,12 @@ int main(void)
         }
         status = SR_OK;
         if (t > t_now) { /* the filter's time, as the Python loop's: predicted only forward */
+#ifdef HAVE_SYSTICK
+            close_sample(&counts);
+#endif
+            COUNT_FROM();
             status = sr_ekf_predict(&ekf, &model, EKF_TASK_METHOD, u, (sr_real)(t - t_now), &process);
+            COUNT_PART(1);
             t_now = t;
         }
         if (status == SR_OK) switch (kind) {
@@ -115,11 +203,15 @@ int main(void)
             if (status == SR_OK) print_row(t, ekf.x, u);
             break;
         case 1:
+            COUNT_FROM();
             status = sr_ekf_update_imu(&ekf, &model, v, u, EKF_TASK_BODY, EKF_TASK_MOUNT, EKF_TASK_GYRO,
                                        EKF_TASK_ACCEL, EKF_TASK_GATE_IMU);
+            COUNT_PART(2);
             break;
         case 2:
+            COUNT_FROM();
             status = sr_ekf_update_encoders(&ekf, &model, v, EKF_TASK_ENCODER, EKF_TASK_GATE_ENCODERS);
+            COUNT_PART(4);
             break;
         case 3:
             status = sr_ekf_update_position(&ekf, &model, v, EKF_TASK_POSITION, EKF_TASK_GATE_POSITION);
@@ -134,5 +226,8 @@ int main(void)
             return 1;
         }
     }
+#ifdef HAVE_SYSTICK
+    report(&counts, per_tick);
+#endif
     return 0;
 }

@@ -17,6 +17,10 @@
 #define SR_FMOD fmod
 #endif
 
+/* The Joseph form by pairs of columns (apply) needs an even NB; the predict's skip of the dq
+ * columns, that they are the two before nu. */
+typedef char layout_fits[(NB % 2 == 0 && SR_E_nu == SR_E_q + 2) ? 1 : -1];
+
 static const sr_real pi_ = SR_C(3.14159265358979323846);
 
 /* a - b wrapped into (-pi, pi]: the innovation of an angle. */
@@ -161,7 +165,7 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
                    const sr_ekf_process *process)
 {
     sr_real xn[SR_NX], F[NE * NE], G[NE * SR_NU], Qnu[SR_NV * SR_NV], T[NE * NB], Pn[NB * NB];
-    int status = arg_model(model, READS(WHOLE)), i, j, k;
+    int status = arg_model(model, READS(WHOLE)), i, j, k, k1, dq_identity = 1;
     if (status != SR_OK) return status;
     if (!ekf || !process) return SR_ERR_NULL;
     if (arg_method(method) != SR_OK || arg_dt(dt) != SR_OK || !valid_process(process)) return SR_ERR_ARG;
@@ -172,12 +176,25 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
     if (status == SR_OK) status = torque_noise(model, ekf->x, process, dt, Qnu);
     if (status != SR_OK) return status;
 
-    /* T = F [P_dd P_db] (the cross terms F P_db come with it), then F P_dd F^T on the upper triangle. */
+    /* F P F^T with F = [[F_d, 0], [0, I]] blockwise: T = F_d [P_dd P_db] (the cross terms F_d P_db come
+     * with it), then F_d P_dd F_d^T = T_dd F_d^T on the upper triangle.  The steps' F_d has the
+     * identity's dq columns (nothing in a step depends on where the robot stands,
+     * sr_step_jacobian): when it does, the first product skips those two columns and takes the
+     * dq rows of P as they are (the second, a twelfth of the work, multiplies by their 0 and 1). */
+    for (k = 0; k < NE; ++k) {
+        const int dq = k == SR_E_q || k == SR_E_q + 1;
+        for (i = 0; i < NE && dq; ++i) dq_identity &= F[NE * i + k] == (i == k ? 1 : 0);
+    }
+    k1 = dq_identity ? SR_E_nu : SR_E_q;   /* the columns summed: [0, SR_E_q) and [k1, NE) */
     for (i = 0; i < NE; ++i) {
-        for (j = 0; j < NB; ++j) T[NB * i + j] = 0;
-        for (k = 0; k < NE; ++k) {
-            const sr_real f = F[NE * i + k];
-            for (j = 0; j < NB; ++j) T[NB * i + j] += f * ekf->P[NB * k + j];
+        sr_real *Ti = T + NB * i;
+        if (dq_identity && (i == SR_E_q || i == SR_E_q + 1))
+            memcpy(Ti, ekf->P + NB * i, NB * sizeof(sr_real));
+        else
+            memset(Ti, 0, NB * sizeof(sr_real));
+        for (k = 0; k < NE; k = k + 1 == SR_E_q ? k1 : k + 1) {
+            const sr_real f = F[NE * i + k], *Pk = ekf->P + NB * k;
+            for (j = 0; j < NB; ++j) Ti[j] += f * Pk[j];
         }
     }
     for (i = 0; i < NE; ++i)
@@ -218,17 +235,18 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
     return SR_OK;
 }
 
-/* Applies an m-entry sample with innovation r, cross-covariance C = Cov(e, r) (NB x m, row stride
- * MAXM) and innovation covariance S (m x m, stride m): gate, gain, the covariance update, injection,
- * reset; W[j] (m x 2, stride 2, at MAXM * 2 j) is Cov(r, z_j) for every waiting slot j (not
- * `released`, the slot this sample comes from, freed whether applied or gated).  The filter is
- * written only on SR_OK. */
-static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_real *r, const sr_real *C,
+/* Applies an m-entry sample with innovation r, the transposed cross-covariance CT = Cov(e, r)^T
+ * (m x NB, row-major) and innovation covariance S (m x m, stride m): gate, gain, the covariance
+ * update, injection, reset; W[j] (m x 2, stride 2, at MAXM * 2 j) is Cov(r, z_j) for every waiting
+ * slot j (not `released`, the slot this sample comes from, freed whether applied or gated).  The
+ * gain and the Joseph terms are kept transposed (m rows of NB), so that every inner loop runs along
+ * a row of NB contiguous numbers.  The filter is written only on SR_OK. */
+static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_real *r, const sr_real *CT,
                  const sr_real *S, sr_real gate, const sr_real *W, int released)
 {
-    sr_real L[MAXM * MAXM], K[NB * MAXM], D[NB * MAXM], Pn[NB * NB];
+    sr_real L[MAXM * MAXM], KT[MAXM * NB], DT[MAXM * NB], Pn[NB * NB];
     sr_real z[MAXM], e[NB], xn[SR_NX], Jr[9], T[3 * NB], nis = 0;
-    int a, b, i, j, status;
+    int a, b, i, j, k, status;
 
     status = cholesky(m, S, L);
     if (status != SR_OK) return status;
@@ -243,33 +261,63 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
         return SR_OK;
     }
 
-    /* K = C S^-1, row by row (S symmetric: K^T = S^-1 C^T); e = K r */
-    for (a = 0; a < NB; ++a) {
-        for (i = 0; i < m; ++i) z[i] = C[MAXM * a + i];
-        solve_both(m, L, z);
-        e[a] = 0;
-        for (i = 0; i < m; ++i) {
-            K[MAXM * a + i] = z[i];
-            e[a] += z[i] * r[i];
+    /* K^T = S^-1 C^T = L^-T L^-1 C^T, both substitutions on all NB columns at once, by the pivots'
+     * reciprocals (a division per pivot, not per entry); e = K r. */
+    for (i = 0; i < m; ++i) {
+        sr_real *Ki = KT + NB * i;
+        const sr_real d = 1 / L[m * i + i];
+        for (a = 0; a < NB; ++a) Ki[a] = CT[NB * i + a];
+        for (k = 0; k < i; ++k) {
+            const sr_real l = L[m * i + k], *Kk = KT + NB * k;
+            for (a = 0; a < NB; ++a) Ki[a] -= l * Kk[a];
         }
+        for (a = 0; a < NB; ++a) Ki[a] *= d;
     }
+    for (i = m - 1; i >= 0; --i) {
+        sr_real *Ki = KT + NB * i;
+        const sr_real d = 1 / L[m * i + i];
+        for (k = i + 1; k < m; ++k) {
+            const sr_real l = L[m * k + i], *Kk = KT + NB * k;
+            for (a = 0; a < NB; ++a) Ki[a] -= l * Kk[a];
+        }
+        for (a = 0; a < NB; ++a) Ki[a] *= d;
+    }
+    for (a = 0; a < NB; ++a) e[a] = 0;
+    for (i = 0; i < m; ++i)
+        for (a = 0; a < NB; ++a) e[a] += KT[NB * i + a] * r[i];
     /* The Joseph form (I - K H) P (I - K H)^T + K R K^T, expanded with C = P H^T and S = H P H^T + R:
      * P - K C^T - C K^T + K S K^T = P - K C^T - (C - K S) K^T.  The same polynomial in K (exact
      * for any gain, so an error in K enters only to second order), in O(NB^2 m) on the upper
      * triangle instead of the products of 18 x 18 matrices.  For a delayed fix the same
-     * expression is the covariance of e - K r with C its cross-covariance. */
-    for (a = 0; a < NB; ++a)
+     * expression is the covariance of e - K r with C its cross-covariance.  D^T = C^T - S K^T. */
+    for (i = 0; i < m; ++i) {
+        sr_real *Di = DT + NB * i;
+        for (a = 0; a < NB; ++a) Di[a] = CT[NB * i + a];
+        for (j = 0; j < m; ++j) {
+            const sr_real s = S[m * j + i], *Kj = KT + NB * j;
+            for (a = 0; a < NB; ++a) Di[a] -= s * Kj[a];
+        }
+    }
+    /* Row a from the pair of columns that holds the diagonal: two columns a statement, which
+     * compilers turn into one vector operation (the entry left of an odd diagonal is computed and
+     * then overwritten by the copy of the upper triangle). */
+    for (a = 0; a < NB; ++a) {
+        sr_real *row = Pn + NB * a;
+        const int b0 = a - a % 2;
+        for (b = b0; b < NB; b += 2) {
+            row[b] = ekf->P[NB * a + b];
+            row[b + 1] = ekf->P[NB * a + b + 1];
+        }
         for (i = 0; i < m; ++i) {
-            sr_real s = C[MAXM * a + i];
-            for (j = 0; j < m; ++j) s -= K[MAXM * a + j] * S[m * j + i];
-            D[MAXM * a + i] = s;
+            const sr_real ka = KT[NB * i + a], da = DT[NB * i + a], *Ci = CT + NB * i, *Ki = KT + NB * i;
+            for (b = b0; b < NB; b += 2) {
+                row[b] -= ka * Ci[b] + da * Ki[b];
+                row[b + 1] -= ka * Ci[b + 1] + da * Ki[b + 1];
+            }
         }
+    }
     for (a = 0; a < NB; ++a)
-        for (b = a; b < NB; ++b) {
-            sr_real s = ekf->P[NB * a + b];
-            for (i = 0; i < m; ++i) s -= K[MAXM * a + i] * C[MAXM * b + i] + D[MAXM * a + i] * K[MAXM * b + i];
-            Pn[NB * a + b] = Pn[NB * b + a] = s;
-        }
+        for (b = a + 1; b < NB; ++b) Pn[NB * b + a] = Pn[NB * a + b];
 
     /* Injection, then the reset of the shell's block by Jr(e_xi). */
     status = sr_retract(model, ekf->x, e, xn);
@@ -302,7 +350,7 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
         for (a = 0; a < NB; ++a)
             for (b = 0; b < 2; ++b) {
                 sr_real s = Cj[2 * a + b];
-                for (i = 0; i < m; ++i) s -= K[MAXM * a + i] * Wj[2 * i + b];
+                for (i = 0; i < m; ++i) s -= KT[NB * i + a] * Wj[2 * i + b];
                 Cj[2 * a + b] = s;
             }
         for (i = 0; i < 3; ++i)
@@ -319,31 +367,32 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
 static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_real *r, const sr_real *H,
                   const sr_real *Rd, sr_real gate)
 {
-    sr_real C[NB * MAXM], S[MAXM * MAXM] = {0}, Hc[MAXM * NB], Pc[NB], W[SR_EKF_NDELAYED * MAXM * 2];
-    int cols[NB], nc = 0, a, i, j, k;
+    sr_real CT[MAXM * NB], S[MAXM * MAXM] = {0}, val[MAXM * NB], W[SR_EKF_NDELAYED * MAXM * 2];
+    int col[MAXM * NB], nnz[MAXM], a, i, j, k;
 
-    /* H is sparse (the encoders and the fix read two columns, the heading four): its nonzero
-     * columns are gathered, Hc (m x nc), and only they enter C = P H^T and S = H C + R. */
-    for (k = 0; k < NB; ++k)
-        for (i = 0; i < m; ++i)
+    /* H is sparse: an IMU row reads at most 13 of the 18 columns (never q, and one bias block),
+     * an encoder or a fix row one or two.  Row by row, its nonzero entries (val, col) are gathered
+     * and only they enter C^T = H P (P symmetric: row i of C^T sums rows of P) and S = H C + R. */
+    for (i = 0; i < m; ++i) {
+        nnz[i] = 0;
+        for (k = 0; k < NB; ++k)
             if (H[NB * i + k] != 0) {
-                for (j = 0; j < m; ++j) Hc[NB * j + nc] = H[NB * j + k];
-                cols[nc++] = k;
-                break;
+                val[NB * i + nnz[i]] = H[NB * i + k];
+                col[NB * i + nnz[i]++] = k;
             }
-    for (a = 0; a < NB; ++a) {
-        const sr_real *Pa = ekf->P + NB * a;
-        for (k = 0; k < nc; ++k) Pc[k] = Pa[cols[k]];
-        for (i = 0; i < m; ++i) {
-            sr_real s = 0;
-            for (k = 0; k < nc; ++k) s += Pc[k] * Hc[NB * i + k];
-            C[MAXM * a + i] = s;
+    }
+    for (i = 0; i < m; ++i) {
+        sr_real *Ci = CT + NB * i;
+        for (a = 0; a < NB; ++a) Ci[a] = 0;
+        for (k = 0; k < nnz[i]; ++k) {
+            const sr_real h = val[NB * i + k], *Pk = ekf->P + NB * col[NB * i + k];
+            for (a = 0; a < NB; ++a) Ci[a] += h * Pk[a];
         }
     }
     for (i = 0; i < m; ++i)
         for (j = i; j < m; ++j) {
             sr_real s = i == j ? Rd[i] : 0;
-            for (k = 0; k < nc; ++k) s += Hc[NB * i + k] * C[MAXM * cols[k] + j];
+            for (k = 0; k < nnz[i]; ++k) s += val[NB * i + k] * CT[NB * j + col[NB * i + k]];
             S[m * i + j] = S[m * j + i] = s;
         }
     /* Cov(r, z_j) = H C_j for every waiting fix. */
@@ -353,11 +402,11 @@ static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_
         for (i = 0; i < m; ++i)
             for (a = 0; a < 2; ++a) {
                 sr_real s = 0;
-                for (k = 0; k < nc; ++k) s += Hc[NB * i + k] * Cj[2 * cols[k] + a];
+                for (k = 0; k < nnz[i]; ++k) s += val[NB * i + k] * Cj[2 * col[NB * i + k] + a];
                 W[MAXM * 2 * j + 2 * i + a] = s;
             }
     }
-    return apply(ekf, model, kind, m, r, C, S, gate, W, -1);
+    return apply(ekf, model, kind, m, r, CT, S, gate, W, -1);
 }
 
 int sr_ekf_update_imu(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
@@ -482,7 +531,7 @@ int sr_ekf_mark_position(sr_ekf *ekf, const sr_model *model, int slot)
 int sr_ekf_update_position_delayed(sr_ekf *ekf, const sr_model *model, int slot, const sr_real y[2], sr_real sigma,
                                    sr_real gate)
 {
-    sr_real r[2], C[NB * MAXM], S[4], W[SR_EKF_NDELAYED * MAXM * 2];
+    sr_real r[2], CT[2 * NB], S[4], W[SR_EKF_NDELAYED * MAXM * 2];
     const sr_ekf_delayed *d;
     int status = arg_model(model, READS(WHOLE)), a, j;
     if (status != SR_OK) return status;
@@ -494,8 +543,8 @@ int sr_ekf_update_position_delayed(sr_ekf *ekf, const sr_model *model, int slot,
     r[0] = y[0] - d->yh[0];
     r[1] = y[1] - d->yh[1];
     for (a = 0; a < NB; ++a) {
-        C[MAXM * a] = d->C[2 * a];
-        C[MAXM * a + 1] = d->C[2 * a + 1];
+        CT[a] = d->C[2 * a];
+        CT[NB + a] = d->C[2 * a + 1];
     }
     memcpy(S, d->Z + 4 * slot, sizeof S);
     S[0] += sigma * sigma;
@@ -503,5 +552,5 @@ int sr_ekf_update_position_delayed(sr_ekf *ekf, const sr_model *model, int slot,
     /* Cov(r, z_j) = Cov(z, z_j): the fix's noise is independent of the others. */
     for (j = 0; j < SR_EKF_NDELAYED; ++j)
         if (j != slot && ekf->delayed[j].marked) memcpy(W + MAXM * 2 * j, d->Z + 4 * j, 4 * sizeof(sr_real));
-    return apply(ekf, model, SR_EKF_POSITION, 2, r, C, S, gate, W, slot);
+    return apply(ekf, model, SR_EKF_POSITION, 2, r, CT, S, gate, W, slot);
 }
