@@ -115,8 +115,8 @@ int main(void)
             if (status == SR_OK) print_row(t, ekf.x, u);
             break;
         case 1:
-            status = sr_ekf_update_imu(&ekf, &model, v, u, EKF_TASK_BODY, EKF_TASK_MOUNT, EKF_TASK_GYRO,
-                                       EKF_TASK_ACCEL, EKF_TASK_GATE_IMU);
+            status = sr_ekf_update_imu_axes(&ekf, &model, v, u, EKF_TASK_BODY, EKF_TASK_MOUNT, EKF_TASK_IMU_SIGMA,
+                                            EKF_TASK_GATE_IMU);
             break;
         case 2:
             status = sr_ekf_update_encoders(&ekf, &model, v, EKF_TASK_ENCODER, EKF_TASK_GATE_ENCODERS);
