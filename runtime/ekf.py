@@ -58,9 +58,10 @@ class EkfNoise:
 
     Per-sample standard deviations of the readings, the biases' spread per run, their random
     walks (0: constant over the run), and the process noise: white generalized torques on the
-    shell (each axis) and on both joints, one spectral density [N·m/√Hz]."""
+    shell (each axis) and on both joints, one spectral density [N·m/√Hz].  `accel` is one number
+    for the accelerometer's three axes or three (x, y, z of the sensor), kept as three."""
     gyro: float = 0.003                                   # rad/s, per axis and sample
-    accel: float = 0.02                                   # m/s², per axis and sample
+    accel: float | tuple = 0.02                           # m/s², per sample: one for all axes, or (x, y, z)
     gyro_bias: float = 0.005                              # rad/s, 1σ of b_g per axis at the start
     accel_bias: float = 0.05                              # m/s², 1σ of b_a per axis at the start
     gyro_bias_rw: float = 0.0                             # rad/s/√s
@@ -71,13 +72,27 @@ class EkfNoise:
     torque_psd: float = 0.01                              # N·m/√Hz
 
     def __post_init__(self):
+        accel = self.accel
+        if isinstance(accel, (list, tuple, np.ndarray)):
+            if len(accel) != 3:
+                raise ValueError(f"accel: expected one number or three (x, y, z), got {len(accel)}")
+            for i, value in enumerate(accel):
+                _noise_number(value, f"accel[{i}]", zero_ok=False)
+            object.__setattr__(self, "accel", tuple(float(v) for v in accel))
+        else:
+            _noise_number(accel, "accel", zero_ok=False)
+            object.__setattr__(self, "accel", (float(accel),) * 3)
         for field in dataclasses.fields(self):
-            value = getattr(self, field.name)
-            zero_ok = field.name.endswith("_rw") or field.name == "torque_psd"
-            if not (isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-                    and (value >= 0 if zero_ok else value > 0)):
-                rule = ">= 0" if zero_ok else "> 0"
-                raise ValueError(f"{field.name}: expected a finite number {rule}, got {value!r}")
+            if field.name == "accel":
+                continue
+            _noise_number(getattr(self, field.name), field.name,
+                          zero_ok=field.name.endswith("_rw") or field.name == "torque_psd")
+
+
+def _noise_number(value, name, zero_ok):
+    if not (isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool)
+            and math.isfinite(value) and (value >= 0 if zero_ok else value > 0)):
+        raise ValueError(f"{name}: expected a finite number {'>= 0' if zero_ok else '> 0'}, got {value!r}")
 
 
 def gate_threshold(probability, size):
@@ -139,6 +154,7 @@ class Ekf:
         self._process.gyro_bias_rw = n.gyro_bias_rw
         self._process.accel_bias_rw = n.accel_bias_rw
         self._imu_mount, self._heading_mount = self.mount.as_array(), self.heading_mount.as_array()
+        self._imu_sigma = np.array([n.gyro] * 3 + list(n.accel))
 
     # -- the filter's equations ------------------------------------------------------------------
     def predict(self, u, dt):
@@ -162,8 +178,8 @@ class Ekf:
         torque = np.zeros(NU) if u is None else _vector(u, "u", NU)
         self._before = self._ekf.accepted[0]
         m = self.mount
-        status = lib.sr_ekf_update_imu(self._ekf, self.model._model, _ptr(y), _ptr(torque), BODIES[m.body],
-                                       _ptr(self._imu_mount), self.noise.gyro, self.noise.accel, self.gate["imu"])
+        status = lib.sr_ekf_update_imu_axes(self._ekf, self.model._model, _ptr(y), _ptr(torque), BODIES[m.body],
+                                            _ptr(self._imu_mount), _ptr(self._imu_sigma), self.gate["imu"])
         return self._applied("imu", status, "the innovation covariance or the inertia is not positive definite")
 
     def update_encoders(self, y):
@@ -322,7 +338,7 @@ def start_from_measurements(model, accel, *, encoders=None, fix=None, heading=No
     R_S = R_B @ Q_B.T
     x0 = initial_state(theta[0], theta[1], R_S=R_S, q=(position[0], position[1], r), r=r)
 
-    tilt = math.sqrt(noise.accel ** 2 / samples + noise.accel_bias ** 2) / g if g > 0 else 1.0
+    tilt = math.sqrt(max(noise.accel) ** 2 / samples + noise.accel_bias ** 2) / g if g > 0 else 1.0
     yaw = heading_sigma if heading is None else noise.heading
     e1 = np.cross(up, [0.0, 1.0, 0.0]) if abs(up[1]) < 0.9 else np.cross(up, [1.0, 0.0, 0.0])
     e1 /= np.linalg.norm(e1)

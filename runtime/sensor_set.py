@@ -34,6 +34,10 @@ SENSOR_RANGES = {
             "gyro_bias": Range(0, 10, "rad/s", "a bias's standard deviation per axis and run"),
             "accel_noise": Range(0, 1e3, "m/s^2", "a white noise's per-sample standard deviation"),
             "accel_bias": Range(0, 1e3, "m/s^2", "a bias's standard deviation per axis and run"),
+            "gyro_bias_rw": Range(0, 1, "rad/s/sqrt(s)", "a bias's random walk: a MEMS gyroscope's is about "
+                                                         "1e-5"),
+            "accel_bias_rw": Range(0, 10, "m/s^2/sqrt(s)", "a bias's random walk: a MEMS accelerometer's is "
+                                                           "about 1e-4"),
             "gyro_range": Range(1e-3, 1e4, "rad/s", "the gyroscope's full scale: a reading at or beyond it "
                                                     "is saturated"),
             "accel_range": Range(1e-3, 1e5, "m/s^2", "the accelerometer's full scale: a reading at or beyond "
@@ -85,7 +89,10 @@ class ImuSpec:
     (the body's frame, from the shell centre), its axes `rotation` (3×3, the sensor's axes in the body's
     frame), sampled at `rate` [Hz].  Noises: white, per-sample standard deviations at that rate; biases:
     the standard deviation per axis of a constant drawn once per run.  A reading at or beyond
-    `gyro_range` [rad/s] or `accel_range` [m/s²] in magnitude on any axis is saturated."""
+    `gyro_range` [rad/s] or `accel_range` [m/s²] in magnitude on any axis is saturated.
+    `gyro_bias_rw` [rad/s/√s] and `accel_bias_rw` [m/s²/√s]: how fast the biases may wander in a
+    run (a random walk's density, the IMU's bias instability), what an estimator allows for;
+    the simulated truth holds its biases constant."""
     body: str = "yoke"
     lever: tuple = (0.0, 0.0, -0.05)
     rotation: tuple = _IDENTITY
@@ -96,6 +103,8 @@ class ImuSpec:
     accel_bias: float = 0.05
     gyro_range: float = 35.0
     accel_range: float = 160.0
+    gyro_bias_rw: float = 1e-5
+    accel_bias_rw: float = 1e-4
 
     def __post_init__(self):
         if not isinstance(self.body, str) or self.body not in BODIES:
@@ -107,7 +116,7 @@ class ImuSpec:
         _set(self, "lever", mount.lever)
         _set(self, "rotation", mount.rotation)
         _set(self, "rate", _number(self.rate, "ImuSpec.rate", low=0))
-        for name in ("gyro_noise", "gyro_bias", "accel_noise", "accel_bias"):
+        for name in ("gyro_noise", "gyro_bias", "accel_noise", "accel_bias", "gyro_bias_rw", "accel_bias_rw"):
             _set(self, name, _nonnegative(getattr(self, name), f"ImuSpec.{name}"))
         for name in ("gyro_range", "accel_range"):
             _set(self, name, _number(getattr(self, name), f"ImuSpec.{name}", low=0))

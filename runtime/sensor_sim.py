@@ -113,11 +113,20 @@ class SensorSimulation:
         return x, new
 
 
-def ekf_noise(sensors, params, x0=None):
+#: How `ekf_noise` spreads the process noise's share over the accelerometer's axes.
+ACCEL_AXES = ("largest", "each")
+
+
+def ekf_noise(sensors, params, x0=None, accel_axes="largest"):
     """The EkfNoise a sensor set declares.  The accelerometer's standard deviation adds to its
-    white noise what the process noise puts into its reading at the IMU's rate (the largest axis,
-    at x0: the robot at rest by default), because the filter's measurement model sees the applied
-    torques only."""
+    white noise what the process noise puts into its reading at the IMU's rate (at x0: the robot
+    at rest by default), because the filter's measurement model sees the applied torques only:
+    `accel_axes` "each", axis by axis; "largest", the largest axis's on all three, the default
+    (each axis's own makes the filter overconfident in the tilt: that share of the reading is
+    correlated with the process noise, which the filter does not model; docs/estimation.md,
+    "Consistency").  The biases' random walks are the IMU's."""
+    if accel_axes not in ACCEL_AXES:
+        raise ValueError(f"accel_axes: expected one of {', '.join(ACCEL_AXES)}, got {accel_axes!r}")
     model = Model(params)
     x0 = initial_state(r=params.r) if x0 is None else x0
     spec = sensors.imu
@@ -125,8 +134,10 @@ def ekf_noise(sensors, params, x0=None):
     Minv = np.linalg.inv(model.inertia(x0))
     q2 = sensors.process.generalized() ** 2 * spec.rate             # (q/√dt)² at the IMU's period
     cov = Hn[3:] @ Minv @ np.diag(q2) @ Minv.T @ Hn[3:].T
-    return EkfNoise(gyro=spec.gyro_noise, accel=math.sqrt(spec.accel_noise ** 2 + float(np.max(np.diag(cov)))),
+    share = np.diag(cov) if accel_axes == "each" else np.full(3, np.max(np.diag(cov)))
+    return EkfNoise(gyro=spec.gyro_noise, accel=tuple(np.sqrt(spec.accel_noise ** 2 + share)),
                     gyro_bias=spec.gyro_bias, accel_bias=spec.accel_bias,
+                    gyro_bias_rw=spec.gyro_bias_rw, accel_bias_rw=spec.accel_bias_rw,
                     encoder=sensors.encoders.step / math.sqrt(12),
                     position=sensors.fixes.noise if sensors.fixes is not None else EkfNoise.position,
                     heading=sensors.heading.noise if sensors.heading is not None else EkfNoise.heading,

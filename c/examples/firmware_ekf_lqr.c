@@ -204,8 +204,8 @@ int main(void)
             break;
         case 1:
             COUNT_FROM();
-            status = sr_ekf_update_imu(&ekf, &model, v, u, EKF_TASK_BODY, EKF_TASK_MOUNT, EKF_TASK_GYRO,
-                                       EKF_TASK_ACCEL, EKF_TASK_GATE_IMU);
+            status = sr_ekf_update_imu_axes(&ekf, &model, v, u, EKF_TASK_BODY, EKF_TASK_MOUNT, EKF_TASK_IMU_SIGMA,
+                                            EKF_TASK_GATE_IMU);
             COUNT_PART(2);
             break;
         case 2:

@@ -70,6 +70,7 @@ extern "C" {
 #define sr_ekf_init_diagonal sr_ekf_init_diagonal_f
 #define sr_ekf_predict sr_ekf_predict_f
 #define sr_ekf_update_imu sr_ekf_update_imu_f
+#define sr_ekf_update_imu_axes sr_ekf_update_imu_axes_f
 #define sr_ekf_update_encoders sr_ekf_update_encoders_f
 #define sr_ekf_update_position sr_ekf_update_position_f
 #define sr_ekf_update_heading sr_ekf_update_heading_f
@@ -142,6 +143,14 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
  * sigma_accel^2 x 3) (per-sample standard deviations), gated at gate. */
 int sr_ekf_update_imu(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
                       int body, const sr_real mount[SR_NMOUNT], sr_real sigma_gyro, sr_real sigma_accel, sr_real gate);
+
+/** sr_ekf_update_imu with a standard deviation per reading: R = diag(sigma[i]^2), sigma[SR_NIMU] in
+ * the sample's order (gyroscope x, y, z [rad/s], accelerometer x, y, z [m/s^2]), each finite and
+ * > 0 (else SR_ERR_ARG; NULL: SR_ERR_NULL).  What the unmodelled accelerations add to the
+ * accelerometer's reading differs between its axes (at rest the process noise reaches the
+ * horizontal ones only): one number for the three would be too wide on some or too narrow on others. */
+int sr_ekf_update_imu_axes(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
+                           int body, const sr_real mount[SR_NMOUNT], const sr_real sigma[SR_NIMU], sr_real gate);
 
 /** One encoder sample y = (theta_Y, theta_P) [rad], standard deviation sigma each (e.g. a count's
  * quantisation, 2 pi / (counts sqrt(12))), gated at gate; the innovations are wrapped into (-pi, pi]. */

@@ -409,26 +409,39 @@ static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_
     return apply(ekf, model, kind, m, r, CT, S, gate, W, -1);
 }
 
-int sr_ekf_update_imu(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
-                      int body, const sr_real mount[SR_NMOUNT], sr_real sigma_gyro, sr_real sigma_accel, sr_real gate)
+int sr_ekf_update_imu_axes(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
+                           int body, const sr_real mount[SR_NMOUNT], const sr_real sigma[SR_NIMU], sr_real gate)
 {
     sr_real yh[SR_NIMU], H[SR_NIMU * NB], r[SR_NIMU], Rd[SR_NIMU];
     int status = arg_model(model, READS(WHOLE)), i;
     if (status != SR_OK) return status;
-    if (!ekf || !y || !mount) return SR_ERR_NULL;
+    if (!ekf || !y || !mount || !sigma) return SR_ERR_NULL;
     status = sr_check_mount(body, mount);
     if (status != SR_OK) return status;
-    if (!positive(sigma_gyro) || !positive(sigma_accel) || !valid_gate(gate)) return SR_ERR_ARG;
+    for (i = 0; i < SR_NIMU; ++i)
+        if (!positive(sigma[i])) return SR_ERR_ARG;
+    if (!valid_gate(gate)) return SR_ERR_ARG;
     if (!all_finite(y, SR_NIMU) || (u && !all_finite(u, SR_NU))) return SR_ERR_NONFINITE;
     status = check_filter(model, ekf);
     if (status == SR_OK) status = sr_imu_jacobian(model, ekf->x, u, body, mount, ekf->bias, yh, H);
     if (status != SR_OK) return status;
-    for (i = 0; i < SR_NIMU; ++i) r[i] = y[i] - yh[i];
-    for (i = 0; i < 3; ++i) {
-        Rd[SR_IMU_gyro + i] = sigma_gyro * sigma_gyro;
-        Rd[SR_IMU_accel + i] = sigma_accel * sigma_accel;
+    for (i = 0; i < SR_NIMU; ++i) {
+        r[i] = y[i] - yh[i];
+        Rd[i] = sigma[i] * sigma[i];
     }
     return update(ekf, model, SR_EKF_IMU, SR_NIMU, r, H, Rd, gate);
+}
+
+int sr_ekf_update_imu(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
+                      int body, const sr_real mount[SR_NMOUNT], sr_real sigma_gyro, sr_real sigma_accel, sr_real gate)
+{
+    sr_real sigma[SR_NIMU];
+    int i;
+    for (i = 0; i < 3; ++i) {
+        sigma[SR_IMU_gyro + i] = sigma_gyro;
+        sigma[SR_IMU_accel + i] = sigma_accel;
+    }
+    return sr_ekf_update_imu_axes(ekf, model, y, u, body, mount, sigma, gate);
 }
 
 /* The checks of the two-entry samples and the one-angle sample: model, pointers, sigma and gate, data. */

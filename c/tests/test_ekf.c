@@ -135,6 +135,37 @@ static void test_a_constant_gyro_offset_at_rest_is_learnt_as_the_gyro_bias(void)
     CHECK(sqrt((double)ekf.P[SR_NEB * (SR_EB_b_g + 2) + SR_EB_b_g + 2]) < 0.01);
 }
 
+static void test_each_imu_reading_has_its_own_standard_deviation(void)
+{
+    /* A reading with a huge sigma is all but ignored, the others not; equal sigmas per sensor are
+     * sr_ekf_update_imu's two numbers. */
+    sr_ekf a, b, c, d;
+    sr_model m;
+    sr_real mount[SR_NMOUNT] = {0, 0, SR_C(-0.05), 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    sr_real y[SR_NIMU], off_x[SR_NIMU], off_z[SR_NIMU];
+    const sr_real loose_z[SR_NIMU] = {SR_C(0.003), SR_C(0.003), SR_C(0.003), SR_C(0.02), SR_C(0.02), SR_C(1e4)};
+    const sr_real same[SR_NIMU] = {SR_C(0.003), SR_C(0.003), SR_C(0.003), SR_C(0.02), SR_C(0.02), SR_C(0.02)};
+    int i;
+    start(&a, &m, 0.01);
+    CHECK_STATUS(sr_imu_measure_u(&m, a.x, NULL, SR_BODY_yoke, mount, a.bias, y), SR_OK);
+    memcpy(off_x, y, sizeof y);
+    memcpy(off_z, y, sizeof y);
+    off_x[SR_IMU_accel] += SR_C(0.05);
+    off_z[SR_IMU_accel + 2] += SR_C(0.05);
+    b = c = d = a;
+    CHECK_STATUS(sr_ekf_update_imu_axes(&a, &m, off_z, NULL, SR_BODY_yoke, mount, loose_z, (sr_real)INFINITY), SR_OK);
+    CHECK_STATUS(sr_ekf_update_imu_axes(&b, &m, y, NULL, SR_BODY_yoke, mount, loose_z, (sr_real)INFINITY), SR_OK);
+    CHECK_STATUS(sr_ekf_update_imu_axes(&c, &m, off_x, NULL, SR_BODY_yoke, mount, loose_z, (sr_real)INFINITY), SR_OK);
+    for (i = 0; i < SR_NBIAS; ++i) CHECK_NEAR(a.bias[i], b.bias[i], 1e-6);
+    CHECK_NEAR(a.nis[SR_EKF_IMU], b.nis[SR_EKF_IMU], 1e-4);
+    CHECK(c.nis[SR_EKF_IMU] > b.nis[SR_EKF_IMU] + 0.1);
+    b = d;
+    CHECK_STATUS(sr_ekf_update_imu_axes(&b, &m, off_x, NULL, SR_BODY_yoke, mount, same, (sr_real)INFINITY), SR_OK);
+    CHECK_STATUS(sr_ekf_update_imu(&d, &m, off_x, NULL, SR_BODY_yoke, mount, SR_C(0.003), SR_C(0.02),
+                                   (sr_real)INFINITY), SR_OK);
+    CHECK(memcmp(&b, &d, sizeof b) == 0);
+}
+
 static void test_a_fix_marked_and_applied_at_once_is_the_plain_fix(void)
 {
     /* No time between the measuring instant and the arrival: the delayed update is the plain one. */
@@ -189,6 +220,7 @@ static void test_bad_input_gives_a_status_and_writes_nothing(void)
     sr_ekf_process q = {{SR_C(0.01), SR_C(0.01), SR_C(0.01)}, 0, 0};
     sr_real mount[SR_NMOUNT] = {0, 0, SR_C(-0.05), 1, 0, 0, 0, 1, 0, 0, 0, 1};
     sr_real y[SR_NIMU] = {0, 0, 0, 0, 0, SR_C(9.81)}, P0[SR_NEB * SR_NEB];
+    sr_real imu_sigma[SR_NIMU] = {SR_C(0.003), SR_C(0.003), SR_C(0.003), SR_C(0.02), SR_C(0.02), SR_C(0.02)};
     const sr_real fix[2] = {0, 0};
     int i;
     start(&ekf, &m, 0.01);
@@ -208,6 +240,11 @@ static void test_bad_input_gives_a_status_and_writes_nothing(void)
     CHECK_STATUS(sr_ekf_update_imu(&ekf, &m, y, NULL, SR_BODY_yoke, mount, SR_C(0.003), SR_C(0.02), chi2_2),
                  SR_ERR_NONFINITE);
     CHECK_STATUS(sr_ekf_update_imu(&ekf, &m, y, NULL, 5, mount, SR_C(0.003), SR_C(0.02), chi2_2), SR_ERR_ARG);
+    imu_sigma[SR_IMU_accel + 2] = 0;
+    CHECK_STATUS(sr_ekf_update_imu_axes(&ekf, &m, y, NULL, SR_BODY_yoke, mount, imu_sigma, chi2_2), SR_ERR_ARG);
+    imu_sigma[SR_IMU_accel + 2] = (sr_real)NAN;
+    CHECK_STATUS(sr_ekf_update_imu_axes(&ekf, &m, y, NULL, SR_BODY_yoke, mount, imu_sigma, chi2_2), SR_ERR_ARG);
+    CHECK_STATUS(sr_ekf_update_imu_axes(&ekf, &m, y, NULL, SR_BODY_yoke, mount, NULL, chi2_2), SR_ERR_NULL);
     CHECK_STATUS(sr_ekf_update_heading(&ekf, &m, (sr_real)NAN, SR_BODY_yoke, mount, SR_C(0.05), chi2_2),
                  SR_ERR_NONFINITE);
     CHECK_STATUS(sr_ekf_mark_position(&ekf, &m, SR_EKF_NDELAYED), SR_ERR_ARG);
@@ -234,6 +271,7 @@ void suite_ekf(void)
     RUN_TEST(test_predict_leaves_the_bias_block_alone_and_moves_the_cross_terms);
     RUN_TEST(test_the_bias_variances_grow_by_their_random_walk_over_dt);
     RUN_TEST(test_a_constant_gyro_offset_at_rest_is_learnt_as_the_gyro_bias);
+    RUN_TEST(test_each_imu_reading_has_its_own_standard_deviation);
     RUN_TEST(test_a_fix_marked_and_applied_at_once_is_the_plain_fix);
     RUN_TEST(test_a_late_fix_corrects_the_estimate_by_what_it_said_when_it_measured);
     RUN_TEST(test_bad_input_gives_a_status_and_writes_nothing);

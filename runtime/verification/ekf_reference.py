@@ -163,9 +163,9 @@ class EkfReference:
         return True
 
     def update_imu(self, y, u, mount, sigma_gyro, sigma_accel, gate):
-        """One IMU sample (6,) under the torques u."""
+        """One IMU sample (6,) under the torques u; `sigma_accel` one number or one per axis (3,)."""
         yh, H = sensors.imu_jacobian(self.model, self.x, u, mount=mount, bias=self.b)
-        R = np.diag([sigma_gyro ** 2] * 3 + [sigma_accel ** 2] * 3)
+        R = np.diag(np.concatenate([np.full(3, sigma_gyro), np.broadcast_to(sigma_accel, (3,))]) ** 2)
         return self._update("imu", np.asarray(y) - yh, H, R, gate)
 
     def update_encoders(self, y, sigma, gate):

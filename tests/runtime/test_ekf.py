@@ -16,7 +16,7 @@ from runtime.ekf import DELAYED_SLOTS, Ekf, EkfNoise, gate_threshold, start_from
 from runtime.verification.ekf_reference import EkfReference
 
 DT = 0.005
-NOISE = EkfNoise(gyro_bias_rw=1e-4, accel_bias_rw=1e-3)
+NOISE = EkfNoise(accel=(0.03, 0.05, 0.02), gyro_bias_rw=1e-4, accel_bias_rw=1e-3)
 IMU_OUTLIER, FIX_OUTLIER = 60, 99           # samples with a 5 m/s² accelerometer spike, a 1 m fix jump
 TOL = 1e-10
 
@@ -210,6 +210,11 @@ class NoBiasRandomWalk(EkfReference):
         return super().process_noise(dt, torque_psd, 0.0, 0.0)
 
 
+class AccelSigmaOneNumber(EkfReference):
+    def update_imu(self, y, u, mount, sigma_gyro, sigma_accel, gate):
+        return super().update_imu(y, u, mount, sigma_gyro, max(sigma_accel), gate)
+
+
 class TorqueNoiseWithoutInertia(EkfReference):
     def process_noise(self, dt, torque_psd, gyro_bias_rw, accel_bias_rw):
         Q = super().process_noise(dt, torque_psd, gyro_bias_rw, accel_bias_rw)
@@ -218,7 +223,8 @@ class TorqueNoiseWithoutInertia(EkfReference):
 
 
 @pytest.mark.parametrize("planted", [WrongGainSign, NoJosephNoiseTerm, NoGate, BiasNotUpdated, NoReset,
-                                     CrossTermsNotPropagated, NoBiasRandomWalk, TorqueNoiseWithoutInertia])
+                                     CrossTermsNotPropagated, NoBiasRandomWalk, AccelSigmaOneNumber,
+                                     TorqueNoiseWithoutInertia])
 def test_the_comparison_fails_for_a_reference_with_one_equation_broken(model, short_run, planted):
     first, samples, c_history, ekf = short_run
     _, good = started(model, first)
@@ -289,8 +295,15 @@ def test_a_bad_start_is_a_value_error_naming_the_argument(model, kwargs, field):
         Ekf(model, initial_state(r=model.params.r), **kwargs)
 
 
-@pytest.mark.parametrize("name, value", [("gyro", 0.0), ("encoder", math.nan), ("torque_psd", -1.0),
-                                         ("gyro_bias_rw", math.inf)])
-def test_a_bad_noise_is_a_value_error_naming_the_field(name, value):
-    with pytest.raises(ValueError, match=rf"^{name}:"):
+@pytest.mark.parametrize("name, value, field", [("gyro", 0.0, "gyro"), ("encoder", math.nan, "encoder"),
+                                                ("torque_psd", -1.0, "torque_psd"), ("gyro_bias_rw", math.inf, "gyro_bias_rw"),
+                                                ("accel", -0.02, "accel"), ("accel", (0.02, 0.0, 0.02), r"accel\[1\]"),
+                                                ("accel", (0.02, 0.02), "accel")])
+def test_a_bad_noise_is_a_value_error_naming_the_field(name, value, field):
+    with pytest.raises(ValueError, match=rf"^{field}:"):
         dataclasses.replace(EkfNoise(), **{name: value})
+
+
+def test_the_accelerometer_sigma_is_one_number_for_three_axes_or_one_per_axis():
+    assert EkfNoise(accel=0.05).accel == (0.05, 0.05, 0.05)
+    assert EkfNoise(accel=[0.01, 0.02, 0.03]).accel == (0.01, 0.02, 0.03)

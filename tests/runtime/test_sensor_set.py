@@ -31,6 +31,7 @@ def test_the_default_set_is_the_one_of_the_estimation_targets():
     assert (s.imu.body, s.imu.lever, s.imu.rate) == ("yoke", (0.0, 0.0, -0.05), 200.0)
     assert s.imu.rotation == ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
     assert (s.imu.gyro_noise, s.imu.gyro_bias, s.imu.accel_noise, s.imu.accel_bias) == (0.003, 0.005, 0.02, 0.05)
+    assert (s.imu.gyro_bias_rw, s.imu.accel_bias_rw) == (1e-5, 1e-4)       # a MEMS IMU's bias instability
     assert (s.encoders.counts_per_rev, s.encoders.rate) == (4096, 200.0)
     assert s.fixes == FixSpec(rate=2.0, noise=0.01, latency=0.0)
     assert s.heading is None

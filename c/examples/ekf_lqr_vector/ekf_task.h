@@ -6,14 +6,12 @@
 
 #define EKF_TASK_METHOD SR_RKMK4
 #define EKF_TASK_BODY 1
-#define EKF_TASK_GYRO SR_C(0.003)
-#define EKF_TASK_ACCEL SR_C(0.08126173015912774)
 #define EKF_TASK_ENCODER SR_C(0.0004428221104087446)
 #define EKF_TASK_POSITION SR_C(0.01)
 #define EKF_TASK_HEADING SR_C(0.05)
 #define EKF_TASK_TORQUE_PSD SR_C(0.01)
-#define EKF_TASK_GYRO_BIAS_RW SR_C(0.0)
-#define EKF_TASK_ACCEL_BIAS_RW SR_C(0.0)
+#define EKF_TASK_GYRO_BIAS_RW SR_C(1e-05)
+#define EKF_TASK_ACCEL_BIAS_RW SR_C(0.0001)
 #define EKF_TASK_GATE_IMU SR_C(22.457744484825323)
 #define EKF_TASK_GATE_ENCODERS SR_C(13.815510557964274)
 #define EKF_TASK_GATE_POSITION SR_C(13.815510557964274)
@@ -23,6 +21,10 @@
 static const sr_real EKF_TASK_MOUNT[SR_NMOUNT] = {
         SR_C(0.0), SR_C(0.0), SR_C(-0.05), SR_C(1.0), SR_C(0.0), SR_C(0.0),
         SR_C(0.0), SR_C(1.0), SR_C(0.0), SR_C(0.0), SR_C(0.0), SR_C(1.0)};
+
+/* The IMU's standard deviation per reading (gyroscope x, y, z, accelerometer x, y, z). */
+static const sr_real EKF_TASK_IMU_SIGMA[SR_NIMU] = {
+        SR_C(0.003), SR_C(0.003), SR_C(0.003), SR_C(0.08126173015912774), SR_C(0.08126173015912774), SR_C(0.08126173015912774)};
 
 /* The start's standard deviations of the error state (d, b_g, b_a). */
 static const sr_real EKF_TASK_SIGMA[SR_NEB] = {
