@@ -44,15 +44,21 @@ def planted(nominal, names, rng, spread):
     raise ValueError(f"params: no physical robot within ±{spread:g} of the nominal one for {names}")
 
 
-def trial(names, duration, seed, spread=0.3, full_state=False, segment=0.5, max_nfev=20):
-    """One seeded fit: {"names", "truth", "estimate", "sigma", "inside", "rms", "wall_time_s", "cpu_time_s"}."""
+def simulated_log(names, duration, seed, spread=0.3):
+    """(log, nominal, truth): a seeded log of the battery-geared robot with the entries `names`
+    planted within ±spread of its values, under `random_torques`, with the default sensor set."""
     rng = np.random.default_rng(seed)
     scenario = load_scenario("battery-geared")
     nominal = scenario.params
     truth = planted(nominal, names, rng, spread)
     run = dataclasses.replace(scenario, params=truth, torques=random_torques(duration, rng),
                               steps=int(round(duration / scenario.dt)))
-    log = simulate_log(run, SensorSet.default(), seed=seed)
+    return simulate_log(run, SensorSet.default(), seed=seed), nominal, truth
+
+
+def trial(names, duration, seed, spread=0.3, full_state=False, segment=0.5, max_nfev=20):
+    """One seeded fit: {"names", "truth", "estimate", "sigma", "inside", "rms", "wall_time_s", "cpu_time_s"}."""
+    log, nominal, truth = simulated_log(names, duration, seed, spread)
     started, cpu = time.perf_counter(), time.process_time()
     fit = identify(log, nominal, names, segment=segment, full_state=full_state, max_nfev=max_nfev)
     wall, cpu = time.perf_counter() - started, time.process_time() - cpu

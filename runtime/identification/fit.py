@@ -54,6 +54,11 @@ GAUGE_SIGMA = 10.0
 DENSE_LIMIT = 2e7
 #: Smallest standard deviation of an end-state difference, for a sensor set without process noise.
 DEFECT_FLOOR = 1e-7
+#: The sources of the parameter sensitivities a fit can use: the analytic ones of the C library, or
+#: central differences computed in C, batched (per parameter the robot at p ± h, every state stepped
+#: at once: `Model.step_param_jacobian_fd`).  Both reach the same optimum; "fd" is the reference
+#: that the analytic sensitivities' speed-up is measured against.
+JACOBIANS = ("analytic", "fd")
 
 
 class IdentifyError(ValueError):
@@ -110,6 +115,37 @@ def bounds_of(entry, params, free=()):
 
 def _wrap(a):
     return np.remainder(a + np.pi, 2 * np.pi) - np.pi
+
+
+def _step_sensitivity(model, x, u, h, method, idx, jacobian):
+    """The steps' sensitivities (B, 12, len(idx)) to the free entries idx, of the `jacobian` source."""
+    if jacobian == "fd":
+        return model.step_param_jacobian_fd(x, u, h, method, columns=idx)
+    return model.step_param_jacobian(x, u, h, method)[:, :, idx]
+
+
+def _accel_sensitivity(model, x, u, idx, jacobian):
+    """∂ν̇/∂θ (B, 5, len(idx)) of the `jacobian` source: "fd" by central differences of the batched
+    C accelerations at p ± h (one-sided where a side is no valid robot)."""
+    if jacobian != "fd":
+        return model.param_jacobian(x, u)[:, :, idx]
+    p = model.params.as_array()
+    out = np.empty(x.shape[:-1] + (NV, len(idx)))
+    for c, i in enumerate(idx):
+        h = 6e-6 * (abs(p[i]) if p[i] != 0 else 1.0)
+        sides = []
+        for step in (h, -h):
+            q = p.copy()
+            q[i] += step
+            try:
+                sides.append((step, Model(Params.from_array(q)).accel(x, u)))
+            except ValueError:
+                continue
+        if len(sides) == 2:
+            out[:, :, c] = (sides[0][1] - sides[1][1]) / (2 * h)
+        else:
+            out[:, :, c] = (sides[0][1] - model.accel(x, u)) / sides[0][0]
+    return out
 
 
 @dataclasses.dataclass
@@ -204,8 +240,8 @@ class Fit:
 class _Problem:
     """The multiple-shooting problem of a sensor log."""
 
-    def __init__(self, log, params, free, segment, method, x_guess, bias_guess):
-        self.log, self.params, self.free, self.method = log, params, free, method
+    def __init__(self, log, params, free, segment, method, x_guess, bias_guess, jacobian="analytic"):
+        self.log, self.params, self.free, self.method, self.jacobian = log, params, free, method, jacobian
         self.idx = [PARAMETER_NAMES.index(n) for n in free]
         self.nf = len(free)
         self.data = d = _grid(log)
@@ -291,13 +327,13 @@ class _Problem:
         steps = k1 - k0
         X = model.simulate(x0, d.h, steps, u=d.u[k0:k1], method=self.method, energy_tol=None)
         F, _ = model.step_jacobian(X[:-1], d.u[k0:k1], d.h, self.method)
-        Jp = model.step_param_jacobian(X[:-1], d.u[k0:k1], d.h, self.method)[:, :, self.idx]
+        Jp = _step_sensitivity(model, X[:-1], d.u[k0:k1], d.h, self.method, self.idx, self.jacobian)
         last = s == self.S - 1
         nodes = np.arange(k0, k1 + 1 if last else k1)
         Xn = X[:len(nodes)]
         nudot = model.accel(Xn, d.u[nodes])
         Ja, _ = model.accel_jacobian(Xn, d.u[nodes])
-        Jpa = model.param_jacobian(Xn, d.u[nodes])[:, :, self.idx]
+        Jpa = _accel_sensitivity(model, Xn, d.u[nodes], self.idx, self.jacobian)
         Phi = np.empty((steps + 1, NE, NE))
         Sens = np.empty((steps + 1, NE, self.nf))
         Phi[0], Sens[0] = np.eye(NE), 0.0
@@ -509,8 +545,8 @@ class _FullState:
     """The one-step prediction-error problem of a full-state log: the velocities at row k + 1 against
     one step of the model from row k, whitened by the process noise's velocity jump."""
 
-    def __init__(self, log, params, free, method):
-        self.params, self.free, self.method = params, free, method
+    def __init__(self, log, params, free, method, jacobian="analytic"):
+        self.params, self.free, self.method, self.jacobian = params, free, method, jacobian
         self.idx = [PARAMETER_NAMES.index(n) for n in free]
         self.nf = len(free)
         self.X = log.truth_states()
@@ -522,11 +558,8 @@ class _FullState:
             raise IdentifyError("sensors.process: a full-state fit weighs the velocities by the process noise; "
                                 "the sensor set declares none on some axis")
         model = Model(params)
-        self.chol = []
-        for x in self.X[:-1]:
-            Minv = np.linalg.inv(model.inertia(x))
-            self.chol.append(np.linalg.cholesky(Minv @ np.diag(q2 * self.h) @ Minv.T))
-        self.chol = np.array(self.chol)
+        Minv = np.linalg.inv(np.array([model.inertia(x) for x in self.X[:-1]]))
+        self.chol = np.linalg.cholesky((Minv * (q2 * self.h)) @ np.swapaxes(Minv, 1, 2))
         self.ncols = self.nf
         self._cache = (None, None)
         self.nfev = 0
@@ -538,9 +571,9 @@ class _FullState:
         if self._cache[0] is not None and np.array_equal(self._cache[0], z):
             return self._cache[1]
         model = self.model(z)
-        pred = np.array([model.step(x, u, self.h, self.method) for x, u in zip(self.X[:-1], self.u)])
+        pred = model.step(self.X[:-1], self.u, self.h, self.method)
         e = self.X[1:, IDX_NU] - pred[:, IDX_NU]
-        Jp = model.step_param_jacobian(self.X[:-1], self.u, self.h, self.method)[:, IDX_E_NU][:, :, self.idx]
+        Jp = _step_sensitivity(model, self.X[:-1], self.u, self.h, self.method, self.idx, self.jacobian)[:, IDX_E_NU]
         r = np.linalg.solve(self.chol, e[..., None])[..., 0]
         J = -np.linalg.solve(self.chol, Jp)
         self._cache = (z.copy(), (r.ravel(), scipy.sparse.csr_matrix(J.reshape(-1, self.nf)), None))
@@ -567,26 +600,29 @@ def _start_guess(log, params):
 
 
 def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, max_nfev=20, progress=None,
-             x_guess=None, bias_guess=None):
+             x_guess=None, bias_guess=None, jacobian="analytic"):
     """Fit the parameters `names` (see `free_parameters`) of the robot `params` (the others held) to
     `log` (runtime.estimation.logs.Log), with the IMU's biases and each segment's start state; or,
     `full_state`, to the log's truth by the one-step prediction error.  `segment` [s]: the
     multiple-shooting segments' length; `x_guess` (n_imu, 35) and `bias_guess` (6,) replace the
-    EKF's start guess.  `progress()` is called once per evaluation.  Returns a `Fit`."""
+    EKF's start guess.  `progress()` is called once per evaluation.  `jacobian`: the parameter
+    sensitivities' source (`JACOBIANS`: "analytic", or "fd", finite differences in C).  Returns a `Fit`."""
     if not isinstance(params, Params):
         raise IdentifyError(f"robot: expected a runtime.Params, got {type(params).__name__}")
     free = free_parameters(names)
+    if jacobian not in JACOBIANS:
+        raise IdentifyError(f"jacobian: expected one of {', '.join(JACOBIANS)}, got {jacobian!r}")
     check_log(log, full_state)
     if not (isinstance(segment, (int, float)) and math.isfinite(segment) and segment > 0):
         raise IdentifyError(f"segment: expected a length > 0 in s, got {segment!r}")
     if full_state:
-        prob = _FullState(log, params, free, method)
+        prob = _FullState(log, params, free, method, jacobian)
     else:
         if x_guess is None:
             x_guess, guess_b = _start_guess(log, params)
             bias_guess = guess_b if bias_guess is None else bias_guess
         prob = _Problem(log, params, free, segment, method, np.asarray(x_guess), np.zeros(6) if bias_guess is None
-                        else bias_guess)
+                        else bias_guess, jacobian)
     prob.progress = progress
     if not full_state:
         prob.fit_starts(prob.z0())
