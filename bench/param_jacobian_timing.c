@@ -28,7 +28,8 @@
 
 enum { MAX_STATES = 1024, ROUNDS = 11 };
 static sr_real X[MAX_STATES][SR_NX], U[MAX_STATES][SR_NU], WORK[MAX_STATES][SR_PARAM_FD_WORK];
-static sr_real JP[MAX_STATES][SR_NE * SR_NPARAM], JFD[MAX_STATES][SR_NE * SR_NPARAM], JFDC[MAX_STATES][SR_NE * SR_NPARAM];
+static sr_real JP[MAX_STATES][SR_NE * SR_NPARAM], JFD[MAX_STATES][SR_NE * SR_NPARAM];
+static sr_real JFDC[MAX_STATES * SR_NE * SR_NPARAM];   /* n x SR_NE x ncols, as the library writes it */
 static sr_real F[SR_NE * SR_NE], G[SR_NE * SR_NU];
 static int SKIPPED[SR_NPARAM];
 
@@ -60,10 +61,10 @@ static int fd_batched(const sr_real p[SR_NPARAM], int method, int n)
     }
     if (status == SR_OK)
         status = sr_step_param_jacobian_fd_batch(&m0, method, n, &X[0][0], &U[0][0], SR_C(0.01), ncols, cols,
-                                                 &JFDC[0][0], &WORK[0][0], NULL);
+                                                 JFDC, &WORK[0][0], NULL);
     for (i = 0; i < n && status == SR_OK; ++i)
         for (k = 0; k < SR_NE; ++k)
-            for (j = 0; j < ncols; ++j) JFD[i][SR_NPARAM * k + cols[j]] = JFDC[i][ncols * k + j];
+            for (j = 0; j < ncols; ++j) JFD[i][SR_NPARAM * k + cols[j]] = JFDC[(i * SR_NE + k) * ncols + j];
     return status;
 }
 

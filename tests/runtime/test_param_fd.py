@@ -4,6 +4,7 @@ is timed against and the Jacobian of a fit without it."""
 import numpy as np
 import pytest
 
+from bindings._sr import ffi, lib
 from runtime import Model, Params
 from runtime.param_derivatives import NPARAM, PARAMETER_NAMES
 from runtime.state import NE
@@ -61,3 +62,37 @@ def test_a_parameter_with_no_robot_on_either_side_is_named():
     X, U = states(model, 1)
     with pytest.raises(ValueError, match="no valid robot on either side"):
         model.step_param_jacobian_fd(X, U, 0.01, "rkmk4", columns=[PARAMETER_NAMES.index("J_Y_xz")])
+
+
+def _call(model, x, method=None, cols=(3,), ncols=None, work=True, n=None):
+    x = np.ascontiguousarray(np.atleast_2d(x))
+    out = np.zeros(x.shape[0] * NE * max(len(cols), 1))
+    buf = np.zeros(x.shape[0] * lib.SR_NX * 5)
+    failed = ffi.new("long *", -7)
+    status = lib.sr_step_param_jacobian_fd_batch(
+        model._model, lib.SR_RKMK4 if method is None else method, x.shape[0] if n is None else n,
+        ffi.cast("double *", ffi.from_buffer(x)), ffi.NULL, 0.01, len(cols) if ncols is None else ncols,
+        ffi.new("int[]", list(cols)) if cols else ffi.NULL, ffi.cast("double *", ffi.from_buffer(out)),
+        ffi.cast("double *", ffi.from_buffer(buf)) if work else ffi.NULL, failed)
+    return status, failed[0]
+
+
+@pytest.mark.parametrize("wrong, status", [
+    (dict(method=2 ** 20), "SR_ERR_ARG"),           # no such method
+    (dict(ncols=0), "SR_ERR_ARG"),
+    (dict(cols=(NPARAM,)), "SR_ERR_ARG"),
+    (dict(n=-1), "SR_ERR_ARG"),
+    (dict(cols=()), "SR_ERR_NULL"),
+    (dict(work=False), "SR_ERR_NULL"),
+])
+def test_the_c_function_refuses_wrong_arguments_with_their_status(wrong, status):
+    model = Model(GENERAL)
+    X, _ = states(model, 2)
+    assert _call(model, X, **wrong) == (getattr(lib, status), -1)
+
+
+def test_the_c_function_names_the_row_of_a_state_it_cannot_step():
+    model = Model(GENERAL)
+    X, _ = states(model, 3)
+    X[1, 0] = np.nan
+    assert _call(model, X) == (lib.SR_ERR_NONFINITE, 1)
