@@ -126,25 +126,33 @@ def _step_sensitivity(model, x, u, h, method, idx, jacobian):
 
 def _accel_sensitivity(model, x, u, idx, jacobian):
     """∂ν̇/∂θ (B, 5, len(idx)) of the `jacobian` source: "fd" by central differences of the batched
-    C accelerations at p ± h (one-sided where a side is no valid robot)."""
+    C accelerations at p ± h; where one side is no valid robot, the one-sided second-order
+    difference (4 D(s) − D(2s)) / 2s from the other, as `Model.step_param_jacobian_fd`."""
     if jacobian != "fd":
         return model.param_jacobian(x, u)[:, :, idx]
     p = model.params.as_array()
     out = np.empty(x.shape[:-1] + (NV, len(idx)))
+
+    def accel_at(i, step):
+        q = p.copy()
+        q[i] += step
+        try:
+            return Model(Params.from_array(q)).accel(x, u)
+        except ValueError:
+            return None
+
     for c, i in enumerate(idx):
         h = 6e-6 * (abs(p[i]) if p[i] != 0 else 1.0)
-        sides = []
-        for step in (h, -h):
-            q = p.copy()
-            q[i] += step
-            try:
-                sides.append((step, Model(Params.from_array(q)).accel(x, u)))
-            except ValueError:
-                continue
-        if len(sides) == 2:
-            out[:, :, c] = (sides[0][1] - sides[1][1]) / (2 * h)
-        else:
-            out[:, :, c] = (sides[0][1] - model.accel(x, u)) / sides[0][0]
+        plus, minus = accel_at(i, h), accel_at(i, -h)
+        if plus is not None and minus is not None:
+            out[:, :, c] = (plus - minus) / (2 * h)
+            continue
+        s, one = (h, plus) if plus is not None else (-h, minus)
+        if one is None:
+            raise IdentifyError(f"params: {PARAMETER_NAMES[i]} has no valid robot on either side of its value; "
+                                "no difference exists")
+        f0 = model.accel(x, u)
+        out[:, :, c] = (4 * (one - f0) - (accel_at(i, 2 * s) - f0)) / (2 * s)
     return out
 
 
