@@ -18,7 +18,8 @@ import numpy as np
 from ..atomic import write_new_file
 from ..param_derivatives import PARAMETER_NAMES
 from .coverage import simulated_log
-from .fit import JACOBIANS, identify
+from .fit import identify
+from .sensitivity import JACOBIANS
 
 #: The fits compared by default: the dampings, the pendulum's mass and hinge inertia and the yoke
 #: rotor's inertia; and every entry of the battery-geared robot that its full-state log identifies

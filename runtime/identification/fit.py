@@ -36,6 +36,7 @@ from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_param
 from ..params import SHAPES, Params, flat_names
 from ..sensors import imu_partials
 from ..state import IDX_E_NU, IDX_E_Q, IDX_E_TH_P, IDX_E_TH_Y, IDX_NU, IDX_Q, NE, NV, pendulum_angle, yoke_angle
+from .sensitivity import JACOBIANS, accel_sensitivity, step_sensitivity
 
 #: Parameters a builder knows and the fit never frees: the shell's radius, the gear ratios, gravity, the slope.
 KNOWN = ("r", "n_Y", "n_P", "g", "slope")
@@ -54,11 +55,6 @@ GAUGE_SIGMA = 10.0
 DENSE_LIMIT = 2e7
 #: Smallest standard deviation of an end-state difference, for a sensor set without process noise.
 DEFECT_FLOOR = 1e-7
-#: The sources of the parameter sensitivities a fit can use: the analytic ones of the C library, or
-#: central differences computed in C, batched (per parameter the robot at p ± h, every state stepped
-#: at once: `Model.step_param_jacobian_fd`).  Both reach the same optimum; "fd" is the reference
-#: that the analytic sensitivities' speed-up is measured against.
-JACOBIANS = ("analytic", "fd")
 
 
 class IdentifyError(ValueError):
@@ -115,45 +111,6 @@ def bounds_of(entry, params, free=()):
 
 def _wrap(a):
     return np.remainder(a + np.pi, 2 * np.pi) - np.pi
-
-
-def _step_sensitivity(model, x, u, h, method, idx, jacobian):
-    """The steps' sensitivities (B, 12, len(idx)) to the free entries idx, of the `jacobian` source."""
-    if jacobian == "fd":
-        return model.step_param_jacobian_fd(x, u, h, method, columns=idx)
-    return model.step_param_jacobian(x, u, h, method)[:, :, idx]
-
-
-def _accel_sensitivity(model, x, u, idx, jacobian):
-    """∂ν̇/∂θ (B, 5, len(idx)) of the `jacobian` source: "fd" by central differences of the batched
-    C accelerations at p ± h; where one side is no valid robot, the one-sided second-order
-    difference (4 D(s) − D(2s)) / 2s from the other, as `Model.step_param_jacobian_fd`."""
-    if jacobian != "fd":
-        return model.param_jacobian(x, u)[:, :, idx]
-    p = model.params.as_array()
-    out = np.empty(x.shape[:-1] + (NV, len(idx)))
-
-    def accel_at(i, step):
-        q = p.copy()
-        q[i] += step
-        try:
-            return Model(Params.from_array(q)).accel(x, u)
-        except ValueError:
-            return None
-
-    for c, i in enumerate(idx):
-        h = 6e-6 * (abs(p[i]) if p[i] != 0 else 1.0)
-        plus, minus = accel_at(i, h), accel_at(i, -h)
-        if plus is not None and minus is not None:
-            out[:, :, c] = (plus - minus) / (2 * h)
-            continue
-        s, one = (h, plus) if plus is not None else (-h, minus)
-        if one is None:
-            raise IdentifyError(f"params: {PARAMETER_NAMES[i]} has no valid robot on either side of its value; "
-                                "no difference exists")
-        f0 = model.accel(x, u)
-        out[:, :, c] = (4 * (one - f0) - (accel_at(i, 2 * s) - f0)) / (2 * s)
-    return out
 
 
 @dataclasses.dataclass
@@ -335,13 +292,13 @@ class _Problem:
         steps = k1 - k0
         X = model.simulate(x0, d.h, steps, u=d.u[k0:k1], method=self.method, energy_tol=None)
         F, _ = model.step_jacobian(X[:-1], d.u[k0:k1], d.h, self.method)
-        Jp = _step_sensitivity(model, X[:-1], d.u[k0:k1], d.h, self.method, self.idx, self.jacobian)
+        Jp = step_sensitivity(model, X[:-1], d.u[k0:k1], d.h, self.method, self.idx, self.jacobian)
         last = s == self.S - 1
         nodes = np.arange(k0, k1 + 1 if last else k1)
         Xn = X[:len(nodes)]
         nudot = model.accel(Xn, d.u[nodes])
         Ja, _ = model.accel_jacobian(Xn, d.u[nodes])
-        Jpa = _accel_sensitivity(model, Xn, d.u[nodes], self.idx, self.jacobian)
+        Jpa = accel_sensitivity(model, Xn, d.u[nodes], self.idx, self.jacobian)
         Phi = np.empty((steps + 1, NE, NE))
         Sens = np.empty((steps + 1, NE, self.nf))
         Phi[0], Sens[0] = np.eye(NE), 0.0
@@ -581,7 +538,7 @@ class _FullState:
         model = self.model(z)
         pred = model.step(self.X[:-1], self.u, self.h, self.method)
         e = self.X[1:, IDX_NU] - pred[:, IDX_NU]
-        Jp = _step_sensitivity(model, self.X[:-1], self.u, self.h, self.method, self.idx, self.jacobian)[:, IDX_E_NU]
+        Jp = step_sensitivity(model, self.X[:-1], self.u, self.h, self.method, self.idx, self.jacobian)[:, IDX_E_NU]
         r = np.linalg.solve(self.chol, e[..., None])[..., 0]
         J = -np.linalg.solve(self.chol, Jp)
         self._cache = (z.copy(), (r.ravel(), scipy.sparse.csr_matrix(J.reshape(-1, self.nf)), None))

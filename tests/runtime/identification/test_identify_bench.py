@@ -53,12 +53,12 @@ def test_the_bench_keeps_both_fits_their_ratio_and_the_optima_distance(tmp_path,
 
 @pytest.mark.parametrize("k_Y", [0.04, 0.0], ids=["central", "one-sided at the bound"])
 def test_the_finite_difference_acceleration_sensitivity_is_the_analytic_one(state_log, k_Y):
-    from runtime.identification.fit import _accel_sensitivity
+    from runtime.identification.sensitivity import accel_sensitivity
     from runtime.param_derivatives import PARAMETER_NAMES
     log, nominal, _ = state_log
     model = Model(nominal.replace(k_Y=k_Y))
     X, U = log.truth_states()[:5], log.torque_at(log.truth.t[:5])
     idx = [PARAMETER_NAMES.index(n) for n in ("m_P", "k_Y", "j_mY", "c_P_z")]
-    fd, exact = _accel_sensitivity(model, X, U, idx, "fd"), _accel_sensitivity(model, X, U, idx, "analytic")
+    fd, exact = accel_sensitivity(model, X, U, idx, "fd"), accel_sensitivity(model, X, U, idx, "analytic")
     scale = np.abs(exact).max(axis=(0, 1))
     assert np.all(np.abs(fd - exact).max(axis=(0, 1)) <= 1e-6 * scale)
