@@ -44,6 +44,7 @@ verify: $(STAMP)
 bench: $(STAMP)
 	$(PY) -m runtime bench --native
 	$(PY) -m runtime nmpc-c --timing --against-python 20 --out bench/results/nmpc-c
+	$(PY) -m runtime identify-bench
 	$(MAKE) sweep-bench
 
 # Sweep throughput on Dask (1 and 2 workers), overhead against the C batch, per-task cost, bytes

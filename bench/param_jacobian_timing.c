@@ -5,10 +5,10 @@
  *
  *   step_jacobian_<m>        sr_step_jacobian (F and G)
  *   step_param_jacobian_<m>  sr_step_param_jacobian (the analytic J_p)
- *   fd_batched_<m>           J_p by central differences, batched as a fit would do it in C: for
- *                            each parameter, the model at p +- h e_j (sr_model_init) and one
- *                            sr_step_batch over all the states each, then sr_local_batch against
- *                            the nominal step and the difference quotient
+ *   fd_batched_<m>           J_p by central differences, batched as a fit does it in C
+ *                            (sr_step_param_jacobian_fd_batch): for each parameter, the model at
+ *                            p +- h e_j and one sr_step_batch over all the states each, then
+ *                            sr_local_batch against the nominal step and the difference quotient
  *   fd_worst_parameter_<m>   the column (SR_P_*) of that largest difference
  *   fd_skipped_columns       parameters with no valid robot on either side of p (the paper's flat
  *                            yoke lies on its tensor's triangle inequality: no product of inertia
@@ -27,10 +27,9 @@
 #include <time.h>
 
 enum { MAX_STATES = 1024, ROUNDS = 11 };
-static sr_real X[MAX_STATES][SR_NX], U[MAX_STATES][SR_NU], XR[MAX_STATES][SR_NX];
-static sr_real NOMINAL[MAX_STATES][SR_NX], PLUS[MAX_STATES][SR_NX], MINUS[MAX_STATES][SR_NX];
-static sr_real DPLUS[MAX_STATES][SR_NE], DMINUS[MAX_STATES][SR_NE];
+static sr_real X[MAX_STATES][SR_NX], U[MAX_STATES][SR_NU], WORK[MAX_STATES][SR_PARAM_FD_WORK];
 static sr_real JP[MAX_STATES][SR_NE * SR_NPARAM], JFD[MAX_STATES][SR_NE * SR_NPARAM];
+static sr_real JFDC[MAX_STATES * SR_NE * SR_NPARAM];   /* n x SR_NE x ncols, as the library writes it */
 static sr_real F[SR_NE * SR_NE], G[SR_NE * SR_NU];
 static int SKIPPED[SR_NPARAM];
 
@@ -41,58 +40,31 @@ static double now_ns(void)
     return 1e9 * (double)t.tv_sec + (double)t.tv_nsec;
 }
 
-/* Central differences in every parameter, each side one batch step of all n states; a parameter
- * at a bound of its rule (a zero rotor inertia, a tensor on its triangle inequality) takes the
- * one-sided second-order difference +-(4 y(+-h) - y(+-2h)) / 2h instead, again two batch steps.
- * h is relative to the parameter (absolute for a zero one), the usual cube-root choice.  A
- * state's height q_z is the radius r, so the column of r steps states whose q_z moves with it
- * (q_z is no error coordinate). */
-static int step_at(const sr_model *m, int method, int n, int j, const sr_real q[SR_NPARAM], sr_real (*out)[SR_NX])
-{
-    int i, k;
-    if (j != SR_P_r) return sr_step_batch(m, method, n, &X[0][0], &U[0][0], SR_C(0.01), &out[0][0], NULL);
-    for (i = 0; i < n; ++i) {
-        for (k = 0; k < SR_NX; ++k) XR[i][k] = X[i][k];
-        XR[i][SR_X_q + 2] = q[SR_P_r];
-    }
-    return sr_step_batch(m, method, n, &XR[0][0], &U[0][0], SR_C(0.01), &out[0][0], NULL);
-}
-
+/* The finite-difference J_p of the library (sr_step_param_jacobian_fd_batch: per parameter, the
+ * robot at p +- h and one sr_step_batch of all n states each side) in every column that has a valid
+ * robot on some side of p, into JFD's full width. */
 static int fd_batched(const sr_real p[SR_NPARAM], int method, int n)
 {
-    sr_model m, m0;
+    sr_model m0, m;
     sr_real q[SR_NPARAM];
-    int j, i, k, status;
-    status = sr_model_init(&m0, p);
-    if (status == SR_OK) status = sr_step_batch(&m0, method, n, &X[0][0], &U[0][0], SR_C(0.01), &NOMINAL[0][0], NULL);
+    int cols[SR_NPARAM], ncols = 0, i, j, k, status = sr_model_init(&m0, p);
     for (j = 0; j < SR_NPARAM && status == SR_OK; ++j) {
         const sr_real h = SR_C(6e-6) * (p[j] != 0 ? fabs(p[j]) : 1);
-        sr_real a = h, b = -h, wa = 1, wb = -1;   /* J = (wa D(a) + wb D(b)) / 2h */
+        int side = 0;
         for (k = 0; k < SR_NPARAM; ++k) q[k] = p[k];
         q[j] = p[j] + h;
-        if (sr_model_init(&m, q) != SR_OK) {
-            q[j] = p[j] - h;
-            if (sr_model_init(&m, q) != SR_OK) {   /* no valid robot on either side: no column */
-                SKIPPED[j] = 1;
-                continue;
-            }
-            a = -h, b = -2 * h, wa = -4, wb = 1;
-        } else {
-            q[j] = p[j] - h;
-            if (sr_model_init(&m, q) != SR_OK) b = 2 * h, wa = 4, wb = -1;
-        }
-        q[j] = p[j] + a;
-        status = sr_model_init(&m, q);
-        if (status == SR_OK) status = step_at(&m, method, n, j, q, PLUS);
-        q[j] = p[j] + b;
-        if (status == SR_OK) status = sr_model_init(&m, q);
-        if (status == SR_OK) status = step_at(&m, method, n, j, q, MINUS);
-        for (i = 0; i < n && j == SR_P_r; ++i) PLUS[i][SR_X_q + 2] = MINUS[i][SR_X_q + 2] = p[SR_P_r];
-        if (status == SR_OK) status = sr_local_batch(&m0, n, &NOMINAL[0][0], &PLUS[0][0], &DPLUS[0][0], NULL);
-        if (status == SR_OK) status = sr_local_batch(&m0, n, &NOMINAL[0][0], &MINUS[0][0], &DMINUS[0][0], NULL);
-        for (i = 0; i < n && status == SR_OK; ++i)
-            for (k = 0; k < SR_NE; ++k) JFD[i][SR_NPARAM * k + j] = (wa * DPLUS[i][k] + wb * DMINUS[i][k]) / (2 * h);
+        side += sr_model_init(&m, q) == SR_OK;
+        q[j] = p[j] - h;
+        side += sr_model_init(&m, q) == SR_OK;
+        SKIPPED[j] = !side;
+        if (side) cols[ncols++] = j;
     }
+    if (status == SR_OK)
+        status = sr_step_param_jacobian_fd_batch(&m0, method, n, &X[0][0], &U[0][0], SR_C(0.01), ncols, cols,
+                                                 JFDC, &WORK[0][0], NULL);
+    for (i = 0; i < n && status == SR_OK; ++i)
+        for (k = 0; k < SR_NE; ++k)
+            for (j = 0; j < ncols; ++j) JFD[i][SR_NPARAM * k + cols[j]] = JFDC[(i * SR_NE + k) * ncols + j];
     return status;
 }
 

@@ -31,6 +31,7 @@ COMMANDS = {
     "excite": ("runtime.identification.excite", "a D-optimal torque program for identifying named parameters, as a scenario"),
     "identify": ("runtime.identification.identify", "fit a robot's parameters to a log: estimates, intervals, identifiability, a robot file"),
     "identify-coverage": ("runtime.identification.coverage", "seeded fits: how often the 95 % intervals hold the truth"),
+    "identify-bench": ("runtime.identification.bench", "the same fit with analytic and with finite-difference sensitivities: times, ratio, optima"),
 }
 
 

@@ -109,6 +109,34 @@ class ParamDerivativeMethods:
         self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
         return out
 
+    def step_param_jacobian_fd(self, x, u=None, dt=0.01, method="lie-euler", columns=None):
+        """`step_param_jacobian` by finite differences in C, batched (C: sr_step_param_jacobian_fd_batch):
+        per parameter the robot at p ± h and one batch step of all the states each side, central
+        differences (one-sided second-order ones for a parameter at a bound of its rule).  `columns`:
+        indices into `PARAMETER_NAMES` (default all); x (B, 35) or (35,) gives (B, 12, len(columns))
+        or (12, len(columns)).  The reference the analytic sensitivity is measured against, and a
+        fit's Jacobian without it (`runtime.identification.fit.identify(..., jacobian="fd")`)."""
+        choice(method, "method", STEP_METHODS, "integrator with a parameter Jacobian")
+        x, u = self._state_and_input(x, u)
+        dt = self._dt(dt)
+        cols = np.arange(NPARAM) if columns is None else np.asarray(columns)
+        if cols.ndim != 1 or len(cols) == 0 or not np.issubdtype(cols.dtype, np.integer) \
+                or cols.min() < 0 or cols.max() >= NPARAM:
+            raise ValueError(f"columns: expected a non-empty list of parameter indices in [0, {NPARAM}), got {columns!r}")
+        xb = np.ascontiguousarray(x.reshape(-1, x.shape[-1]))
+        ub = np.ascontiguousarray(u.reshape(-1, u.shape[-1]))
+        out = np.empty((xb.shape[0], NE, len(cols)))
+        work = np.empty(xb.shape[0] * (4 * xb.shape[1] + 2 * NE))
+        cint = ffi.new("int[]", [int(c) for c in cols])
+        failed = ffi.new("long *")
+        status = lib.sr_step_param_jacobian_fd_batch(self._model, getattr(lib, STEP_METHODS[method]), xb.shape[0],
+                                                     _ptr(xb), _ptr(ub), dt, len(cols), cint, _ptr(out), _ptr(work),
+                                                     failed)
+        if status == lib.SR_ERR_PARAM:
+            raise ValueError("columns: a parameter has no valid robot on either side of its value, no difference exists")
+        self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
+        return out if x.ndim > 1 else out[0]
+
     def regressor(self, x, nudot):
         """Y (5, 27), columns `PI_NAMES`: M(x) ν̇ − f(x, u = 0) = Y(x, ν̇) π for this robot's π
         (`inertial_parameters(model.params)`), so that along a motion Y π = (0, 0, 0, u_Y, u_P).

@@ -509,6 +509,7 @@ int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 #define sr_accel_param_jacobian_batch sr_accel_param_jacobian_batch_f
 #define sr_step_param_jacobian sr_step_param_jacobian_f
 #define sr_step_param_jacobian_batch sr_step_param_jacobian_batch_f
+#define sr_step_param_jacobian_fd_batch sr_step_param_jacobian_fd_batch_f
 #define sr_regressor sr_regressor_f
 #define sr_regressor_batch sr_regressor_batch_f
 #endif
@@ -605,6 +606,24 @@ int sr_step_param_jacobian(const sr_model *model, int method, const sr_real x[SR
  * and dt; stops at the first failing row, its index in *failed_row (-1 when all succeed). */
 int sr_step_param_jacobian_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u,
                                  sr_real dt, sr_real *Jp, long *failed_row);
+
+/** Entries of work per state that sr_step_param_jacobian_fd_batch needs. */
+#define SR_PARAM_FD_WORK (4 * SR_NX + 2 * SR_NE)
+
+/** The sensitivity of a step to the parameters cols[0..ncols) (SR_P_*) by finite differences,
+ * batched (c/src/sr_param_fd.c): per column, the robot at p +- h (h about the cube root of the
+ * rounding unit relative to p_j, absolute for a zero p_j), one sr_step_batch of all n states each
+ * side, sr_local_batch against the model's own step and the central difference; a parameter at a
+ * bound of its rule (a side that sr_check_params refuses) takes the one-sided second-order
+ * difference from the valid side.  What sr_step_param_jacobian computes exactly, to O(h^2); the
+ * reference it is timed against and a fit's Jacobian without it.  Jp n x SR_NE x ncols row-major;
+ * work n * SR_PARAM_FD_WORK entries, the caller's.  Checks: the model, the pointers (SR_ERR_NULL),
+ * method SR_LIE_EULER or SR_RKMK4, dt, ncols >= 1 and every column an index of p (SR_ERR_ARG);
+ * SR_ERR_PARAM for a column with no valid robot on either side; otherwise the status of the first
+ * failing step or local map, its row in *failed_row (-1 when all succeed). */
+int sr_step_param_jacobian_fd_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u,
+                                    sr_real dt, int ncols, const int *cols, sr_real *Jp, sr_real *work,
+                                    long *failed_row);
 
 /** The regressor Y (row-major SR_NV x SR_NPI, columns SR_PI_*) of the model's robot at state x and
  * accelerations nudot: M nu' - f(u = 0) = Y pi for the robot's pi, so that along any motion

@@ -36,6 +36,7 @@ from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_param
 from ..params import SHAPES, Params, flat_names
 from ..sensors import imu_partials
 from ..state import IDX_E_NU, IDX_E_Q, IDX_E_TH_P, IDX_E_TH_Y, IDX_NU, IDX_Q, NE, NV, pendulum_angle, yoke_angle
+from .sensitivity import JACOBIANS, accel_sensitivity, step_sensitivity
 
 #: Parameters a builder knows and the fit never frees: the shell's radius, the gear ratios, gravity, the slope.
 KNOWN = ("r", "n_Y", "n_P", "g", "slope")
@@ -204,8 +205,8 @@ class Fit:
 class _Problem:
     """The multiple-shooting problem of a sensor log."""
 
-    def __init__(self, log, params, free, segment, method, x_guess, bias_guess):
-        self.log, self.params, self.free, self.method = log, params, free, method
+    def __init__(self, log, params, free, segment, method, x_guess, bias_guess, jacobian="analytic"):
+        self.log, self.params, self.free, self.method, self.jacobian = log, params, free, method, jacobian
         self.idx = [PARAMETER_NAMES.index(n) for n in free]
         self.nf = len(free)
         self.data = d = _grid(log)
@@ -291,13 +292,13 @@ class _Problem:
         steps = k1 - k0
         X = model.simulate(x0, d.h, steps, u=d.u[k0:k1], method=self.method, energy_tol=None)
         F, _ = model.step_jacobian(X[:-1], d.u[k0:k1], d.h, self.method)
-        Jp = model.step_param_jacobian(X[:-1], d.u[k0:k1], d.h, self.method)[:, :, self.idx]
+        Jp = step_sensitivity(model, X[:-1], d.u[k0:k1], d.h, self.method, self.idx, self.jacobian)
         last = s == self.S - 1
         nodes = np.arange(k0, k1 + 1 if last else k1)
         Xn = X[:len(nodes)]
         nudot = model.accel(Xn, d.u[nodes])
         Ja, _ = model.accel_jacobian(Xn, d.u[nodes])
-        Jpa = model.param_jacobian(Xn, d.u[nodes])[:, :, self.idx]
+        Jpa = accel_sensitivity(model, Xn, d.u[nodes], self.idx, self.jacobian)
         Phi = np.empty((steps + 1, NE, NE))
         Sens = np.empty((steps + 1, NE, self.nf))
         Phi[0], Sens[0] = np.eye(NE), 0.0
@@ -509,8 +510,8 @@ class _FullState:
     """The one-step prediction-error problem of a full-state log: the velocities at row k + 1 against
     one step of the model from row k, whitened by the process noise's velocity jump."""
 
-    def __init__(self, log, params, free, method):
-        self.params, self.free, self.method = params, free, method
+    def __init__(self, log, params, free, method, jacobian="analytic"):
+        self.params, self.free, self.method, self.jacobian = params, free, method, jacobian
         self.idx = [PARAMETER_NAMES.index(n) for n in free]
         self.nf = len(free)
         self.X = log.truth_states()
@@ -522,11 +523,8 @@ class _FullState:
             raise IdentifyError("sensors.process: a full-state fit weighs the velocities by the process noise; "
                                 "the sensor set declares none on some axis")
         model = Model(params)
-        self.chol = []
-        for x in self.X[:-1]:
-            Minv = np.linalg.inv(model.inertia(x))
-            self.chol.append(np.linalg.cholesky(Minv @ np.diag(q2 * self.h) @ Minv.T))
-        self.chol = np.array(self.chol)
+        Minv = np.linalg.inv(np.array([model.inertia(x) for x in self.X[:-1]]))
+        self.chol = np.linalg.cholesky((Minv * (q2 * self.h)) @ np.swapaxes(Minv, 1, 2))
         self.ncols = self.nf
         self._cache = (None, None)
         self.nfev = 0
@@ -538,9 +536,9 @@ class _FullState:
         if self._cache[0] is not None and np.array_equal(self._cache[0], z):
             return self._cache[1]
         model = self.model(z)
-        pred = np.array([model.step(x, u, self.h, self.method) for x, u in zip(self.X[:-1], self.u)])
+        pred = model.step(self.X[:-1], self.u, self.h, self.method)
         e = self.X[1:, IDX_NU] - pred[:, IDX_NU]
-        Jp = model.step_param_jacobian(self.X[:-1], self.u, self.h, self.method)[:, IDX_E_NU][:, :, self.idx]
+        Jp = step_sensitivity(model, self.X[:-1], self.u, self.h, self.method, self.idx, self.jacobian)[:, IDX_E_NU]
         r = np.linalg.solve(self.chol, e[..., None])[..., 0]
         J = -np.linalg.solve(self.chol, Jp)
         self._cache = (z.copy(), (r.ravel(), scipy.sparse.csr_matrix(J.reshape(-1, self.nf)), None))
@@ -567,26 +565,29 @@ def _start_guess(log, params):
 
 
 def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, max_nfev=20, progress=None,
-             x_guess=None, bias_guess=None):
+             x_guess=None, bias_guess=None, jacobian="analytic"):
     """Fit the parameters `names` (see `free_parameters`) of the robot `params` (the others held) to
     `log` (runtime.estimation.logs.Log), with the IMU's biases and each segment's start state; or,
     `full_state`, to the log's truth by the one-step prediction error.  `segment` [s]: the
     multiple-shooting segments' length; `x_guess` (n_imu, 35) and `bias_guess` (6,) replace the
-    EKF's start guess.  `progress()` is called once per evaluation.  Returns a `Fit`."""
+    EKF's start guess.  `progress()` is called once per evaluation.  `jacobian`: the parameter
+    sensitivities' source (`JACOBIANS`: "analytic", or "fd", finite differences in C).  Returns a `Fit`."""
     if not isinstance(params, Params):
         raise IdentifyError(f"robot: expected a runtime.Params, got {type(params).__name__}")
     free = free_parameters(names)
+    if jacobian not in JACOBIANS:
+        raise IdentifyError(f"jacobian: expected one of {', '.join(JACOBIANS)}, got {jacobian!r}")
     check_log(log, full_state)
     if not (isinstance(segment, (int, float)) and math.isfinite(segment) and segment > 0):
         raise IdentifyError(f"segment: expected a length > 0 in s, got {segment!r}")
     if full_state:
-        prob = _FullState(log, params, free, method)
+        prob = _FullState(log, params, free, method, jacobian)
     else:
         if x_guess is None:
             x_guess, guess_b = _start_guess(log, params)
             bias_guess = guess_b if bias_guess is None else bias_guess
         prob = _Problem(log, params, free, segment, method, np.asarray(x_guess), np.zeros(6) if bias_guess is None
-                        else bias_guess)
+                        else bias_guess, jacobian)
     prob.progress = progress
     if not full_state:
         prob.fit_starts(prob.z0())

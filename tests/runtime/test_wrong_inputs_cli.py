@@ -45,6 +45,8 @@ OPTIONS = {
     "identify-coverage": (["--params", "k_Y", "--out", "{tmp}/coverage.json"],
                           {"--fits": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER,
                            "--duration": NOT_A_NUMBER + NOT_POSITIVE}),
+    "identify-bench": (["--out", "{tmp}/bench"], {"--rounds": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER,
+                                                  "--duration": NOT_A_NUMBER + NOT_POSITIVE}),
     "consistency": (["circle", "--out", "{tmp}/c"], {"--runs": NOT_A_NUMBER + ["0", "1", "-1"] + NOT_AN_INTEGER,
                                                      "--first-seed": NOT_A_NUMBER + ["-1"] + NOT_AN_INTEGER,
                                                      "--workers": NOT_A_NUMBER + ["0", "-1"] + NOT_AN_INTEGER,
