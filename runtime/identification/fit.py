@@ -51,8 +51,9 @@ Z95 = float(scipy.stats.norm.ppf(0.975))
 #: Standard deviation [rad, m, rad/s] of the weak prior on the first segment's start state: it fixes
 #: what no sensor sees (the position without fixes, the heading without fixes or a magnetometer).
 GAUGE_SIGMA = 10.0
-#: Largest Jacobian (entries) solved densely; beyond it the trust-region steps use LSMR.
-DENSE_LIMIT = 2e7
+#: Largest Jacobian (entries, after each segment's compression) solved densely; beyond it the
+#: trust-region steps use LSMR on the sparse Jacobian.
+DENSE_LIMIT = 2e6
 #: Smallest standard deviation of an end-state difference, for a sensor set without process noise.
 DEFECT_FLOOR = 1e-7
 
@@ -617,7 +618,7 @@ def _identify(log, params, free, segment, method, full_state, max_nfev, progress
         return prob.assemble(z)[0]
 
     # a dense trust-region solve while J is small, LSMR on the sparse J beyond
-    dense = full_state or prob.ncols * (prob.ncols + 8 * len(prob.data.t)) <= DENSE_LIMIT
+    dense = full_state or prob.ncols * (prob.S * (prob.nf + 7 + 2 * NE) + NE) <= DENSE_LIMIT
 
     def jac(z):
         return prob.assemble(z)[1].toarray() if dense else prob.assemble(z)[1]
