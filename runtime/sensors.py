@@ -12,7 +12,7 @@ centre) with its axes `rotation` in the body's frame (`Mount`; the default is th
 (0, 0, −0.05) m, axes along the yoke's).  The conventions (frames, signs, units, the slope) are
 those of docs/estimation.md.  Jacobians are in the estimator's error state: the 12 error
 coordinates of `Model.retract` (`runtime.state.NE`), then the biases b_g, b_a (`NEB` = 18
-columns).  Single states only; every argument is checked (a ValueError names it) before C runs.
+columns).  Single states, and the `*_batch` functions over many (the loop in C); every argument is checked (a ValueError names it) before C runs.
 """
 import dataclasses
 
@@ -135,6 +135,54 @@ def imu_partials(model, x, nu_dot, *, mount=None, bias=None):
     _call("x", lib.sr_imu_partials(model._model, _ptr(x), _ptr(a), BODIES[m.body], _ptr(m.as_array()), _ptr(b),
                                    _ptr(y), _ptr(H), _ptr(Hn)))
     return y, H, Hn
+
+
+def _states(model, x):
+    x = np.ascontiguousarray(model._valid_states(x, batch=True), dtype=float)
+    return x.reshape(-1, x.shape[-1]), x.shape[:-1]
+
+
+def _batch_call(model, x, status, failed):
+    if status != lib.SR_OK and failed >= 0:
+        _call(f"x[{failed}]", status)
+    _call("x", status)
+
+
+def imu_partials_batch(model, x, nu_dot, *, mount=None, bias=None):
+    """`imu_partials` over many states, the loop in C: x (B, 35), nu_dot (B, 5) give y (B, 6),
+    H (B, 6, 18), Hn (B, 6, 5); one mount and bias for all."""
+    X, lead = _states(model, x)
+    m, b = _mount(mount), _vector(bias, "bias", NBIAS, default_zero=True)
+    a = np.ascontiguousarray(real_array(nu_dot, "nu_dot", (NV,)), dtype=float)
+    if a.shape[:-1] != lead:
+        raise ValueError(f"nu_dot: shape {a.shape} does not match x of shape {lead + (X.shape[-1],)}")
+    check_finite(a, "nu_dot")
+    n = X.shape[0]
+    y, H, Hn = np.empty((n, NIMU)), np.empty((n, NIMU, NEB)), np.empty((n, NIMU, NV))
+    failed = ffi.new("long *")
+    status = lib.sr_imu_partials_batch(model._model, n, _ptr(X), _ptr(a), BODIES[m.body], _ptr(m.as_array()), _ptr(b),
+                                       _ptr(y), _ptr(H), _ptr(Hn), failed)
+    _batch_call(model, X, status, failed[0])
+    return y.reshape(lead + (NIMU,)), H.reshape(lead + (NIMU, NEB)), Hn.reshape(lead + (NIMU, NV))
+
+
+def _pair_batch(model, x, function):
+    X, lead = _states(model, x)
+    n = X.shape[0]
+    y, H = np.empty((n, 2)), np.empty((n, 2, NEB))
+    failed = ffi.new("long *")
+    _batch_call(model, X, function(model._model, n, _ptr(X), _ptr(y), _ptr(H), failed), failed[0])
+    return y.reshape(lead + (2,)), H.reshape(lead + (2, NEB))
+
+
+def encoders_jacobian_batch(model, x):
+    """`encoders_jacobian` over many states (x (B, 35)): y (B, 2), H (B, 2, 18), the loop in C."""
+    return _pair_batch(model, x, lib.sr_encoders_jacobian_batch)
+
+
+def position_jacobian_batch(model, x):
+    """`position_jacobian` over many states (x (B, 35)): y (B, 2), H (B, 2, 18), the loop in C."""
+    return _pair_batch(model, x, lib.sr_position_jacobian_batch)
 
 
 def imu_jacobian(model, x, u=None, *, mount=None, bias=None):

@@ -56,6 +56,9 @@ extern "C" {
 #define sr_imu_partials sr_imu_partials_f
 #define sr_imu_jacobian sr_imu_jacobian_f
 #define sr_encoders_measure sr_encoders_measure_f
+#define sr_imu_partials_batch sr_imu_partials_batch_f
+#define sr_encoders_jacobian_batch sr_encoders_jacobian_batch_f
+#define sr_position_jacobian_batch sr_position_jacobian_batch_f
 #define sr_encoders_jacobian sr_encoders_jacobian_f
 #define sr_position_measure sr_position_measure_f
 #define sr_position_jacobian sr_position_jacobian_f
@@ -122,6 +125,26 @@ int sr_heading_measure(const sr_model *model, const sr_real x[SR_NX], int body, 
 /** The heading of the sensor's x axis and its H (1 x SR_NEB). */
 int sr_heading_jacobian(const sr_model *model, const sr_real x[SR_NX], int body, const sr_real mount[SR_NMOUNT],
                         sr_real *heading, sr_real H[SR_NEB]);
+/** @} */
+
+/** @name Sensor models over many states */
+/** @{ */
+
+/** sr_imu_partials on n rows (x n x SR_NX, nu_dot n x SR_NV; y n x SR_NIMU, H n x SR_NIMU x SR_NEB,
+ * Hn n x SR_NIMU x SR_NV, row-major), one body, mount and bias for all: what a fit to a whole log
+ * needs in one call.  Stops at the first failing row, its index in *failed_row (if not NULL; -1 when
+ * all rows succeed); n < 0: SR_ERR_ARG.  Rows before the failing one are written. */
+int sr_imu_partials_batch(const sr_model *model, long n, const sr_real *x, const sr_real *nu_dot, int body,
+                          const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real *y, sr_real *H,
+                          sr_real *Hn, long *failed_row);
+
+/** sr_encoders_jacobian on n rows (y n x 2, H n x 2 x SR_NEB), as sr_imu_partials_batch. */
+int sr_encoders_jacobian_batch(const sr_model *model, long n, const sr_real *x, sr_real *y, sr_real *H,
+                               long *failed_row);
+
+/** sr_position_jacobian on n rows (y n x 2, H n x 2 x SR_NEB), as sr_imu_partials_batch. */
+int sr_position_jacobian_batch(const sr_model *model, long n, const sr_real *x, sr_real *y, sr_real *H,
+                               long *failed_row);
 /** @} */
 
 #ifdef __cplusplus

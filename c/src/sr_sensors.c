@@ -152,6 +152,26 @@ int sr_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real
     return SR_OK;
 }
 
+int sr_imu_partials_batch(const sr_model *model, long n, const sr_real *x, const sr_real *nu_dot, int body,
+                          const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real *y, sr_real *H,
+                          sr_real *Hn, long *failed_row)
+{
+    long i;
+    int status = arg_model(model, READS(STATE) | READS(SENSORS));
+    if (failed_row) *failed_row = -1;
+    if (status == SR_OK) status = arg_rows(n, x && nu_dot && y && H && Hn);
+    if (status != SR_OK) return status;
+    for (i = 0; i < n; ++i) {
+        status = sr_imu_partials(model, x + i * SR_NX, nu_dot + i * SR_NV, body, mount, bias, y + i * SR_NIMU,
+                                 H + i * SR_NIMU * SR_NEB, Hn + i * SR_NIMU * SR_NV);
+        if (status != SR_OK) {
+            if (failed_row) *failed_row = i;
+            return status;
+        }
+    }
+    return SR_OK;
+}
+
 /* R_Y = rot_x(theta_Y): (cos, sin) in its (1,1), (2,1) entries; R_P = rot_y(theta_P): (0,0), (0,2). */
 static void encoder_angles(const sr_real x[SR_NX], sr_real y[2])
 {
@@ -226,4 +246,37 @@ int sr_heading_jacobian(const sr_model *model, const sr_real x[SR_NX], int body,
     *heading = SR_ATAN2(h[1], h[0]);
     memcpy(H, HH, sizeof HH);
     return SR_OK;
+}
+
+/* The encoders' and the position fix's batches share the row loop (position: nonzero for the fix);
+ * the call is chosen per row by a direct call, as the kernels above are. */
+static int pair_batch(int position, const sr_model *model, long n, const sr_real *x, sr_real *y, sr_real *H,
+                      long *failed_row)
+{
+    long i;
+    int status = arg_model(model, READS(STATE));
+    if (failed_row) *failed_row = -1;
+    if (status == SR_OK) status = arg_rows(n, x && y && H);
+    if (status != SR_OK) return status;
+    for (i = 0; i < n; ++i) {
+        status = position ? sr_position_jacobian(model, x + i * SR_NX, y + 2 * i, H + 2 * i * SR_NEB)
+                          : sr_encoders_jacobian(model, x + i * SR_NX, y + 2 * i, H + 2 * i * SR_NEB);
+        if (status != SR_OK) {
+            if (failed_row) *failed_row = i;
+            return status;
+        }
+    }
+    return SR_OK;
+}
+
+int sr_encoders_jacobian_batch(const sr_model *model, long n, const sr_real *x, sr_real *y, sr_real *H,
+                               long *failed_row)
+{
+    return pair_batch(0, model, n, x, y, H, failed_row);
+}
+
+int sr_position_jacobian_batch(const sr_model *model, long n, const sr_real *x, sr_real *y, sr_real *H,
+                               long *failed_row)
+{
+    return pair_batch(1, model, n, x, y, H, failed_row);
 }

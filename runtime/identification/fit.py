@@ -30,12 +30,13 @@ import scipy.linalg
 import scipy.optimize
 import scipy.sparse
 import scipy.stats
+import threadpoolctl
 
 from ..model import Model
 from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_parameters
 from ..params import SHAPES, Params, flat_names
-from ..sensors import imu_partials
-from ..state import IDX_E_NU, IDX_E_Q, IDX_E_TH_P, IDX_E_TH_Y, IDX_NU, IDX_Q, NE, NV, pendulum_angle, yoke_angle
+from ..sensors import encoders_jacobian_batch, imu_partials_batch, position_jacobian_batch
+from ..state import IDX_E_NU, IDX_NU, NE, NV
 from .sensitivity import JACOBIANS, accel_sensitivity, step_sensitivity
 
 #: Parameters a builder knows and the fit never frees: the shell's radius, the gear ratios, gravity, the slope.
@@ -51,8 +52,9 @@ Z95 = float(scipy.stats.norm.ppf(0.975))
 #: Standard deviation [rad, m, rad/s] of the weak prior on the first segment's start state: it fixes
 #: what no sensor sees (the position without fixes, the heading without fixes or a magnetometer).
 GAUGE_SIGMA = 10.0
-#: Largest Jacobian (entries) solved densely; beyond it the trust-region steps use LSMR.
-DENSE_LIMIT = 2e7
+#: Largest Jacobian (entries, after each segment's compression) solved densely; beyond it the
+#: trust-region steps use LSMR on the sparse Jacobian.
+DENSE_LIMIT = 2e6
 #: Smallest standard deviation of an end-state difference, for a sensor set without process noise.
 DEFECT_FLOOR = 1e-7
 
@@ -251,24 +253,20 @@ class _Problem:
         group maps (exact maps, no dynamics); the start-state unknowns are offsets about a fixed guess."""
         x0 = model.retract(x, d)
         e = 1e-6
-        D = np.empty((NE, NE))
-        for i in range(NE):
-            dp, dm = d.copy(), d.copy()
-            dp[i] += e
-            dm[i] -= e
-            D[:, i] = (model.local(x0, model.retract(x, dp)) - model.local(x0, model.retract(x, dm))) / (2 * e)
-        return x0, D
+        E = e * np.eye(NE)
+        moved = model.retract(np.broadcast_to(x, (2 * NE, len(x))), np.vstack([d + E, d - E]))
+        diff = model.local(np.broadcast_to(x0, moved.shape), moved)
+        return x0, (diff[:NE] - diff[NE:]).T / (2 * e)
 
     def _dlocal(self, model, a, b):
         """(∂ local(a ⊕ δ, b)/∂δ, ∂ local(a, b ⊕ δ)/∂δ) at δ = 0, central differences."""
         e = 1e-6
-        A, B = np.empty((NE, NE)), np.empty((NE, NE))
-        for i in range(NE):
-            di = np.zeros(NE)
-            di[i] = e
-            A[:, i] = (model.local(model.retract(a, di), b) - model.local(model.retract(a, -di), b)) / (2 * e)
-            B[:, i] = (model.local(a, model.retract(b, di)) - model.local(a, model.retract(b, -di))) / (2 * e)
-        return A, B
+        steps = np.vstack([e * np.eye(NE), -e * np.eye(NE)])
+        a_moved = model.retract(np.broadcast_to(a, (2 * NE, len(a))), steps)
+        b_moved = model.retract(np.broadcast_to(b, (2 * NE, len(b))), steps)
+        da = model.local(a_moved, np.broadcast_to(b, a_moved.shape))
+        db = model.local(np.broadcast_to(a, b_moved.shape), b_moved)
+        return (da[:NE] - da[NE:]).T / (2 * e), (db[:NE] - db[NE:]).T / (2 * e)
 
     # -- one evaluation -------------------------------------------------------------------------
     def segment_blocks(self, z):
@@ -285,7 +283,9 @@ class _Problem:
 
     def segment_block(self, model, s, start, nxt, b):
         """One segment's block: simulated from start = (x0, D) under the logged torques; the
-        end-state difference to nxt = (x0 of the next segment, its D) unless nxt is None."""
+        end-state difference to nxt = (x0 of the next segment, its D) unless nxt is None.  The
+        readings are ordered by time, at one time IMU, encoders, fix; `rows` keeps, per reading row,
+        its node, kind (0 IMU, 1 encoders, 2 fix), ∂y/∂x, ∂y/∂ν̇ and noise σ."""
         d = self.data
         x0, D = start
         k0, k1 = self.starts[s], self.ends[s]
@@ -299,44 +299,43 @@ class _Problem:
         nudot = model.accel(Xn, d.u[nodes])
         Ja, _ = model.accel_jacobian(Xn, d.u[nodes])
         Jpa = accel_sensitivity(model, Xn, d.u[nodes], self.idx, self.jacobian)
-        Phi = np.empty((steps + 1, NE, NE))
-        Sens = np.empty((steps + 1, NE, self.nf))
-        Phi[0], Sens[0] = np.eye(NE), 0.0
+        G = np.empty((steps + 1, NE, NE + self.nf))     # [Φ_k | S_k]: one product per step
+        G[0] = np.hstack([np.eye(NE), np.zeros((NE, self.nf))])
         for k in range(steps):
-            Phi[k + 1] = F[k] @ Phi[k]
-            Sens[k + 1] = F[k] @ Sens[k] + Jp[k]
-        rows_r, rows_th, rows_b, rows_x, meta = [], [], [], [], []
-        enc_H = np.zeros((2, NE))
-        enc_H[0, IDX_E_TH_Y] = enc_H[1, IDX_E_TH_P] = 1.0
-        fix_H = np.zeros((2, NE))
-        fix_H[:, IDX_E_Q] = np.eye(2)
-        for i, k in enumerate(nodes):
-            j = d.imu_row[k]
-            if j >= 0:
-                y, H, Hn = imu_partials(model, Xn[i], nudot[i], mount=self.mount, bias=b)
-                Hx = H[:, :NE] + Hn @ Ja[i]
-                rows_r.append((self.log.imu.data[j] - y) / self.sig_imu)
-                rows_th.append(-(Hx @ Sens[i] + Hn @ Jpa[i]) / self.sig_imu[:, None])
-                rows_b.append(-H[:, NE:] / self.sig_imu[:, None])
-                rows_x.append(-(Hx @ Phi[i]) / self.sig_imu[:, None])
-                meta.append(("imu", k, Hx, Hn))
-            for kind, row, H, sig, pred in (
-                    ("encoders", d.enc_row[k], enc_H, self.sig_enc, None),
-                    ("fixes", d.fix_row[k], fix_H, self.sig_fix, None)):
-                if row < 0:
-                    continue
-                if kind == "encoders":
-                    e = _wrap(self.log.encoders.data[row] - np.array([yoke_angle(Xn[i]), pendulum_angle(Xn[i])]))
-                else:
-                    e = self.fix_xy[row] - Xn[i][IDX_Q][:2]
-                rows_r.append(e / sig)
-                rows_th.append(-(H @ Sens[i]) / sig)
-                rows_b.append(np.zeros((2, 6)))
-                rows_x.append(-(H @ Phi[i]) / sig)
-                meta.append((kind, k, H, None))
-        block = {"r": np.concatenate(rows_r), "th": np.vstack(rows_th), "b": np.vstack(rows_b),
-                 "x": np.vstack(rows_x) @ D, "next": None, "meta": meta, "X": X, "Phi": Phi,
-                 "nodes": nodes, "model": model, "n_out": len(np.concatenate(rows_r))}
+            G[k + 1] = F[k] @ G[k]
+            G[k + 1][:, NE:] += Jp[k]
+        Phi, Sens = G[:, :, :NE], G[:, :, NE:]
+        parts = []                  # (node, kind, r, Hx, Hn, sig, Hb) per kind, row-wise
+        li = np.flatnonzero(d.imu_row[nodes] >= 0)
+        if li.size:
+            y, H, Hn = imu_partials_batch(model, Xn[li], nudot[li], mount=self.mount, bias=b)
+            Hx = H[:, :, :NE] + Hn @ Ja[li]
+            r = self.log.imu.data[d.imu_row[nodes[li]]] - y
+            parts.append((np.repeat(li, 6), 0, r.ravel(), Hx.reshape(-1, NE), Hn.reshape(-1, NV),
+                          np.tile(self.sig_imu, li.size), H[:, :, NE:].reshape(-1, 6)))
+        for kind, rows_of, batch, sig in ((1, d.enc_row, encoders_jacobian_batch, self.sig_enc),
+                                          (2, d.fix_row, position_jacobian_batch, self.sig_fix)):
+            lk = np.flatnonzero(rows_of[nodes] >= 0)
+            if not lk.size:
+                continue
+            y, H = batch(model, Xn[lk])
+            if kind == 1:
+                r = _wrap(self.log.encoders.data[rows_of[nodes[lk]]] - y)
+            else:
+                r = self.fix_xy[rows_of[nodes[lk]]] - y
+            parts.append((np.repeat(lk, 2), kind, r.ravel(), H[:, :, :NE].reshape(-1, NE), np.zeros((2 * lk.size, NV)),
+                          np.full(2 * lk.size, float(sig)), np.zeros((2 * lk.size, 6))))
+        node = np.concatenate([p[0] for p in parts])
+        kinds = np.concatenate([np.full(len(p[0]), p[1]) for p in parts])
+        order = np.lexsort((kinds, node))           # stable: each reading's components stay in order
+        node, kinds = node[order], kinds[order]
+        r, Hx, Hn, sig, Hb = (np.concatenate([p[i] for p in parts])[order] for i in range(2, 7))
+        r = r / sig
+        th = -(np.einsum("rj,rjk->rk", Hx, Sens[node]) + np.einsum("rj,rjk->rk", Hn, Jpa[node])) / sig[:, None]
+        xs = -np.einsum("rj,rjk->rk", Hx, Phi[node]) / sig[:, None]
+        block = {"r": r, "th": th, "b": -Hb / sig[:, None], "x": xs @ D, "next": None,
+                 "rows": {"node": node, "kind": kinds, "Hx": Hx, "Hn": Hn, "sig": sig},
+                 "X": X, "Phi": Phi, "nodes": nodes, "model": model, "n_out": len(r)}
         if nxt is not None:
             A, B = self._dlocal(model, X[-1], nxt[0])
             defect = model.local(X[-1], nxt[0])
@@ -389,33 +388,29 @@ class _Problem:
         accelerometer reads M⁻¹ w_j, the velocities jump by M⁻¹ w_j τ at its end), w_j of
         covariance diag(Q)."""
         d = self.data
-        model, X, Phi = blk["model"], blk["X"], blk["Phi"]
+        model, X, Phi, rows = blk["model"], blk["X"], blk["Phi"], blk["rows"]
         k0, last_node = self.starts[s], self.ends[s]
         js = np.unique(d.interval[k0:last_node + 1])
-        col = {j: c for c, j in enumerate(js)}
-        A = np.zeros((blk["n_out"] + NE, 5 * len(js)))
         P = np.zeros((NE, 5 * len(js)))
         enters = np.full(len(js), np.iinfo(int).max)
+        Minv = np.linalg.inv(np.array([model.inertia(x) for x in X]))
+        later = d.interval[k0 + 1:last_node + 1]
         for c, j in enumerate(js):
-            after = np.flatnonzero(d.interval[k0 + 1:last_node + 1] > j)
+            after = np.flatnonzero(later > j)
             if after.size:
                 kappa = after[0] + 1
                 Bk = np.zeros((NE, 5))
-                Bk[IDX_E_NU] = np.linalg.inv(model.inertia(X[kappa - 1])) * d.tau
+                Bk[IDX_E_NU] = Minv[kappa - 1] * d.tau
                 P[:, 5 * c:5 * c + 5] = np.linalg.solve(Phi[kappa], Bk)
                 enters[c] = kappa
-        row = 0
-        sig = {"imu": self.sig_imu, "encoders": self.sig_enc, "fixes": self.sig_fix}
-        for kind, k, Hx, Hn in blk["meta"]:
-            i = k - k0
-            m = Hx.shape[0]
-            scale = np.broadcast_to(np.asarray(sig[kind], dtype=float), (m,))[:, None]
-            A[row:row + m] = (Hx @ Phi[i] @ P) / scale * np.repeat(enters <= i, 5)
-            if kind == "imu":
-                c = col[d.interval[k]]
-                A[row:row + m, 5 * c:5 * c + 5] += Hn @ np.linalg.inv(model.inertia(X[i])) / scale
-            row += m
-        A[row:] = (Phi[-1] @ P) * np.repeat(enters <= len(Phi) - 1, 5)
+        node, sig = rows["node"], rows["sig"][:, None]
+        n = len(node)
+        A = np.zeros((n + NE, 5 * len(js)))
+        A[:n] = np.einsum("rj,rjk->rk", rows["Hx"], Phi[node]) @ P / sig * np.repeat(enters[None, :] <= node[:, None], 5, 1)
+        imu = np.flatnonzero(rows["kind"] == 0)
+        c = np.searchsorted(js, d.interval[k0 + node[imu]])
+        A[imu[:, None], 5 * c[:, None] + np.arange(5)] += np.einsum("rj,rjk->rk", rows["Hn"][imu], Minv[node[imu]]) / sig[imu]
+        A[n:] = (Phi[-1] @ P) * np.repeat(enters <= len(Phi) - 1, 5)
         return A, np.tile(self.q2 / d.tau, len(js))
 
     def end_covariance(self, s, blk):
@@ -425,21 +420,35 @@ class _Problem:
         return (E * Q) @ E.T + DEFECT_FLOOR ** 2 * np.eye(NE)
 
     def covariances(self, blocks):
-        """Cholesky factors of each segment's residual covariance, in units of the sensor noise:
-        I + A Q Aᵀ (`noise_map`) for the readings and their end-state difference."""
+        """Each segment's whitening W (Wᵀ W = C⁻¹) of its residual covariance, in units of the
+        sensor noise: C = D + A Q Aᵀ (`noise_map`), D the unit noise of the readings and the floor
+        of their end-state difference.  A has a few columns per torque period, so W is kept as
+        the symmetric root (I + U diag(f) Uᵀ) D^-1/2 from the thin SVD D^-1/2 A Q^1/2 = U S Vᵀ,
+        f = (1 + S²)^-1/2 − 1, never as a matrix of the segment's size."""
         out = []
         for s, blk in enumerate(blocks):
             A, Q = self.noise_map(s, blk)
             nrow, row = len(blk["r"]), blk["n_out"]
-            A = A[:nrow]
-            C = (A * Q) @ A.T
-            C[np.arange(row), np.arange(row)] += 1.0
-            C[np.arange(row, nrow), np.arange(row, nrow)] += DEFECT_FLOOR ** 2
-            out.append(scipy.linalg.cholesky(C, lower=True))
+            dinv = np.ones(nrow)
+            dinv[row:] = 1.0 / DEFECT_FLOOR
+            B = dinv[:, None] * A[:nrow] * np.sqrt(Q)
+            U, S, _ = scipy.linalg.svd(B, full_matrices=False, check_finite=False)
+            out.append((dinv, U, 1.0 / np.sqrt(1.0 + S ** 2) - 1.0))
         return out
 
+    @staticmethod
+    def whiten(white, M):
+        """W M for a segment's whitening `white` (`covariances`)."""
+        dinv, U, f = white
+        M = dinv.reshape((-1,) + (1,) * (M.ndim - 1)) * M
+        return M + U @ (f.reshape((-1,) + (1,) * (M.ndim - 1)) * (U.T @ M))
+
     def assemble(self, z):
-        """(whitened residuals, sparse Jacobian) at z."""
+        """(residuals, sparse Jacobian, segment blocks) at z.  Each segment's whitened residuals r_s
+        and Jacobian J_s (columns θ, b, its start and the next) enter compressed: with the QR
+        factorisation [J_s r_s] = Q [[R, c], [0, ρ]], the rows (c, ρ) and Jacobian (R; 0) have the
+        same sum of squares, gradient and Gauss–Newton matrix as the segment's own, at a few
+        dozen rows instead of its readings' hundreds."""
         if self._cache[0] is not None and np.array_equal(self._cache[0], z):
             return self._cache[1]
         blocks = self.segment_blocks(z)
@@ -449,21 +458,24 @@ class _Problem:
         row0 = 0
         cols_g = np.arange(self.nf + 6)
         for s, blk in enumerate(blocks):
-            L = self.chol[s]
-            w = scipy.linalg.solve_triangular
-            r = w(L, blk["r"], lower=True)
-            parts = [(np.hstack([blk["th"], blk["b"]]), cols_g),
-                     (blk["x"], self.nf + 6 + NE * s + np.arange(NE))]
+            parts = [np.hstack([blk["th"], blk["b"]]), blk["x"]]
+            cols = [cols_g, self.nf + 6 + NE * s + np.arange(NE)]
             if blk["next"] is not None:
-                parts.append((blk["next"], self.nf + 6 + NE * (s + 1) + np.arange(NE)))
-            for M, cols in parts:
-                Mw = w(L, M, lower=True)
-                rr, cc = np.meshgrid(row0 + np.arange(len(r)), cols, indexing="ij")
-                data.append(Mw.ravel())
-                ri.append(rr.ravel())
-                ci.append(cc.ravel())
+                parts.append(blk["next"])
+                cols.append(self.nf + 6 + NE * (s + 1) + np.arange(NE))
+            M = self.whiten(self.chol[s], np.hstack(parts + [blk["r"][:, None]]))
+            R = scipy.linalg.qr(M, mode="r", overwrite_a=True, check_finite=False)[0]
+            m = R.shape[1] - 1
+            R = np.vstack([R, np.zeros((max(0, m + 1 - R.shape[0]), m + 1))])[:m + 1]
+            r = R[:, m].copy()
+            r[m] = abs(r[m])
+            cols = np.concatenate(cols)
+            rr, cc = np.meshgrid(row0 + np.arange(m), cols, indexing="ij")
+            data.append(R[:m, :m].ravel())
+            ri.append(rr.ravel())
+            ci.append(cc.ravel())
             rs.append(r)
-            row0 += len(r)
+            row0 += m + 1
         # the weak prior on the first start state (the gauge no sensor fixes)
         _, _, Dz = self.split(z)
         rs.append(Dz[0] / GAUGE_SIGMA)
@@ -473,6 +485,7 @@ class _Problem:
         r = np.concatenate(rs)
         J = scipy.sparse.csr_matrix((np.concatenate(data), (np.concatenate(ri), np.concatenate(ci))),
                                     shape=(len(r), self.ncols))
+        self.n_residuals = sum(len(blk["r"]) for blk in blocks) + NE
         self._cache = (z.copy(), (r, J, blocks))
         self.nfev += 1
         if self.progress is not None:
@@ -491,19 +504,18 @@ class _Problem:
 
     def residual_series(self, z):
         """{kind: (t, whitened residuals (n, m))} along the log: each segment's residuals whitened by
-        their covariance (the Cholesky factor's order: each reading's innovation given the earlier
-        readings of its segment), so that a right model leaves unit white noise."""
+        their covariance (`covariances`), so that a right model leaves unit white noise."""
         blocks = self.assemble(z)[2]
         out = {"imu": ([], []), "encoders": ([], []), "fixes": ([], [])}
         for s, blk in enumerate(blocks):
-            w = scipy.linalg.solve_triangular(self.chol[s], blk["r"], lower=True)
-            row = 0
-            for kind, k, Hx, _ in blk["meta"]:
-                m = Hx.shape[0]
-                out[kind][0].append(self.data.t[k])
-                out[kind][1].append(w[row:row + m])
-                row += m
-        return {k: (np.array(t), np.array(v)) for k, (t, v) in out.items() if t}
+            w = self.whiten(self.chol[s], blk["r"])
+            rows = blk["rows"]
+            for code, kind, m in ((0, "imu", 6), (1, "encoders", 2), (2, "fixes", 2)):
+                sel = np.flatnonzero(rows["kind"] == code)
+                if sel.size:
+                    out[kind][0].append(self.data.t[self.starts[s] + rows["node"][sel[::m]]])
+                    out[kind][1].append(w[sel].reshape(-1, m))
+        return {k: (np.concatenate(t), np.concatenate(v)) for k, (t, v) in out.items() if t}
 
 
 class _FullState:
@@ -580,6 +592,14 @@ def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, 
     check_log(log, full_state)
     if not (isinstance(segment, (int, float)) and math.isfinite(segment) and segment > 0):
         raise IdentifyError(f"segment: expected a length > 0 in s, got {segment!r}")
+    # The fit's products are small: one BLAS thread each (threads spinning for a busy core cost
+    # far more than they gain on a shared 2-core machine).
+    with threadpoolctl.threadpool_limits(1, user_api="blas"):
+        return _identify(log, params, free, segment, method, full_state, max_nfev, progress, x_guess, bias_guess,
+                         jacobian)
+
+
+def _identify(log, params, free, segment, method, full_state, max_nfev, progress, x_guess, bias_guess, jacobian):
     if full_state:
         prob = _FullState(log, params, free, method, jacobian)
     else:
@@ -600,7 +620,7 @@ def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, 
         return prob.assemble(z)[0]
 
     # a dense trust-region solve while J is small, LSMR on the sparse J beyond
-    dense = full_state or prob.ncols * (prob.ncols + 8 * len(prob.data.t)) <= DENSE_LIMIT
+    dense = full_state or prob.ncols * (prob.S * (prob.nf + 7 + 2 * NE) + NE) <= DENSE_LIMIT
 
     def jac(z):
         return prob.assemble(z)[1].toarray() if dense else prob.assemble(z)[1]
@@ -662,8 +682,8 @@ def _report(prob, sol, free, params, full_state):
     estimated = Params.from_array(p)
     combos = _combinations(params, estimated, prob.idx, cov, null, scale)
     nulls = [{free[i]: float(v[i]) for i in np.argsort(-np.abs(v)) if abs(v[i]) > 1e-3} for v in null.T]
-    n_data = len(r) - (0 if full_state else NE)
-    chi2 = float(np.sum(r[:n_data] ** 2))
+    n_data = len(r) if full_state else prob.n_residuals - NE
+    chi2 = float(np.sum(r[:len(r) - (0 if full_state else NE)] ** 2))
     dof = max(n_data - (nf if full_state else prob.ncols), 1)
     rms = math.sqrt(chi2 / dof)
     check = {"rms": rms, "chi2": chi2, "dof": dof, "p_value": float(scipy.stats.chi2.sf(chi2, dof)),

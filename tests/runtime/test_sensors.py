@@ -93,3 +93,29 @@ def test_a_bad_mount_is_a_value_error_naming_its_field(mount, field):
 def test_bad_input_is_a_value_error_naming_the_argument(model, call, field):
     with pytest.raises(ValueError, match=f"^{field}:"):
         call(model)
+
+
+def test_the_batches_are_the_single_calls_row_by_row(model):
+    rng = np.random.default_rng(3)
+    X = np.array([initial_state(theta_Y=a, theta_P=b, w_S=w, q=(c, -c, model.params.r))
+                  for a, b, w, c in zip(rng.uniform(-3, 3, 4), rng.uniform(-3, 3, 4), rng.normal(size=(4, 3)),
+                                        rng.normal(size=4))])
+    A = rng.normal(size=(4, 5))
+    bias, mount = rng.normal(size=6), Mount("pendulum", (0.01, 0.0, -0.1))
+    y, H, Hn = sensors.imu_partials_batch(model, X, A, mount=mount, bias=bias)
+    for i in range(4):
+        for got, want in zip((y[i], H[i], Hn[i]), sensors.imu_partials(model, X[i], A[i], mount=mount, bias=bias)):
+            assert np.array_equal(got, want)
+        for batch, single in ((sensors.encoders_jacobian_batch, sensors.encoders_jacobian),
+                              (sensors.position_jacobian_batch, sensors.position_jacobian)):
+            got, want = batch(model, X)
+            assert np.array_equal(got[i], single(model, X[i])[0])
+            assert np.array_equal(want[i], single(model, X[i])[1])
+
+
+def test_a_batch_names_the_bad_state_and_the_shape_of_nu_dot(model):
+    X = np.array([initial_state(), np.zeros(35)])
+    with pytest.raises(ValueError, match=r"^x\[1\]"):
+        sensors.encoders_jacobian_batch(model, X)
+    with pytest.raises(ValueError, match="^nu_dot:"):
+        sensors.imu_partials_batch(model, X[:1], np.zeros((2, 5)))

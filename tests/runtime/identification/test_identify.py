@@ -60,7 +60,7 @@ def test_a_full_state_fit_recovers_the_planted_parameters_within_its_intervals(s
 
 
 def test_a_sensor_log_fit_recovers_the_planted_parameters_within_its_intervals(short_log):
-    fit = identify(short_log, NOMINAL, ["m_P", "k_Y"], segment=0.25, max_nfev=10)
+    fit = identify(short_log, NOMINAL, ["m_P", "k_Y"], segment=0.25, max_nfev=30)
     truth = truth_of(fit.names)
     assert np.all(np.abs(fit.estimate - truth) <= 3 * fit.sigma), (fit.estimate, truth, fit.sigma)
     assert abs(fit.nominal[0] - truth[0]) > 3 * fit.sigma[0]      # m_P: the nominal value would fail the check
