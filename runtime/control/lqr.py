@@ -6,6 +6,8 @@ interpolated bilinearly in (v_ref, κ) over the design grid, u = u* − K (z −
 integrators (∫e_y, ∫ of the rolling-rate error) advance by one period at any error, each unless its
 step would push a clipped torque further past its limit (conditional integration: the anti-windup),
 and ∫e_y only while the error is steady, |ė_y| ≤ `steady_rate_m_s` (a moving error is a transient).
+On a slope (the model's own, or one estimated online: `slope_estimate_s`) the torques gain the
+slope's feedforward (runtime/control/slope.py), the schedule being designed on the flat model.
 """
 import dataclasses
 import typing
@@ -20,6 +22,7 @@ from ..schema import check_arguments
 from .controller import DEFAULT_U_MAX, Controller
 from .ranges import LQR_RANGES
 from . import lqr_design as design
+from .slope import SlopeEstimator, design_slope_schedule, slope_components
 
 
 @dataclasses.dataclass(frozen=True)
@@ -47,6 +50,7 @@ class LqrGains:
     preview_m: float = 0.3            # the path's curvature is averaged over preview_m ± smoothing_m [m]
     smoothing_m: float = 0.5          # ... along the path from the nearest point (0: the curvature there)
     steady_rate_m_s: float = 0.002   # ∫e_y advances only while |ė_y| ≤ this [m/s]
+    slope_estimate_s: float = 0.0     # the slope estimate's time constant [s] (0: the model's slope only)
     #: The ranges of the settings (runtime/control/ranges.py: those of a task file's keys).
     RANGES: typing.ClassVar[dict] = LQR_RANGES
 
@@ -175,9 +179,19 @@ class Lqr(Controller):
     def __init__(self, params, rate=50.0, u_max=DEFAULT_U_MAX, gains=LqrGains(), schedule=None):
         super().__init__(params, rate, u_max)
         self.gains = gains
-        self.schedule = schedule if schedule is not None else design_schedule(params, rate, u_max, gains)
+        # A slope in the model is fed forward in whichever direction the path runs: the schedule is
+        # the flat one, and the slope's direction (the model's +x) is a world vector.
+        flat = params.replace(slope=0.0)
+        self.model_slope = np.array([params.slope, 0.0])
+        self.schedule = schedule if schedule is not None else design_schedule(flat, rate, u_max, gains)
         self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate, gains.steady_rate_m_s)
-        self._model = Model(params)
+        self._model = Model(flat)
+        self._slope_schedule = None
+        if params.slope != 0.0 or gains.slope_estimate_s > 0.0:
+            self._slope_schedule = design_slope_schedule(flat, self.schedule)
+        self._estimator = SlopeEstimator(flat, self.period, gains.slope_estimate_s) \
+            if gains.slope_estimate_s > 0.0 else None
+        self._applied = np.zeros(2)
         self._memory = ffi.new("sr_lqr_memory *")
         self._u, self._raw = np.zeros(2), np.zeros(2)
 
@@ -185,6 +199,19 @@ class Lqr(Controller):
         """Starts a run at x0: zeroes the controller's memory (integrals, operating curvature)."""
         super().reset(x0)
         lib.sr_lqr_reset(self._memory)
+        self._applied = np.zeros(2)
+        if self._estimator is not None:
+            self._estimator.reset()
+
+    @property
+    def slope(self):
+        """The world's slope vector α (cos β, sin β) [rad] the feedforward uses: the estimate when the
+        controller estimates one (against the flat model: the whole slope), else the model's."""
+        return self.model_slope if self._estimator is None else self._estimator.slope
+
+    def after_limits(self, raw, u):
+        """Keeps the torques applied: the slope estimate's next prediction holds them."""
+        self._applied = np.array(u, dtype=float)
 
     def preview_distances(self, target):
         """Where the path's curvature is read (runtime/control/closed_loop.py fills
@@ -210,6 +237,8 @@ class Lqr(Controller):
     def compute(self, t, x, target):
         """The torques of one sample of the C controller (sr_lqr_control) for state x and the target."""
         x = np.ascontiguousarray(x, dtype=np.float64)
+        if self._estimator is not None:
+            self._estimator.update(x, self._applied)
         if target.cross_track is not None:
             target = dataclasses.replace(target, curvature=self.operating_curvature(target))
         status = lib.sr_lqr_control(self._c, self._model._model, ffi.cast("double *", ffi.from_buffer(x)),
@@ -220,4 +249,18 @@ class Lqr(Controller):
         if status != lib.SR_OK:
             raise ValueError(f"controller lqr: {ffi.string(lib.sr_status_string(status)).decode()} "
                              f"at t = {t:g} s")
-        return self._raw.copy()
+        if self._slope_schedule is None:
+            return self._raw.copy()
+        ff = self.slope_feedforward(target)
+        if self._estimator is not None:
+            ff = ff - self._estimator.torque_offset
+        return self._raw + ff
+
+    def slope_feedforward(self, target):
+        """Δu* + K Δz* (2,) [N m]: the operating point's move on the slope `self.slope`, at the
+        reference's speed and the operating curvature of the last sample."""
+        up, right = slope_components(self.slope, target.heading)
+        kappa = float(self._memory.kappa) if target.cross_track is not None else 0.0
+        dz, du = self._slope_schedule.at(target.speed, kappa, up, right)
+        _, _, K_path, K_heading = self.schedule.at(target.speed, kappa)
+        return du + (K_path if target.cross_track is not None else K_heading) @ dz

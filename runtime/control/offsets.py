@@ -19,12 +19,21 @@ from ..state import IDX_RS
 from .climbing import climbing_limit
 
 #: The controllers the offset table runs (the PID has no integral on the path); nmpc-c is the NMPC's
-#: formulation in C (runtime/control/nmpc.py's NmpcC), which runs the table many times faster.
-OFFSET_CONTROLLERS = ("lqr", "nmpc", "nmpc-c")
+#: formulation in C (runtime/control/nmpc.py's NmpcC), which runs the table many times faster;
+#: lqr-slope is the task's LQR with its online slope estimate on (runtime/control/slope.py).
+OFFSET_CONTROLLERS = ("lqr", "lqr-slope", "nmpc", "nmpc-c")
+#: The slope estimate's time constant [s] of the lqr-slope runs.
+SLOPE_ESTIMATE_S = 5.0
 
 
 def with_controller(task, kind):
-    """The task with only its controller of `kind`; nmpc-c takes the settings of the task's nmpc."""
+    """The task with only its controller of `kind`; nmpc-c takes the settings of the task's nmpc,
+    lqr-slope those of its lqr with `slope_estimate_s` = SLOPE_ESTIMATE_S."""
+    if kind == "lqr-slope":
+        task = task.with_controller("lqr")
+        spec = task.controllers[0]
+        gains = dataclasses.replace(spec.gains, slope_estimate_s=SLOPE_ESTIMATE_S)
+        return dataclasses.replace(task, controllers=(dataclasses.replace(spec, gains=gains),))
     if kind != "nmpc-c" or "nmpc-c" in task.controller_kinds:
         return task.with_controller(kind)
     task = task.with_controller("nmpc")

@@ -35,6 +35,7 @@ LQR_RANGES = {
     "preview_m": Range(0, 100, "m", "a preview along the path"),
     "smoothing_m": Range(0, 100, "m", "a smoothing window along the path"),
     "steady_rate_m_s": Range(0, 10, "m/s", "a rate of the cross-track error"),
+    "slope_estimate_s": Range(0, 1e4, "s", "the slope estimate's time constant (0: no estimate)"),
 }
 
 #: `NmpcGains`: the LQR's and the horizon's.

@@ -1,0 +1,163 @@
+"""A slope in any direction for the LQR: its feedforward, and its estimate from the measured rates.
+
+The model carries a slope along the plane's x axis only (`Params.slope`), but the dynamics do not
+change when the robot and the slope turn together about the floor's normal: a robot heading ψ on a
+slope whose uphill direction is β moves as one heading ψ − β on the model's slope.  So one slope
+model serves every direction, and a small slope acts through two numbers, the world's slope vector
+
+    s = α (cos β, sin β)      [rad]: the inclination α, uphill towards β,
+
+read against the reference's heading ψ as its components along the path, s·t, and to the right of
+it, s_x sin ψ − s_y cos ψ (= α sin(ψ − β)).
+
+Feedforward.  At each point (v, κ) of the LQR's design grid, the operating point (z*, u*) of the
+flat design moves, to first order in α, by α (cos(ψ − β) D_up + sin(ψ − β) D_right): D_up and D_right
+the derivatives of the operating point (Newton on the reduced field, runtime/control/lqr_design.py)
+on the model's slope with the reference heading up it and across it (uphill on the right).  The law
+u = u* − K (z − z*) then gains Δu* + K Δz*.  On a line that is the exact steady state to first order;
+on a circle the pull turns with the heading and this holds the operating point of the moment.
+
+Estimate.  Between two samples the torques are held, so the rates one period later are those the
+model predicts plus what the slope adds, linear in s: ν⁺ − ν̂⁺(flat) ≈ G_x s_x + G_y s_y, G the
+model's step on a slope along x (for s_y: with the state turned by −π/2 about the normal) less the
+flat one, per radian.  `SlopeEstimator` solves these with exponential forgetting (time constant τ).
+"""
+import dataclasses
+import math
+
+import numpy as np
+
+from ..model import Model
+from ..so3 import rot_z
+from ..state import IDX_NU, IDX_Q, IDX_RS
+from . import lqr_design as design
+
+#: The slope [rad] at which the operating points' derivatives are taken (small: first order; large
+#: enough that Newton's tolerance is far below the change).
+PROBE_SLOPE = 1e-3
+#: The model's time step [s] of the estimator's one-period prediction is at most this.
+PREDICT_DT = 0.005
+#: The torque step [N m] of the estimator's derivatives with respect to the torques.
+TORQUE_PROBE = 1e-3
+
+
+class _Turned:
+    """A model seen from a frame turned by ψ about the floor's normal: `accel` of the state turned by ψ
+    (the body rates and the joints are unchanged by the turn; only the shell's attitude moves)."""
+
+    def __init__(self, model, psi):
+        self.params, self._model, self._turn = model.params, model, rot_z(psi)
+
+    def accel(self, x, u):
+        y = np.array(x, dtype=float)
+        y[IDX_RS] = (self._turn @ y[IDX_RS].reshape(3, 3)).ravel()
+        return self._model.accel(y, u)
+
+
+def turned_state(x, psi):
+    """The state x turned by ψ about the floor's normal (attitude and position; rates are body-frame)."""
+    y = np.array(x, dtype=float)
+    y[IDX_RS] = (rot_z(psi) @ y[IDX_RS].reshape(3, 3)).ravel()
+    q = y[IDX_Q]
+    y[IDX_Q.start:IDX_Q.start + 2] = rot_z(psi)[:2, :2] @ q[:2]
+    return y
+
+
+@dataclasses.dataclass(frozen=True)
+class SlopeSchedule:
+    """The operating point's derivatives per radian of slope on the LQR's grid: dz_up, dz_right
+    (nv, nk, NZ), du_up, du_right (nv, nk, 2)."""
+    speeds: np.ndarray
+    curvatures: np.ndarray
+    dz_up: np.ndarray
+    du_up: np.ndarray
+    dz_right: np.ndarray
+    du_right: np.ndarray
+
+    def at(self, v, kappa, up, right):
+        """(Δz*, Δu*) for the slope components `up` (along the path) and `right` [rad], interpolated
+        bilinearly in (v, κ) as the LQR's schedule is."""
+        from .lqr import Schedule
+        zero = np.zeros(self.du_up.shape[:2] + (2, design.NZ))
+        a = Schedule(self.speeds, self.curvatures, self.dz_up, self.du_up, zero, zero).at(v, kappa)
+        b = Schedule(self.speeds, self.curvatures, self.dz_right, self.du_right, zero, zero).at(v, kappa)
+        return up * a[0] + right * b[0], up * a[1] + right * b[1]
+
+
+def slope_components(slope_vector, psi):
+    """(along the heading ψ, to its right) [rad] of the world's slope vector s = α (cos β, sin β)."""
+    s_x, s_y = slope_vector
+    return s_x * math.cos(psi) + s_y * math.sin(psi), s_x * math.sin(psi) - s_y * math.cos(psi)
+
+
+def design_slope_schedule(params, schedule):
+    """The SlopeSchedule of the flat LQR schedule `schedule` designed on `params` (slope 0)."""
+    key = (params.as_array().tobytes(), schedule.speeds.tobytes(), schedule.curvatures.tobytes())
+    if key not in _SLOPE_SCHEDULES:
+        _SLOPE_SCHEDULES[key] = _design(params, schedule)
+    return _SLOPE_SCHEDULES[key]
+
+
+_SLOPE_SCHEDULES = {}
+
+
+def _design(params, schedule):
+    sloped = Model(params.replace(slope=PROBE_SLOPE))
+    shape = schedule.z_star.shape[:2]
+    out = {name: np.zeros(shape + (n,)) for name, n in
+           (("dz_up", design.NZ), ("du_up", 2), ("dz_right", design.NZ), ("du_right", 2))}
+    for i, v in enumerate(schedule.speeds):
+        for j, kappa in enumerate(schedule.curvatures):
+            flat = (schedule.z_star[i, j], schedule.u_star[i, j])
+            # heading ψ − β = 0: up the slope; π/2: uphill on the robot's right
+            for name, psi in (("up", 0.0), ("right", math.pi / 2)):
+                z, u = design.operating_point(_Turned(sloped, psi), v, kappa, start=flat)
+                out[f"dz_{name}"][i, j] = (z - flat[0]) / PROBE_SLOPE
+                out[f"du_{name}"][i, j] = (u - flat[1]) / PROBE_SLOPE
+    return SlopeSchedule(schedule.speeds, schedule.curvatures, **out)
+
+
+class SlopeEstimator:
+    """The world's slope vector s [rad] and a torque offset d [N m] (the plant moving as the model
+    under u + d: a moved centre of mass, a motor's bias) from the measured states and the torques held
+    between them (see the module's docstring): least squares with exponential forgetting over
+    `time_constant_s`.  The torque offset is estimated with the slope so that what a torque explains
+    is not read as a slope; the two act on the rates along different directions."""
+
+    def __init__(self, params, period, time_constant_s):
+        self.period, self.time_constant_s = float(period), float(time_constant_s)
+        self._flat = Model(params.replace(slope=0.0))
+        self._sloped = Model(params.replace(slope=PROBE_SLOPE))
+        self._steps = max(1, math.ceil(self.period / PREDICT_DT - 1e-9))
+        self._forget = math.exp(-self.period / self.time_constant_s)
+        self.reset()
+
+    def reset(self):
+        """Forgets the samples and the estimate."""
+        self._normal, self._rhs = np.zeros((4, 4)), np.zeros(4)
+        self._last = None
+        self.slope, self.torque_offset = np.zeros(2), np.zeros(2)
+
+    def _rates(self, model, x, u):
+        return model.simulate(x, self.period / self._steps, self._steps, np.tile(u, (self._steps, 1)),
+                              method="rkmk4")[-1, IDX_NU]
+
+    def update(self, x, u_applied_before):
+        """The slope estimate after the measured state x, the torques `u_applied_before` held since
+        the last one."""
+        if self._last is not None:
+            x0, u = self._last, np.asarray(u_applied_before, dtype=float)
+            flat = self._rates(self._flat, x0, u)
+            columns = [(self._rates(self._sloped, x0, u) - flat) / PROBE_SLOPE,
+                       # a slope towards the world's +y is the model's (+x) with the world turned by −π/2
+                       (self._rates(self._sloped, turned_state(x0, -math.pi / 2), u) - flat) / PROBE_SLOPE]
+            columns += [(self._rates(self._flat, x0, u + TORQUE_PROBE * e) - flat) / TORQUE_PROBE for e in np.eye(2)]
+            G = np.stack(columns, axis=1)
+            residual = np.asarray(x)[IDX_NU] - flat
+            self._normal = self._forget * self._normal + G.T @ G
+            self._rhs = self._forget * self._rhs + G.T @ residual
+            if np.linalg.cond(self._normal) < 1e10:
+                theta = np.linalg.solve(self._normal, self._rhs)
+                self.slope, self.torque_offset = theta[:2], theta[2:]
+        self._last = np.array(x, dtype=float)
+        return self.slope
