@@ -23,7 +23,7 @@ from ..model import Model
 from ..atomic import write_text
 from ..state import IDX_Q
 from .runner import CONNECT_TIMEOUT, SERIAL, run_sweep, scheduler_address
-from .robustness import RobustnessSpec
+from .robustness import RobustnessSpec, with_nominal
 from .robustness_summary import summary_text, write_robustness_figure
 from .spec import MAX_SAMPLES, load_sweep, shipped_sweeps
 from .store import MANIFEST, SweepIncomplete, SweepStore
@@ -89,6 +89,9 @@ def build_parser():
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--rerun", type=_whole(0, MAX_SAMPLES - 1), metavar="SAMPLE",
                    help="a robustness sweep: run this one sample here and print its row (nothing written)")
+    p.add_argument("--nominal", default="", metavar="GROUPS",
+                   help="with --rerun: comma-separated perturbations left out (masses, dampings, "
+                        "centre_of_mass, slope, start)")
     p.add_argument("--finished", action="store_true",
                    help="a robustness sweep: summarise the verified runs in --out so far, running nothing")
     return p
@@ -134,13 +137,15 @@ def _finished(spec, args):
     return 0
 
 
-def _rerun(spec, sample):
-    """Runs one sample of a robustness sweep and prints its inputs and outcome, one per line."""
+def _rerun(spec, sample, nominal=()):
+    """Runs one sample of a robustness sweep (the perturbation groups `nominal` left out) and prints
+    its inputs and outcome, one per line."""
     if not isinstance(spec, RobustnessSpec):
         raise ValueError("--rerun: only for a robustness sweep (a sweep file with [control])")
     if sample >= spec.samples:
         raise ValueError(f"--rerun: the sweep has samples 0..{spec.samples - 1}, got {sample}")
-    row = spec.run_chunk(sample, sample + 1)
+    with_nominal({}, nominal)                 # names the unknown group before anything runs
+    row = spec.run_chunk(sample, sample + 1, nominal)
     task, kind = spec.combos[int(row["task"][0]) * len(spec.controllers) + int(row["controller"][0])]
     print(f"task {task}, controller {kind}")
     for name, values in row.items():
@@ -156,7 +161,7 @@ def main(argv):
         if args.samples is not None:
             spec = spec.with_samples(args.samples)
         if args.rerun is not None:
-            return _rerun(spec, args.rerun)
+            return _rerun(spec, args.rerun, [g for g in args.nominal.split(",") if g])
         if args.finished:
             return _finished(spec, args)
         table = run_sweep(spec, args.out, scheduler=args.scheduler, workers=args.workers,

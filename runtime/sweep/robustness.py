@@ -61,6 +61,10 @@ INT_INPUTS = ("plant", "task", "controller", "sensor_seed")
 OUTCOMES = ("status", "steps_done", "cross_track_rms_m", "cross_track_max_m", "progress", "steady_torque_nm",
             "slope_rad", "counted_apart", "success", "saturated_fraction", "estimate_position_rms_m")
 INT_OUTCOMES = ("status", "steps_done", "counted_apart", "success")
+#: The perturbations by group, and their values on the controllers' model (`--rerun S --nominal GROUPS`).
+GROUPS = {"masses": dict.fromkeys(MASSES, 1.0), "dampings": dict.fromkeys(DAMPINGS, 1.0),
+          "centre_of_mass": dict.fromkeys(("c_P_dx_m", "c_P_dy_m", "c_P_dz_m"), 0.0),
+          "slope": {"slope_fraction": 0.0}, "start": dict.fromkeys(("dx0_m", "dy0_m", "dpsi0_rad"), 0.0)}
 #: Status of a run whose steady operating point could not be found or whose inputs are not a robot.
 STATUS_BAD_PLANT = 5
 
@@ -181,10 +185,13 @@ class RobustnessSpec:
         out["sensor_seed"] = int(rng.integers(0, 2**63 - 1))
         return out
 
-    def run_chunk(self, start, stop):
-        """{column: array} of runs start..stop-1 (the sweep store's rows)."""
+    def run_chunk(self, start, stop, nominal=()):
+        """{column: array} of runs start..stop-1 (the sweep store's rows); `nominal`: groups of
+        perturbations (GROUPS) left out."""
         columns = {"sample": np.arange(start, stop, dtype=np.int64)}
         inputs = self.draw(start, stop)
+        for group in nominal:
+            inputs.update({k: np.full(stop - start, v) for k, v in with_nominal({}, [group]).items()})
         columns.update(inputs)
         rows = [run_one(self, {k: v[j] for k, v in inputs.items()}) for j in range(stop - start)]
         for name in OUTCOMES:
@@ -313,6 +320,18 @@ def judge(reference, t, positions, rms_limit, coverage):
     rms, largest = second_half_stats(t, reference.cross_track(positions))
     fraction = progress(reference, positions) / (abs(reference.speed) * (t[-1] - t[0]))
     return rms, largest, fraction, bool(rms <= rms_limit and fraction >= coverage)
+
+
+def with_nominal(inputs, groups):
+    """The inputs of a run with the perturbations of `groups` (names of GROUPS) set to the model's
+    values: which perturbation makes a run fail."""
+    unknown = sorted(set(groups) - set(GROUPS))
+    if unknown:
+        raise ValueError(f"--nominal: {unknown[0]!r} is not one of {', '.join(GROUPS)}")
+    out = dict(inputs)
+    for group in groups:
+        out.update(GROUPS[group])
+    return out
 
 
 def run_one(spec, inputs):

@@ -7,7 +7,7 @@ import pytest
 
 from runtime.__main__ import main
 from runtime.control.reference import circle_path, line_path
-from runtime.sweep.robustness import DRAWN, judge
+from runtime.sweep.robustness import DRAWN, GROUPS, judge, with_nominal
 from runtime.sweep.spec import load_sweep
 
 SMALL = """
@@ -108,3 +108,14 @@ def test_laps_of_a_circle_count_as_progress():
     positions = np.stack([2.0 * np.cos(angle), 2.0 + 2.0 * np.sin(angle)], axis=1)
     _, _, progress, ok = judge(circle, t, positions, 0.03, 0.9)
     assert progress == pytest.approx(1.0, abs=0.01) and ok
+
+
+def test_a_rerun_can_leave_out_one_perturbation_at_a_time(tmp_path):
+    spec = load_sweep(str(_sweep(tmp_path)))
+    drawn = {k: v[0].item() for k, v in spec.draw(0, 1).items()}
+    for group, values in GROUPS.items():
+        changed = with_nominal(drawn, [group])
+        assert all(changed[k] == v for k, v in values.items())
+        assert all(changed[k] == drawn[k] for k in drawn if k not in values)
+    with pytest.raises(ValueError, match="--nominal: 'mass' is not one of masses"):
+        with_nominal(drawn, ["mass"])
