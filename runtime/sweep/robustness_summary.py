@@ -15,6 +15,8 @@ from ..scenarios.plots import save_figure  # noqa: E402
 CONFIDENCE = 0.95
 #: Worst runs listed per task and controller.
 WORST = 3
+#: An estimate whose position RMS exceeds this [m] is counted as off (the filter lost the robot).
+ESTIMATE_OFF_M = 0.03
 #: Inputs whose rank correlation with the cross-track RMS is reported (and derived ones, below).
 CAUSES = ("m_S", "m_b", "m_h", "m_P", "k_S", "k_Y", "k_P", "c_P_dx_m", "c_P_dy_m", "c_P_dz_m")
 
@@ -73,6 +75,7 @@ def group_stats(table, spec):
                         "stopped": int((cols["status"][counted] != 0).sum()), "n": n, "success": k,
                         "fraction": k / n if n else math.nan, "ci": (ci.low, ci.high) if ci else (math.nan,) * 2,
                         "rms": rms[ran], "progress": cols["progress"][counted],
+                        "estimate_off": int((cols["estimate_position_rms_m"][counted] > ESTIMATE_OFF_M).sum()),
                         "worst": [{name: cols[name][i].item() for name in cols} for i in idx],
                         "causes": causes[:3]})
     return out
@@ -91,8 +94,8 @@ def summary_text(table, spec, command):
              f"along the path ≥ {100 * spec.coverage:g} % of the reference's; {100 * CONFIDENCE:g} % intervals "
              "Clopper–Pearson.", "",
              "| task | controller | runs | counted apart | stopped | succeed | fraction | 95 % interval | "
-             "RMS p50 [mm] | p95 [mm] | max [mm] | least progress |",
-             "|---|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|"]
+             "RMS p50 [mm] | p95 [mm] | max [mm] | least progress | estimate off > 3 cm |",
+             "|---|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|"]
     for g in groups:
         rms = g["rms"]
         pct = np.percentile(rms, [50, 95]) if len(rms) else [math.nan] * 2
@@ -101,18 +104,19 @@ def summary_text(table, spec, command):
         lines.append(f"| {g['task']} | {g['controller']} | {g['runs']} | {g['apart']} | {g['stopped']} | "
                      f"{g['success']} / {g['n']} | {100 * g['fraction']:.1f} % | "
                      f"{100 * low:.1f}–{100 * high:.1f} % | {_mm(pct[0])} | {_mm(pct[1])} | "
-                     f"{_mm(rms.max() if len(rms) else math.nan)} | {least:.3f} |")
+                     f"{_mm(rms.max() if len(rms) else math.nan)} | {least:.3f} | {g['estimate_off']} |")
     lines += ["", f"Worst runs (rerun one: `{command} --rerun SAMPLE`):", "",
-              "| task | controller | sample | plant | RMS [mm] | progress | slope [fraction of limit] | "
-              "c_P shift [mm] | masses | dampings | start error [mm, deg] |",
-              "|---|---|---:|---:|---:|---:|---:|---|---|---|---|"]
+              "| task | controller | sample | plant | RMS [mm] | progress | estimate's position RMS [mm] | "
+              "slope [fraction of limit] | c_P shift [mm] | masses | dampings | start error [mm, deg] |",
+              "|---|---|---:|---:|---:|---:|---:|---:|---|---|---|---|"]
     for g in groups:
         for w in g["worst"]:
             masses = ", ".join(f"{n} {w[n]:.2f}" for n in ("m_S", "m_b", "m_h", "m_P"))
             damp = ", ".join(f"{n} {w[n]:.2f}" for n in ("k_S", "k_Y", "k_P"))
             shift = ", ".join(f"{1e3 * w[n]:+.1f}" for n in ("c_P_dx_m", "c_P_dy_m", "c_P_dz_m"))
             lines.append(f"| {g['task']} | {g['controller']} | {w['sample']} | {w['plant']} | "
-                         f"{_mm(w['cross_track_rms_m'])} | {w['progress']:.3f} | {w['slope_fraction']:+.3f} "
+                         f"{_mm(w['cross_track_rms_m'])} | {w['progress']:.3f} | "
+                         f"{_mm(w['estimate_position_rms_m'])} | {w['slope_fraction']:+.3f} "
                          f"(direction {math.degrees(w['slope_direction_rad']):.0f}°) | {shift} | {masses} | {damp} | "
                          f"{1e3 * w['dx0_m']:+.0f}, {1e3 * w['dy0_m']:+.0f}, {math.degrees(w['dpsi0_rad']):+.1f} |"
                          + ("" if w["status"] == 0 else f" status {w['status']}"))
