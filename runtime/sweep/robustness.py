@@ -36,7 +36,8 @@ is laid from the task's start pose; the robot starts `dx0_m`, `dy0_m` off it and
 runtime/control/estimator.py).  A plant is counted apart when its steady torque at the reference's
 speed would exceed u_max: its operating point on the flat at the path's curvatures (yoke and
 pendulum torques) plus the slope's pull along the heading (the whole of it where the path turns
-through every heading).
+through every heading); NaN, and the plant not counted apart, where Newton finds no operating point
+from level rolling (a centre of mass moved off the pendulum's plane can do that).
 """
 import dataclasses
 import functools
@@ -346,11 +347,14 @@ def run_one(spec, inputs):
     out.update(status=0, steps_done=0, counted_apart=0, success=0)
     try:
         plant = plant_of(task, inputs)
-        out["slope_rad"] = plant.slope
-        out["steady_torque_nm"] = steady_torque(task, plant, float(inputs["slope_direction_rad"]))
     except ValueError as exc:
         out["status"] = getattr(exc, "status", STATUS_BAD_PLANT)
         return out
+    out["slope_rad"] = plant.slope
+    try:
+        out["steady_torque_nm"] = steady_torque(task, plant, float(inputs["slope_direction_rad"]))
+    except ValueError:      # Newton found no operating point: the torque is unknown (NaN), the run is made
+        pass
     out["counted_apart"] = int(out["steady_torque_nm"] > task.u_max)
     reference = task.reference()
     x0 = task.scenario.x0.copy()
