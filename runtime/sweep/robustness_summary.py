@@ -150,6 +150,8 @@ def robustness_figure(table, spec, size=(11.0, 4.0)):
     for ax in (ecdf, slope):
         ax.axvline(1e3 * spec.rms_m, color="0.4", ls="--", lw=0.8) if ax is ecdf else \
             ax.axhline(1e3 * spec.rms_m, color="0.4", ls="--", lw=0.8)
+    ecdf.set_xscale("log")              # the RMS spans from the noise floor to runs the filter lost
+    slope.set_yscale("log")
     ecdf.set_xlabel("second-half cross-track RMS [mm]")
     ecdf.set_ylabel("fraction of runs")
     ecdf.legend(fontsize=7)
