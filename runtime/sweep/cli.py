@@ -15,6 +15,7 @@ written); 2 on a bad argument, sweep file or output folder.  Every error is one 
 import argparse
 import math
 import os
+import pathlib
 import sys
 
 from ..errors import SimulationStopped
@@ -22,8 +23,10 @@ from ..model import Model
 from ..atomic import write_text
 from ..state import IDX_Q
 from .runner import CONNECT_TIMEOUT, SERIAL, run_sweep, scheduler_address
+from .robustness import RobustnessSpec, with_nominal
+from .robustness_summary import summary_text, write_robustness_figure
 from .spec import MAX_SAMPLES, load_sweep, shipped_sweeps
-from .store import SweepIncomplete
+from .store import MANIFEST, SweepIncomplete, SweepStore
 from .summary import percentile_table, write_summary_figure
 
 #: Most worker processes of the embedded LocalCluster, per core (more only share the cores).
@@ -84,6 +87,13 @@ def build_parser():
     p.add_argument("--samples-per-task", type=_whole(1, MAX_SAMPLES),
                    help="task size (default: the file's, else ~2 s of work)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--rerun", type=_whole(0, MAX_SAMPLES - 1), metavar="SAMPLE",
+                   help="a robustness sweep: run this one sample here and print its row (nothing written)")
+    p.add_argument("--nominal", default="", metavar="GROUPS",
+                   help="with --rerun: comma-separated perturbations left out (masses, dampings, "
+                        "centre_of_mass, slope, start)")
+    p.add_argument("--finished", action="store_true",
+                   help="a robustness sweep: summarise the verified runs in --out so far, running nothing")
     return p
 
 
@@ -97,6 +107,52 @@ def nominal_end_point(spec):
     return tuple(traj[-1, IDX_Q][:2])
 
 
+def robustness_outputs(spec, table, args):
+    """Writes OUT/summary.md and OUT/summary.png of a robustness sweep; returns the summary."""
+    command = f"python -m runtime sweep {args.sweep} --out {args.out}" + \
+        (f" --samples {args.samples}" if args.samples is not None else "")
+    summary = summary_text(table, spec, command)
+    write_text(f"{args.out}/summary.md", summary + "\n")
+    write_robustness_figure(table, spec, f"{args.out}/summary.png")
+    return summary
+
+
+def _finished(spec, args):
+    """Summarises the verified chunks of an unfinished robustness sweep (OUT/summary.md, .png)."""
+    import pyarrow as pa
+    if not isinstance(spec, RobustnessSpec):
+        raise ValueError("--finished: only for a robustness sweep (a sweep file with [control])")
+    if not (pathlib.Path(args.out) / MANIFEST).is_file():
+        raise ValueError(f"--out: {args.out} holds no sweep")
+    store = SweepStore.open(args.out, spec, lambda: None)
+    tables = [table for a, b in store.chunks() if store.chunk_path(a, b).exists()
+              for table in [store.read_chunk(a, b)[0]] if table is not None]
+    if not tables:
+        raise ValueError(f"--finished: {args.out} holds no verified runs yet")
+    table = pa.concat_tables(tables)
+    summary = (f"Unfinished: {table.num_rows} of the sweep's {spec.samples} runs.\n\n"
+               + robustness_outputs(spec, table, args))
+    write_text(f"{args.out}/summary.md", summary + "\n")
+    print(summary)
+    return 0
+
+
+def _rerun(spec, sample, nominal=()):
+    """Runs one sample of a robustness sweep (the perturbation groups `nominal` left out) and prints
+    its inputs and outcome, one per line."""
+    if not isinstance(spec, RobustnessSpec):
+        raise ValueError("--rerun: only for a robustness sweep (a sweep file with [control])")
+    if sample >= spec.samples:
+        raise ValueError(f"--rerun: the sweep has samples 0..{spec.samples - 1}, got {sample}")
+    with_nominal({}, nominal)                 # names the unknown group before anything runs
+    row = spec.run_chunk(sample, sample + 1, nominal)
+    task, kind = spec.combos[int(row["task"][0]) * len(spec.controllers) + int(row["controller"][0])]
+    print(f"task {task}, controller {kind}")
+    for name, values in row.items():
+        print(f"{name} = {values[0].item()!r}")
+    return 0 if row["status"][0] == 0 else 1
+
+
 def main(argv):
     """`python -m runtime sweep`: run (or resume) a sweep and write its store and summary."""
     try:
@@ -104,9 +160,17 @@ def main(argv):
         spec = load_sweep(args.sweep)
         if args.samples is not None:
             spec = spec.with_samples(args.samples)
+        if args.rerun is not None:
+            return _rerun(spec, args.rerun, [g for g in args.nominal.split(",") if g])
+        if args.finished:
+            return _finished(spec, args)
         table = run_sweep(spec, args.out, scheduler=args.scheduler, workers=args.workers,
                           samples_per_task=args.samples_per_task, progress=not args.no_progress,
                           connect_timeout=args.connect_timeout)
+        if isinstance(spec, RobustnessSpec):
+            summary = robustness_outputs(spec, table, args)
+            print(summary)
+            return 1 if any(s != 0 for s in table.column("status").to_pylist()) else 0
         first = spec.quantities[0] if spec.quantities else None
         write_summary_figure(table, f"{args.out}/summary.png", spec.name, colour_by=first and first.name,
                              colour_label=first and (f"{first.name} (factor)" if first.relative else first.name),

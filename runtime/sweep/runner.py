@@ -58,6 +58,8 @@ def memory_estimate(spec, samples_per_task, at_once=1):
     samples running at once (parameters, initial and final states, a torque program per sample
     when a torque factor varies, the result columns), and the unvaried scenario's run that the
     summary's figure marks."""
+    if hasattr(spec, "memory_estimate"):      # a robustness sweep sizes its own runs
+        return spec.memory_estimate(samples_per_task, at_once)
     columns = len(column_names(spec))
     steps = spec.scenario.steps
     per_sample = 8 * (lib.SR_NPARAM + 2 * NX + columns + 2 * (len(spec.quantities) + 1))

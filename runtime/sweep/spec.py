@@ -38,6 +38,7 @@ from bindings._sr import lib
 from ..params import PAPER_NAMES, Params, paper_rows_to_params
 from ..schema import Range, check_range, check_ranges, check_table
 from ..scenario import ROBOT_RANGES, SCENARIO_RANGES, Scenario, load_scenario
+from .robustness import CONTROL_RANGES, is_robustness, parse_robustness
 from ..state import IDX_QZ, IDX_RP, IDX_RY, IDX_WP, IDX_WY, IDX_UP, IDX_UY, pendulum_angle, rot_x, rot_y, yoke_angle
 
 #: A sweep varies parameters by the paper's names (r, m_S, k_S, b, h, m_b, m_h, k_Y, l, m_P, k_P,
@@ -71,6 +72,8 @@ SWEEP_RANGES = {
     "initial": {key: SCENARIO_RANGES["initial"][key] for key in INITIAL_KEYS},
     "torque": {key: Range(-1e3, 1e3, "", "a factor on the scenario's torques") for key in TORQUE_KEYS},
 }
+#: A robustness sweep's `[control]` (runtime/sweep/robustness.py).
+SWEEP_RANGES["control"] = CONTROL_RANGES
 
 
 def quantity_range(name, relative):
@@ -154,6 +157,8 @@ def load_sweep(name_or_path):
         raise ValueError(f"{path}: not valid TOML ({exc})") from None
     except OSError as exc:
         raise ValueError(f"{path}: cannot be read ({exc.strerror})") from None
+    if is_robustness(data):
+        return parse_robustness(data, source=str(path), name=path.stem)
     return parse_sweep(data, source=str(path), name=path.stem, folder=path.parent)
 
 
@@ -277,6 +282,8 @@ def _count(value, where):
 # -- the inputs of samples start..stop-1 ----------------------------------------------------------
 def quantity_values(spec, start, stop):
     """{quantity name: (n,) values} of samples start..stop-1 (as drawn, before `relative` applies)."""
+    if hasattr(spec, "draw"):                 # a robustness sweep draws its own
+        return spec.draw(start, stop)
     n = stop - start
     values = {q.name: np.empty(n) for q in spec.quantities}
     grid = spec.grid

@@ -73,6 +73,8 @@ def sweep_digest(spec):
 def chunk_schema(spec):
     """The Arrow schema of a chunk's rows (without metadata)."""
     types = {"sample": pa.int64(), "status": pa.int32(), "steps_done": pa.int64()}
+    if hasattr(spec, "arrow_types"):
+        types.update(spec.arrow_types())
     return pa.schema([(name, types.get(name, pa.float64())) for name in column_names(spec)])
 
 

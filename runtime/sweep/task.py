@@ -15,11 +15,15 @@ OUTCOME_COLUMNS = ("status", "steps_done") + METRIC_NAMES + ("end_x", "end_y")
 
 def column_names(spec):
     """The columns of the result table, in order: sample, the quantities by name, the outcome."""
+    if hasattr(spec, "columns"):              # a robustness sweep has its own outcome
+        return spec.columns()
     return ("sample",) + tuple(q.name for q in spec.quantities) + OUTCOME_COLUMNS
 
 
 def run_chunk(spec, start, stop):
     """{column: (stop-start,) array} for samples start..stop-1 (failed samples: NaN metrics)."""
+    if hasattr(spec, "run_chunk"):            # a robustness sweep: closed loops, not one C batch
+        return spec.run_chunk(start, stop)
     params, x0, u, values = sample_inputs(spec, start, stop)
     s = spec.scenario
     result = simulate_many(params, x0, s.dt, s.steps, u, method=s.method)

@@ -51,7 +51,7 @@ def test_a_quantity_takes_the_range_of_what_it_varies(name, relative, expected):
 @pytest.mark.parametrize("name", shipped_sweeps())
 def test_every_shipped_sweep_fits_the_budget(name):
     spec = load_sweep(name)
-    assert runner.check_memory(spec, spec.samples_per_task or 1000, at_once=4) < 64 * 2**20
+    assert runner.check_memory(spec, spec.samples_per_task or 1000, at_once=4) < 4 * 32 * 2**20
 
 
 def test_the_estimate_holds_a_torque_program_per_sample_when_a_torque_factor_varies(spec):

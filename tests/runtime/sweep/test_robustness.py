@@ -1,0 +1,121 @@
+"""The robustness sweep: closed loops on the estimator over drawn plants, judged by the success rule."""
+import math
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from runtime.__main__ import main
+from runtime.control.reference import circle_path, line_path
+from runtime.sweep.robustness import DRAWN, GROUPS, judge, with_nominal
+from runtime.sweep.spec import load_sweep
+
+SMALL = """
+description = "a handful of plants, cut short"
+samples = 3
+seed = 7
+samples_per_task = 2
+
+[control]
+tasks = ["line"]
+controllers = ["lqr"]
+sensors = "default"
+duration = 1.0
+"""
+
+SPEED = 0.3
+
+
+def _sweep(tmp_path, text=SMALL):
+    path = tmp_path / "small.toml"
+    path.write_text(text)
+    return path
+
+
+def test_a_handful_of_plants_run_through_the_sweep_command_into_a_table_a_summary_and_a_figure(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["sweep", str(_sweep(tmp_path)), "--out", str(out), "--scheduler", "serial", "--no-progress"]) == 0
+    rows = pq.read_table(out / "results.parquet").to_pydict()
+    assert rows["sample"] == [0, 1, 2] and rows["plant"] == [0, 1, 2]
+    assert rows["status"] == [0, 0, 0] and all(n == 200 for n in rows["steps_done"])
+    assert len(set(rows["m_P"])) == 3 and len(set(rows["cross_track_rms_m"])) == 3
+    summary = (out / "summary.md").read_text()
+    assert "| line | lqr | 3 | 0 | 0 |" in summary
+    assert (out / "summary.png").stat().st_size > 0
+    # a row is what rerunning its sample alone gives
+    capsys.readouterr()
+    assert main(["sweep", str(_sweep(tmp_path)), "--out", str(out), "--rerun", "2"]) == 0
+    printed = capsys.readouterr().out
+    assert f"cross_track_rms_m = {rows['cross_track_rms_m'][2]!r}" in printed
+
+
+def test_every_run_of_a_plant_sees_the_same_robot_and_the_runs_cycle_through_tasks_and_controllers(tmp_path):
+    spec = load_sweep("control-robustness")
+    draws = spec.draw(0, 12)
+    assert list(draws["plant"]) == [0] * 6 + [1] * 6
+    assert list(draws["task"]) == [0, 0, 1, 1, 2, 2] * 2 and list(draws["controller"]) == [0, 1] * 6
+    for name in DRAWN:
+        assert len(set(draws[name][:6])) == 1 and draws[name][0] != draws[name][6]
+
+
+def test_the_drawn_plants_stay_within_the_files_ranges(tmp_path):
+    spec = load_sweep(str(_sweep(tmp_path))).with_samples(400)
+    draws = spec.draw(0, 400)
+    for name in ("m_S", "m_b", "m_h", "m_P"):
+        assert np.all(np.abs(draws[name] - 1) <= 0.2)
+    for name in ("k_S", "k_Y", "k_P"):
+        assert np.all(np.abs(draws[name] - 1) <= 0.3) and np.abs(draws[name] - 1).max() > 0.25
+    shift = np.linalg.norm([draws["c_P_dx_m"], draws["c_P_dy_m"], draws["c_P_dz_m"]], axis=0)
+    assert shift.max() <= 0.01 and shift.max() > 0.009
+    assert np.all(np.abs(draws["slope_fraction"]) <= 0.25)
+    assert np.all(np.abs(draws["dx0_m"]) <= 0.05) and np.all(np.abs(draws["dpsi0_rad"]) <= math.radians(5))
+    assert set(DRAWN) <= set(draws)
+
+
+@pytest.fixture
+def line():
+    return line_path(np.zeros(2), 0.0, 0.0, 12.0 + 2.0, SPEED)
+
+
+def _along(t, offset=0.0, stall_after=None):
+    x = SPEED * (t if stall_after is None else np.minimum(t, stall_after))
+    return np.stack([x, np.full_like(t, offset)], axis=1)
+
+
+def test_a_run_on_the_path_at_the_reference_speed_succeeds(line):
+    t = np.linspace(0.0, 40.0, 401)
+    rms, _, progress, ok = judge(line, t, _along(t, offset=0.01), 0.03, 0.9)
+    assert rms == pytest.approx(0.01) and progress == pytest.approx(1.0, abs=0.01) and ok
+
+
+def test_a_run_that_stalls_on_the_path_fails(line):
+    t = np.linspace(0.0, 40.0, 401)
+    rms, _, progress, ok = judge(line, t, _along(t, stall_after=20.0), 0.03, 0.9)
+    assert rms == pytest.approx(0.0, abs=1e-9) and progress == pytest.approx(0.5, abs=0.01)
+    assert not ok
+
+
+def test_a_run_that_goes_far_off_the_path_fails(line):
+    t = np.linspace(0.0, 40.0, 401)
+    rms, _, progress, ok = judge(line, t, _along(t, offset=0.2), 0.03, 0.9)
+    assert rms == pytest.approx(0.2) and progress == pytest.approx(1.0, abs=0.01) and not ok
+
+
+def test_laps_of_a_circle_count_as_progress():
+    circle = circle_path(np.zeros(2), 0.0, 2.0, 20.0, SPEED)
+    t = np.linspace(0.0, 60.0, 3001)
+    angle = SPEED * t / 2.0 - math.pi / 2
+    positions = np.stack([2.0 * np.cos(angle), 2.0 + 2.0 * np.sin(angle)], axis=1)
+    _, _, progress, ok = judge(circle, t, positions, 0.03, 0.9)
+    assert progress == pytest.approx(1.0, abs=0.01) and ok
+
+
+def test_a_rerun_can_leave_out_one_perturbation_at_a_time(tmp_path):
+    spec = load_sweep(str(_sweep(tmp_path)))
+    drawn = {k: v[0].item() for k, v in spec.draw(0, 1).items()}
+    for group, values in GROUPS.items():
+        changed = with_nominal(drawn, [group])
+        assert all(changed[k] == v for k, v in values.items())
+        assert all(changed[k] == drawn[k] for k in drawn if k not in values)
+    with pytest.raises(ValueError, match="--nominal: 'mass' is not one of masses"):
+        with_nominal(drawn, ["mass"])
