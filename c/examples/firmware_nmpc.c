@@ -129,7 +129,9 @@ int main(void)
         uint32_t start;
 #endif
         /* The library's atan2, not libm's: the double build then matches its host build bit for bit. */
-        target.heading = sr_atan2(dy, dx) + half_pi;
+        sr_real bearing;
+        if (sr_atan2(dy, dx, &bearing) != SR_OK) return 1;
+        target.heading = bearing + half_pi;
         target.cross_track = (sr_real)NMPC_TASK_RADIUS - SQRT(dx * dx + dy * dy);
 #ifdef HAVE_SYSTICK
         start = SYST_CVR;

@@ -800,11 +800,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     EXPECT_STATUS("sr_so3_exp", status, SR_OK, SR_ERR_NONFINITE);
     expect("sr_so3_exp", status, &g, status == SR_OK ? 9 : 0, 1);
     {
-        /* the library's atan2: an angle in [-pi, pi] for any two non-NaN arguments, NaN otherwise */
-        const sr_real ay = pick(&rd, 0.3), ax = pick(&rd, -0.7), angle = sr_atan2(ay, ax);
-        const int nan_in = ay != ay || ax != ax;
-        if (nan_in ? angle == angle : !(angle >= -SR_C(3.1415927) && angle <= SR_C(3.1415927)))
-            fail("sr_atan2", SR_OK, nan_in ? "no NaN for a NaN argument" : "an angle outside [-pi, pi]");
+        /* the library's atan2: an angle in [-pi, pi] for two finite arguments, SR_ERR_NONFINITE otherwise */
+        const sr_real ay = pick(&rd, 0.3), ax = pick(&rd, -0.7);
+        sr_real angle = SR_C(9.0);
+        const int finite_in = ay - ay == 0 && ax - ax == 0;
+        status = sr_atan2(ay, ax, &angle);
+        if (status != (finite_in ? SR_OK : SR_ERR_NONFINITE))
+            fail("sr_atan2", status, finite_in ? "refused two finite arguments" : "accepted a NaN or an infinity");
+        else if (finite_in ? !(angle >= -SR_C(3.1415927) && angle <= SR_C(3.1415927)) : angle != SR_C(9.0))
+            fail("sr_atan2", status, finite_in ? "an angle outside [-pi, pi]" : "wrote its output on an error");
     }
 
     /* batches: two rows, the second a copy of x with one more perturbation */

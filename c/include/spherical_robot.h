@@ -80,6 +80,7 @@ extern "C" {
 #define sr_contact_force sr_contact_force_f
 #define sr_contact_force_batch sr_contact_force_batch_f
 #define sr_so3_exp sr_so3_exp_f
+#define sr_atan2 sr_atan2_f
 #define sr_step sr_step_f
 #define sr_step_lie_euler sr_step_lie_euler_f
 #define sr_step_rkmk4 sr_step_rkmk4_f
@@ -300,8 +301,10 @@ int sr_contact_force_batch(const sr_model *model, long n, const sr_real *x, cons
 /** atan2(y, x) as the library computes it (its controllers' headings and pendulum angles): in
  * double the library's own, the same bits on every platform (within 2 ulp of the exact value, with
  * C99's values at zeros and infinities), so that a firmware computing its targets with it matches
- * its host build bit for bit; in float libm's atan2f (or libm's atan2 with -DSR_LIBM_TRIG). */
-sr_real sr_atan2(sr_real y, sr_real x);
+ * its host build bit for bit; in float libm's atan2f (or libm's atan2 with -DSR_LIBM_TRIG).  Writes
+ * *angle in [-pi, pi].  Returns SR_OK, SR_ERR_NULL (angle) or SR_ERR_NONFINITE (y or x NaN or
+ * infinite; *angle untouched). */
+int sr_atan2(sr_real y, sr_real x, sr_real *angle);
 
 /** R = Exp([[w]]) by Rodrigues' formula, with a series branch for |w| < 1e-4 rad.
  * SR_ERR_NONFINITE (R untouched) if w is not finite or |w|^2 overflows. */

@@ -36,6 +36,7 @@
  * The float build's atan2 is libm's atan2f: the float build is held to a tolerance, not to bits.
  */
 #include "sr_math.h"
+#include "sr_finite.h"
 
 #if defined(SR_USE_FLOAT) && !defined(SR_LIBM_TRIG)
 
@@ -271,4 +272,11 @@ double sr_internal_atan2(double y, double x)
 
 #endif
 
-sr_real sr_atan2(sr_real y, sr_real x) { return SR_ATAN2(y, x); }
+int sr_atan2(sr_real y, sr_real x, sr_real *angle)
+{
+    const sr_real yx[2] = {y, x};
+    if (!angle) return SR_ERR_NULL;
+    if (!all_finite(yx, 2)) return SR_ERR_NONFINITE;
+    *angle = SR_ATAN2(y, x);
+    return SR_OK;
+}

@@ -113,7 +113,16 @@ static void test_own_atan2_gives_c99s_values_at_zeros_infinities_and_nan(void)
 static void test_the_public_atan2_is_the_librarys_own(void)
 {
     const double y = 0.7315, x = -0.2201;
-    CHECK(sr_atan2(y, x) == sr_internal_atan2(y, x));
+    double angle = 0.0;
+    CHECK(sr_atan2(y, x, &angle) == SR_OK && angle == sr_internal_atan2(y, x));
+}
+
+static void test_the_public_atan2_refuses_nan_infinities_and_a_null_output(void)
+{
+    double angle = 5.0;
+    CHECK(sr_atan2(NAN, 1.0, &angle) == SR_ERR_NONFINITE && angle == 5.0);
+    CHECK(sr_atan2(1.0, HUGE_VAL, &angle) == SR_ERR_NONFINITE && angle == 5.0);
+    CHECK(sr_atan2(1.0, 1.0, NULL) == SR_ERR_NULL);
 }
 
 void suite_trig(void)
@@ -124,6 +133,7 @@ void suite_trig(void)
     RUN_TEST(test_own_atan2_is_within_two_ulp_of_libm_in_every_quadrant);
     RUN_TEST(test_own_atan2_gives_c99s_values_at_zeros_infinities_and_nan);
     RUN_TEST(test_the_public_atan2_is_the_librarys_own);
+    RUN_TEST(test_the_public_atan2_refuses_nan_infinities_and_a_null_output);
 }
 
 #elif !defined(SR_LIBM_TRIG)

@@ -238,3 +238,30 @@ def gains(A, B, period, weights=Weights(), path=True):
     K = np.zeros((2, NZ))
     K[:, keep] = np.where(np.abs(K_keep) < SYMMETRY_ZERO * np.abs(K_keep).max(), 0.0, K_keep)
     return K
+
+
+@dataclasses.dataclass(frozen=True)
+class Schedule:
+    """Operating points on a grid: z_star (nv, nk, NZ), u_star (nv, nk, 2), K_path / K_heading (nv, nk, 2, NZ)."""
+    speeds: np.ndarray
+    curvatures: np.ndarray
+    z_star: np.ndarray
+    u_star: np.ndarray
+    K_path: np.ndarray
+    K_heading: np.ndarray
+
+    def at(self, v, kappa):
+        """(z*, u*, K_path, K_heading) bilinearly interpolated, clamped to the grid."""
+        def bracket(grid, value):
+            if len(grid) == 1:
+                return 0, 0, 0.0
+            i = int(np.clip(np.searchsorted(grid, value) - 1, 0, len(grid) - 2))
+            w = float(np.clip((value - grid[i]) / (grid[i + 1] - grid[i]), 0.0, 1.0))
+            return i, i + 1, w
+        i0, i1, wv = bracket(self.speeds, v)
+        j0, j1, wk = bracket(self.curvatures, kappa)
+
+        def mix(a):
+            return ((1 - wv) * ((1 - wk) * a[i0, j0] + wk * a[i0, j1])
+                    + wv * ((1 - wk) * a[i1, j0] + wk * a[i1, j1]))
+        return mix(self.z_star), mix(self.u_star), mix(self.K_path), mix(self.K_heading)

@@ -31,6 +31,7 @@ from ..model import Model
 from ..so3 import rot_z
 from ..state import IDX_NU, IDX_Q, IDX_RS
 from . import lqr_design as design
+from .lqr_design import Schedule
 
 #: The slope [rad] at which the operating points' derivatives are taken (small: first order; large
 #: enough that Newton's tolerance is far below the change).
@@ -77,7 +78,6 @@ class SlopeSchedule:
     def at(self, v, kappa, up, right):
         """(Δz*, Δu*) for the slope components `up` (along the path) and `right` [rad], interpolated
         bilinearly in (v, κ) as the LQR's schedule is."""
-        from .lqr import Schedule
         zero = np.zeros(self.du_up.shape[:2] + (2, design.NZ))
         a = Schedule(self.speeds, self.curvatures, self.dz_up, self.du_up, zero, zero).at(v, kappa)
         b = Schedule(self.speeds, self.curvatures, self.dz_right, self.du_right, zero, zero).at(v, kappa)
