@@ -26,27 +26,13 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from runtime.atomic import write_new_file  # noqa: E402
-from runtime.bench.harness import LIBRARY_FLAGS, _compiler, _library_sources  # noqa: E402
+from runtime.bench.harness import LIBRARY_FLAGS, _compiler, compile_library, with_baseline  # noqa: E402
 from runtime.bench.timing import cpu_name  # noqa: E402
 
 #: The bench's EKF build (runtime.bench.harness.ekf_sample): portable, -O2, no contraction.
 FLAGS = [f for f in LIBRARY_FLAGS if f != "-O3"] + ["-O2", "-ffp-contract=off"]
 #: bench_ekf's PARTS: what each counted run does.
 PARTS = {"predict_imu_encoders": 7, "predict": 1, "update_imu": 2, "update_encoders": 4}
-
-
-def compile_objects(folder):
-    """The library's objects in `folder`, rebuilt when a source or a header is newer."""
-    sources = _library_sources()
-    newest_header = max(p.stat().st_mtime for d in ("generated", "c/include", "c/src") for p in (ROOT / d).glob("*.h"))
-    objects = [folder / (src.stem + ".o") for src in sources]
-    stale = [(src, obj) for src, obj in zip(sources, objects)
-             if not obj.exists() or obj.stat().st_mtime < max(src.stat().st_mtime, newest_header)]
-    for k in range(0, len(stale), 2):     # two compilers at a time: the machine's two cores
-        jobs = [subprocess.Popen([_compiler(), *FLAGS, "-c", str(src), "-o", str(obj)]) for src, obj in stale[k:k + 2]]
-        if any(job.wait() for job in jobs):
-            sys.exit("compilation failed")
-    return objects
 
 
 def instructions(exe, samples, parts):
@@ -75,16 +61,10 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         folder = args.objects or pathlib.Path(tmp)
         folder.mkdir(parents=True, exist_ok=True)
-        objects = compile_objects(folder)
+        objects = compile_library(folder, FLAGS)
         builds = {"current": objects}
         if args.baseline:
-            old = folder / "baseline" / "sr_ekf.c"
-            old.parent.mkdir(exist_ok=True)
-            old.write_bytes(subprocess.run(["git", "show", f"{args.baseline}:c/src/sr_ekf.c"], cwd=ROOT, check=True,
-                                           capture_output=True).stdout)
-            subprocess.run([_compiler(), *FLAGS, f"-I{ROOT / 'c' / 'src'}", "-c", str(old), "-o",
-                            str(old.with_suffix(".o"))], check=True)
-            builds = {"baseline": [old.with_suffix(".o") if o.stem == "sr_ekf" else o for o in objects],
+            builds = {"baseline": with_baseline(folder, objects, "sr_ekf.c", args.baseline, FLAGS),
                       "current": objects}
         exes = {}
         for label, objs in builds.items():

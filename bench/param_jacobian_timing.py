@@ -23,7 +23,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from runtime.atomic import write_new_file  # noqa: E402
-from runtime.bench.harness import LIBRARY_FLAGS, _compiler, _library_sources, general_robot  # noqa: E402
+from runtime.bench.harness import LIBRARY_FLAGS, _compiler, compile_library, general_robot, with_baseline  # noqa: E402
 from runtime.param_derivatives import random_states  # noqa: E402
 from runtime.params import Params  # noqa: E402
 from runtime.bench.timing import cpu_name  # noqa: E402
@@ -48,25 +48,10 @@ def main():
         exe = pathlib.Path(tmp) / "param_jacobian_timing"
         folder = args.objects or pathlib.Path(tmp)
         folder.mkdir(parents=True, exist_ok=True)
-        sources = _library_sources()
-        newest_header = max(p.stat().st_mtime for d in ("generated", "c/include", "c/src") for p in (ROOT / d).glob("*.h"))
-        objects = [folder / (src.stem + ".o") for src in sources]
-        stale = [(src, obj) for src, obj in zip(sources, objects)
-                 if not obj.exists() or obj.stat().st_mtime < max(src.stat().st_mtime, newest_header)]
-        for k in range(0, len(stale), 2):     # two compilers at a time: the machine's two cores
-            jobs = [subprocess.Popen([_compiler(), *LIBRARY_FLAGS, "-c", str(src), "-o", str(obj)])
-                    for src, obj in stale[k:k + 2]]
-            if any(job.wait() for job in jobs):
-                sys.exit("compilation failed")
+        objects = compile_library(folder, LIBRARY_FLAGS)
         builds = {"current": objects}
         if args.baseline:
-            old = folder / "baseline" / "sr_param_jacobians.c"
-            old.parent.mkdir(exist_ok=True)
-            old.write_bytes(subprocess.run(["git", "show", f"{args.baseline}:c/src/sr_param_jacobians.c"], cwd=ROOT,
-                                           check=True, capture_output=True).stdout)
-            subprocess.run([_compiler(), *LIBRARY_FLAGS, f"-I{ROOT / 'c' / 'src'}", "-c", str(old), "-o",
-                            str(old.with_suffix(".o"))], check=True)
-            builds = {"baseline": [old.with_suffix(".o") if o.stem == "sr_param_jacobians" else o for o in objects],
+            builds = {"baseline": with_baseline(folder, objects, "sr_param_jacobians.c", args.baseline, LIBRARY_FLAGS),
                       "current": objects}
         exes = {}
         for label, objs in builds.items():

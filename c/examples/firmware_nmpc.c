@@ -44,39 +44,10 @@
 
 static sr_nmpc_memory memory; /* the controller's whole workspace, static: no heap, not on the stack */
 
-#if defined(__ARM_ARCH_7M__) || defined(__ARM_ARCH_7EM__)
-#define HAVE_SYSTICK 1
-#include <stdint.h>
-/* SysTick (Armv7-M): a 24-bit down-counter of the processor clock, free-running, no interrupt. */
-#define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
-#define SYST_RVR (*(volatile uint32_t *)0xE000E014u)
-#define SYST_CVR (*(volatile uint32_t *)0xE000E018u)
-#define SYSTICK_MASK 0xFFFFFFu
+#include "systick.h"
 
-static void systick_start(void)
-{
-    SYST_RVR = SYSTICK_MASK;
-    SYST_CVR = 0;
-    SYST_CSR = 5u; /* enable, processor clock */
-}
-
-static uint32_t ticks_since(uint32_t start) { return (start - SYST_CVR) & SYSTICK_MASK; }
-
-/* Instructions per SysTick tick: a loop of 2^20 iterations of two instructions (subs, bne). */
-static double instructions_per_tick(void)
-{
-    uint32_t n = 1u << 20, start = SYST_CVR;
-    __asm__ volatile("1: subs %0, %0, #1\n\tbne 1b" : "+r"(n)::"cc");
-    return 2.0 * (double)(1u << 20) / (double)ticks_since(start);
-}
-
+#ifdef HAVE_SYSTICK
 static uint32_t sample_ticks[NMPC_FIRMWARE_SAMPLES];
-
-static int by_ticks(const void *a, const void *b)
-{
-    const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
-    return (x > y) - (x < y);
-}
 #endif
 
 static void print_header(void)

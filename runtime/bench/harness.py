@@ -50,6 +50,33 @@ def _library_sources():
     return [p for d in ("generated", "c/src") for p in sorted((ROOT / d).glob("*.c"))]
 
 
+def compile_library(folder, flags):
+    """The library's objects compiled with `flags` into `folder`, each rebuilt only when its source or
+    a header is newer (a bench's --objects folder is kept between runs)."""
+    sources = _library_sources()
+    newest_header = max(p.stat().st_mtime for d in ("generated", "c/include", "c/src") for p in (ROOT / d).glob("*.h"))
+    objects = [folder / (src.stem + ".o") for src in sources]
+    stale = [(src, obj) for src, obj in zip(sources, objects)
+             if not obj.exists() or obj.stat().st_mtime < max(src.stat().st_mtime, newest_header)]
+    for k in range(0, len(stale), 2):     # two compilers at a time: the machine's two cores
+        jobs = [subprocess.Popen([_compiler(), *flags, "-c", str(src), "-o", str(obj)]) for src, obj in stale[k:k + 2]]
+        if any(job.wait() for job in jobs):
+            raise RuntimeError("compilation of the library failed")
+    return objects
+
+
+def with_baseline(folder, objects, source, revision, flags):
+    """`objects` with the one built from c/src/`source` replaced by that file as it was at the git
+    `revision`, compiled with `flags` into folder/baseline: the same library before a change."""
+    old = folder / "baseline" / source
+    old.parent.mkdir(exist_ok=True)
+    old.write_bytes(subprocess.run(["git", "show", f"{revision}:c/src/{source}"], cwd=ROOT, check=True,
+                                   capture_output=True).stdout)
+    subprocess.run([_compiler(), *flags, f"-I{ROOT / 'c' / 'src'}", "-c", str(old), "-o", str(old.with_suffix(".o"))],
+                   check=True)
+    return [old.with_suffix(".o") if o.stem == old.stem else o for o in objects]
+
+
 def build_harness(build, native, with_casadi, kane=None):
     """The C loop's executable; `kane` = (sources, macros) of runtime/bench/kane_compiled.write_kane_c."""
     cc = _compiler()
