@@ -19,6 +19,7 @@ COMMANDS = {
     "errata": ("runtime.verification.errata", "the paper's printed formulas against the kernels (docs/errata.md)"),
     "stability": ("runtime.stability", "eigenvalues and Floquet exponents; writes docs/figures/rolling-stability.png"),
     "envelope": ("runtime.control.envelope", "what the torque limits allow (make envelope)"),
+    "noise-floor": ("runtime.control.noise_floor", "the LQR's steady wander under a sensor set's process noise, and its floor"),
     "climbing": ("runtime.control.climbing", "the climbing limit on a slope; writes docs/figures/climbing-limit.png"),
     "nmpc-c": ("runtime.control.nmpc_c", "the C NMPC: its design as C, its timing in a C loop, its QPs against DAQP"),
     "firmware-table": ("runtime.control.firmware", "the firmware examples' LQR gain table, generated/lqr_task.h, and the estimator example's vector (make generate)"),
