@@ -20,14 +20,12 @@ import math
 
 import numpy as np
 
-from ..model import Model
-from . import lqr_design as design
-from .lqr import LqrGains
+# The model and the LQR's design are imported where used: the command refuses bad options at once.
 
-#: The heading error's coordinate: E_z, the yoke's attitude error about the vertical.
-Z_HEADING = design.Z_E.start + 2
+#: The heading error's coordinate in lqr_design's z: E_z, the yoke's attitude error about the vertical.
+Z_HEADING = 2
 #: The lean's coordinate: E_y.
-Z_LEAN = design.Z_E.start + 1
+Z_LEAN = 1
 #: Quadrature points over one period of the noise's integral (its integrand is smooth: e^{Aτ}).
 NOISE_QUADRATURE = 20
 
@@ -52,6 +50,7 @@ def noise_covariance(model, z_star, v, A, densities, period):
     put onto the rates z[4:9] by M⁻¹ at the operating point z* of speed v and integrated over one
     period through e^{Aτ} (midpoint rule in NOISE_QUADRATURE pieces)."""
     from scipy.linalg import expm
+    from . import lqr_design as design
     x = design.lift(z_star, v, model.params.r)
     G = np.zeros((design.NZ, 5))
     G[design.Z_OM.start:design.Z_WP + 1] = np.linalg.inv(model.inertia(x))
@@ -64,10 +63,15 @@ def noise_covariance(model, z_star, v, A, densities, period):
     return out
 
 
-def wander(params, densities, v, kappa=0.0, path=True, rate=50.0, u_max=0.5, gains=LqrGains()):
-    """The Wander of the LQR designed with `gains` (at the torque bound u_max [N·m]) at (v, κ) under
-    the white torque of densities (5,) [N·m/√Hz] (a sensor set's `process.generalized()`)."""
+def wander(params, densities, v, kappa=0.0, path=True, rate=50.0, u_max=0.5, gains=None):
+    """The Wander of the LQR designed with `gains` (an LqrGains; None: the shipped ones) at the torque
+    bound u_max [N·m] at (v, κ) under the white torque of densities (5,) [N·m/√Hz] (a sensor set's
+    `process.generalized()`)."""
     from scipy.linalg import solve_discrete_lyapunov
+    from ..model import Model
+    from . import lqr_design as design
+    from .lqr import LqrGains
+    gains = LqrGains() if gains is None else gains
     densities = np.asarray(densities, dtype=float)
     if densities.shape != (5,) or not np.all(np.isfinite(densities)) or np.any(densities < 0):
         raise ValueError(f"densities: expected 5 finite values >= 0 [N m/sqrt(Hz)], got {densities!r}")
@@ -110,16 +114,17 @@ def main(argv=()):
     under the sensor set's process noise: on the paths at the shipped gains and tighter cross-track
     weights, on the heading step at the shipped gains, a tighter heading weight, and with the torque
     nearly free (the floor no gains go below)."""
-    from ..sensor_set import load_sensor_set
-    from .metrics import HEADING_BAND_RAD
-    from .task import load_task
     parser = argparse.ArgumentParser(prog="python -m runtime noise-floor")
     parser.add_argument("--sensors", default="default", help="a shipped sensor set or a sensors file")
     parser.add_argument("--hold", type=float, default=18.4,
                         help="how long [s] the heading must stay in its ±3° band (a 30 s step settled by 11.6 s)")
     args = parser.parse_args(list(argv))
-    if not args.hold > 0:
-        parser.error(f"--hold: must be > 0 s, got {args.hold:g}")
+    if not (math.isfinite(args.hold) and 0 < args.hold <= 3600):
+        parser.error(f"--hold: must be a time in (0, 3600] s, got {args.hold:g}")
+    from ..sensor_set import load_sensor_set
+    from .lqr import LqrGains
+    from .metrics import HEADING_BAND_RAD
+    from .task import load_task
     try:
         densities = load_sensor_set(args.sensors).process.generalized()
     except ValueError as exc:

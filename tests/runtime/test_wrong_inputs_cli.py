@@ -60,6 +60,7 @@ OPTIONS = {
                {"--duration": NOT_A_NUMBER + NOT_POSITIVE, "--harmonics": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER,
                 "--iterations": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER,
                 "--seed": NOT_A_NUMBER + ["-1", "-5"] + NOT_AN_INTEGER, "--params": ["", ",", "k_X", "k_S,k_S"]}),
+    "noise-floor": ([], {"--hold": NOT_A_NUMBER + NOT_POSITIVE + ["inf", "nan", "1e9"], "--sensors": ["no-such-set", ""]}),
     "sweep-bench": ([], {"--samples": NOT_A_NUMBER + NOT_POSITIVE, "--samples-per-task": NOT_A_NUMBER + NOT_POSITIVE,
                          "--noop-tasks": NOT_A_NUMBER + NOT_POSITIVE, "--rounds": NOT_A_NUMBER + NOT_POSITIVE}),
 }

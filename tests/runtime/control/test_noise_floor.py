@@ -71,3 +71,8 @@ def test_bad_densities_are_refused_by_name(densities):
 def test_the_command_refuses_a_hold_time_of_zero():
     with pytest.raises(SystemExit):
         noise_floor.main(["--hold", "0"])
+
+
+def test_the_heading_and_lean_coordinates_are_the_designs():
+    from runtime.control import lqr_design
+    assert (noise_floor.Z_LEAN, noise_floor.Z_HEADING) == (lqr_design.Z_E.start + 1, lqr_design.Z_E.start + 2)
