@@ -18,9 +18,9 @@
 #define SR_FMOD fmod
 #endif
 
-/* The Joseph form by pairs of columns (apply) needs an even NB; the predict's skip of the dq
- * columns, that they are the two before nu. */
-typedef char layout_fits[(NB % 2 == 0 && SR_E_nu == SR_E_q + 2) ? 1 : -1];
+/* The Joseph form by pairs of columns (apply) needs an even NB, the predict's pairs of rows an
+ * even NE; the predict's skip of the dq columns, that they are the two before nu. */
+typedef char layout_fits[(NB % 2 == 0 && NE % 2 == 0 && SR_E_nu == SR_E_q + 2) ? 1 : -1];
 
 static const sr_real pi_ = SR_C(3.14159265358979323846);
 
@@ -47,6 +47,21 @@ static inline void row_plus(sr_real a, const sr_real *restrict x, sr_real *restr
 {
     int k;
     for (k = 0; k < NB; ++k) y[k] += a * x[k];
+}
+
+/* The same with two rows a pass (half the loads and stores of y). */
+static inline void rows_minus2(sr_real a, const sr_real *restrict x, sr_real b, const sr_real *restrict z,
+                               sr_real *restrict y)
+{
+    int k;
+    for (k = 0; k < NB; ++k) y[k] -= a * x[k] + b * z[k];
+}
+
+static inline void rows_plus2(sr_real a, const sr_real *restrict x, sr_real b, const sr_real *restrict z,
+                              sr_real *restrict y)
+{
+    int k;
+    for (k = 0; k < NB; ++k) y[k] += a * x[k] + b * z[k];
 }
 
 /* A = L L^T for a symmetric n x n A (row-major; only its lower triangle is read).  SR_ERR_SINGULAR
@@ -204,20 +219,29 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
     for (k = 0; k < NE; ++k)   /* the columns summed */
         if (!dq_identity || (k != SR_E_q && k != SR_E_q + 1)) cols[ncols++] = k;
     for (i = 0; i < NE; ++i) {
-        sr_real *Ti = T + NB * i;
         if (dq_identity && (i == SR_E_q || i == SR_E_q + 1))
-            memcpy(Ti, ekf->P + NB * i, NB * sizeof(sr_real));
+            memcpy(T + NB * i, ekf->P + NB * i, NB * sizeof(sr_real));
         else
-            memset(Ti, 0, NB * sizeof(sr_real));
-        /* Two rows of P a pass: half the loads and stores of T's row. */
+            memset(T + NB * i, 0, NB * sizeof(sr_real));
+    }
+    /* Two rows of T and two rows of P a pass: each load serves two products. */
+    for (i = 0; i < NE; i += 2) {
+        sr_real *T0 = T + NB * i, *T1 = T0 + NB;
+        const sr_real *F0 = F + NE * i, *F1 = F0 + NE;
         for (k = 0; k + 1 < ncols; k += 2) {
-            const sr_real f0 = F[NE * i + cols[k]], f1 = F[NE * i + cols[k + 1]];
+            const sr_real a0 = F0[cols[k]], a1 = F0[cols[k + 1]], b0 = F1[cols[k]], b1 = F1[cols[k + 1]];
             const sr_real *P0 = ekf->P + NB * cols[k], *P1 = ekf->P + NB * cols[k + 1];
-            for (j = 0; j < NB; ++j) Ti[j] += f0 * P0[j] + f1 * P1[j];
+            for (j = 0; j < NB; ++j) {
+                T0[j] += a0 * P0[j] + a1 * P1[j];
+                T1[j] += b0 * P0[j] + b1 * P1[j];
+            }
         }
         for (; k < ncols; ++k) {
-            const sr_real f = F[NE * i + cols[k]], *Pk = ekf->P + NB * cols[k];
-            for (j = 0; j < NB; ++j) Ti[j] += f * Pk[j];
+            const sr_real a0 = F0[cols[k]], b0 = F1[cols[k]], *Pk = ekf->P + NB * cols[k];
+            for (j = 0; j < NB; ++j) {
+                T0[j] += a0 * Pk[j];
+                T1[j] += b0 * Pk[j];
+            }
         }
     }
     for (i = 0; i < NE; ++i)
@@ -290,19 +314,17 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
         sr_real *Ki = KT + NB * i;
         const sr_real d = 1 / L[m * i + i];
         for (a = 0; a < NB; ++a) Ki[a] = CT[NB * i + a];
-        for (k = 0; k < i; ++k) {
-            const sr_real l = L[m * i + k], *Kk = KT + NB * k;
-            row_minus(l, Kk, Ki);
-        }
+        for (k = 0; k + 1 < i; k += 2)
+            rows_minus2(L[m * i + k], KT + NB * k, L[m * i + k + 1], KT + NB * (k + 1), Ki);
+        if (k < i) row_minus(L[m * i + k], KT + NB * k, Ki);
         for (a = 0; a < NB; ++a) Ki[a] *= d;
     }
     for (i = m - 1; i >= 0; --i) {
         sr_real *Ki = KT + NB * i;
         const sr_real d = 1 / L[m * i + i];
-        for (k = i + 1; k < m; ++k) {
-            const sr_real l = L[m * k + i], *Kk = KT + NB * k;
-            row_minus(l, Kk, Ki);
-        }
+        for (k = i + 1; k + 1 < m; k += 2)
+            rows_minus2(L[m * k + i], KT + NB * k, L[m * (k + 1) + i], KT + NB * (k + 1), Ki);
+        if (k < m) row_minus(L[m * k + i], KT + NB * k, Ki);
         for (a = 0; a < NB; ++a) Ki[a] *= d;
     }
     for (a = 0; a < NB; ++a) e[a] = 0;
@@ -316,10 +338,9 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
     for (i = 0; i < m; ++i) {
         sr_real *Di = DT + NB * i;
         for (a = 0; a < NB; ++a) Di[a] = CT[NB * i + a];
-        for (j = 0; j < m; ++j) {
-            const sr_real s = S[m * j + i], *Kj = KT + NB * j;
-            row_minus(s, Kj, Di);
-        }
+        for (j = 0; j + 1 < m; j += 2)
+            rows_minus2(S[m * j + i], KT + NB * j, S[m * (j + 1) + i], KT + NB * (j + 1), Di);
+        if (j < m) row_minus(S[m * j + i], KT + NB * j, Di);
     }
     /* Row a from the pair of columns that holds the diagonal: two columns a statement, which
      * compilers turn into one vector operation (the entry left of an odd diagonal is computed and
@@ -415,10 +436,10 @@ static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_
     for (i = 0; i < m; ++i) {
         sr_real *Ci = CT + NB * i;
         for (a = 0; a < NB; ++a) Ci[a] = 0;
-        for (k = 0; k < nnz[i]; ++k) {
-            const sr_real h = val[NB * i + k], *Pk = ekf->P + NB * col[NB * i + k];
-            row_plus(h, Pk, Ci);
-        }
+        for (k = 0; k + 1 < nnz[i]; k += 2)
+            rows_plus2(val[NB * i + k], ekf->P + NB * col[NB * i + k], val[NB * i + k + 1],
+                       ekf->P + NB * col[NB * i + k + 1], Ci);
+        if (k < nnz[i]) row_plus(val[NB * i + k], ekf->P + NB * col[NB * i + k], Ci);
     }
     for (i = 0; i < m; ++i)
         for (j = i; j < m; ++j) {
