@@ -1,7 +1,8 @@
 """Builds and runs bench/bench_ekf.c (one 200 Hz sample of the error-state EKF: an RKMK4 predict, an
 IMU and an encoder update; each part alone too) in the portable -O2 build of the bench
 (runtime.bench.harness.ekf_sample), and prints its JSON.  With --baseline REV the same program is
-also built with c/src/sr_ekf.c as it was at the git revision REV, and the two run in turns (the same
+also built with the filter's sources (EKF_SOURCES: the filter, the step Jacobians and the
+accelerations' Jacobians) as they were at the git revision REV, and the two run in turns (the same
 samples, the same load): before and after, C against C in one run.  With --callgrind each build's
 instructions per sample and per part are counted too (valgrind's callgrind, the setup subtracted):
 the numbers a loaded machine does not move.
@@ -33,6 +34,8 @@ from runtime.bench.timing import cpu_name  # noqa: E402
 FLAGS = [f for f in LIBRARY_FLAGS if f != "-O3"] + ["-O2", "-ffp-contract=off"]
 #: bench_ekf's PARTS: what each counted run does.
 PARTS = {"predict_imu_encoders": 7, "predict": 1, "update_imu": 2, "update_encoders": 4}
+#: The sources of c/src that --baseline takes from the other revision: those a sample's own work runs in.
+EKF_SOURCES = ("sr_ekf.c", "sr_step_jacobians.c", "sr_jacobians.c")
 
 
 def instructions(exe, samples, parts):
@@ -48,7 +51,7 @@ def instructions(exe, samples, parts):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=2000)
-    parser.add_argument("--baseline", help="a git revision whose c/src/sr_ekf.c to run beside this one")
+    parser.add_argument("--baseline", help="a git revision whose filter sources (EKF_SOURCES) to run beside these")
     parser.add_argument("--rounds", type=int, default=5, help="turns of the builds; the best of each")
     parser.add_argument("--callgrind", action="store_true", help="also count instructions per sample (valgrind)")
     parser.add_argument("--objects", type=pathlib.Path, default=None,
@@ -64,8 +67,10 @@ def main():
         objects = compile_library(folder, FLAGS)
         builds = {"current": objects}
         if args.baseline:
-            builds = {"baseline": with_baseline(folder, objects, "sr_ekf.c", args.baseline, FLAGS),
-                      "current": objects}
+            old = objects
+            for source in EKF_SOURCES:
+                old = with_baseline(folder, old, source, args.baseline, FLAGS)
+            builds = {"baseline": old, "current": objects}
         exes = {}
         for label, objs in builds.items():
             exes[label] = folder / f"bench_ekf_{label}"

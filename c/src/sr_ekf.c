@@ -4,6 +4,7 @@
 #include "sr_argcheck.h"
 #include "sr_checks.h"
 #include "sr_so3.h"
+#include "sr_step_jacobians.h"
 
 #include <string.h>
 
@@ -17,9 +18,9 @@
 #define SR_FMOD fmod
 #endif
 
-/* The Joseph form by pairs of columns (apply) needs an even NB; the predict's skip of the dq
- * columns, that they are the two before nu. */
-typedef char layout_fits[(NB % 2 == 0 && SR_E_nu == SR_E_q + 2) ? 1 : -1];
+/* The Joseph form by pairs of columns (apply) needs an even NB, the predict's pairs of rows an
+ * even NE; the predict's skip of the dq columns, that they are the two before nu. */
+typedef char layout_fits[(NB % 2 == 0 && NE % 2 == 0 && SR_E_nu == SR_E_q + 2) ? 1 : -1];
 
 static const sr_real pi_ = SR_C(3.14159265358979323846);
 
@@ -31,6 +32,36 @@ static sr_real angle_difference(sr_real a, sr_real b)
     if (w < 0) w += two_pi;
     w -= pi_;
     return w == -pi_ ? pi_ : w;
+}
+
+/* y <- y - a x and y <- y + a x over a row of NB: restrict-qualified, so that the compiler
+ * vectorises them without a run-time overlap test (rows of one array looked as if they might
+ * overlap, and the loop ran scalar). */
+static inline void row_minus(sr_real a, const sr_real *restrict x, sr_real *restrict y)
+{
+    int k;
+    for (k = 0; k < NB; ++k) y[k] -= a * x[k];
+}
+
+static inline void row_plus(sr_real a, const sr_real *restrict x, sr_real *restrict y)
+{
+    int k;
+    for (k = 0; k < NB; ++k) y[k] += a * x[k];
+}
+
+/* The same with two rows a pass (half the loads and stores of y). */
+static inline void rows_minus2(sr_real a, const sr_real *restrict x, sr_real b, const sr_real *restrict z,
+                               sr_real *restrict y)
+{
+    int k;
+    for (k = 0; k < NB; ++k) y[k] -= a * x[k] + b * z[k];
+}
+
+static inline void rows_plus2(sr_real a, const sr_real *restrict x, sr_real b, const sr_real *restrict z,
+                              sr_real *restrict y)
+{
+    int k;
+    for (k = 0; k < NB; ++k) y[k] += a * x[k] + b * z[k];
 }
 
 /* A = L L^T for a symmetric n x n A (row-major; only its lower triangle is read).  SR_ERR_SINGULAR
@@ -164,15 +195,15 @@ static int torque_noise(const sr_model *model, const sr_real x[SR_NX], const sr_
 int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real u[SR_NU], sr_real dt,
                    const sr_ekf_process *process)
 {
-    sr_real xn[SR_NX], F[NE * NE], G[NE * SR_NU], Qnu[SR_NV * SR_NV], T[NE * NB], Pn[NB * NB];
-    int status = arg_model(model, READS(WHOLE)), i, j, k, k1, dq_identity = 1;
+    sr_real xn[SR_NX], F[NE * NE], Qnu[SR_NV * SR_NV], T[NE * NB], Pn[NB * NB];
+    int status = arg_model(model, READS(WHOLE)), i, j, k, dq_identity = 1, cols[NE], ncols = 0;
     if (status != SR_OK) return status;
     if (!ekf || !process) return SR_ERR_NULL;
     if (arg_method(method) != SR_OK || arg_dt(dt) != SR_OK || !valid_process(process)) return SR_ERR_ARG;
     if (u && !all_finite(u, SR_NU)) return SR_ERR_NONFINITE;
     status = check_filter(model, ekf);
-    if (status == SR_OK) status = sr_step(model, method, ekf->x, u, dt, xn);
-    if (status == SR_OK) status = sr_step_jacobian(model, method & ~SR_PROJECT, ekf->x, u, dt, F, G);
+    /* The state and u are checked: the step and F at once, RKMK4's from the same stages. */
+    if (status == SR_OK) status = sr_internal_step_and_jacobian(model, method, ekf->x, u, dt, xn, F);
     if (status == SR_OK) status = torque_noise(model, ekf->x, process, dt, Qnu);
     if (status != SR_OK) return status;
 
@@ -185,16 +216,32 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
         const int dq = k == SR_E_q || k == SR_E_q + 1;
         for (i = 0; i < NE && dq; ++i) dq_identity &= F[NE * i + k] == (i == k ? 1 : 0);
     }
-    k1 = dq_identity ? SR_E_nu : SR_E_q;   /* the columns summed: [0, SR_E_q) and [k1, NE) */
+    for (k = 0; k < NE; ++k)   /* the columns summed */
+        if (!dq_identity || (k != SR_E_q && k != SR_E_q + 1)) cols[ncols++] = k;
     for (i = 0; i < NE; ++i) {
-        sr_real *Ti = T + NB * i;
         if (dq_identity && (i == SR_E_q || i == SR_E_q + 1))
-            memcpy(Ti, ekf->P + NB * i, NB * sizeof(sr_real));
+            memcpy(T + NB * i, ekf->P + NB * i, NB * sizeof(sr_real));
         else
-            memset(Ti, 0, NB * sizeof(sr_real));
-        for (k = 0; k < NE; k = k + 1 == SR_E_q ? k1 : k + 1) {
-            const sr_real f = F[NE * i + k], *Pk = ekf->P + NB * k;
-            for (j = 0; j < NB; ++j) Ti[j] += f * Pk[j];
+            memset(T + NB * i, 0, NB * sizeof(sr_real));
+    }
+    /* Two rows of T and two rows of P a pass: each load serves two products. */
+    for (i = 0; i < NE; i += 2) {
+        sr_real *T0 = T + NB * i, *T1 = T0 + NB;
+        const sr_real *F0 = F + NE * i, *F1 = F0 + NE;
+        for (k = 0; k + 1 < ncols; k += 2) {
+            const sr_real a0 = F0[cols[k]], a1 = F0[cols[k + 1]], b0 = F1[cols[k]], b1 = F1[cols[k + 1]];
+            const sr_real *P0 = ekf->P + NB * cols[k], *P1 = ekf->P + NB * cols[k + 1];
+            for (j = 0; j < NB; ++j) {
+                T0[j] += a0 * P0[j] + a1 * P1[j];
+                T1[j] += b0 * P0[j] + b1 * P1[j];
+            }
+        }
+        for (; k < ncols; ++k) {
+            const sr_real a0 = F0[cols[k]], b0 = F1[cols[k]], *Pk = ekf->P + NB * cols[k];
+            for (j = 0; j < NB; ++j) {
+                T0[j] += a0 * Pk[j];
+                T1[j] += b0 * Pk[j];
+            }
         }
     }
     for (i = 0; i < NE; ++i)
@@ -267,19 +314,17 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
         sr_real *Ki = KT + NB * i;
         const sr_real d = 1 / L[m * i + i];
         for (a = 0; a < NB; ++a) Ki[a] = CT[NB * i + a];
-        for (k = 0; k < i; ++k) {
-            const sr_real l = L[m * i + k], *Kk = KT + NB * k;
-            for (a = 0; a < NB; ++a) Ki[a] -= l * Kk[a];
-        }
+        for (k = 0; k + 1 < i; k += 2)
+            rows_minus2(L[m * i + k], KT + NB * k, L[m * i + k + 1], KT + NB * (k + 1), Ki);
+        if (k < i) row_minus(L[m * i + k], KT + NB * k, Ki);
         for (a = 0; a < NB; ++a) Ki[a] *= d;
     }
     for (i = m - 1; i >= 0; --i) {
         sr_real *Ki = KT + NB * i;
         const sr_real d = 1 / L[m * i + i];
-        for (k = i + 1; k < m; ++k) {
-            const sr_real l = L[m * k + i], *Kk = KT + NB * k;
-            for (a = 0; a < NB; ++a) Ki[a] -= l * Kk[a];
-        }
+        for (k = i + 1; k + 1 < m; k += 2)
+            rows_minus2(L[m * k + i], KT + NB * k, L[m * (k + 1) + i], KT + NB * (k + 1), Ki);
+        if (k < m) row_minus(L[m * k + i], KT + NB * k, Ki);
         for (a = 0; a < NB; ++a) Ki[a] *= d;
     }
     for (a = 0; a < NB; ++a) e[a] = 0;
@@ -293,10 +338,9 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
     for (i = 0; i < m; ++i) {
         sr_real *Di = DT + NB * i;
         for (a = 0; a < NB; ++a) Di[a] = CT[NB * i + a];
-        for (j = 0; j < m; ++j) {
-            const sr_real s = S[m * j + i], *Kj = KT + NB * j;
-            for (a = 0; a < NB; ++a) Di[a] -= s * Kj[a];
-        }
+        for (j = 0; j + 1 < m; j += 2)
+            rows_minus2(S[m * j + i], KT + NB * j, S[m * (j + 1) + i], KT + NB * (j + 1), Di);
+        if (j < m) row_minus(S[m * j + i], KT + NB * j, Di);
     }
     /* Row a from the pair of columns that holds the diagonal: two columns a statement, which
      * compilers turn into one vector operation (the entry left of an odd diagonal is computed and
@@ -308,7 +352,15 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
             row[b] = ekf->P[NB * a + b];
             row[b + 1] = ekf->P[NB * a + b + 1];
         }
-        for (i = 0; i < m; ++i) {
+        for (i = 0; i + 1 < m; i += 2) {   /* two entries of the sample a pass: half the row's loads and stores */
+            const sr_real ka = KT[NB * i + a], da = DT[NB * i + a], *Ci = CT + NB * i, *Ki = KT + NB * i;
+            const sr_real kb = KT[NB * (i + 1) + a], db = DT[NB * (i + 1) + a], *Cj = Ci + NB, *Kj = Ki + NB;
+            for (b = b0; b < NB; b += 2) {
+                row[b] -= (ka * Ci[b] + da * Ki[b]) + (kb * Cj[b] + db * Kj[b]);
+                row[b + 1] -= (ka * Ci[b + 1] + da * Ki[b + 1]) + (kb * Cj[b + 1] + db * Kj[b + 1]);
+            }
+        }
+        for (; i < m; ++i) {
             const sr_real ka = KT[NB * i + a], da = DT[NB * i + a], *Ci = CT + NB * i, *Ki = KT + NB * i;
             for (b = b0; b < NB; b += 2) {
                 row[b] -= ka * Ci[b] + da * Ki[b];
@@ -384,10 +436,10 @@ static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_
     for (i = 0; i < m; ++i) {
         sr_real *Ci = CT + NB * i;
         for (a = 0; a < NB; ++a) Ci[a] = 0;
-        for (k = 0; k < nnz[i]; ++k) {
-            const sr_real h = val[NB * i + k], *Pk = ekf->P + NB * col[NB * i + k];
-            for (a = 0; a < NB; ++a) Ci[a] += h * Pk[a];
-        }
+        for (k = 0; k + 1 < nnz[i]; k += 2)
+            rows_plus2(val[NB * i + k], ekf->P + NB * col[NB * i + k], val[NB * i + k + 1],
+                       ekf->P + NB * col[NB * i + k + 1], Ci);
+        if (k < nnz[i]) row_plus(val[NB * i + k], ekf->P + NB * col[NB * i + k], Ci);
     }
     for (i = 0; i < m; ++i)
         for (j = i; j < m; ++j) {

@@ -71,17 +71,43 @@ static int joint_first_factor(const sr_real Mu[15], joint_first *s)
     return SR_OK;
 }
 
-/* B <- M^-1 B for the first n columns, M factored by joint_first_factor. */
+/* B <- M^-1 B for the first n columns, M factored by joint_first_factor: each step a loop along
+ * the columns (which the compiler vectorises), every entry the same expression as column by column. */
 static inline void joint_first_solve(const joint_first *s, sr_real B[SR_NV][NCOL], int n)
 {
+    sr_real g[3][NCOL], v[3][NCOL];
     int i, c;
-    for (c = 0; c < n; ++c) {
-        sr_real g[3], v[3];
-        for (i = 0; i < 3; ++i) g[i] = B[i][c] - s->beta[i][0] * B[3][c] - s->beta[i][1] * B[4][c];
-        for (i = 0; i < 3; ++i) v[i] = s->Sinv[i][0] * g[0] + s->Sinv[i][1] * g[1] + s->Sinv[i][2] * g[2];
-        B[3][c] = s->dinv[0] * B[3][c] - (s->beta[0][0] * v[0] + s->beta[1][0] * v[1] + s->beta[2][0] * v[2]);
-        B[4][c] = s->dinv[1] * B[4][c] - (s->beta[0][1] * v[0] + s->beta[1][1] * v[1] + s->beta[2][1] * v[2]);
-        for (i = 0; i < 3; ++i) B[i][c] = v[i];
+    for (i = 0; i < 3; ++i)
+        for (c = 0; c < n; ++c) g[i][c] = B[i][c] - s->beta[i][0] * B[3][c] - s->beta[i][1] * B[4][c];
+    for (i = 0; i < 3; ++i)
+        for (c = 0; c < n; ++c) v[i][c] = s->Sinv[i][0] * g[0][c] + s->Sinv[i][1] * g[1][c] + s->Sinv[i][2] * g[2][c];
+    for (c = 0; c < n; ++c)
+        B[3][c] = s->dinv[0] * B[3][c] - (s->beta[0][0] * v[0][c] + s->beta[1][0] * v[1][c] + s->beta[2][0] * v[2][c]);
+    for (c = 0; c < n; ++c)
+        B[4][c] = s->dinv[1] * B[4][c] - (s->beta[0][1] * v[0][c] + s->beta[1][1] * v[1][c] + s->beta[2][1] * v[2][c]);
+    for (i = 0; i < 3; ++i)
+        for (c = 0; c < n; ++c) B[i][c] = v[i][c];
+}
+
+/* B[i][k] -= (dM'_k g)_i for the four directions that move M' (d_xi', d_th_P), M' packed upper: one
+ * index lookup per (i, j) for all four, the four sums in locals (the order of each sum kept). */
+static inline void subtract_dM_g(const sr_real dM[4 * 15], const sr_real g[SR_NV][NCOL], sr_real B[SR_NV][NCOL])
+{
+    int i, j;
+    for (i = 0; i < SR_NV; ++i) {
+        sr_real b0 = B[i][0], b1 = B[i][1], b2 = B[i][2], b3 = B[i][3];
+        for (j = 0; j < SR_NV; ++j) {
+            const int e = SR_UPPER[i][j];
+            const sr_real gj = g[j][0];
+            b0 -= dM[e] * gj;
+            b1 -= dM[15 + e] * gj;
+            b2 -= dM[30 + e] * gj;
+            b3 -= dM[45 + e] * gj;
+        }
+        B[i][0] = b0;
+        B[i][1] = b1;
+        B[i][2] = b2;
+        B[i][3] = b3;
     }
 }
 
@@ -125,7 +151,10 @@ static int general_accel_jacobian(const sr_model *model, const sr_real x[SR_NX],
  *   d_th_P, d_w_Y, d_w_P, u:                                   -> T^T G
  *   d_w_S:             d_w' = R_Y^T d_w_S                      -> T^T G_w' R_Y^T
  * where T^T on the left turns rows 1 and 2 (the shell's y and z) by R_Y. */
-enum { Y_XI = 0, Y_TH_P = 3, Y_W = 4, Y_U = 9, Y_NCOL = 11 };
+/* Y_SOLVED: the columns solved, Y_NCOL and one of zeros, an even count, so that the vectorised
+ * column loops of joint_first_solve need no scalar remainder (which GCC's -O2 does not vectorise). */
+enum { Y_XI = 0, Y_TH_P = 3, Y_W = 4, Y_U = 9, Y_NCOL = 11, Y_SOLVED = 12 };
+typedef char solved_fit[(Y_SOLVED <= NCOL && Y_SOLVED % 4 == 0) ? 1 : -1];
 
 static int paper_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                                 sr_real acc[SR_NV], sr_real ja[SR_NV * SR_NE], sr_real jb[SR_NV * SR_NU])
@@ -136,7 +165,7 @@ static int paper_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], c
     sr_real g[SR_NV][NCOL], B[SR_NV][NCOL], Y[SR_NV][SR_NE + SR_NU];
     sr_real wy, wz;
     joint_first jf;
-    int status, i, j, k;
+    int status, i, k;
     status = sr_gen_accel_jacobian_yoke_terms(model->c, x, u, Mu, f, df, dfdu, dM);
     if (status != SR_OK) return status;
     status = joint_first_factor(Mu, &jf);
@@ -151,10 +180,10 @@ static int paper_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], c
     for (i = 0; i < SR_NV; ++i) {
         for (k = 0; k < 9; ++k) B[i][k] = df[9 * i + k];
         for (k = 0; k < SR_NU; ++k) B[i][Y_U + k] = dfdu[SR_NU * i + k];
-        for (k = 0; k < 4; ++k) /* d_xi', d_th_P move M' */
-            for (j = 0; j < SR_NV; ++j) B[i][k] -= dM[15 * k + SR_UPPER[i][j]] * g[j][0];
+        B[i][Y_NCOL] = 0;
     }
-    joint_first_solve(&jf, B, Y_NCOL);
+    subtract_dM_g(dM, (const sr_real(*)[NCOL])g, B);   /* d_xi', d_th_P move M' */
+    joint_first_solve(&jf, B, Y_SOLVED);
     wy = c * w[1] + s * w[2];                                /* w' = R_Y^T w_S */
     wz = c * w[2] - s * w[1];
     for (i = 0; i < SR_NV; ++i) {                            /* the columns, rows still in the yoke frame */
@@ -214,7 +243,7 @@ static int paper_accel_jacobian_along(const sr_model *model, const sr_real x[SR_
     sr_real Mu[15], f[SR_NV], df[SR_NV * 9], dfdu[SR_NV * SR_NU], dM[4 * 15];
     sr_real g[SR_NV][NCOL], B[SR_NV][NCOL], Z[NZ][SR_J_NC], o[SR_NV][SR_J_NC];
     joint_first jf;
-    int status, i, j, k, l;
+    int status, i, k, l;
     status = sr_gen_accel_jacobian_yoke_terms(model->c, x, u, Mu, f, df, dfdu, dM);
     if (status != SR_OK) return status;
     status = joint_first_factor(Mu, &jf);
@@ -229,10 +258,10 @@ static int paper_accel_jacobian_along(const sr_model *model, const sr_real x[SR_
     for (i = 0; i < SR_NV; ++i) {
         for (k = 0; k < 9; ++k) B[i][k] = df[9 * i + k];
         for (k = 0; k < SR_NU; ++k) B[i][Y_U + k] = dfdu[SR_NU * i + k];
-        for (k = 0; k < 4; ++k)
-            for (j = 0; j < SR_NV; ++j) B[i][k] -= dM[15 * k + SR_UPPER[i][j]] * g[j][0];
+        B[i][Y_NCOL] = 0;
     }
-    joint_first_solve(&jf, B, Y_NCOL);
+    subtract_dM_g(dM, (const sr_real(*)[NCOL])g, B);
+    joint_first_solve(&jf, B, Y_SOLVED);
     for (l = 0; l < SR_J_NC; ++l) {
         const sr_real vY = V[SR_J_TH_Y][l];
         Z[Y_XI + 0][l] = V[SR_J_XI + 0][l] + vY;
