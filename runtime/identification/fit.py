@@ -366,13 +366,17 @@ class _Problem:
                 x_ref = prior[0]
             cache = {}
 
-            def evaluate(dv, x_ref=x_ref, prior=prior, s=s):
+            white = {}
+
+            def evaluate(dv, x_ref=x_ref, prior=prior, s=s, white=white):
                 key = dv.tobytes()
                 if key not in cache:
                     cache.clear()
                     start = self._dretract(model, x_ref, dv)
                     blk = self.segment_block(model, s, start, None, b)
-                    r, J = blk["r"], blk["x"]
+                    if not white:       # the readings weighed as the joint fit weighs them
+                        white["w"] = self.covariances([blk], first=s)[0]
+                    r, J = self.whiten(white["w"], blk["r"]), self.whiten(white["w"], blk["x"])
                     if prior is not None:
                         e = model.local(prior[0], start[0])
                         _, Bd = self._dlocal(model, prior[0], start[0])
@@ -425,14 +429,15 @@ class _Problem:
         E = A[blk["n_out"]:]
         return (E * Q) @ E.T + DEFECT_FLOOR ** 2 * np.eye(NE)
 
-    def covariances(self, blocks):
+    def covariances(self, blocks, first=0):
         """Each segment's whitening W (Wᵀ W = C⁻¹) of its residual covariance, in units of the
         sensor noise: C = D + A Q Aᵀ (`noise_map`), D the unit noise of the readings and the floor
         of their end-state difference.  A has a few columns per torque period, so W is kept as
         the symmetric root (I + U diag(f) Uᵀ) D^-1/2 from the thin SVD D^-1/2 A Q^1/2 = U S Vᵀ,
-        f = (1 + S²)^-1/2 − 1, never as a matrix of the segment's size."""
+        f = (1 + S²)^-1/2 − 1, never as a matrix of the segment's size.  `blocks` are those of the
+        segments first, first + 1, ..."""
         out = []
-        for s, blk in enumerate(blocks):
+        for s, blk in enumerate(blocks, start=first):
             A, Q = self.noise_map(s, blk)
             nrow, row = len(blk["r"]), blk["n_out"]
             dinv = np.ones(nrow)
