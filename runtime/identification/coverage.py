@@ -3,12 +3,15 @@ robot whose parameters differ from the nominal ones, each fitted; the fraction o
 interval holds the truth, per parameter (docs/identification.md, "Measured").
 
 The robot is robots/battery-geared.toml; the truth scales the named entries by factors drawn
-uniformly in [1 − spread, 1 + spread] per fit (the entries not named held at their true values); the
-torques are piecewise constant, uniform within ±0.3 N m (yoke) and ±0.15 N m (pendulum), new every
-0.25 s: a rich program while the excitation design is not in use.
+uniformly in [1 − spread, 1 + spread] per fit (the entries not named held at their true values).
+The torques are a scenario's torque program (`--excitation FILE`, e.g. one `python -m runtime
+excite` designed), or else piecewise constant, uniform within ±0.3 N m (yoke) and ±0.15 N m
+(pendulum), new every 0.25 s.  Each log is the default sensor set's (IMU, encoders, fixes) and is
+fitted as a sensor log, or by its truth table with `--full-state`; `--jobs` fits run at once.
 """
 import dataclasses
 import json
+import os
 import time
 
 import numpy as np
@@ -19,7 +22,7 @@ from ..param_derivatives import PARAMETER_NAMES
 from ..params import Params
 from ..scenario import TorqueWindow, load_scenario
 from ..sensor_set import SensorSet
-from .fit import free_parameters, identify
+from .fit import STARTS, free_parameters, identify
 
 
 def random_torques(duration, rng, period=0.25, yoke=0.3, pendulum=0.15):
@@ -44,35 +47,75 @@ def planted(nominal, names, rng, spread):
     raise ValueError(f"params: no physical robot within ±{spread:g} of the nominal one for {names}")
 
 
-def simulated_log(names, duration, seed, spread=0.3):
+def simulated_log(names, duration, seed, spread=0.3, excitation=None):
     """(log, nominal, truth): a seeded log of the battery-geared robot with the entries `names`
-    planted within ±spread of its values, under `random_torques`, with the default sensor set."""
+    planted within ±spread of its values, with the default sensor set, under the torque program of
+    the scenario file `excitation` (its first `duration` s; its own robot is not used) or else
+    `random_torques`."""
     rng = np.random.default_rng(seed)
     scenario = load_scenario("battery-geared")
     nominal = scenario.params
     truth = planted(nominal, names, rng, spread)
-    run = dataclasses.replace(scenario, params=truth, torques=random_torques(duration, rng),
-                              steps=int(round(duration / scenario.dt)))
+    if excitation is None:
+        program = random_torques(duration, rng)
+    else:
+        program = load_scenario(excitation).torques
+        if max(w.t_to for w in program) < duration - 1e-9:
+            raise ValueError(f"excitation: {excitation} drives {max(w.t_to for w in program):g} s, shorter than the "
+                             f"{duration:g} s asked")
+    run = dataclasses.replace(scenario, params=truth, torques=program, steps=int(round(duration / scenario.dt)))
     return simulate_log(run, SensorSet.default(), seed=seed), nominal, truth
 
 
-def trial(names, duration, seed, spread=0.3, full_state=False, segment=0.5, max_nfev=20):
-    """One seeded fit: {"names", "truth", "estimate", "sigma", "inside", "rms", "wall_time_s", "cpu_time_s"}."""
-    log, nominal, truth = simulated_log(names, duration, seed, spread)
+def trial(names, duration, seed, spread=0.3, full_state=False, segment=0.5, max_nfev=20, excitation=None,
+          start="regressor"):
+    """One seeded fit: {"seed", "names", "truth", "start", "estimate", "sigma", "inside", "rms",
+    "passed" (the residual check), "wall_time_s", "cpu_time_s" (the fit's, without the log's
+    simulation), "load_average" (the machine's, over the last minute, at the fit's end)}."""
+    log, nominal, truth = simulated_log(names, duration, seed, spread, excitation)
     started, cpu = time.perf_counter(), time.process_time()
-    fit = identify(log, nominal, names, segment=segment, full_state=full_state, max_nfev=max_nfev)
+    fit = identify(log, nominal, names, segment=segment, full_state=full_state, max_nfev=max_nfev, start=start)
     wall, cpu = time.perf_counter() - started, time.process_time() - cpu
     true = np.array([truth.as_array()[PARAMETER_NAMES.index(n)] for n in fit.names])
-    return {"names": list(fit.names), "truth": true.tolist(), "estimate": fit.estimate.tolist(),
-            "sigma": fit.sigma.tolist(), "inside": (np.abs(fit.estimate - true) <= 1.959964 * fit.sigma).tolist(),
-            "rms": fit.residual_check["rms"], "wall_time_s": wall, "cpu_time_s": cpu}
+    return {"seed": seed, "names": list(fit.names), "truth": true.tolist(), "start": fit.start.tolist(),
+            "estimate": fit.estimate.tolist(), "sigma": fit.sigma.tolist(),
+            "inside": (np.abs(fit.estimate - true) <= 1.959964 * fit.sigma).tolist(),
+            "rms": fit.residual_check["rms"], "passed": fit.residual_check["passed"],
+            "wall_time_s": wall, "cpu_time_s": cpu, "load_average": os.getloadavg()[0]}
 
 
-def coverage(names, duration, fits, seed=0, **options):
-    """`fits` trials with seeds seed, seed + 1, ...: the trials and, per entry, the fraction inside."""
-    trials = [trial(names, duration, seed + i, **options) for i in range(fits)]
+def _trial(args):
+    names, duration, seed, options = args
+    return trial(names, duration, seed, **options)
+
+
+def coverage(names, duration, fits, seed=0, jobs=1, done=None, **options):
+    """`fits` trials with seeds seed, seed + 1, ... (`jobs` processes at once): the trials (in
+    seed order) and, per entry, the fraction inside its interval, with the fraction of fits that
+    pass their residual check.  `done(result)` is called with the result so far after each trial."""
+    work = [(names, duration, seed + i, options) for i in range(fits)]
+    trials = []
+    if jobs > 1:
+        import concurrent.futures
+        with concurrent.futures.ProcessPoolExecutor(jobs) as pool:
+            for future in concurrent.futures.as_completed([pool.submit(_trial, w) for w in work]):
+                trials.append(future.result())
+                if done is not None:
+                    done(summarise(trials))
+    else:
+        for w in work:
+            trials.append(_trial(w))
+            if done is not None:
+                done(summarise(trials))
+    return summarise(trials)
+
+
+def summarise(trials):
+    """{"names", "coverage" (per entry), "passed", "trials" (in seed order)} of some trials."""
+    trials = sorted(trials, key=lambda t: t["seed"])
     inside = np.array([t["inside"] for t in trials], dtype=float)
-    return {"names": trials[0]["names"], "coverage": inside.mean(axis=0).tolist(), "trials": trials}
+    return {"names": trials[0]["names"], "coverage": inside.mean(axis=0).tolist(),
+            "passed": float(np.mean([t["passed"] for t in trials])), "trials": trials}
 
 
 def calibration_figure(result, path, title=""):
@@ -113,8 +156,8 @@ def calibration_figure(result, path, title=""):
 
 
 def main(argv):
-    """`python -m runtime identify-coverage --params NAMES [--fits N] [--duration S] [--full-state] --out FILE
-    [--figure PNG]`."""
+    """`python -m runtime identify-coverage --params NAMES [--fits N] [--duration S] [--full-state]
+    [--excitation FILE] [--start regressor|nominal] [--jobs N] --out FILE [--figure PNG]`."""
     import argparse
     import pathlib
     import sys
@@ -127,22 +170,37 @@ def main(argv):
     parser.add_argument("--duration", type=duration, default=30.0, help="each log's length [s] (30)")
     parser.add_argument("--seed", type=whole_number(0), default=0, help="the first seed (0)")
     parser.add_argument("--full-state", action="store_true", help="fit the logs' truth (a full-state log)")
+    parser.add_argument("--excitation", metavar="FILE", help="a scenario whose torque program drives every log "
+                                                             "(python -m runtime excite writes one); default: "
+                                                             "random piecewise-constant torques")
+    parser.add_argument("--start", choices=STARTS, default="regressor",
+                        help="the fits' start: the regressor's first guess (default) or the nominal robot")
+    parser.add_argument("--max-evaluations", type=whole_number(1), default=20,
+                        help="each fit's evaluation budget (20)")
+    parser.add_argument("--jobs", type=whole_number(1), default=1, help="fits run at once, one process each (1)")
     parser.add_argument("--out", required=True, type=pathlib.Path, help="the JSON file of the results")
     parser.add_argument("--figure", type=pathlib.Path, help="also draw the calibration figure (PNG)")
     args = parser.parse_args(argv)
+    def done(result):       # the results so far, so that an interrupted run keeps its fits
+        write_text(args.out, json.dumps(result, indent=1) + "\n")
+        if args.figure:
+            calibration_figure(result, args.figure, _title(result, args))
+
     try:
-        result = coverage(args.params, args.duration, args.fits, args.seed, full_state=args.full_state)
+        result = coverage(args.params, args.duration, args.fits, args.seed, jobs=args.jobs, done=done,
+                          full_state=args.full_state, excitation=args.excitation, start=args.start,
+                          max_nfev=args.max_evaluations)
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    write_text(args.out, json.dumps(result, indent=1) + "\n")
-    if args.figure:
-        calibration_figure(result, args.figure, _title(result, args))
     for name, c in zip(result["names"], result["coverage"]):
         print(f"{name}: truth inside the 95 % interval in {100 * c:.0f} % of {args.fits} fits")
+    print(f"residual check passed in {100 * result['passed']:.0f} % of {args.fits} fits")
     return 0
 
 
 def _title(result, args):
     kind = "full-state" if args.full_state else "sensor"
-    return f"{len(result['trials'])} seeded {kind} fits of {args.duration:g} s logs of the battery-geared robot"
+    program = "a designed excitation" if args.excitation else "random torques"
+    return (f"{len(result['trials'])} seeded {kind} fits of {args.duration:g} s logs of the battery-geared robot "
+            f"({program})")

@@ -37,8 +37,11 @@ from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_param
 from ..params import SHAPES, Params, flat_names
 from ..sensors import encoders_jacobian_batch, imu_partials_batch, position_jacobian_batch
 from ..state import IDX_E_NU, IDX_NU, NE, NV
+from .first_guess import regressor_guess
 from .sensitivity import JACOBIANS, accel_sensitivity, step_sensitivity
 
+#: Where the fit starts the parameters: the regressor's linear least-squares first guess, or the nominal robot.
+STARTS = ("regressor", "nominal")
 #: Parameters a builder knows and the fit never frees: the shell's radius, the gear ratios, gravity, the slope.
 KNOWN = ("r", "n_Y", "n_P", "g", "slope")
 #: The shortest log [s] a fit accepts: two segments of the shortest length.
@@ -178,7 +181,8 @@ class Fit:
     for the base parameters the free entries enter; `null_directions`: [{name: weight}] the
     combinations the log cannot separate; `biases` (6,) and their sigma; `residual_check`: {"rms",
     "chi2", "dof", "p_value", "passed"}; `residuals` {kind: (t, whitened residuals)} for plots;
-    `params` the estimated robot; `nfev`, `status`, `message` of the solver."""
+    `params` the estimated robot; `nfev`, `status`, `message` of the solver; `start` the free
+    entries where the fit started them (`STARTS`)."""
     names: tuple
     nominal: np.ndarray
     estimate: np.ndarray
@@ -202,6 +206,7 @@ class Fit:
     status: int
     message: str
     mode: str
+    start: np.ndarray = None
 
 
 class _Problem:
@@ -211,6 +216,7 @@ class _Problem:
         self.log, self.params, self.free, self.method, self.jacobian = log, params, free, method, jacobian
         self.idx = [PARAMETER_NAMES.index(n) for n in free]
         self.nf = len(free)
+        self.theta_start = params.as_array()[self.idx]
         self.data = d = _grid(log)
         n = len(d.t)
         per = max(2, int(round(segment / d.h)))
@@ -360,13 +366,17 @@ class _Problem:
                 x_ref = prior[0]
             cache = {}
 
-            def evaluate(dv, x_ref=x_ref, prior=prior, s=s):
+            white = {}
+
+            def evaluate(dv, x_ref=x_ref, prior=prior, s=s, white=white):
                 key = dv.tobytes()
                 if key not in cache:
                     cache.clear()
                     start = self._dretract(model, x_ref, dv)
                     blk = self.segment_block(model, s, start, None, b)
-                    r, J = blk["r"], blk["x"]
+                    if not white:       # the readings weighed as the joint fit weighs them
+                        white["w"] = self.covariances([blk], first=s)[0]
+                    r, J = self.whiten(white["w"], blk["r"]), self.whiten(white["w"], blk["x"])
                     if prior is not None:
                         e = model.local(prior[0], start[0])
                         _, Bd = self._dlocal(model, prior[0], start[0])
@@ -419,14 +429,15 @@ class _Problem:
         E = A[blk["n_out"]:]
         return (E * Q) @ E.T + DEFECT_FLOOR ** 2 * np.eye(NE)
 
-    def covariances(self, blocks):
+    def covariances(self, blocks, first=0):
         """Each segment's whitening W (Wᵀ W = C⁻¹) of its residual covariance, in units of the
         sensor noise: C = D + A Q Aᵀ (`noise_map`), D the unit noise of the readings and the floor
         of their end-state difference.  A has a few columns per torque period, so W is kept as
         the symmetric root (I + U diag(f) Uᵀ) D^-1/2 from the thin SVD D^-1/2 A Q^1/2 = U S Vᵀ,
-        f = (1 + S²)^-1/2 − 1, never as a matrix of the segment's size."""
+        f = (1 + S²)^-1/2 − 1, never as a matrix of the segment's size.  `blocks` are those of the
+        segments first, first + 1, ..."""
         out = []
-        for s, blk in enumerate(blocks):
+        for s, blk in enumerate(blocks, start=first):
             A, Q = self.noise_map(s, blk)
             nrow, row = len(blk["r"]), blk["n_out"]
             dinv = np.ones(nrow)
@@ -493,7 +504,7 @@ class _Problem:
         return self._cache[1]
 
     def z0(self):
-        return np.concatenate([self.params.as_array()[self.idx], self.b0, np.zeros(NE * self.S)])
+        return np.concatenate([self.theta_start, self.b0, np.zeros(NE * self.S)])
 
     def bounds(self):
         lo = np.full(self.ncols, -np.inf)
@@ -526,6 +537,7 @@ class _FullState:
         self.params, self.free, self.method, self.jacobian = params, free, method, jacobian
         self.idx = [PARAMETER_NAMES.index(n) for n in free]
         self.nf = len(free)
+        self.theta_start = params.as_array()[self.idx]
         self.X = log.truth_states()
         self.t = log.truth.t
         self.h = float(np.median(np.diff(self.t)))
@@ -560,7 +572,7 @@ class _FullState:
         return self._cache[1]
 
     def z0(self):
-        return self.params.as_array()[self.idx]
+        return self.theta_start
 
     def bounds(self):
         lo, hi = zip(*(bounds_of(n, self.params, self.free) for n in self.free))
@@ -568,27 +580,35 @@ class _FullState:
 
 
 def _start_guess(log, params):
-    """The EKF's estimate at every IMU time and its final biases (the fit's starting point)."""
+    """The EKF's estimate at every IMU time and its final biases (the fit's starting point).  The
+    filter runs on the nominal robot with its gate open: the readings of a robot that differs from
+    the nominal one are what the gate would refuse (on a robot within ±30 % it refused half of them
+    and lost the motion), and a log to identify is taken as free of outliers."""
     from ..estimation.estimate import estimate_log
-    est = estimate_log(log, params)
+    est = estimate_log(log, params, gate=1.0)
     k = np.searchsorted(est.t, log.imu.t)
     k = np.clip(k, 0, len(est.t) - 1)
     return est.x[k], est.biases[-1]
 
 
 def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, max_nfev=20, progress=None,
-             x_guess=None, bias_guess=None, jacobian="analytic"):
+             x_guess=None, bias_guess=None, jacobian="analytic", start="regressor"):
     """Fit the parameters `names` (see `free_parameters`) of the robot `params` (the others held) to
     `log` (runtime.estimation.logs.Log), with the IMU's biases and each segment's start state; or,
     `full_state`, to the log's truth by the one-step prediction error.  `segment` [s]: the
     multiple-shooting segments' length; `x_guess` (n_imu, 35) and `bias_guess` (6,) replace the
     EKF's start guess.  `progress()` is called once per evaluation.  `jacobian`: the parameter
-    sensitivities' source (`JACOBIANS`: "analytic", or "fd", finite differences in C).  Returns a `Fit`."""
+    sensitivities' source (`JACOBIANS`: "analytic", or "fd", finite differences in C).  `start`
+    (`STARTS`): the parameters' start, "regressor" the linear least-squares first guess
+    (runtime.identification.first_guess) from the start guess's states (the log's truth for a
+    full-state fit), "nominal" the robot's values.  Returns a `Fit`."""
     if not isinstance(params, Params):
         raise IdentifyError(f"robot: expected a runtime.Params, got {type(params).__name__}")
     free = free_parameters(names)
     if jacobian not in JACOBIANS:
         raise IdentifyError(f"jacobian: expected one of {', '.join(JACOBIANS)}, got {jacobian!r}")
+    if start not in STARTS:
+        raise IdentifyError(f"start: expected one of {', '.join(STARTS)}, got {start!r}")
     check_log(log, full_state)
     if not (isinstance(segment, (int, float)) and math.isfinite(segment) and segment > 0):
         raise IdentifyError(f"segment: expected a length > 0 in s, got {segment!r}")
@@ -596,10 +616,11 @@ def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, 
     # far more than they gain on a shared 2-core machine).
     with threadpoolctl.threadpool_limits(1, user_api="blas"):
         return _identify(log, params, free, segment, method, full_state, max_nfev, progress, x_guess, bias_guess,
-                         jacobian)
+                         jacobian, start)
 
 
-def _identify(log, params, free, segment, method, full_state, max_nfev, progress, x_guess, bias_guess, jacobian):
+def _identify(log, params, free, segment, method, full_state, max_nfev, progress, x_guess, bias_guess, jacobian,
+              start):
     if full_state:
         prob = _FullState(log, params, free, method, jacobian)
     else:
@@ -609,6 +630,8 @@ def _identify(log, params, free, segment, method, full_state, max_nfev, progress
         prob = _Problem(log, params, free, segment, method, np.asarray(x_guess), np.zeros(6) if bias_guess is None
                         else bias_guess, jacobian)
     prob.progress = progress
+    if start == "regressor":
+        prob.theta_start = first_guess(log, params, free, prob, full_state, x_guess).theta
     if not full_state:
         prob.fit_starts(prob.z0())
     lo, hi = prob.bounds()
@@ -635,6 +658,20 @@ def _identify(log, params, free, segment, method, full_state, max_nfev, progress
         prob._cache = (None, None)
         sol = scipy.optimize.least_squares(fun, sol.x, **{**opts, "max_nfev": max(3, max_nfev // 2)})
     return _report(prob, sol, free, params, full_state)
+
+
+def first_guess(log, params, free, prob, full_state, x_guess):
+    """The regressor's first guess (`runtime.identification.first_guess.regressor_guess`) for
+    `prob`'s free entries, from the log's truth (full state) or the start guess's states at the IMU's
+    times; the equations weighed by the process noise's generalized forces."""
+    if full_state:
+        t, x = prob.t, prob.X
+    else:
+        t, x = np.asarray(log.imu.t, dtype=float), np.asarray(x_guess)
+    q = np.sqrt(log.sensors.process.generalized() ** 2)
+    weights = 1.0 / np.where(q > 0, q, q.max() if q.max() > 0 else 1.0)
+    lo, hi = prob.bounds()
+    return regressor_guess(t, x, log.torque_at(t), params, free, (lo[:len(free)], hi[:len(free)]), weights)
 
 
 def _report(prob, sol, free, params, full_state):
@@ -703,7 +740,7 @@ def _report(prob, sol, free, params, full_state):
                identified=identified, on_bound=on_bound, combinations=combos, null_directions=nulls,
                biases=biases, bias_sigma=bsig, residual_check=check, residuals=series, params=estimated,
                nfev=int(prob.nfev), status=int(sol.status), message=str(sol.message),
-               mode="full-state" if full_state else "sensors")
+               mode="full-state" if full_state else "sensors", start=prob.theta_start.copy())
 
 
 def _dpi(params, idx):

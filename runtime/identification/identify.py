@@ -18,7 +18,7 @@ import numpy as np
 
 from ..atomic import write_text
 from ..params import SHAPES, Params
-from .fit import RESIDUAL_TOLERANCE, Z95, identify
+from .fit import RESIDUAL_TOLERANCE, STARTS, Z95, identify
 
 REPORT_FILES = ("estimates.csv", "correlation.csv", "report.md", "residuals.png", "params.toml", "summary.json")
 
@@ -125,6 +125,7 @@ def summary(fit, wall, log_path, robot_source):
         return None if not np.isfinite(v) else float(v)
     return {"log": str(log_path), "robot": robot_source, "mode": fit.mode, "wall_time_s": wall,
             "evaluations": fit.nfev, "solver_status": fit.status, "solver_message": fit.message,
+            "start": dict(zip(fit.names, map(float, fit.start))),
             "rank": fit.rank, "condition": num(fit.condition),
             "parameters": [{"name": n, "nominal": float(fit.nominal[i]), "estimate": float(fit.estimate[i]),
                             "sigma": num(fit.sigma[i]), "low_95": num(fit.low[i]), "high_95": num(fit.high[i]),
@@ -161,6 +162,9 @@ def build_parser():
     parser.add_argument("--full-state", action="store_true", help="fit to the log's truth table (a full-state log)")
     parser.add_argument("--segment", type=positive, default=0.5, help="multiple-shooting segment length [s] (0.5)")
     parser.add_argument("--max-evaluations", type=count, default=20, help="the solver's evaluation budget (20)")
+    parser.add_argument("--start", choices=STARTS, default="regressor",
+                        help="where the parameters start: the regressor's linear least-squares first guess "
+                             "(default) or the nominal robot")
     parser.add_argument("--quiet", action="store_true", help="no progress bar, print nothing but errors")
     return parser
 
@@ -188,7 +192,7 @@ def main(argv):
         started, cpu = time.perf_counter(), time.process_time()
         try:
             fit = identify(log, params, args.params, segment=args.segment, full_state=args.full_state,
-                           max_nfev=args.max_evaluations, progress=lambda: bar.update(1))
+                           max_nfev=args.max_evaluations, progress=lambda: bar.update(1), start=args.start)
         finally:
             bar.close()
         wall, cpu = time.perf_counter() - started, time.process_time() - cpu

@@ -1,0 +1,92 @@
+"""The regressor's linear least-squares first guess (runtime.identification.first_guess): from a
+smoothed state estimate it lands nearer the truth than the nominal robot, inside the fit's bounds,
+and the fit starts there unless told to start at the nominal robot."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from runtime.estimation.sense import simulate_log
+from runtime.identification import fit as fitmod
+from runtime.identification.first_guess import regressor_guess, smoothed_motion
+from runtime.param_derivatives import PARAMETER_NAMES
+from runtime.scenario import TorqueWindow, load_scenario
+from runtime.sensor_set import SensorSet
+
+SCENARIO = load_scenario("battery-geared")
+NOMINAL = SCENARIO.params
+TRUTH = NOMINAL.replace(k_S=0.2, k_Y=0.03, k_P=0.12, m_P=1.1)
+NAMES = ("k_S", "k_Y", "k_P", "m_P")
+
+
+def torques(duration, seed=1, period=0.25):
+    rng = np.random.default_rng(seed)
+    return tuple(TorqueWindow(i * period, (i + 1) * period, float(rng.uniform(-0.3, 0.3)),
+                              float(rng.uniform(-0.15, 0.15))) for i in range(int(round(duration / period))))
+
+
+@pytest.fixture(scope="module")
+def log():
+    run = dataclasses.replace(SCENARIO, params=TRUTH, torques=torques(2.0), steps=int(round(2.0 / SCENARIO.dt)))
+    return simulate_log(run, SensorSet.default(), seed=2)
+
+
+def truth_of(names, params=TRUTH):
+    return np.array([params.as_array()[PARAMETER_NAMES.index(n)] for n in names])
+
+
+def relative_error(theta, names):
+    truth = truth_of(names)
+    return np.abs(theta - truth) / np.abs(truth)
+
+
+def bounds(names):
+    lo, hi = zip(*(fitmod.bounds_of(n, NOMINAL, names) for n in names))
+    return np.array(lo), np.array(hi)
+
+
+def test_the_guess_from_the_logs_smoothed_truth_lands_nearer_the_truth_than_the_nominal_robot(log):
+    X = log.truth_states()
+    guess = regressor_guess(log.truth.t, X, log.torque_at(log.truth.t), NOMINAL, NAMES, bounds(NAMES))
+    assert np.linalg.norm(relative_error(guess.theta, NAMES)) < 0.9 * np.linalg.norm(relative_error(guess.nominal, NAMES)), \
+        (guess.theta, truth_of(NAMES))
+
+
+def test_the_guess_from_the_ekfs_estimate_of_a_sensor_log_lands_nearer_the_truth_than_the_nominal_robot(log):
+    x_guess, bias = fitmod._start_guess(log, NOMINAL)
+    prob = fitmod._Problem(log, NOMINAL, NAMES, 0.5, "rkmk4", x_guess, bias)
+    guess = fitmod.first_guess(log, NOMINAL, NAMES, prob, False, x_guess)
+    assert np.linalg.norm(relative_error(guess.theta, NAMES)) < 0.9 * np.linalg.norm(relative_error(guess.nominal, NAMES)), \
+        (guess.theta, truth_of(NAMES))
+
+
+def test_a_guess_outside_the_bounds_is_clipped_into_them(log):
+    lo, hi = bounds(NAMES)
+    hi = hi.copy()
+    hi[NAMES.index("m_P")] = 1.0            # the truth, 1.1, lies beyond
+    guess = regressor_guess(log.truth.t, log.truth_states(), log.torque_at(log.truth.t), NOMINAL, NAMES, (lo, hi))
+    assert guess.theta[NAMES.index("m_P")] < 1.0
+
+
+@pytest.mark.parametrize("start", ["regressor", "nominal"])
+def test_the_fit_starts_from_the_guess_unless_told_to_start_at_the_nominal_robot(log, start):
+    fit = fitmod.identify(log, NOMINAL, NAMES, full_state=True, max_nfev=1, start=start)
+    nominal = truth_of(NAMES, NOMINAL)
+    if start == "nominal":
+        assert np.array_equal(fit.start, nominal)
+    else:
+        assert np.linalg.norm(relative_error(fit.start, NAMES)) < 0.9 * np.linalg.norm(relative_error(nominal, NAMES))
+
+
+def test_an_unknown_start_is_named(log):
+    with pytest.raises(fitmod.IdentifyError, match="start"):
+        fitmod.identify(log, NOMINAL, NAMES, full_state=True, start="truth")
+
+
+def test_the_smoothing_keeps_a_linear_velocity_and_differentiates_it_exactly():
+    t = 0.005 * np.arange(200)
+    x = np.tile(SCENARIO.x0, (200, 1))
+    from runtime.state import IDX_NU
+    x[:, IDX_NU] = np.outer(t, [1.0, -2.0, 0.5, 3.0, -1.0])
+    xs, nudot, _ = smoothed_motion(t, x)
+    assert np.allclose(xs[:, IDX_NU], x[:, IDX_NU]) and np.allclose(nudot, [1.0, -2.0, 0.5, 3.0, -1.0])
