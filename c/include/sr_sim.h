@@ -93,8 +93,8 @@ typedef struct sr_sim {
 
 /** Checks a run's description: SR_ERR_NULL (sim, or a buffer of a stream with n > 0, or process
  * or bias), SR_ERR_ARG (dt not > 0 or not finite, steps < 0, a negative n or cursor, a stride
- * that is neither 0 nor SR_NBIAS, an unknown method, a negative or non-finite noise, range,
- * sigma or gate), or a mount's sr_check_mount status. */
+ * that is neither 0 nor SR_NBIAS, an unknown method, a negative or non-finite noise, range or
+ * sigma, a negative or NaN gate), or a mount's sr_check_mount status. */
 int sr_sim_check(const sr_sim *sim);
 
 /** Advances the run by steps step..step+count-1 from the plant's state x (SR_NX, overwritten with

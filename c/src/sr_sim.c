@@ -30,7 +30,7 @@ static int check_stream(const sr_sim_stream *s, int kind)
     for (j = 0; j < WIDTH[kind]; ++j) {
         if (!finite_nonnegative(s->noise[j]) || !finite_nonnegative(s->sigma[j])) return SR_ERR_ARG;
     }
-    if (!finite_nonnegative(s->gate)) return SR_ERR_ARG;
+    if (!(s->gate >= 0)) return SR_ERR_ARG;     /* +infinity: no gate, as in sr_ekf */
     if (kind == SR_SIM_IMU) {
         for (j = 0; j < SR_NIMU; ++j) {
             if (!(finite_nonnegative(s->range[j]) && s->range[j] > 0)) return SR_ERR_ARG;
