@@ -57,6 +57,7 @@ int main(void)
     suite_ekf();
     suite_param_jacobians();
     suite_nmpc();
+    suite_sim();
     return sr_test_summary();
 }
 

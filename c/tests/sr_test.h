@@ -79,6 +79,7 @@ void suite_sensors(void);
 void suite_ekf(void);
 void suite_param_jacobians(void);
 void suite_nmpc(void);
+void suite_sim(void);
 
 /* ---- shared helpers (sr_test.c) ---------------------------------------------------- */
 

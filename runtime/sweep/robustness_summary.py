@@ -10,6 +10,7 @@ import numpy as np  # noqa: E402
 from scipy import stats  # noqa: E402
 
 from ..scenarios.plots import save_figure  # noqa: E402
+from .robustness import APART_REASONS  # noqa: E402
 
 #: Confidence level of the success fractions' intervals (Clopper-Pearson, exact).
 CONFIDENCE = 0.95
@@ -17,6 +18,8 @@ CONFIDENCE = 0.95
 WORST = 3
 #: An estimate whose position RMS exceeds this [m] is counted as off (the filter lost the robot).
 ESTIMATE_OFF_M = 0.03
+#: The causes a failed run is counted under (`failure_causes`), in the order they are tried.
+FAILURES = ("stopped", "estimate lost", "stall", "offset")
 #: Inputs whose rank correlation with the cross-track RMS is reported (and derived ones, below).
 CAUSES = ("m_S", "m_b", "m_h", "m_P", "k_S", "k_Y", "k_P", "c_P_dx_m", "c_P_dy_m", "c_P_dz_m")
 
@@ -55,7 +58,7 @@ def group_stats(table, spec):
     for t, task in enumerate(spec.tasks):
         for c, kind in enumerate(spec.controllers):
             on = (cols["task"] == t) & (cols["controller"] == c)
-            apart = on & (cols["counted_apart"] == 1)
+            apart = on & (cols["counted_apart"] != 0)
             counted = on & ~apart
             n, k = int(counted.sum()), int((cols["success"][counted] == 1).sum())
             ci = stats.binomtest(k, n).proportion_ci(CONFIDENCE, method="exact") if n else None
@@ -77,8 +80,23 @@ def group_stats(table, spec):
                         "rms": rms[ran], "progress": cols["progress"][counted],
                         "estimate_off": int((cols["estimate_position_rms_m"][counted] > ESTIMATE_OFF_M).sum()),
                         "worst": [{name: cols[name][i].item() for name in cols} for i in idx],
-                        "causes": causes[:3]})
+                        "causes": causes[:3], "apart_reasons": {code: int((cols["counted_apart"][on] == code).sum())
+                                                                for code in APART_REASONS},
+                        "failures": failure_causes(cols, counted, spec)})
     return out
+
+
+def failure_causes(cols, rows, spec):
+    """{cause: runs} of the failed runs among `rows` (a mask), each under its first cause:
+    "stopped" (a kernel refused a state), "estimate lost" (the filter's position RMS above
+    ESTIMATE_OFF_M), "stall" (progress below the coverage), "offset" (the RMS above the limit)."""
+    failed = rows & (cols["success"] == 0)
+    stopped = failed & (cols["status"] != 0)
+    lost = failed & ~stopped & (cols["estimate_position_rms_m"] > ESTIMATE_OFF_M)
+    stall = failed & ~stopped & ~lost & (cols["progress"] < spec.coverage)
+    offset = failed & ~stopped & ~lost & ~stall
+    return {"stopped": int(stopped.sum()), "estimate lost": int(lost.sum()), "stall": int(stall.sum()),
+            "offset": int(offset.sum())}
 
 
 def _mm(value):
@@ -105,6 +123,15 @@ def summary_text(table, spec, command):
                      f"{g['success']} / {g['n']} | {100 * g['fraction']:.1f} % | "
                      f"{100 * low:.1f}–{100 * high:.1f} % | {_mm(pct[0])} | {_mm(pct[1])} | "
                      f"{_mm(rms.max() if len(rms) else math.nan)} | {least:.3f} | {g['estimate_off']} |")
+    lines += ["", "Why runs are counted apart, and why the others fail (each failure under its first cause: a "
+              "stopped run, then an estimate more than "
+              f"{1e3 * ESTIMATE_OFF_M:g} mm off, a stall below {100 * spec.coverage:g} % progress, an offset):", "",
+              "| task | controller | " + " | ".join(f"apart: {r}" for r in APART_REASONS.values()) + " | "
+              + " | ".join(FAILURES) + " |", "|---|---|" + "---:|" * (len(APART_REASONS) + len(FAILURES))]
+    for g in groups:
+        lines.append(f"| {g['task']} | {g['controller']} | "
+                     + " | ".join(str(g["apart_reasons"][code]) for code in APART_REASONS) + " | "
+                     + " | ".join(str(g["failures"][f]) for f in FAILURES) + " |")
     lines += ["", f"Worst runs (rerun one: `{command} --rerun SAMPLE`):", "",
               "| task | controller | sample | plant | RMS [mm] | progress | estimate's position RMS [mm] | "
               "slope [fraction of limit] | c_P shift [mm] | masses | dampings | start error [mm, deg] |",

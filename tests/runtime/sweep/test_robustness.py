@@ -119,3 +119,44 @@ def test_a_rerun_can_leave_out_one_perturbation_at_a_time(tmp_path):
         assert all(changed[k] == drawn[k] for k in drawn if k not in values)
     with pytest.raises(ValueError, match="--nominal: 'mass' is not one of masses"):
         with_nominal(drawn, ["mass"])
+
+
+def _no_operating_point(*args, **kwargs):
+    raise ValueError("operating_point: no steady rolling found")
+
+
+def test_a_plant_without_a_steady_operating_point_is_run_and_counted_apart_under_its_reason(tmp_path, monkeypatch):
+    import runtime.control.lqr_design as lqr_design
+    from runtime.sweep.robustness import APART_NO_OPERATING_POINT, APART_REASONS
+    from runtime.sweep.robustness_summary import group_stats, summary_text
+    spec = load_sweep(str(_sweep(tmp_path)))
+    monkeypatch.setattr(lqr_design, "operating_point", _no_operating_point)
+    row = spec.run_chunk(0, 1)
+    assert row["counted_apart"][0] == APART_NO_OPERATING_POINT and math.isnan(row["steady_torque_nm"][0])
+    assert row["status"][0] == 0 and row["steps_done"][0] == 200
+    group = group_stats(row, spec)[0]
+    assert group["apart"] == 1 and group["n"] == 0
+    assert group["apart_reasons"] == {code: int(code == APART_NO_OPERATING_POINT) for code in APART_REASONS}
+    assert "| line | lqr | 0 | 1 | 0 | 0 | 0 | 0 |" in summary_text(row, spec, "cmd")
+
+
+def test_a_plant_whose_steady_torque_exceeds_the_limit_is_counted_apart_under_its_reason(tmp_path, monkeypatch):
+    import runtime.control.lqr_design as lqr_design
+    from runtime.sweep.robustness import APART_TORQUE
+    spec = load_sweep(str(_sweep(tmp_path)))
+    monkeypatch.setattr(lqr_design, "operating_point", lambda *a, **k: (None, np.array([9.0, 0.0])))
+    row = spec.run_chunk(0, 1)
+    assert row["counted_apart"][0] == APART_TORQUE and row["steady_torque_nm"][0] >= 9.0
+
+
+def test_each_failed_run_is_counted_under_its_first_cause():
+    from types import SimpleNamespace
+    from runtime.sweep.robustness_summary import failure_causes
+    cols = {"success": np.array([1, 0, 0, 0, 0, 0]), "status": np.array([0, 7, 0, 0, 0, 7]),
+            "estimate_position_rms_m": np.array([0.0, 0.0, 0.5, 0.5, 0.0, 0.0]),
+            "progress": np.array([1.0, 1.0, 1.0, 0.1, 0.1, 1.0]),}
+    rows = np.array([True, True, True, True, True, False])
+    assert failure_causes(cols, rows, SimpleNamespace(coverage=0.9)) == \
+        {"stopped": 1, "estimate lost": 2, "stall": 1, "offset": 0}
+    cols["progress"][4] = 1.0
+    assert failure_causes(cols, rows, SimpleNamespace(coverage=0.9))["offset"] == 1
