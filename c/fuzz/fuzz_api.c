@@ -5,8 +5,9 @@
  * step, a method and small step counts, calls every function of spherical_robot.h (the
  * controller's sr_lqr_* with a fuzzed gain schedule, target and memory) and of sr_sensors.h
  * (a fuzzed body, mount, nu_dot and biases) and of sr_ekf.h (a fuzzed start, process noise,
- * samples, noise levels, gates and delayed-fix slots) and of sr_nmpc.h (a fuzzed box QP; a fuzzed NMPC design
- * of a short horizon, target and curvatures ahead) and checks their
+ * samples, noise levels, one per reading for sr_ekf_update_imu_axes, gates and delayed-fix slots)
+ * and of sr_nmpc.h (a fuzzed box QP; a fuzzed NMPC design of a short horizon, target and
+ * curvatures ahead) and checks their
  * contract (abort() on a violation, so libFuzzer and the plain driver both report it with the
  * input that caused it):
  *
