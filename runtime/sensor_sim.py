@@ -11,9 +11,14 @@ spectral densities q (`ProcessNoise`), is a constant generalized force of standa
 ν = (ω_S, ω_Y, ω_P).  Its velocity change M⁻¹ w τ after a time τ into the step is added to the step's
 state (the first-order effect of the force), and the accelerometer reads its acceleration M⁻¹ w.
 Every sensor samples at k/rate (k = 0, 1, ...) up to the end of the run; between steps the state is
-the stepper's over the partial step.  Readings: runtime.sensors (the plant's robot), plus per-run
-biases, white noise, the IMU's saturation at its full scale, the encoders' quantisation; a fix
+the stepper's over the partial step.  Readings: runtime.sensors (the plant's robot), plus the
+IMU's biases, white noise, the IMU's saturation at its full scale, the encoders' quantisation; a fix
 measured at t arrives at t + latency (`arrival`).  Seeded: one seed gives the same readings.
+
+The biases are drawn once per run, N(0, bias²) per axis, then walk as the IMU declares: each step
+adds N(0, rw² dt) per axis (`gyro_bias_rw`, `accel_bias_rw`), the discrete form of the random walk
+a filter's predict allows for over the same step.  The samples of a step read the bias of its start
+(`bias`; `bias_at(k)` after the run).
 """
 import math
 
@@ -25,8 +30,8 @@ from .sensors import encoders, heading, imu, imu_partials, position
 from .state import IDX_NU, initial_state
 
 #: The random streams of a run, each its own child of the seed: changing one sensor's rate or noise
-#: leaves the others' draws alone.
-STREAMS = ("process", "bias", "imu", "encoders", "fixes", "heading")
+#: leaves the others' draws alone.  A new stream goes at the end: the others keep their draws.
+STREAMS = ("process", "bias", "imu", "encoders", "fixes", "heading", "bias_walk")
 #: The sensor kinds, in the order samples of one time are applied.
 KINDS = ("imu", "encoders", "fixes", "heading")
 #: The numbers of one reading of each sensor.
@@ -42,7 +47,8 @@ def sample_times(rate, duration):
 class SensorSimulation:
     """The readings of `sensors` along `plant` (a runtime.Model: the true robot) stepped by `dt` with
     `method` for `steps` steps, seeded by `seed`.  `times[kind]` (measurement times) and
-    `readings[kind]` (rows) hold every sample; `advance` fills them step by step.
+    `readings[kind]` (rows) hold every sample; `advance` fills them step by step.  `bias` (6,) is the
+    IMU's bias now (gyroscope, then accelerometer), `bias_at(k)` the bias of step k's samples.
     `disturbance_in_accel=False`: the accelerometer reads the acceleration of the applied torques
     alone (the disturbance still moves the plant)."""
 
@@ -54,6 +60,9 @@ class SensorSimulation:
         spec = sensors.imu
         self.bias = np.concatenate([self.rng["bias"].normal(0.0, spec.gyro_bias, 3),
                                     self.rng["bias"].normal(0.0, spec.accel_bias, 3)])
+        self._bias0 = self.bias.copy()
+        self.bias_step_std = np.repeat([spec.gyro_bias_rw, spec.accel_bias_rw], 3) * math.sqrt(dt)
+        self._walk = np.zeros((steps + 1, 6))     # the bias's offset from its draw at each step's start
         self.q_std = sensors.process.generalized() / math.sqrt(dt)
         self.latency = sensors.fixes.latency if sensors.fixes is not None else 0.0
         self.times = {kind: sample_times(getattr(sensors, kind).rate, duration)
@@ -63,6 +72,11 @@ class SensorSimulation:
             self.times["fixes"] = t[t + self.latency <= duration * (1 + 1e-12) + 1e-9]
         self.readings = {kind: np.empty((len(t), WIDTH[kind])) for kind, t in self.times.items()}
         self.cursor = dict.fromkeys(self.times, 0)
+
+    def bias_at(self, k):
+        """The IMU's bias (6,) at the start of step k (the one its samples read), for k up to the
+        steps advanced so far (and every step once the run is done)."""
+        return self._bias0 + self._walk[k]
 
     def arrival(self, kind, i):
         """When sample i of `kind` reaches its reader [s]: its time, plus the latency of a fix."""
@@ -110,6 +124,9 @@ class SensorSimulation:
             return x, new
         x = self.plant.step(x, u, self.dt, method=self.method)
         x[IDX_NU] += nu_dot_w * self.dt
+        if np.any(self.bias_step_std):            # a zero walk draws nothing: the bias stays its draw
+            self._walk[k + 1] = self._walk[k] + self.rng["bias_walk"].normal(0.0, 1.0, 6) * self.bias_step_std
+            self.bias = self._bias0 + self._walk[k + 1]
         return x, new
 
 

@@ -5,8 +5,9 @@
  * step, a method and small step counts, calls every function of spherical_robot.h (the
  * controller's sr_lqr_* with a fuzzed gain schedule, target and memory) and of sr_sensors.h
  * (a fuzzed body, mount, nu_dot and biases) and of sr_ekf.h (a fuzzed start, process noise,
- * samples, noise levels, gates and delayed-fix slots) and of sr_nmpc.h (a fuzzed box QP; a fuzzed NMPC design
- * of a short horizon, target and curvatures ahead) and checks their
+ * samples, noise levels, one per reading for sr_ekf_update_imu_axes, gates and delayed-fix slots)
+ * and of sr_nmpc.h (a fuzzed box QP; a fuzzed NMPC design of a short horizon, target and
+ * curvatures ahead) and checks their
  * contract (abort() on a violation, so libFuzzer and the plain driver both report it with the
  * input that caused it):
  *
@@ -632,7 +633,7 @@ static void fuzz_ekf(reader *r, const sr_model *model, const sr_real x[SR_NX], c
 {
     static sr_ekf ekf, before;
     static sr_real P0[SR_NEB * SR_NEB];
-    sr_real sigma[SR_NEB], bias[SR_NBIAS], mount[SR_NMOUNT], y[SR_NIMU], dt, noise, gate;
+    sr_real sigma[SR_NEB], bias[SR_NBIAS], mount[SR_NMOUNT], y[SR_NIMU], sigma_axes[SR_NIMU], dt, noise, gate;
     sr_ekf_process q;
     const sr_real gates[4] = {SR_C(13.8), SR_C(1.0), (sr_real)INFINITY, SR_C(-1.0)};
     int i, k, status, slot;
@@ -692,6 +693,13 @@ static void fuzz_ekf(reader *r, const sr_model *model, const sr_real x[SR_NX], c
         EXPECT_STATUS("sr_ekf_update_imu", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
                       SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
         check_ekf("sr_ekf_update_imu", status, &ekf, &before);
+        /* a σ per reading, any of them perturbed (zero, negative, NaN, huge): the axes' own check */
+        for (i = 0; i < SR_NIMU; ++i) sigma_axes[i] = pick(r, 0.01 + 0.1 * fabs(unit(r)));
+        memcpy(&before, &ekf, sizeof ekf);
+        status = sr_ekf_update_imu_axes(&ekf, model, y, u, body, mount, sigma_axes, gate);
+        EXPECT_STATUS("sr_ekf_update_imu_axes", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
+        check_ekf("sr_ekf_update_imu_axes", status, &ekf, &before);
         memcpy(&before, &ekf, sizeof ekf);
         status = sr_ekf_update_encoders(&ekf, model, y, noise, gate);
         EXPECT_STATUS("sr_ekf_update_encoders", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
@@ -716,6 +724,10 @@ static void fuzz_ekf(reader *r, const sr_model *model, const sr_real x[SR_NX], c
     }
     EXPECT_STATUS("sr_ekf_predict(NULL)", sr_ekf_predict(&ekf, model, SR_RKMK4, u, SR_C(0.005), NULL), SR_ERR_NULL);
     EXPECT_STATUS("sr_ekf_mark_position(NULL)", sr_ekf_mark_position(NULL, model, 0), SR_ERR_NULL);
+    memcpy(&before, &ekf, sizeof ekf);
+    status = sr_ekf_update_imu_axes(&ekf, model, y, u, SR_BODY_yoke, mount, NULL, SR_C(13.8));
+    EXPECT_STATUS("sr_ekf_update_imu_axes(NULL)", status, SR_ERR_NULL);
+    check_ekf("sr_ekf_update_imu_axes(NULL)", status, &ekf, &before);
     EXPECT_STATUS("sr_ekf_update_position_delayed(NULL)",
                   sr_ekf_update_position_delayed(&ekf, model, 0, NULL, SR_C(0.01), SR_C(1.0)), SR_ERR_NULL);
 }

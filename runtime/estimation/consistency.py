@@ -97,8 +97,7 @@ def run_once(run, sensors, seed, duration=None, plant_mismatch=False, every=EVER
     rows, i = rows[keep], i[keep]
     x = result.x[rows]
     d = model.local(x, log.truth_states()[i])
-    bias = log.meta["truth_bias"]
-    db = np.concatenate([bias["gyro"], bias["accel"]])[None, :] - result.biases[rows]
+    db = log.truth_biases()[i] - result.biases[rows]
     T = transform(x, log.sensors.imu.mount.body)
     e = np.einsum("nij,nj->ni", T, np.column_stack([d, db]))
     P = T @ result.P[keep] @ np.transpose(T, (0, 2, 1))

@@ -94,8 +94,7 @@ def estimate_figure(log, result, path, title):
     rows, i = rows[keep], i[keep]
     t, x = result.t[rows], result.x[rows]
     d = model.local(x, log.truth_states()[i])
-    bias = log.meta["truth_bias"]
-    db = np.concatenate([bias["gyro"], bias["accel"]])[None, :] - result.biases[rows]
+    db = log.truth_biases()[i] - result.biases[rows]
     T = transform(x, log.sensors.imu.mount.body)
     e = np.einsum("nij,nj->ni", T, np.column_stack([d, db]))
     sigma = np.sqrt(np.diagonal(T @ result.P[keep] @ np.transpose(T, (0, 2, 1)), axis1=-2, axis2=-1))

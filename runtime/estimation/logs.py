@@ -24,6 +24,9 @@ from ..params import Params
 from ..sensor_set import SensorSet
 from ..state import COLUMN_INDEX, NX, STATE_COLUMNS
 
+#: The truth's IMU biases (gyroscope [rad/s], accelerometer [m/s²], sensor axes) as they walk: the
+#: truth table's last columns, optional (a truth without them is the state alone).
+TRUTH_BIAS_COLUMNS = ("b_g_x", "b_g_y", "b_g_z", "b_a_x", "b_a_y", "b_a_z")
 #: The columns of each kind of table, in order; `t` [s] is when the sample was taken (for fixes:
 #: when it arrived; `t_measured` when it was measured).
 COLUMNS = {
@@ -32,7 +35,7 @@ COLUMNS = {
     "encoders": ("t", "theta_Y", "theta_P"),
     "fixes": ("t", "t_measured", "x", "y"),
     "heading": ("t", "psi"),
-    "truth": ("t", *STATE_COLUMNS),
+    "truth": ("t", *STATE_COLUMNS, *TRUTH_BIAS_COLUMNS),
 }
 #: Tables every log has; the others as its sensor set says (fixes, heading) or when present (truth).
 REQUIRED = ("torques", "imu", "encoders")
@@ -139,15 +142,31 @@ class Log:
         if self.truth is None:
             return None
         x = np.empty((len(self.truth), NX))
-        x[:, COLUMN_INDEX] = self.truth.data
+        x[:, COLUMN_INDEX] = self.truth.data[:, :len(STATE_COLUMNS)]
         return x
+
+    def truth_biases(self):
+        """The truth's IMU biases (n, 6) at the truth's times (TRUTH_BIAS_COLUMNS): its columns, else
+        log.json's "truth_bias" held over the run (a log whose biases did not walk), else None."""
+        if self.truth is None:
+            return None
+        if self.truth.columns[-len(TRUTH_BIAS_COLUMNS):] == TRUTH_BIAS_COLUMNS:
+            return self.truth.data[:, -len(TRUTH_BIAS_COLUMNS):].copy()
+        bias = self.meta.get("truth_bias")
+        if bias is None:
+            return None
+        return np.tile(np.concatenate([bias["gyro"], bias["accel"]]), (len(self.truth), 1))
 
 
 def samples(kind, t, data):
-    """A `Samples` of `kind` (its COLUMNS) from times (n,) and the other columns (n, k)."""
+    """A `Samples` of `kind` (its COLUMNS) from times (n,) and the other columns (n, k); a truth may
+    come without its bias columns."""
     t = np.ascontiguousarray(t, dtype=float)
-    data = np.asarray(data, dtype=float).reshape(len(t), len(COLUMNS[kind]) - 1)
-    return Samples(COLUMNS[kind], t, data)
+    data = np.asarray(data, dtype=float)
+    columns = COLUMNS[kind]
+    if kind == "truth" and data.ndim == 2 and data.shape[1] == len(STATE_COLUMNS):
+        columns = columns[:-len(TRUTH_BIAS_COLUMNS)]
+    return Samples(columns, t, data.reshape(len(t), len(columns) - 1))
 
 
 # -- writing ----------------------------------------------------------------------------------
@@ -162,7 +181,7 @@ def write_log(log, folder, formats=FORMATS):
         raise ValueError(f"formats: expected some of {', '.join(FORMATS)}, got {formats!r}")
     written = []
     for kind, table in log.tables().items():
-        arrow = pa.table({name: table.table()[:, i] for i, name in enumerate(COLUMNS[kind])})
+        arrow = pa.table({name: table.table()[:, i] for i, name in enumerate(table.columns)})
         for fmt in formats:
             target = folder / f"{kind}.{fmt}"
             with atomic_path(target) as tmp:
@@ -215,7 +234,7 @@ def read_log(folder, format=None, sensors=None, gap_periods=GAP_PERIODS):
         if not path.is_file():
             why = "every log has one" if kind in REQUIRED else f"the sensor set has {kind}"
             raise LogError(f"{path}: missing ({why})")
-        raw = _read_table(path, format, COLUMNS[kind])
+        raw = _read_table(path, format, COLUMNS[kind], OPTIONAL.get(kind, ()))
         tables[kind], by_kind[kind] = _clean(kind, raw, sensors, path)
         if kind in REQUIRED and not len(tables[kind]):
             raise LogError(f"{path}: no usable samples")
@@ -227,6 +246,8 @@ def read_log(folder, format=None, sensors=None, gap_periods=GAP_PERIODS):
 
 
 _META_OWN = ("format", "version", "kinds", "sensors")
+#: Columns a table may go without, all together.
+OPTIONAL = {"truth": TRUTH_BIAS_COLUMNS}
 
 
 def _read_meta(folder):
@@ -244,9 +265,9 @@ def _read_meta(folder):
     return meta
 
 
-def _read_table(path, format, columns):
-    """The named columns of the file as float64 arrays {name: (n,)}; LogError for a missing column or
-    an unreadable file or value."""
+def _read_table(path, format, columns, optional=()):
+    """The named columns of the file as float64 arrays {name: (n,)}, the `optional` ones (all or none)
+    only when present; LogError for a missing column or an unreadable file or value."""
     try:
         if format == "csv":
             table = pa_csv.read_csv(path, convert_options=pa_csv.ConvertOptions(
@@ -256,6 +277,9 @@ def _read_table(path, format, columns):
     except (pa.ArrowInvalid, pa.ArrowTypeError, OSError) as exc:
         raise LogError(f"{path}: not readable as {format.upper()} ({str(exc).splitlines()[0]})") from None
     missing = [name for name in columns if name not in table.column_names]
+    if optional and set(missing) == set(optional):
+        columns = [name for name in columns if name not in optional]
+        missing = []
     if missing:
         raise LogError(f"{path}: missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)} "
                        f"(a {path.stem} table has {', '.join(columns)})")
@@ -273,7 +297,7 @@ def _read_table(path, format, columns):
 def _clean(kind, raw, sensors, path):
     """(Samples, {reason: count}): rows with a non-finite value or a saturated reading dropped; then
     LogError where the time does not increase (or a fix is measured after it arrives)."""
-    columns = COLUMNS[kind]
+    columns = tuple(name for name in COLUMNS[kind] if name in raw)
     table = np.column_stack([raw[name] for name in columns]) if len(raw["t"]) else np.empty((0, len(columns)))
     finite = np.isfinite(table).all(axis=1)
     keep = finite.copy()

@@ -8,7 +8,8 @@ noise driving the truth (docs/estimation.md, "Simulated logs").
 The truth is the verified model on the C steppers (the scenario's integrator and dt) under the
 applied torques and the set's white torque disturbance, read by runtime/sensor_sim.py (the same
 simulation the closed loop on the estimator runs): per-run biases, white noise, the IMU's
-saturation, the encoders' quantisation, the fixes' latency.  Seeded: one seed gives the same log.
+saturation, the encoders' quantisation, the fixes' latency; the biases as they walk are the truth's
+last columns (log.json's "truth_bias": their draw at t = 0).  Seeded: one seed gives the same log.
 """
 import dataclasses
 import math
@@ -42,7 +43,7 @@ def mismatched(params):
 
 def memory_estimate(steps, duration, sensors):
     """{what: bytes} of a simulated log's arrays."""
-    parts = {"truth": memory.trajectory_bytes(steps), "torques": (steps + 1) * 3 * 8}
+    parts = {"truth": memory.trajectory_bytes(steps) + (steps + 1) * 6 * 8, "torques": (steps + 1) * 3 * 8}
     for kind in ("imu", "encoders", "fixes", "heading"):
         spec = getattr(sensors, kind)
         if spec is not None:
@@ -108,17 +109,18 @@ def simulate_log(run, sensors=None, seed=0, plant_mismatch=False, progress=None,
     torque = _OpenLoop(scenario) if isinstance(run, Scenario) else _ClosedLoop(run)
     started = time.perf_counter()
     sim = SensorSimulation(Model(truth_params), sensors, dt, steps, method, seed, disturbance_in_accel)
-    truth = np.empty((steps + 1, len(COLUMN_INDEX)))
+    truth = np.empty((steps + 1, len(COLUMN_INDEX) + 6))
     applied = np.empty((steps + 1, 2))
     x = scenario.x0.copy()
     for k in range(steps + 1):
-        truth[k] = x[COLUMN_INDEX]
+        truth[k, :-6] = x[COLUMN_INDEX]
+        truth[k, -6:] = sim.bias                                # what step k's IMU samples read
         u = torque(k, x) if k < steps else applied[k - 1]    # the last row starts no step: held
         applied[k] = u
         x, _ = sim.advance(k, x, u, last=k == steps)
         if progress is not None and k % 1000 == 0:
             progress(k, steps)
-    times, readings, bias, fix_latency = sim.times, sim.readings, sim.bias, sim.latency
+    times, readings, bias, fix_latency = sim.times, sim.readings, sim.bias_at(0), sim.latency
     fixes = None
     if "fixes" in times:
         fixes = samples("fixes", times["fixes"] + fix_latency, np.column_stack([times["fixes"], readings["fixes"]]))

@@ -75,3 +75,54 @@ def test_a_bias_random_walk_keeps_the_bias_sigma_from_shrinking_without_bound(pa
     assert final[0.0][-1] < 0.8 * final[0.0][-2]                                  # still shrinking
     assert final[1e-3][-1] == pytest.approx(final[1e-3][-2], rel=0.02)            # settled
     assert final[1e-3][-1] > 3 * final[0.0][-1] and math.isfinite(final[1e-3][-1])
+
+
+# -- the truth's biases walk ----------------------------------------------------------------------
+def walked(params, gyro_rw, accel_rw, steps, seed=5, streams=None, monkeypatch=None, **imu):
+    """A SensorSimulation at rest for `steps` steps of 5 ms with the given bias random walks (and
+    other `imu` fields) and no process noise: (the simulation, the biases of every step (steps + 1, 6))."""
+    from runtime import Model, initial_state
+    from runtime import sensor_sim
+    from runtime.sensor_set import ProcessNoise
+    if streams is not None:
+        monkeypatch.setattr(sensor_sim, "STREAMS", streams)
+    default = SensorSet.default()
+    sensors = dataclasses.replace(default, process=ProcessNoise(0.0, 0.0, 0.0),
+                                  imu=dataclasses.replace(default.imu, gyro_bias_rw=gyro_rw, accel_bias_rw=accel_rw, **imu))
+    sim = sensor_sim.SensorSimulation(Model(params), sensors, 0.005, steps, "rkmk4", seed)
+    x, u = initial_state(r=params.r), np.zeros(2)
+    for k in range(steps + 1):
+        x, _ = sim.advance(k, x, u, last=k == steps)
+    return sim, np.array([sim.bias_at(k) for k in range(steps + 1)])
+
+
+def test_the_truths_biases_walk_with_the_declared_variance_per_step(params):
+    # 2000 steps, 3 axes: 6000 increments per sensor, whose sample variance is within 15 % of
+    # rw² dt at 8 standard deviations of its spread; a walk off by a factor 2 in variance fails.
+    steps, dt = 2000, 0.005
+    _, b = walked(params, 1e-5, 1e-4, steps)
+    d = np.diff(b, axis=0)
+    assert abs(np.mean(d[:, :3] ** 2) / (1e-5 ** 2 * dt) - 1) < 0.15
+    assert abs(np.mean(d[:, 3:] ** 2) / (1e-4 ** 2 * dt) - 1) < 0.15
+
+
+def test_the_imu_reads_the_bias_of_its_step(params):
+    sim, b = walked(params, 1e-3, 1e-2, 200, gyro_noise=0.0, accel_noise=0.0)
+    assert np.ptp(b, axis=0).min() > 1e-4                  # the bias moved
+    at_rest = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 9.81])
+    assert np.abs(sim.readings["imu"] - b - at_rest).max() < 1e-9
+
+
+def test_without_a_walk_every_reading_is_the_old_streams_bit_for_bit(params, monkeypatch):
+    from runtime import sensor_sim
+    old = tuple(s for s in sensor_sim.STREAMS if s != "bias_walk")
+    new, b = walked(params, 0.0, 0.0, 100)
+    assert np.array_equal(b, np.tile(b[0], (101, 1)))
+    before, _ = walked(params, 0.0, 0.0, 100, streams=old, monkeypatch=monkeypatch)
+    monkeypatch.undo()
+    for kind in new.readings:
+        assert np.array_equal(new.readings[kind], before.readings[kind]), kind
+    # The walk's own stream leaves every other draw alone: only the IMU moves, by the walk.
+    walking, wb = walked(params, 1e-3, 1e-2, 100)
+    assert np.array_equal(walking.readings["encoders"], new.readings["encoders"])
+    assert np.abs(walking.readings["imu"] - new.readings["imu"] - (wb - b)).max() < 1e-12

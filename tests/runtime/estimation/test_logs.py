@@ -9,7 +9,8 @@ import pyarrow.parquet as pq
 import pytest
 
 from runtime import initial_state
-from runtime.estimation.logs import COLUMNS, FORMATS, Gap, Log, LogError, read_log, samples, write_log
+from runtime.estimation.logs import (COLUMNS, FORMATS, TRUTH_BIAS_COLUMNS, Gap, Log, LogError, read_log, samples,
+                                     write_log)
 from runtime.sensor_set import HeadingSpec, ImuSpec, SensorSet
 from runtime.state import STATE_COLUMNS
 
@@ -46,10 +47,40 @@ def test_a_log_reads_back_exactly_from_either_format(tmp_path, fmt):
     assert back.skipped == {"nonfinite": 0, "saturated": 0} and back.gaps == ()
 
 
-def test_the_truth_columns_are_the_trajectory_csv_state_columns():
+def test_the_truth_columns_are_the_trajectory_csv_state_columns_then_the_biases():
     from runtime.scenarios.report import CSV_COLUMNS
-    assert COLUMNS["truth"] == ("t", *STATE_COLUMNS)
-    assert [c for c in CSV_COLUMNS if c in COLUMNS["truth"]] == list(COLUMNS["truth"])
+    assert COLUMNS["truth"] == ("t", *STATE_COLUMNS, *TRUTH_BIAS_COLUMNS)
+    state = COLUMNS["truth"][:-len(TRUTH_BIAS_COLUMNS)]
+    assert [c for c in CSV_COLUMNS if c in state] == list(state)
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_the_truths_walking_biases_read_back_per_row(tmp_path, fmt):
+    log = small_log()
+    walk = np.cumsum(np.full((len(log.truth), 6), 1e-4), axis=0)
+    truth = samples("truth", log.truth.t, np.column_stack([log.truth.data, walk]))
+    write_log(Log(**{**log.tables(), "truth": truth}, sensors=log.sensors, meta=log.meta), tmp_path)
+    back = read_log(tmp_path, format=fmt)
+    assert back.truth.columns == COLUMNS["truth"]
+    assert np.array_equal(back.truth_biases(), walk)
+    assert np.array_equal(back.truth_states(), log.truth_states())
+
+
+def test_a_truth_without_bias_columns_holds_the_drawn_biases_of_log_json(tmp_path):
+    log = small_log()
+    drawn = {"gyro": [0.001, 0.002, 0.003], "accel": [0.01, 0.02, 0.03]}
+    write_log(Log(**log.tables(), sensors=log.sensors, meta={"truth_bias": drawn}), tmp_path)
+    back = read_log(tmp_path)
+    assert back.truth.columns == ("t", *STATE_COLUMNS)
+    assert np.array_equal(back.truth_biases(), np.tile(drawn["gyro"] + drawn["accel"], (len(back.truth), 1)))
+
+
+def test_a_truth_with_some_bias_columns_only_is_refused(tmp_path):
+    write_log(small_log(), tmp_path)
+    table = pq.read_table(tmp_path / "truth.parquet")
+    pq.write_table(table.append_column("b_g_x", pa.array(np.zeros(table.num_rows))), tmp_path / "truth.parquet")
+    with pytest.raises(LogError, match=r"truth\.parquet: missing columns b_g_y"):
+        read_log(tmp_path)
 
 
 def test_the_truth_comes_back_as_states_in_the_library_layout(tmp_path):

@@ -1,7 +1,7 @@
 """Simulated sensor logs (runtime/estimation/sense.py, `python -m runtime sense`): the readings have
-the declared noise, constant biases, quantisation and latency; the truth moves by the declared
-process noise; one seed gives one log; the mismatch case simulates another robot than the log
-claims.  Short runs only."""
+the declared noise, biases drawn per run that walk as declared, quantisation and latency; the
+truth moves by the declared process noise; one seed gives one log; the mismatch case simulates
+another robot than the log claims.  Short runs only."""
 import dataclasses
 import json
 import math
@@ -45,13 +45,26 @@ def test_gyro_and_accelerometer_noise_have_their_declared_standard_deviations():
     assert np.all(np.abs(accel.mean(axis=0)) < 4 * 0.02 / math.sqrt(401))
 
 
-def test_without_noise_the_imu_reads_its_bias_constantly_at_rest():
-    sensors = SensorSet(imu=ImuSpec(gyro_noise=0.0, accel_noise=0.0), process=QUIET)
+def test_without_noise_or_walk_the_imu_reads_its_bias_constantly_at_rest():
+    sensors = SensorSet(imu=ImuSpec(gyro_noise=0.0, accel_noise=0.0, gyro_bias_rw=0.0, accel_bias_rw=0.0),
+                        process=QUIET)
     log = simulate_log(at_rest(0.5), sensors, seed=2)
     bias = log.meta["truth_bias"]
     expected = np.array(bias["gyro"] + [b + g for b, g in zip(bias["accel"], (0.0, 0.0, 9.81))])
     assert np.abs(log.imu.data - expected).max() < 1e-12
     assert np.abs(bias["gyro"]).max() > 1e-4          # a bias was drawn at all
+    assert np.array_equal(log.truth_biases(), np.tile(bias["gyro"] + bias["accel"], (len(log.truth), 1)))
+
+
+def test_the_truth_carries_the_walking_biases_the_imu_reads():
+    sensors = SensorSet(imu=ImuSpec(gyro_noise=0.0, accel_noise=0.0, gyro_bias_rw=1e-3, accel_bias_rw=1e-2),
+                        process=QUIET)
+    log = simulate_log(at_rest(0.5), sensors, seed=2)
+    walk = log.truth_biases()
+    assert np.ptp(walk, axis=0).min() > 1e-4
+    assert np.abs(log.imu.data - walk - [0.0, 0.0, 0.0, 0.0, 0.0, 9.81]).max() < 1e-9
+    bias = log.meta["truth_bias"]                     # the draw at t = 0
+    assert np.array_equal(walk[0], bias["gyro"] + bias["accel"])
 
 
 def test_biases_are_drawn_per_run_with_their_declared_spread():
@@ -165,7 +178,7 @@ def test_sense_writes_a_log_its_truth_and_a_summary(tmp_path, capsys):
     log_csv, log_parquet = read_log(out, format="csv"), read_log(out, format="parquet")
     assert np.array_equal(log_csv.imu.table(), log_parquet.imu.table())
     assert np.array_equal(log_csv.truth.table(), log_parquet.truth.table())
-    assert log_csv.truth.data.shape == (101, NX) and log_csv.sensors == SensorSet.default()
+    assert log_csv.truth.data.shape == (101, NX + 6) and log_csv.sensors == SensorSet.default()
     summary = json.loads((out / "summary.json").read_text())
     assert summary["seed"] == 3 and summary["samples"] == {"torques": 101, "imu": 101, "encoders": 101, "fixes": 2}
     again = simulate_log(parse_scenario(
