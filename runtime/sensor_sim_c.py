@@ -33,8 +33,16 @@ def _ptr(arr):
 def imu_biases(sim):
     """(rows (n, 6), stride): the IMU's biases at each of its samples, one row for the run when
     they hold constant (stride 0)."""
-    rows = np.ascontiguousarray(np.atleast_2d(sim.bias), dtype=np.float64)
-    return rows, (0 if len(rows) == 1 else rows.shape[1])
+    if not np.any(sim.bias_step_std):
+        return np.ascontiguousarray(np.atleast_2d(sim.bias), dtype=np.float64), 0
+    # The walk is drawn as SensorSimulation.advance draws it, one row per plant step from its own
+    # stream, and summed in the same order; a sample reads the bias at the start of its step.
+    steps = len(sim._walk) - 1
+    walk = np.zeros((steps + 1, 6))
+    walk[1:] = np.cumsum(sim.rng["bias_walk"].normal(0.0, 1.0, (steps, 6)) * sim.bias_step_std, axis=0)
+    t = sim.times["imu"]
+    step = np.minimum(np.floor((t + 1e-9 * sim.dt) / sim.dt).astype(int), steps)
+    return np.ascontiguousarray(sim._bias0 + walk[step], dtype=np.float64), 6
 
 
 class SensorRunC:
