@@ -114,6 +114,76 @@ static const sr_real *general_constants(const sr_model *model, sr_real cg[SR_GEN
     return cg;
 }
 
+/* d(M nu' - f)/dp on the columns cs (dR row-major SR_NV x NP, its first cs->n columns), nu' = a held. */
+static int residual_columns(const sr_model *model, const colset *cs, const sr_real x[SR_NX], const sr_real a[SR_NV],
+                            sr_real dR[SR_NV * NP])
+{
+    int i, c, status = SR_OK;
+    if (!cs->cols) return sr_gen_general_param_residual_jacobian(model->p, x, a, dR);
+    for (c = 0; c < cs->n && status == SR_OK; ++c) {
+        sr_real col[SR_NV];
+        status = RESIDUAL_COLUMN[cs->cols[c]](model->p, x, a, col);
+        for (i = 0; i < SR_NV; ++i) dR[NP * i + c] = col[i];
+    }
+    return status;
+}
+
+/* B <- M^-1 B on the first nc columns, M = L L^T (sr_internal_cholesky). */
+static void solve_columns(const sr_real L[SR_NV * SR_NV], const sr_real inv[SR_NV], int nc, sr_real B[SR_NV][NP])
+{
+    int i, k, c;
+    for (i = 0; i < SR_NV; ++i) {
+        for (k = 0; k < i; ++k)
+            for (c = 0; c < nc; ++c) B[i][c] -= L[SR_NV * i + k] * B[k][c];
+        for (c = 0; c < nc; ++c) B[i][c] *= inv[i];
+    }
+    for (i = SR_NV - 1; i >= 0; --i) {
+        for (k = i + 1; k < SR_NV; ++k)
+            for (c = 0; c < nc; ++c) B[i][c] -= L[SR_NV * k + i] * B[k][c];
+        for (c = 0; c < nc; ++c) B[i][c] *= inv[i];
+    }
+}
+
+/* A general robot's stage: nu' = a and its whole derivative along the stage's dy on the columns
+ * cs, D = Ja dy + d(nu')/dp = M^-1 ((df - (dM) a) dy - d(M nu' - f)/dp), from one kernel for M, f
+ * and their state derivatives and one factorisation: Ja itself is never formed, and the solve runs
+ * on the few columns only. */
+static int general_stage_rows(const sr_model *model, const colset *cs, const sr_real y[SR_NX],
+                              const sr_real u[SR_NU], const error_p dy, sr_real a[SR_NV], sr_real D[SR_NV][NP])
+{
+    sr_real Mu[15], f[SR_NV], df[SR_NV * SR_NE], dfdu[SR_NV * SR_NU], dM[5 * 15], L[SR_NV * SR_NV], inv[SR_NV];
+    sr_real g[SR_NV][SR_NE], dR[SR_NV * NP];
+    const int nc = cs->n;
+    int i, j, k, c, status = sr_internal_general_accel_jacobian_terms(model, y, u, Mu, f, df, dfdu, dM);
+    if (status == SR_OK) status = sr_internal_cholesky(Mu, L, inv);
+    if (status != SR_OK) return status;
+    for (i = 0; i < SR_NV; ++i) {   /* a = M^-1 f */
+        sr_real t = f[i];
+        for (k = 0; k < i; ++k) t -= L[SR_NV * i + k] * a[k];
+        a[i] = t * inv[i];
+    }
+    for (i = SR_NV - 1; i >= 0; --i) {
+        sr_real t = a[i];
+        for (k = i + 1; k < SR_NV; ++k) t -= L[SR_NV * k + i] * a[k];
+        a[i] = t * inv[i];
+    }
+    status = residual_columns(model, cs, y, a, dR);
+    if (status != SR_OK) return status;
+    for (i = 0; i < SR_NV; ++i) {
+        for (k = 0; k < SR_NE; ++k) g[i][k] = df[SR_NE * i + k];
+        for (k = 0; k < 5; ++k)   /* the configuration directions d_xi_S, d_th_Y, d_th_P move M */
+            for (j = 0; j < SR_NV; ++j) g[i][k] -= dM[15 * k + SR_UPPER[i][j]] * a[j];
+        for (c = 0; c < nc; ++c) D[i][c] = -dR[NP * i + c];
+        for (k = 0; k < SR_NE; ++k) {
+            const sr_real m = g[i][k];
+            if (k == SR_E_q || k == SR_E_q + 1) continue;   /* nothing depends on q */
+            for (c = 0; c < nc; ++c) D[i][c] += m * dy[k][c];
+        }
+    }
+    solve_columns(L, inv, nc, D);
+    return SR_OK;
+}
+
 /* nu' and d(nu')/dp on the columns cs at a state the caller checked (u not NULL), the general
  * kernels' constants given; J row-major SR_NV x NP, its first cs->n columns written. */
 static int accel_param_jacobian(const sr_model *model, const sr_real *constants, const colset *cs,
@@ -136,27 +206,11 @@ static int accel_param_jacobian(const sr_model *model, const sr_real *constants,
         for (k = i + 1; k < SR_NV; ++k) s -= L[SR_NV * k + i] * a[k];
         a[i] = s * inv[i];
     }
-    if (!cs->cols) {
-        status = sr_gen_general_param_residual_jacobian(model->p, x, a, dR);
-    } else {
-        for (c = 0, status = SR_OK; c < nc && status == SR_OK; ++c) {
-            sr_real col[SR_NV];
-            status = RESIDUAL_COLUMN[cs->cols[c]](model->p, x, a, col);
-            for (i = 0; i < SR_NV; ++i) dR[NP * i + c] = col[i];
-        }
-    }
+    status = residual_columns(model, cs, x, a, dR);
     if (status != SR_OK) return status;
-    for (i = 0; i < SR_NV; ++i) {   /* J = -M^-1 dR, all columns at once */
+    for (i = 0; i < SR_NV; ++i)
         for (c = 0; c < nc; ++c) J[i][c] = -dR[NP * i + c];
-        for (k = 0; k < i; ++k)
-            for (c = 0; c < nc; ++c) J[i][c] -= L[SR_NV * i + k] * J[k][c];
-        for (c = 0; c < nc; ++c) J[i][c] *= inv[i];
-    }
-    for (i = SR_NV - 1; i >= 0; --i) {
-        for (k = i + 1; k < SR_NV; ++k)
-            for (c = 0; c < nc; ++c) J[i][c] -= L[SR_NV * k + i] * J[k][c];
-        for (c = 0; c < nc; ++c) J[i][c] *= inv[i];
-    }
+    solve_columns(L, inv, nc, J);   /* J = -M^-1 dR */
     return SR_OK;
 }
 
@@ -225,9 +279,11 @@ static int field_rows(const sr_model *model, const sr_real *constants, const col
     const size_t row = (size_t)nc * sizeof(sr_real);
     sr_real a[SR_NV], Jp[SR_NV][NP], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], p[2][3], wxp[2][3];
     int i, j, c, status;
+    const int general_stage = dy && model->general;
     sr_internal_kinematics(model, y, f);
-    status = accel_param_jacobian(model, constants, cs, y, u, f + SR_T_V, Jp);
-    if (status == SR_OK && dy) status = sr_internal_accel_jacobian(model, y, u, a, Ja, Jb);
+    if (general_stage) status = general_stage_rows(model, cs, y, u, dy, f + SR_T_V, Jp);
+    else status = accel_param_jacobian(model, constants, cs, y, u, f + SR_T_V, Jp);
+    if (status == SR_OK && dy && !general_stage) status = sr_internal_accel_jacobian(model, y, u, a, Ja, Jb);
     /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
     if (status != SR_OK) return status == SR_ERR_SINGULAR && !all_finite(y, SR_NX) ? SR_ERR_NONFINITE : status;
     for (i = 0; i < SR_T_V; ++i) memset(df[i], 0, row);
@@ -250,7 +306,7 @@ static int field_rows(const sr_model *model, const sr_real *constants, const col
             for (c = 0; c < nc; ++c)
                 df[SR_T_Q + i][c] += p[i][j] * dy[SR_E_nu + j][c] + wxp[i][j] * dy[SR_E_xi_S + j][c];
     }
-    for (i = 0; i < SR_NV; ++i)   /* the accelerations: Ja dy (q's columns of Ja are zero) */
+    for (i = 0; i < SR_NV && !general_stage; ++i)   /* the accelerations: Ja dy (q's columns of Ja are zero) */
         for (j = 0; j < SR_NE; ++j) {
             const sr_real m = Ja[SR_NE * i + j];
             if (j == SR_E_q || j == SR_E_q + 1) continue;
