@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 681944a418b61699], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 19c6a7b61f2be7e1], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/include/spherical_robot.h.
@@ -163,38 +163,6 @@
 #define SR_GEN_GENERAL_EQUILIBRIUM_RESIDUAL_FLOPS 126
 #define SR_GEN_GENERAL_ACCEL_JACOBIAN_TERMS_FLOPS 4398
 #define SR_GEN_GENERAL_PARAM_RESIDUAL_JACOBIAN_FLOPS 2812
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_R_FLOPS 622
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_M_S_FLOPS 55
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_S_FLOPS 4
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_K_S_FLOPS 4
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_M_Y_FLOPS 459
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_C_Y_X_FLOPS 155
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_C_Y_Y_FLOPS 264
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_C_Y_Z_FLOPS 266
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_Y_XX_FLOPS 9
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_Y_YY_FLOPS 46
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_Y_ZZ_FLOPS 44
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_Y_XY_FLOPS 36
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_Y_XZ_FLOPS 36
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_Y_YZ_FLOPS 57
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_K_Y_FLOPS 4
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_M_P_FLOPS 1254
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_C_P_X_FLOPS 777
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_C_P_Y_FLOPS 578
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_C_P_Z_FLOPS 800
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_P_XX_FLOPS 185
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_P_YY_FLOPS 68
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_P_ZZ_FLOPS 215
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_P_XY_FLOPS 147
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_P_XZ_FLOPS 202
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_P_YZ_FLOPS 158
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_K_P_FLOPS 4
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_MY_FLOPS 14
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_N_Y_FLOPS 12
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_J_MP_FLOPS 73
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_N_P_FLOPS 32
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_G_FLOPS 137
-#define SR_GEN_GENERAL_PARAM_RESIDUAL_SLOPE_FLOPS 156
 #define SR_GEN_REGRESSOR_FLOPS 1488
 #define SR_GEN_SENSOR_CONSTANTS_FLOPS 4
 #define SR_GEN_IMU_SHELL_FLOPS 95
@@ -233,38 +201,6 @@
 #define SR_GEN_READS_general_equilibrium_residual(R) R(cg, 67, 70) R(cg, 71, 72) R(cg, 75, 81) R(cg, 82, 83)
 #define SR_GEN_READS_general_accel_jacobian_terms(R) R(cg, 4, 7) R(cg, 16, 17) R(cg, 18, 19) R(cg, 22, 25) R(cg, 31, 56) R(cg, 67, 70) R(cg, 71, 72) R(cg, 75, 81) R(cg, 82, 104)
 #define SR_GEN_READS_general_param_residual_jacobian(R) R(p, 0, 2) R(p, 4, 8) R(p, 15, 19) R(p, 26, 32)
-#define SR_GEN_READS_general_param_residual_r(R) R(p, 0, 2) R(p, 4, 8) R(p, 15, 19) R(p, 30, 32)
-#define SR_GEN_READS_general_param_residual_m_S(R) R(p, 0, 1) R(p, 30, 32)
-#define SR_GEN_READS_general_param_residual_j_S(R)
-#define SR_GEN_READS_general_param_residual_k_S(R)
-#define SR_GEN_READS_general_param_residual_m_Y(R) R(p, 0, 1) R(p, 5, 8) R(p, 30, 32)
-#define SR_GEN_READS_general_param_residual_c_Y_x(R) R(p, 0, 1) R(p, 4, 8) R(p, 30, 32)
-#define SR_GEN_READS_general_param_residual_c_Y_y(R) R(p, 0, 1) R(p, 4, 8) R(p, 30, 32)
-#define SR_GEN_READS_general_param_residual_c_Y_z(R) R(p, 0, 1) R(p, 4, 8) R(p, 30, 32)
-#define SR_GEN_READS_general_param_residual_J_Y_xx(R)
-#define SR_GEN_READS_general_param_residual_J_Y_yy(R)
-#define SR_GEN_READS_general_param_residual_J_Y_zz(R)
-#define SR_GEN_READS_general_param_residual_J_Y_xy(R)
-#define SR_GEN_READS_general_param_residual_J_Y_xz(R)
-#define SR_GEN_READS_general_param_residual_J_Y_yz(R)
-#define SR_GEN_READS_general_param_residual_k_Y(R)
-#define SR_GEN_READS_general_param_residual_m_P(R) R(p, 0, 1) R(p, 16, 19) R(p, 30, 32)
-#define SR_GEN_READS_general_param_residual_c_P_x(R) R(p, 0, 1) R(p, 15, 19) R(p, 30, 32)
-#define SR_GEN_READS_general_param_residual_c_P_y(R) R(p, 0, 1) R(p, 15, 19) R(p, 30, 32)
-#define SR_GEN_READS_general_param_residual_c_P_z(R) R(p, 0, 1) R(p, 15, 19) R(p, 30, 32)
-#define SR_GEN_READS_general_param_residual_J_P_xx(R)
-#define SR_GEN_READS_general_param_residual_J_P_yy(R)
-#define SR_GEN_READS_general_param_residual_J_P_zz(R)
-#define SR_GEN_READS_general_param_residual_J_P_xy(R)
-#define SR_GEN_READS_general_param_residual_J_P_xz(R)
-#define SR_GEN_READS_general_param_residual_J_P_yz(R)
-#define SR_GEN_READS_general_param_residual_k_P(R)
-#define SR_GEN_READS_general_param_residual_j_mY(R) R(p, 27, 28)
-#define SR_GEN_READS_general_param_residual_n_Y(R) R(p, 26, 28)
-#define SR_GEN_READS_general_param_residual_j_mP(R) R(p, 29, 30)
-#define SR_GEN_READS_general_param_residual_n_P(R) R(p, 28, 30)
-#define SR_GEN_READS_general_param_residual_g(R) R(p, 0, 2) R(p, 4, 8) R(p, 15, 19) R(p, 31, 32)
-#define SR_GEN_READS_general_param_residual_slope(R) R(p, 0, 2) R(p, 4, 8) R(p, 15, 19) R(p, 30, 32)
 #define SR_GEN_READS_regressor(R) R(p, 0, 1) R(p, 27, 28) R(p, 29, 32)
 #define SR_GEN_READS_sensor_constants(R) R(p, 0, 1) R(p, 30, 32)
 #define SR_GEN_READS_imu_shell(R)
@@ -302,38 +238,6 @@
 #define sr_gen_general_equilibrium_residual sr_gen_general_equilibrium_residual_f
 #define sr_gen_general_accel_jacobian_terms sr_gen_general_accel_jacobian_terms_f
 #define sr_gen_general_param_residual_jacobian sr_gen_general_param_residual_jacobian_f
-#define sr_gen_general_param_residual_r sr_gen_general_param_residual_r_f
-#define sr_gen_general_param_residual_m_S sr_gen_general_param_residual_m_S_f
-#define sr_gen_general_param_residual_j_S sr_gen_general_param_residual_j_S_f
-#define sr_gen_general_param_residual_k_S sr_gen_general_param_residual_k_S_f
-#define sr_gen_general_param_residual_m_Y sr_gen_general_param_residual_m_Y_f
-#define sr_gen_general_param_residual_c_Y_x sr_gen_general_param_residual_c_Y_x_f
-#define sr_gen_general_param_residual_c_Y_y sr_gen_general_param_residual_c_Y_y_f
-#define sr_gen_general_param_residual_c_Y_z sr_gen_general_param_residual_c_Y_z_f
-#define sr_gen_general_param_residual_J_Y_xx sr_gen_general_param_residual_J_Y_xx_f
-#define sr_gen_general_param_residual_J_Y_yy sr_gen_general_param_residual_J_Y_yy_f
-#define sr_gen_general_param_residual_J_Y_zz sr_gen_general_param_residual_J_Y_zz_f
-#define sr_gen_general_param_residual_J_Y_xy sr_gen_general_param_residual_J_Y_xy_f
-#define sr_gen_general_param_residual_J_Y_xz sr_gen_general_param_residual_J_Y_xz_f
-#define sr_gen_general_param_residual_J_Y_yz sr_gen_general_param_residual_J_Y_yz_f
-#define sr_gen_general_param_residual_k_Y sr_gen_general_param_residual_k_Y_f
-#define sr_gen_general_param_residual_m_P sr_gen_general_param_residual_m_P_f
-#define sr_gen_general_param_residual_c_P_x sr_gen_general_param_residual_c_P_x_f
-#define sr_gen_general_param_residual_c_P_y sr_gen_general_param_residual_c_P_y_f
-#define sr_gen_general_param_residual_c_P_z sr_gen_general_param_residual_c_P_z_f
-#define sr_gen_general_param_residual_J_P_xx sr_gen_general_param_residual_J_P_xx_f
-#define sr_gen_general_param_residual_J_P_yy sr_gen_general_param_residual_J_P_yy_f
-#define sr_gen_general_param_residual_J_P_zz sr_gen_general_param_residual_J_P_zz_f
-#define sr_gen_general_param_residual_J_P_xy sr_gen_general_param_residual_J_P_xy_f
-#define sr_gen_general_param_residual_J_P_xz sr_gen_general_param_residual_J_P_xz_f
-#define sr_gen_general_param_residual_J_P_yz sr_gen_general_param_residual_J_P_yz_f
-#define sr_gen_general_param_residual_k_P sr_gen_general_param_residual_k_P_f
-#define sr_gen_general_param_residual_j_mY sr_gen_general_param_residual_j_mY_f
-#define sr_gen_general_param_residual_n_Y sr_gen_general_param_residual_n_Y_f
-#define sr_gen_general_param_residual_j_mP sr_gen_general_param_residual_j_mP_f
-#define sr_gen_general_param_residual_n_P sr_gen_general_param_residual_n_P_f
-#define sr_gen_general_param_residual_g sr_gen_general_param_residual_g_f
-#define sr_gen_general_param_residual_slope sr_gen_general_param_residual_slope_f
 #define sr_gen_regressor sr_gen_regressor_f
 #define sr_gen_sensor_constants sr_gen_sensor_constants_f
 #define sr_gen_imu_shell sr_gen_imu_shell_f
@@ -486,70 +390,6 @@ int sr_gen_general_equilibrium_residual(const sr_real cg[SR_GEN_GENERAL_NCONST],
 int sr_gen_general_accel_jacobian_terms(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real u[SR_GEN_NU], sr_real M[15], sr_real f[5], sr_real df[60], sr_real dfdu[10], sr_real dM[75]);
 /* ∂(M ν̇ − f)/∂p of the general robot with ν̇ held (5 x SR_GEN_NPARAM, row-major, columns SR_P_*), for ∂ν̇/∂p = −M⁻¹ ∂(M ν̇ − f)/∂p (derive.param_derivatives). */
 int sr_gen_general_param_residual_jacobian(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[160]);
-/* Column SR_P_r of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂r of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_r(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_m_S of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂m_S of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_m_S(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_j_S of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂j_S of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_j_S(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_k_S of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂k_S of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_k_S(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_m_Y of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂m_Y of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_m_Y(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_c_Y_x of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂c_Y_x of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_c_Y_x(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_c_Y_y of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂c_Y_y of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_c_Y_y(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_c_Y_z of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂c_Y_z of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_c_Y_z(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_J_Y_xx of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂J_Y_xx of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_J_Y_xx(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_J_Y_yy of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂J_Y_yy of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_J_Y_yy(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_J_Y_zz of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂J_Y_zz of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_J_Y_zz(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_J_Y_xy of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂J_Y_xy of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_J_Y_xy(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_J_Y_xz of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂J_Y_xz of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_J_Y_xz(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_J_Y_yz of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂J_Y_yz of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_J_Y_yz(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_k_Y of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂k_Y of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_k_Y(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_m_P of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂m_P of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_m_P(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_c_P_x of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂c_P_x of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_c_P_x(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_c_P_y of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂c_P_y of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_c_P_y(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_c_P_z of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂c_P_z of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_c_P_z(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_J_P_xx of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂J_P_xx of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_J_P_xx(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_J_P_yy of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂J_P_yy of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_J_P_yy(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_J_P_zz of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂J_P_zz of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_J_P_zz(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_J_P_xy of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂J_P_xy of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_J_P_xy(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_J_P_xz of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂J_P_xz of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_J_P_xz(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_J_P_yz of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂J_P_yz of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_J_P_yz(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_k_P of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂k_P of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_k_P(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_j_mY of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂j_mY of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_j_mY(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_n_Y of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂n_Y of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_n_Y(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_j_mP of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂j_mP of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_j_mP(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_n_P of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂n_P of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_n_P(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_g of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂g of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_g(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-/* Column SR_P_slope of sr_gen_general_param_residual_jacobian: ∂(M ν̇ − f)/∂slope of the general robot with ν̇ held (5 entries). */
-int sr_gen_general_param_residual_slope(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real dR[5]);
 /* The regressor Y (5 x SR_GEN_NPI, row-major, columns SR_PI_*): M ν̇ − f(u = 0) = Y π, π the inertial parameters and dampings (derive.param_derivatives.INERTIAL_PARAMETERS). */
 int sr_gen_regressor(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real Y[135]);
 /* The sensor kernels' constants sc = (r, g sin(slope), g cos(slope)) (SR_SC_*) from the parameters (derive.sensors.constant_expressions). */

@@ -614,9 +614,7 @@ int sr_step_param_jacobian_batch(const sr_model *model, int method, long n, cons
 
 /** sr_step_param_jacobian_batch on the columns cols[0..ncols) (SR_P_*) only, in their order:
  * Jp n x SR_NE x ncols row-major, equal to those columns of sr_step_param_jacobian.  The stages run
- * on those columns alone and each column's bracket d(M nu' - f)/dp_j comes from its own generated
- * kernel (sr_gen_general_param_residual_<name>), so a sensitivity to a few parameters costs a
- * fraction of all of them.  Checks: the model, the pointers (SR_ERR_NULL), 1 <= ncols <= SR_NPARAM
+ * on those columns alone, so a sensitivity to a few parameters costs a fraction of all of them.  Checks: the model, the pointers (SR_ERR_NULL), 1 <= ncols <= SR_NPARAM
  * and every column an index of p, method SR_LIE_EULER or SR_RKMK4, dt (SR_ERR_ARG); then per row
  * as sr_step_param_jacobian, stopping at the first failing row, its index in *failed_row (-1 when
  * all succeed); the rows before it are written. */

@@ -15,8 +15,7 @@
  * and RKMK4's dexp^-1 on the SO(3) block, dk_S = P df_S + Q dth_S (sr_dexpinv.h).
  *
  * The columns are independent all the way: a sensitivity to a few parameters (the free ones of a
- * fit) runs the same stages on those columns only, with the bracket's derivative by the generated
- * kernel of each column (sr_gen_general_param_residual_<name>) instead of all of them.
+ * fit) runs the same stages on those columns only.
  */
 #include "sr_checks.h"
 #include "sr_dexpinv.h"
@@ -41,44 +40,6 @@ typedef struct {
 } colset;
 
 static const colset ALL_COLUMNS = {NP, SR_P_r, NULL};
-
-typedef int (*residual_column)(const sr_real p[SR_GEN_NPARAM], const sr_real x[SR_GEN_NX],
-                               const sr_real nud[SR_GEN_NV], sr_real dR[5]);
-
-static const residual_column RESIDUAL_COLUMN[NP] = {
-    [SR_P_r] = sr_gen_general_param_residual_r,
-    [SR_P_m_S] = sr_gen_general_param_residual_m_S,
-    [SR_P_j_S] = sr_gen_general_param_residual_j_S,
-    [SR_P_k_S] = sr_gen_general_param_residual_k_S,
-    [SR_P_m_Y] = sr_gen_general_param_residual_m_Y,
-    [SR_P_c_Y_x] = sr_gen_general_param_residual_c_Y_x,
-    [SR_P_c_Y_y] = sr_gen_general_param_residual_c_Y_y,
-    [SR_P_c_Y_z] = sr_gen_general_param_residual_c_Y_z,
-    [SR_P_J_Y_xx] = sr_gen_general_param_residual_J_Y_xx,
-    [SR_P_J_Y_yy] = sr_gen_general_param_residual_J_Y_yy,
-    [SR_P_J_Y_zz] = sr_gen_general_param_residual_J_Y_zz,
-    [SR_P_J_Y_xy] = sr_gen_general_param_residual_J_Y_xy,
-    [SR_P_J_Y_xz] = sr_gen_general_param_residual_J_Y_xz,
-    [SR_P_J_Y_yz] = sr_gen_general_param_residual_J_Y_yz,
-    [SR_P_k_Y] = sr_gen_general_param_residual_k_Y,
-    [SR_P_m_P] = sr_gen_general_param_residual_m_P,
-    [SR_P_c_P_x] = sr_gen_general_param_residual_c_P_x,
-    [SR_P_c_P_y] = sr_gen_general_param_residual_c_P_y,
-    [SR_P_c_P_z] = sr_gen_general_param_residual_c_P_z,
-    [SR_P_J_P_xx] = sr_gen_general_param_residual_J_P_xx,
-    [SR_P_J_P_yy] = sr_gen_general_param_residual_J_P_yy,
-    [SR_P_J_P_zz] = sr_gen_general_param_residual_J_P_zz,
-    [SR_P_J_P_xy] = sr_gen_general_param_residual_J_P_xy,
-    [SR_P_J_P_xz] = sr_gen_general_param_residual_J_P_xz,
-    [SR_P_J_P_yz] = sr_gen_general_param_residual_J_P_yz,
-    [SR_P_k_P] = sr_gen_general_param_residual_k_P,
-    [SR_P_j_mY] = sr_gen_general_param_residual_j_mY,
-    [SR_P_n_Y] = sr_gen_general_param_residual_n_Y,
-    [SR_P_j_mP] = sr_gen_general_param_residual_j_mP,
-    [SR_P_n_P] = sr_gen_general_param_residual_n_P,
-    [SR_P_g] = sr_gen_general_param_residual_g,
-    [SR_P_slope] = sr_gen_general_param_residual_slope
-};
 
 /* The set of ncols columns cols (checked by the caller: 1 <= ncols <= NP, each an index of p). */
 static colset columns_of(int ncols, const int *cols)
@@ -114,17 +75,17 @@ static const sr_real *general_constants(const sr_model *model, sr_real cg[SR_GEN
     return cg;
 }
 
-/* d(M nu' - f)/dp on the columns cs (dR row-major SR_NV x NP, its first cs->n columns), nu' = a held. */
+/* d(M nu' - f)/dp on the columns cs (dR row-major SR_NV x NP, its first cs->n columns), nu' = a held:
+ * the generated bracket, its chosen columns moved to the front. */
 static int residual_columns(const sr_model *model, const colset *cs, const sr_real x[SR_NX], const sr_real a[SR_NV],
                             sr_real dR[SR_NV * NP])
 {
-    int i, c, status = SR_OK;
+    sr_real all[SR_NV * NP];
+    int i, c, status;
     if (!cs->cols) return sr_gen_general_param_residual_jacobian(model->p, x, a, dR);
-    for (c = 0; c < cs->n && status == SR_OK; ++c) {
-        sr_real col[SR_NV];
-        status = RESIDUAL_COLUMN[cs->cols[c]](model->p, x, a, col);
-        for (i = 0; i < SR_NV; ++i) dR[NP * i + c] = col[i];
-    }
+    status = sr_gen_general_param_residual_jacobian(model->p, x, a, all);
+    for (i = 0; i < SR_NV && status == SR_OK; ++i)
+        for (c = 0; c < cs->n; ++c) dR[NP * i + c] = all[NP * i + cs->cols[c]];
     return status;
 }
 

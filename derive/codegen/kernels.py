@@ -159,23 +159,10 @@ def param_kernels():
         Kernel("general_param_residual_jacobian", "∂(M ν̇ − f)/∂p of the general robot with ν̇ held (5 x SR_GEN_NPARAM,"
                " row-major, columns SR_P_*), for ∂ν̇/∂p = −M⁻¹ ∂(M ν̇ − f)/∂p (derive.param_derivatives).",
                ("p", "x", "nud"), (Output("dR", tuple(PD.residual_param_jacobian()), "d(M nu_dot - f)/dp, row-major 5 x SR_GEN_NPARAM"),)),
-        *param_column_kernels(),
         Kernel("regressor", "The regressor Y (5 x SR_GEN_NPI, row-major, columns SR_PI_*): M ν̇ − f(u = 0) = Y π, π the"
                " inertial parameters and dampings (derive.param_derivatives.INERTIAL_PARAMETERS).",
                ("p", "x", "nud"), (Output("Y", tuple(PD.regressor()), "Y, row-major 5 x SR_GEN_NPI"),)),
     )
-
-
-def param_column_kernels():
-    """One column of ∂(M ν̇ − f)/∂p per parameter, `general_param_residual_<name>`: what a fit with a
-    few free parameters needs, without the cost of the other columns (c/src/sr_param_jacobians.c
-    picks them by SR_P_* index); each is its column of `general_param_residual_jacobian`."""
-    dR = PD.residual_param_jacobian()
-    return tuple(
-        Kernel(f"general_param_residual_{p.name}", f"Column SR_P_{p.name} of sr_gen_general_param_residual_jacobian:"
-               f" ∂(M ν̇ − f)/∂{p.name} of the general robot with ν̇ held (5 entries).",
-               ("p", "x", "nud"), (Output("dR", tuple(dR[:, j]), f"d(M nu_dot - f)/d{p.name}"),))
-        for j, p in enumerate(P.PARAMETERS))
 
 
 def accel_jacobian_yoke_terms():
