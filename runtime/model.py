@@ -199,8 +199,16 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativ
         return out
 
     def inertia(self, x):
-        """Generalized inertia M (5, 5), symmetric positive definite; kinetic energy ½νᵀMν."""
-        return self._single(lib.sr_inertia, x, NV * NV).reshape(NV, NV)
+        """Generalized inertia M (5, 5), symmetric positive definite; kinetic energy ½νᵀMν; (B, 5, 5)
+        for x (B, 35)."""
+        if np.ndim(x) != 2:
+            return self._single(lib.sr_inertia, x, NV * NV).reshape(NV, NV)
+        x = np.ascontiguousarray(self._valid_states(x))
+        out = np.empty((x.shape[0], NV, NV))
+        xp, op = _ptr(x), _ptr(out)
+        for i in range(x.shape[0]):     # C has no batch of M; the states are checked once, above
+            self._check(f"x[{i}]", lib.sr_inertia(self._model, xp + NX * i, op + NV * NV * i))
+        return out
 
     def rhs(self, x, u=None):
         """f (5,) with M ν̇ = f."""

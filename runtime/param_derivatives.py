@@ -68,6 +68,15 @@ def inertial_parameters(params):
     return np.array([float(values[n]) for n in PI_NAMES])
 
 
+def _column_list(columns):
+    """`columns` as an integer array of parameter indices, or a ValueError naming it."""
+    cols = np.asarray(columns)
+    if cols.ndim != 1 or len(cols) == 0 or not np.issubdtype(cols.dtype, np.integer) \
+            or cols.min() < 0 or cols.max() >= NPARAM:
+        raise ValueError(f"columns: expected a non-empty list of parameter indices in [0, {NPARAM}), got {columns!r}")
+    return cols
+
+
 class ParamDerivativeMethods:
     """`param_jacobian`, `step_param_jacobian` and `regressor` of `Model` (which provides _model,
     _check, _state_and_input, _valid_states, _dt)."""
@@ -81,25 +90,32 @@ class ParamDerivativeMethods:
         self._check(f"{field}[{failed[0]}]" if failed[0] >= 0 else field, status)
         return out
 
-    def param_jacobian(self, x, u=None):
+    def param_jacobian(self, x, u=None, columns=None):
         """∂ν̇/∂p with the state and the torques held: ν̇(x, u; p + δp) = ν̇(x, u; p) + J δp + O(|δp|²).
 
         J (5, 31), columns `PARAMETER_NAMES` (the order of `Params.as_array()`); (B, 5, 31) for x
-        (B, 35), u (B, 2) or None.  From M ν̇ = f: J = −M⁻¹ ∂(M ν̇ − f)/∂p, ν̇ held in the bracket."""
+        (B, 35), u (B, 2) or None.  From M ν̇ = f: J = −M⁻¹ ∂(M ν̇ − f)/∂p, ν̇ held in the bracket.
+        `columns`: indices into `PARAMETER_NAMES`; only those columns, in that order, computed alone
+        (C: sr_accel_param_jacobian_cols_batch)."""
         x, u = self._state_and_input(x, u)
+        if columns is not None:
+            return self._columns(lib.sr_accel_param_jacobian_cols_batch, x, u, NV, columns)
         out = np.empty(x.shape[:-1] + (NV, NPARAM))
         return self._rows(lib.sr_accel_param_jacobian, lib.sr_accel_param_jacobian_batch, x, out, _ptr(x), _ptr(u))
 
-    def step_param_jacobian(self, x, u=None, dt=0.01, method="lie-euler"):
+    def step_param_jacobian(self, x, u=None, dt=0.01, method="lie-euler", columns=None):
         """Jp (12, 31): step(x, u; p + δp) ⊖ step(x, u; p) = Jp δp + O(|δp|²), the exact derivative of
         one step of `method` ("lie-euler" or "rkmk4") as implemented, in the error coordinates of
         `retract`/`local`; columns `PARAMETER_NAMES`.  Batches: x (B, 35), u (B, 2) or None give
         (B, 12, 31).  Chaining steps: Jp of n steps = F_n (Jp of n − 1 steps) + Jp_n, with F of
-        `step_jacobian`."""
+        `step_jacobian`.  `columns`: indices into `PARAMETER_NAMES`; only those columns, in that
+        order, at the cost of those alone (C: sr_step_param_jacobian_cols_batch)."""
         choice(method, "method", STEP_METHODS, "integrator with a parameter Jacobian")
         x, u = self._state_and_input(x, u)
         dt = self._dt(dt)
         code = getattr(lib, STEP_METHODS[method])
+        if columns is not None:
+            return self._columns(lib.sr_step_param_jacobian_cols_batch, x, u, NE, columns, (code, dt))
         out = np.empty(x.shape[:-1] + (NE, NPARAM))
         if x.ndim == 1:
             self._check("x", lib.sr_step_param_jacobian(self._model, code, _ptr(x), _ptr(u), dt, _ptr(out)))
@@ -108,6 +124,19 @@ class ParamDerivativeMethods:
         status = lib.sr_step_param_jacobian_batch(self._model, code, x.shape[0], _ptr(x), _ptr(u), dt, _ptr(out), failed)
         self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
         return out
+
+    def _columns(self, batch, x, u, rows, columns, step=()):
+        """The columns `columns` of a parameter Jacobian with `rows` rows by the C batch `batch`, for
+        one state or a batch; `step`: a step's (method code, dt)."""
+        cols = _column_list(columns)
+        xb = np.ascontiguousarray(x.reshape(-1, x.shape[-1]))
+        ub = np.ascontiguousarray(u.reshape(-1, u.shape[-1]))
+        out = np.empty((xb.shape[0], rows, len(cols)))
+        failed = ffi.new("long *")
+        status = batch(self._model, *step[:1], xb.shape[0], _ptr(xb), _ptr(ub), *step[1:], len(cols),
+                       ffi.new("int[]", [int(c) for c in cols]), _ptr(out), failed)
+        self._check(f"x[{failed[0]}]" if failed[0] >= 0 and x.ndim > 1 else "x", status)
+        return out if x.ndim > 1 else out[0]
 
     def step_param_jacobian_fd(self, x, u=None, dt=0.01, method="lie-euler", columns=None):
         """`step_param_jacobian` by finite differences in C, batched (C: sr_step_param_jacobian_fd_batch):
@@ -119,10 +148,7 @@ class ParamDerivativeMethods:
         choice(method, "method", STEP_METHODS, "integrator with a parameter Jacobian")
         x, u = self._state_and_input(x, u)
         dt = self._dt(dt)
-        cols = np.arange(NPARAM) if columns is None else np.asarray(columns)
-        if cols.ndim != 1 or len(cols) == 0 or not np.issubdtype(cols.dtype, np.integer) \
-                or cols.min() < 0 or cols.max() >= NPARAM:
-            raise ValueError(f"columns: expected a non-empty list of parameter indices in [0, {NPARAM}), got {columns!r}")
+        cols = np.arange(NPARAM) if columns is None else _column_list(columns)
         xb = np.ascontiguousarray(x.reshape(-1, x.shape[-1]))
         ub = np.ascontiguousarray(u.reshape(-1, u.shape[-1]))
         out = np.empty((xb.shape[0], NE, len(cols)))

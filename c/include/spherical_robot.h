@@ -513,6 +513,8 @@ int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 #define sr_step_param_jacobian sr_step_param_jacobian_f
 #define sr_step_param_jacobian_batch sr_step_param_jacobian_batch_f
 #define sr_step_param_jacobian_fd_batch sr_step_param_jacobian_fd_batch_f
+#define sr_step_param_jacobian_cols_batch sr_step_param_jacobian_cols_batch_f
+#define sr_accel_param_jacobian_cols_batch sr_accel_param_jacobian_cols_batch_f
 #define sr_regressor sr_regressor_f
 #define sr_regressor_batch sr_regressor_batch_f
 #endif
@@ -609,6 +611,21 @@ int sr_step_param_jacobian(const sr_model *model, int method, const sr_real x[SR
  * and dt; stops at the first failing row, its index in *failed_row (-1 when all succeed). */
 int sr_step_param_jacobian_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u,
                                  sr_real dt, sr_real *Jp, long *failed_row);
+
+/** sr_step_param_jacobian_batch on the columns cols[0..ncols) (SR_P_*) only, in their order:
+ * Jp n x SR_NE x ncols row-major, equal to those columns of sr_step_param_jacobian.  The stages run
+ * on those columns alone, so a sensitivity to a few parameters costs a fraction of all of them.  Checks: the model, the pointers (SR_ERR_NULL), 1 <= ncols <= SR_NPARAM
+ * and every column an index of p, method SR_LIE_EULER or SR_RKMK4, dt (SR_ERR_ARG); then per row
+ * as sr_step_param_jacobian, stopping at the first failing row, its index in *failed_row (-1 when
+ * all succeed); the rows before it are written. */
+int sr_step_param_jacobian_cols_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u,
+                                      sr_real dt, int ncols, const int *cols, sr_real *Jp, long *failed_row);
+
+/** sr_accel_param_jacobian_batch on the columns cols[0..ncols) (SR_P_*) only, in their order: J n x
+ * SR_NV x ncols row-major, equal to those columns of sr_accel_param_jacobian.  Checks as
+ * sr_step_param_jacobian_cols_batch (no method, no dt). */
+int sr_accel_param_jacobian_cols_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, int ncols,
+                                       const int *cols, sr_real *J, long *failed_row);
 
 /** Entries of work per state that sr_step_param_jacobian_fd_batch needs. */
 #define SR_PARAM_FD_WORK (4 * SR_NX + 2 * SR_NE)

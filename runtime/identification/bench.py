@@ -23,8 +23,9 @@ from .sensitivity import JACOBIANS
 
 #: The fits compared by default: the dampings, the pendulum's mass and hinge inertia and the yoke
 #: rotor's inertia; and every entry of the battery-geared robot that its full-state log identifies
-#: alone with the other entries held (docs/identification.md, "Base parameters").  The analytic
-#: sensitivity costs the same for any number of free entries, the differences two batch steps each.
+#: alone with the other entries held (docs/identification.md, "Base parameters").  Both sources run
+#: on the free columns only: the analytic sensitivity has a share every column needs, the
+#: differences two batch steps each.
 DEFAULT_PARAMS = ("k_S,k_Y,k_P,m_P,J_P_yy,j_mY",
                   "j_S,k_S,k_Y,k_P,m_P,c_P_x,c_P_z,J_P_yy,J_Y_xx,J_Y_yz,c_Y_x,c_Y_z,j_mY,j_mP")
 

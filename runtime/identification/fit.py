@@ -547,8 +547,9 @@ class _FullState:
             raise IdentifyError("sensors.process: a full-state fit weighs the velocities by the process noise; "
                                 "the sensor set declares none on some axis")
         model = Model(params)
-        Minv = np.linalg.inv(np.array([model.inertia(x) for x in self.X[:-1]]))
-        self.chol = np.linalg.cholesky((Minv * (q2 * self.h)) @ np.swapaxes(Minv, 1, 2))
+        Minv = np.linalg.inv(model.inertia(self.X[:-1]))
+        # whitened by the inverse of each row's Cholesky factor: one batched product per evaluation
+        self.white = np.linalg.inv(np.linalg.cholesky((Minv * (q2 * self.h)) @ np.swapaxes(Minv, 1, 2)))
         self.ncols = self.nf
         self._cache = (None, None)
         self.nfev = 0
@@ -563,8 +564,8 @@ class _FullState:
         pred = model.step(self.X[:-1], self.u, self.h, self.method)
         e = self.X[1:, IDX_NU] - pred[:, IDX_NU]
         Jp = step_sensitivity(model, self.X[:-1], self.u, self.h, self.method, self.idx, self.jacobian)[:, IDX_E_NU]
-        r = np.linalg.solve(self.chol, e[..., None])[..., 0]
-        J = -np.linalg.solve(self.chol, Jp)
+        r = np.matmul(self.white, e[..., None])[..., 0]
+        J = -np.matmul(self.white, Jp)
         self._cache = (z.copy(), (r.ravel(), scipy.sparse.csr_matrix(J.reshape(-1, self.nf)), None))
         self.nfev += 1
         if self.progress is not None:

@@ -1,6 +1,7 @@
 """The parameter sensitivities of the identification fit, from either source (`JACOBIANS`): the
-analytic ones of the C library (`Model.step_param_jacobian`, `Model.param_jacobian`) or finite
-differences computed in C, batched (`Model.step_param_jacobian_fd`; the accelerations at p ± h)."""
+analytic ones of the C library on the free columns alone (`Model.step_param_jacobian`,
+`Model.param_jacobian` with `columns`) or finite differences computed in C, batched, on the same
+columns (`Model.step_param_jacobian_fd`; the accelerations at p ± h)."""
 import numpy as np
 
 from ..model import Model
@@ -19,7 +20,7 @@ def step_sensitivity(model, x, u, h, method, idx, jacobian):
     """The steps' sensitivities (B, 12, len(idx)) to the free entries idx, of the `jacobian` source."""
     if jacobian == "fd":
         return model.step_param_jacobian_fd(x, u, h, method, columns=idx)
-    return model.step_param_jacobian(x, u, h, method)[:, :, idx]
+    return model.step_param_jacobian(x, u, h, method, columns=idx)
 
 
 def accel_sensitivity(model, x, u, idx, jacobian):
@@ -27,7 +28,7 @@ def accel_sensitivity(model, x, u, idx, jacobian):
     C accelerations at p ± h; where one side is no valid robot, the one-sided second-order
     difference (4 D(s) − D(2s)) / 2s from the other, as `Model.step_param_jacobian_fd`."""
     if jacobian != "fd":
-        return model.param_jacobian(x, u)[:, :, idx]
+        return model.param_jacobian(x, u, columns=idx)
     p = model.params.as_array()
     out = np.empty(x.shape[:-1] + (NV, len(idx)))
 
