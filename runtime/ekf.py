@@ -43,6 +43,9 @@ METHODS = {"lie-euler": lib.SR_LIE_EULER, "rkmk4": lib.SR_RKMK4, "cf4": lib.SR_C
 SAMPLE_SIZES = {"imu": lib.SR_NIMU, "encoders": 2, "position": 2, "heading": 1}
 #: How many delayed fixes may wait at once (the slots of `Ekf.mark_position`).
 DELAYED_SLOTS = lib.SR_EKF_NDELAYED
+#: The default recovery policy (`Ekf`'s `recover_after`): per sensor kind, the samples refused in a
+#: row after which the next refused one is admitted with the prior inflated.
+RECOVER_AFTER = {"imu": 10, "encoders": 10, "position": 4, "heading": 4}
 #: The bias blocks of the error state.
 IDX_EB_BG = slice(lib.SR_EB_b_g, lib.SR_EB_b_g + 3)
 IDX_EB_BA = slice(lib.SR_EB_b_a, lib.SR_EB_b_a + 3)
@@ -111,10 +114,13 @@ class Ekf:
     the covariance P0 (18, 18) or the standard deviations sigma (18,) of the error state (the 12
     error coordinates of `Model.retract`, then b_g, b_a).  `mount`: the IMU's (and the heading
     sensor's, unless `heading_mount`); `method`: the prediction's stepper; `gate`: the probability
-    of the chi-square gate of every update (1: no gate)."""
+    of the chi-square gate of every update (1: no gate); `recover_after`: the recovery policy, per
+    kind ({"position": 4, ...}) the number of samples refused in a row after which the next refused
+    one is admitted with the prior and its noise inflated (docs/estimation.md, "Recovery"); None:
+    RECOVER_AFTER, {}: off."""
 
     def __init__(self, model, x0, *, P0=None, sigma=None, biases=None, noise=None, mount=None, heading_mount=None,
-                 method="rkmk4", gate=0.999):
+                 method="rkmk4", gate=0.999, recover_after=None):
         if not isinstance(model, Model):
             raise ValueError(f"model: expected a runtime.Model, got {type(model).__name__}")
         self.model = model
@@ -148,6 +154,9 @@ class Ekf:
         if status == lib.SR_ERR_SINGULAR:
             raise ValueError(f"{what}: the covariance is not positive definite")
         _check(status, "x0")
+        self.recover_after = _recovery(RECOVER_AFTER if recover_after is None else recover_after)
+        for kind, after in self.recover_after.items():
+            _check(lib.sr_ekf_set_recovery(self._ekf, KINDS.index(kind), after), "recover_after")
         n = self.noise
         self._process = ffi.new("sr_ekf_process *")
         self._process.torque_psd = [n.torque_psd] * 3
@@ -169,14 +178,15 @@ class Ekf:
         if status == lib.SR_ERR_SINGULAR:
             raise KernelError("x", status, message=f"x: {singular}")
         _check(status, "x")
-        return self._ekf.accepted[KINDS.index(kind)] > self._before
+        k = KINDS.index(kind)
+        return self._ekf.accepted[k] + self._ekf.recovered[k] > self._before
 
     def update_imu(self, y, u=None):
         """One IMU sample (6,): gyroscope [rad/s] then accelerometer [m/s²] in the sensor's axes,
         while the torques u (2,) act (None: zero)."""
         y = _vector(y, "y", 6)
         torque = np.zeros(NU) if u is None else _vector(u, "u", NU)
-        self._before = self._ekf.accepted[0]
+        self._before = self._ekf.accepted[0] + self._ekf.recovered[0]
         m = self.mount
         status = lib.sr_ekf_update_imu_axes(self._ekf, self.model._model, _ptr(y), _ptr(torque), BODIES[m.body],
                                             _ptr(self._imu_mount), _ptr(self._imu_sigma), self.gate["imu"])
@@ -185,7 +195,7 @@ class Ekf:
     def update_encoders(self, y):
         """One encoder sample (θ_Y, θ_P) [rad]."""
         y = _vector(y, "y", 2)
-        self._before = self._ekf.accepted[1]
+        self._before = self._ekf.accepted[1] + self._ekf.recovered[1]
         status = lib.sr_ekf_update_encoders(self._ekf, self.model._model, _ptr(y), self.noise.encoder,
                                             self.gate["encoders"])
         return self._applied("encoders", status, "the innovation covariance is not positive definite")
@@ -193,7 +203,7 @@ class Ekf:
     def update_position(self, y):
         """One position fix (q_x, q_y) [m]."""
         y = _vector(y, "y", 2)
-        self._before = self._ekf.accepted[2]
+        self._before = self._ekf.accepted[2] + self._ekf.recovered[2]
         status = lib.sr_ekf_update_position(self._ekf, self.model._model, _ptr(y), self.noise.position,
                                             self.gate["position"])
         return self._applied("position", status, "the innovation covariance is not positive definite")
@@ -210,7 +220,7 @@ class Ekf:
         if not self._ekf.delayed[slot].marked:
             raise ValueError(f"slot: {slot} waits for no fix (mark_position first)")
         y = _vector(y, "y", 2)
-        self._before = self._ekf.accepted[2]
+        self._before = self._ekf.accepted[2] + self._ekf.recovered[2]
         status = lib.sr_ekf_update_position_delayed(self._ekf, self.model._model, slot, _ptr(y), self.noise.position,
                                                     self.gate["position"])
         return self._applied("position", status, "the innovation covariance is not positive definite")
@@ -224,7 +234,7 @@ class Ekf:
         value = float(_vector([y], "y", 1)[0]) if np.ndim(y) == 0 else None
         if value is None:
             raise ValueError(f"y: expected one number (a heading in rad), got shape {np.shape(y)}")
-        self._before = self._ekf.accepted[3]
+        self._before = self._ekf.accepted[3] + self._ekf.recovered[3]
         m = self.heading_mount
         status = lib.sr_ekf_update_heading(self._ekf, self.model._model, value, BODIES[m.body],
                                            _ptr(self._heading_mount), self.noise.heading, self.gate["heading"])
@@ -254,10 +264,12 @@ class Ekf:
 
     @property
     def counters(self):
-        """Per kind ("imu", "encoders", "position", "heading"): {"accepted", "gated", "nis"}, nis the
-        last sample's normalised innovation squared."""
+        """Per kind ("imu", "encoders", "position", "heading"): {"accepted", "gated", "recovered",
+        "nis"}: samples applied, refused by the gate, admitted by the recovery policy, and the last
+        sample's normalised innovation squared."""
         e = self._ekf
-        return {kind: {"accepted": int(e.accepted[i]), "gated": int(e.gated[i]), "nis": float(e.nis[i])}
+        return {kind: {"accepted": int(e.accepted[i]), "gated": int(e.gated[i]), "recovered": int(e.recovered[i]),
+                       "nis": float(e.nis[i])}
                 for i, kind in enumerate(KINDS)}
 
 
@@ -267,6 +279,19 @@ def _mount(mount, name):
     if not isinstance(mount, Mount):
         raise ValueError(f"{name}: expected a runtime.sensors.Mount, got {type(mount).__name__}")
     return mount
+
+
+def _recovery(policy):
+    if not isinstance(policy, dict):
+        raise ValueError(f"recover_after: expected a dict of sensor kind to a count, got {type(policy).__name__}")
+    out = {}
+    for kind, after in policy.items():
+        if kind not in KINDS:
+            raise ValueError(f"recover_after: unknown sensor kind {kind!r} (known: {', '.join(KINDS)})")
+        if not (isinstance(after, (int, np.integer)) and not isinstance(after, bool) and after >= 0):
+            raise ValueError(f"recover_after[{kind!r}]: expected a whole number >= 0, got {after!r}")
+        out[kind] = int(after)
+    return out
 
 
 def _slot(slot):

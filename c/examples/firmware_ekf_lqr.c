@@ -148,6 +148,8 @@ int main(void)
     if (status == SR_OK) status = sr_lqr_check(&LQR_TASK_SCHEDULE);
     if (status == SR_OK) status = sr_lqr_reset(&memory);
     if (status == SR_OK) status = sr_ekf_init_diagonal(&ekf, &model, LQR_TASK_X0, zero_bias, EKF_TASK_SIGMA);
+    for (kind = 0; kind < SR_EKF_NKINDS && status == SR_OK; ++kind)
+        status = sr_ekf_set_recovery(&ekf, kind, EKF_TASK_RECOVER_AFTER[kind]);
     if (status != SR_OK) {
         fprintf(stderr, "firmware_ekf_lqr: setup failed: %s\n", sr_status_string(status));
         return 1;

@@ -27,6 +27,15 @@
  * gate: the caller's threshold on the NIS, e.g. the 99.9 % quantile of chi-square with m degrees
  * of freedom (10.83, 13.82, 22.46 for m = 1, 2, 6); +INFINITY accepts every sample.
  *
+ * Recovery from a lost estimate (off unless sr_ekf_set_recovery turns it on for a kind): a filter
+ * whose covariance has shrunk below its true error refuses every sample that would correct it.
+ * Once n samples of a kind have been refused in a row, the next one that fails the gate is applied
+ * as if both the prior and the sample's noise were lambda = NIS / gate times larger (P -> lambda P,
+ * R -> lambda R, the waiting fixes' covariances alike): S becomes lambda S, so its NIS is the
+ * gate's; the gain, and so the correction, is the ungated one, and the covariance after it is lambda
+ * times the ungated one, wide enough for the samples that follow to pass the gate and finish the
+ * correction.  Counted in recovered[kind] (not in accepted or gated); the run of refusals restarts.
+ *
  * Delayed fixes (a position fix that arrives some time after the instant it measures; Larsen's
  * method with the cross-covariance carried already projected onto the fix):
  *   at the instant s the fix is measured, sr_ekf_mark_position keeps in a slot the prediction
@@ -76,6 +85,7 @@ extern "C" {
 #define sr_ekf_update_heading sr_ekf_update_heading_f
 #define sr_ekf_mark_position sr_ekf_mark_position_f
 #define sr_ekf_update_position_delayed sr_ekf_update_position_delayed_f
+#define sr_ekf_set_recovery sr_ekf_set_recovery_f
 #endif
 
 #ifndef SR_EKF_NDELAYED
@@ -109,6 +119,9 @@ typedef struct sr_ekf {
     long accepted[SR_EKF_NKINDS];     /**< samples applied, per kind (SR_EKF_*) */
     long gated[SR_EKF_NKINDS];        /**< samples refused by the gate, per kind */
     sr_real nis[SR_EKF_NKINDS];       /**< the last sample's r^T S^-1 r, per kind (applied or gated) */
+    long recovered[SR_EKF_NKINDS];    /**< samples admitted by the recovery policy (sr_ekf_set_recovery), per kind */
+    long streak[SR_EKF_NKINDS];       /**< samples refused in a row, per kind (0 once one is applied) */
+    long recover_after[SR_EKF_NKINDS]; /**< the recovery policy per kind: 0 off (the start), else n of sr_ekf_set_recovery */
     sr_ekf_delayed delayed[SR_EKF_NDELAYED]; /**< the delayed fixes waiting, by slot */
 } sr_ekf;
 
@@ -176,6 +189,12 @@ int sr_ekf_update_position_delayed(sr_ekf *ekf, const sr_model *model, int slot,
  * estimate's sensor x axis is along the floor's normal (the heading is undefined there). */
 int sr_ekf_update_heading(sr_ekf *ekf, const sr_model *model, sr_real y, int body, const sr_real mount[SR_NMOUNT],
                           sr_real sigma, sr_real gate);
+
+/** The recovery policy of sensor kind (SR_EKF_IMU ... SR_EKF_HEADING, else SR_ERR_ARG): after n
+ * samples of that kind refused by the gate in a row, the next refused one is admitted with the
+ * prior and its noise inflated (see the file's description); n = 0 turns it off (the default after
+ * sr_ekf_init), n < 0 is SR_ERR_ARG.  The counters stay as they are. */
+int sr_ekf_set_recovery(sr_ekf *ekf, int kind, long n);
 
 #ifdef __cplusplus
 }

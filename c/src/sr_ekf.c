@@ -292,8 +292,8 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
                  const sr_real *S, sr_real gate, const sr_real *W, int released)
 {
     sr_real L[MAXM * MAXM], KT[MAXM * NB], DT[MAXM * NB], Pn[NB * NB];
-    sr_real z[MAXM], e[NB], xn[SR_NX], Jr[9], T[3 * NB], nis = 0;
-    int a, b, i, j, k, status;
+    sr_real z[MAXM], e[NB], xn[SR_NX], Jr[9], T[3 * NB], nis = 0, inflate = 1;
+    int a, b, i, j, k, status, recovering = 0;
 
     status = cholesky(m, S, L);
     if (status != SR_OK) return status;
@@ -302,10 +302,17 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
     for (i = 0; i < m; ++i) nis += z[i] * z[i];
     if (!isfinite(nis)) return SR_ERR_NONFINITE;
     if (!(nis <= gate)) {
-        ekf->gated[kind] += 1;
-        ekf->nis[kind] = nis;
-        if (released >= 0) ekf->delayed[released].marked = 0;
-        return SR_OK;
+        if (!(ekf->recover_after[kind] > 0 && ekf->streak[kind] >= ekf->recover_after[kind])) {
+            ekf->gated[kind] += 1;
+            ekf->streak[kind] += 1;
+            ekf->nis[kind] = nis;
+            if (released >= 0) ekf->delayed[released].marked = 0;
+            return SR_OK;
+        }
+        /* Recovery: the prior and R times lambda leave K as it is and scale what follows by lambda
+         * (the Joseph form is homogeneous in (P, R), the reset and the slots' updates linear). */
+        inflate = nis / gate;
+        recovering = 1;
     }
 
     /* K^T = S^-1 C^T = L^-T L^-1 C^T, both substitutions on all NB columns at once, by the pivots'
@@ -370,6 +377,7 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
     }
     for (a = 0; a < NB; ++a)
         for (b = a + 1; b < NB; ++b) Pn[NB * b + a] = Pn[NB * a + b];
+    for (a = 0; a < NB * NB && recovering; ++a) Pn[a] *= inflate;
 
     /* Injection, then the reset of the shell's block by Jr(e_xi). */
     status = sr_retract(model, ekf->x, e, xn);
@@ -390,7 +398,11 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
     memcpy(ekf->x, xn, sizeof xn);
     for (i = 0; i < SR_NBIAS; ++i) ekf->bias[i] += e[SR_EB_b_g + i];
     memcpy(ekf->P, Pn, sizeof Pn);
-    ekf->accepted[kind] += 1;
+    if (recovering)
+        ekf->recovered[kind] += 1;
+    else
+        ekf->accepted[kind] += 1;
+    ekf->streak[kind] = 0;
     ekf->nis[kind] = nis;
     if (released >= 0) ekf->delayed[released].marked = 0;
 
@@ -403,8 +415,9 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
             for (b = 0; b < 2; ++b) {
                 sr_real s = Cj[2 * a + b];
                 for (i = 0; i < m; ++i) s -= KT[NB * i + a] * Wj[2 * i + b];
-                Cj[2 * a + b] = s;
+                Cj[2 * a + b] = inflate * s;
             }
+        for (i = 0; i < SR_EKF_NDELAYED * 4 && recovering; ++i) ekf->delayed[j].Z[i] *= inflate;
         for (i = 0; i < 3; ++i)
             for (b = 0; b < 2; ++b)
                 t[2 * i + b] = Jr[3 * i] * Cj[2 * SR_EB_xi_S + b] + Jr[3 * i + 1] * Cj[2 * (SR_EB_xi_S + 1) + b]
@@ -618,4 +631,12 @@ int sr_ekf_update_position_delayed(sr_ekf *ekf, const sr_model *model, int slot,
     for (j = 0; j < SR_EKF_NDELAYED; ++j)
         if (j != slot && ekf->delayed[j].marked) memcpy(W + MAXM * 2 * j, d->Z + 4 * j, 4 * sizeof(sr_real));
     return apply(ekf, model, SR_EKF_POSITION, 2, r, CT, S, gate, W, slot);
+}
+
+int sr_ekf_set_recovery(sr_ekf *ekf, int kind, long n)
+{
+    if (!ekf) return SR_ERR_NULL;
+    if (kind < 0 || kind >= SR_EKF_NKINDS || n < 0) return SR_ERR_ARG;
+    ekf->recover_after[kind] = n;
+    return SR_OK;
 }

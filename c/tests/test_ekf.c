@@ -1,7 +1,7 @@
 /*
  * test_ekf.c -- the error-state EKF (c/src/sr_ekf.c): updates whose answer is known by hand (a
  * position fix on a diagonal covariance is a scalar Kalman filter per axis), the block structure
- * of the prediction, gating, the bias states, and status codes with nothing written on error.
+ * of the prediction, gating and the recovery from a run of refusals, the bias states, and status codes with nothing written on error.
  */
 #include "sr_test.h"
 #include "sr_ekf.h"
@@ -52,6 +52,34 @@ static void test_an_outlier_is_gated_counted_and_not_applied(void)
     /* with the gate open the same sample is applied */
     CHECK_STATUS(sr_ekf_update_position(&ekf, &m, y, SR_C(0.1), (sr_real)INFINITY), SR_OK);
     CHECK(ekf.accepted[SR_EKF_POSITION] == 1);
+}
+
+static void test_after_n_refusals_in_a_row_the_next_outlier_is_admitted_with_the_prior_inflated(void)
+{
+    /* P = p I, R = s^2, the fix 1 m off: NIS = 1/(p + s^2) above the gate.  Refused twice, then
+     * admitted with P and R times lambda = NIS/gate: the ungated gain k = p/(p + s^2) and
+     * P_qq = lambda p s^2/(p + s^2); the other states' variance grows by lambda too. */
+    sr_ekf ekf;
+    sr_model m;
+    const double p = 1e-4, s = 0.1, k = p / (p + s * s), lambda = 1 / (p + s * s) / (double)chi2_2;
+    const sr_real y[2] = {SR_C(1.0), SR_C(0.0)};
+    start(&ekf, &m, sqrt(p));
+    CHECK_STATUS(sr_ekf_set_recovery(&ekf, SR_EKF_POSITION, 2), SR_OK);
+    CHECK_STATUS(sr_ekf_update_position(&ekf, &m, y, (sr_real)s, chi2_2), SR_OK);
+    CHECK_STATUS(sr_ekf_update_position(&ekf, &m, y, (sr_real)s, chi2_2), SR_OK);
+    CHECK(ekf.gated[SR_EKF_POSITION] == 2 && ekf.streak[SR_EKF_POSITION] == 2 && ekf.x[SR_X_q] == 0);
+    CHECK_STATUS(sr_ekf_update_position(&ekf, &m, y, (sr_real)s, chi2_2), SR_OK);
+    CHECK(ekf.recovered[SR_EKF_POSITION] == 1 && ekf.accepted[SR_EKF_POSITION] == 0);
+    CHECK(ekf.gated[SR_EKF_POSITION] == 2 && ekf.streak[SR_EKF_POSITION] == 0);
+    CHECK_NEAR(ekf.x[SR_X_q + 0], k, 8 * TEST_EPS);
+    CHECK_NEAR(ekf.P[SR_NEB * SR_EB_q + SR_EB_q] / (lambda * p * s * s / (p + s * s)), 1, 64 * TEST_EPS);
+    CHECK_NEAR(ekf.P[SR_NEB * SR_EB_nu + SR_EB_nu] / (lambda * p), 1, 64 * TEST_EPS);
+    /* off (the start's policy): the same fix is refused however often it comes */
+    start(&ekf, &m, sqrt(p));
+    CHECK_STATUS(sr_ekf_update_position(&ekf, &m, y, (sr_real)s, chi2_2), SR_OK);
+    CHECK_STATUS(sr_ekf_update_position(&ekf, &m, y, (sr_real)s, chi2_2), SR_OK);
+    CHECK_STATUS(sr_ekf_update_position(&ekf, &m, y, (sr_real)s, chi2_2), SR_OK);
+    CHECK(ekf.gated[SR_EKF_POSITION] == 3 && ekf.recovered[SR_EKF_POSITION] == 0 && ekf.x[SR_X_q] == 0);
 }
 
 static void test_encoder_innovations_wrap_around_pi(void)
@@ -252,6 +280,10 @@ static void test_bad_input_gives_a_status_and_writes_nothing(void)
     CHECK_STATUS(sr_ekf_mark_position(NULL, &m, 0), SR_ERR_NULL);
     CHECK_STATUS(sr_ekf_update_position_delayed(&ekf, &m, 0, fix, SR_C(0.1), chi2_2), SR_ERR_ARG); /* not marked */
     CHECK_STATUS(sr_ekf_update_position_delayed(&ekf, &broken, 0, fix, SR_C(0.1), chi2_2), SR_ERR_MODEL);
+    CHECK_STATUS(sr_ekf_set_recovery(&ekf, SR_EKF_NKINDS, 1), SR_ERR_ARG);
+    CHECK_STATUS(sr_ekf_set_recovery(&ekf, -1, 1), SR_ERR_ARG);
+    CHECK_STATUS(sr_ekf_set_recovery(&ekf, SR_EKF_IMU, -1), SR_ERR_ARG);
+    CHECK_STATUS(sr_ekf_set_recovery(NULL, SR_EKF_IMU, 1), SR_ERR_NULL);
     CHECK(memcmp(&ekf, &before, sizeof ekf) == 0);
     /* a covariance that is not symmetric, or not positive definite */
     memcpy(P0, ekf.P, sizeof P0);
@@ -267,6 +299,7 @@ void suite_ekf(void)
 {
     RUN_TEST(test_a_position_fix_on_a_diagonal_covariance_is_the_scalar_filter_per_axis);
     RUN_TEST(test_an_outlier_is_gated_counted_and_not_applied);
+    RUN_TEST(test_after_n_refusals_in_a_row_the_next_outlier_is_admitted_with_the_prior_inflated);
     RUN_TEST(test_encoder_innovations_wrap_around_pi);
     RUN_TEST(test_predict_leaves_the_bias_block_alone_and_moves_the_cross_terms);
     RUN_TEST(test_the_bias_variances_grow_by_their_random_walk_over_dt);

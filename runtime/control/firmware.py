@@ -138,7 +138,8 @@ EVENT_CODES = {"tick": 0, "imu": 1, "encoders": 2, "fixes": 3, "heading": 4}
 def ekf_header(task, estimator):
     """The text of ekf_task.h for `task` on sensors and its `estimator.SensorEkf`: the filter's
     start (its standard deviations; the state is lqr_task.h's x0, the biases zero), noise, IMU
-    mount, gates and prediction method, as the Python filter has them."""
+    mount, gates, recovery policy and prediction method, as the Python filter has them."""
+    from ..ekf import KINDS
     from ..sensors import BODIES
     f = estimator.filter
     n = f.noise
@@ -163,6 +164,10 @@ def ekf_header(task, estimator):
         "",
         "/* The IMU's standard deviation per reading (gyroscope x, y, z, accelerometer x, y, z). */",
         f"static const sr_real EKF_TASK_IMU_SIGMA[SR_NIMU] = {_array([n.gyro] * 3 + list(n.accel))};",
+        "",
+        "/* The recovery policy per sensor kind (sr_ekf_set_recovery; 0: off). */",
+        "static const long EKF_TASK_RECOVER_AFTER[SR_EKF_NKINDS] = {"
+        + ", ".join(str(f.recover_after.get(kind, 0)) for kind in KINDS) + "};",
         "",
         "/* The start's standard deviations of the error state (d, b_g, b_a). */",
         f"static const sr_real EKF_TASK_SIGMA[SR_NEB] = {_array(estimator.sigma0)};",

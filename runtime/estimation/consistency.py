@@ -329,11 +329,12 @@ def main(argv):
             pq.write_table(sample_table(runs), path)
         text = io.StringIO()
         writer = csv.writer(text, lineterminator="\n")
-        writer.writerow(["seed", *METRICS, "gated_imu", "gated_encoders", "gated_position"])
+        kinds = ("imu", "encoders", "position")
+        writer.writerow(["seed", *METRICS, *(f"gated_{k}" for k in kinds), *(f"recovered_{k}" for k in kinds)])
         for r in runs:
             c = r["counters"]
-            writer.writerow([r["seed"], *(repr(r["metrics"][m]) for m in METRICS), c["imu"]["gated"],
-                             c["encoders"]["gated"], c["position"]["gated"]])
+            writer.writerow([r["seed"], *(repr(r["metrics"][m]) for m in METRICS), *(c[k]["gated"] for k in kinds),
+                             *(c[k]["recovered"] for k in kinds)])
         write_text(args.out / "runs.csv", text.getvalue())
         low, high = report["band"]
         write_text(args.out / "nees.csv", "t,anees,low,high\n" + "".join(

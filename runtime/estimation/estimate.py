@@ -41,7 +41,7 @@ MOVING_RATE_SIGMA = 2.0
 class Estimate:
     """The filter's output at every torque row and sample time `t` (n,): the state `x` (n, 35) and
     the error state's standard deviations `sigma` (n, 18) (ERROR_NAMES), the biases (n, 6), and the
-    filter's counters per sensor kind ({"accepted", "gated", "nis"}); with `covariance_every` = k,
+    filter's counters per sensor kind ({"accepted", "gated", "recovered", "nis"}); with `covariance_every` = k,
     the whole covariance `P` (m, 18, 18) at the rows `P_rows` (every k-th), else None."""
     t: np.ndarray
     x: np.ndarray

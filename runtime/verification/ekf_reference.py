@@ -11,7 +11,10 @@ right Jacobian of SO(3) as its power series, angle innovations wrapped through t
 Delayed fixes by stochastic cloning: marking a fix appends a copy of the whole error state (and
 of x) to the state, so the covariance grows to (18 (1 + n)) square; every equation is then a
 linear map T of that augmented error, P_aug ← T P_aug Tᵀ (+ the noise on the current block):
-the current block moves by Φ, I − K H and G, the clones stay.  On arrival the fix measures its
+the current block moves by Φ, I − K H and G, the clones stay.
+
+Recovery (`recover_after`): a sample refused after that many refusals of its kind in a row is
+applied with P_aug and R multiplied by λ = NIS / gate before the update, literally.  On arrival the fix measures its
 clone, H_aug reads that clone's q; the gain changes the current error only (Larsen's update: the
 clones are not revised), then the clone is dropped.  Nothing of the C's projected bookkeeping.
 """
@@ -45,8 +48,11 @@ class EkfReference:
     `P` is the current error's block of the augmented covariance `P_aug`; `clones` the marked
     fixes' states by slot, in the order of their blocks."""
 
-    def __init__(self, model, x0, bias, P0, method="rkmk4"):
+    def __init__(self, model, x0, bias, P0, method="rkmk4", recover_after=None):
         self.model, self.method = model, method
+        self.recover_after = dict(recover_after or {})
+        self.streak = dict.fromkeys(KINDS, 0)
+        self.recovered = dict.fromkeys(KINDS, 0)
         self.x = np.array(x0, dtype=float)
         self.b = np.array(bias, dtype=float)
         self.P_aug = np.array(P0, dtype=float)
@@ -123,6 +129,27 @@ class EkfReference:
         """The chi-square gate."""
         return nis <= gate
 
+    def admission(self, kind, nis, gate):
+        """The gate with the recovery policy: None (refused, counted), or the factor λ by which the
+        prior and the sample's noise are inflated for it (1 when it passes; NIS / gate when it
+        recovers after `recover_after[kind]` refusals in a row)."""
+        if self.accepts(nis, gate):
+            return 1.0
+        after = self.recover_after.get(kind, 0)
+        if after > 0 and self.streak[kind] >= after:
+            return nis / gate
+        self.gated[kind] += 1
+        self.streak[kind] += 1
+        return None
+
+    def admitted(self, kind, lam):
+        """Counts an applied sample (`lam` > 1: a recovery)."""
+        if lam > 1:
+            self.recovered[kind] += 1
+        else:
+            self.accepted[kind] += 1
+        self.streak[kind] = 0
+
     def gain(self, H, S):
         """K = P Hᵀ S⁻¹ (through a solve with S; S and P symmetric)."""
         return np.linalg.solve(S, H @ self.P).T
@@ -149,9 +176,13 @@ class EkfReference:
         S = H @ self.P @ H.T + R
         nis = float(r @ np.linalg.solve(S, r))
         self.nis[kind] = nis
-        if not self.accepts(nis, gate):
-            self.gated[kind] += 1
+        lam = self.admission(kind, nis, gate)
+        if lam is None:
             return False
+        if lam != 1.0:
+            self.P_aug = lam * self.P_aug
+            R = lam * R
+            S = H @ self.P @ H.T + R
         K = self.gain(H, S)
         e = K @ r
         P = self.joseph(K, H, R)
@@ -159,7 +190,7 @@ class EkfReference:
         self.P = P
         self.inject(e)
         self.reset(e)
-        self.accepted[kind] += 1
+        self.admitted(kind, lam)
         return True
 
     def update_imu(self, y, u, mount, sigma_gyro, sigma_accel, gate):
@@ -197,10 +228,14 @@ class EkfReference:
         r = np.asarray(y) - yh
         nis = float(r @ np.linalg.solve(S, r))
         self.nis["position"] = nis
-        if not self.accepts(nis, gate):
-            self.gated["position"] += 1
+        lam = self.admission("position", nis, gate)
+        if lam is None:
             self.drop(slot)
             return False
+        if lam != 1.0:
+            self.P_aug = lam * self.P_aug
+            R = lam * R
+            S = H_aug @ self.P_aug @ H_aug.T + R
         K = np.linalg.solve(S, H_aug @ self.P_aug[:, :NB]).T
         T = np.eye(len(self.P_aug))
         T[:NB] -= K @ H_aug
@@ -210,5 +245,5 @@ class EkfReference:
         self.drop(slot)
         self.inject(e)
         self.reset(e)
-        self.accepted["position"] += 1
+        self.admitted("position", lam)
         return True

@@ -26,6 +26,9 @@ static const sr_real EKF_TASK_MOUNT[SR_NMOUNT] = {
 static const sr_real EKF_TASK_IMU_SIGMA[SR_NIMU] = {
         SR_C(0.003), SR_C(0.003), SR_C(0.003), SR_C(0.08126173015912774), SR_C(0.08126173015912774), SR_C(0.08126173015912774)};
 
+/* The recovery policy per sensor kind (sr_ekf_set_recovery; 0: off). */
+static const long EKF_TASK_RECOVER_AFTER[SR_EKF_NKINDS] = {10, 10, 4, 4};
+
 /* The start's standard deviations of the error state (d, b_g, b_a). */
 static const sr_real EKF_TASK_SIGMA[SR_NEB] = {
         SR_C(0.01), SR_C(0.01), SR_C(0.01), SR_C(0.0004428221104087446), SR_C(0.0004428221104087446), SR_C(0.01),
