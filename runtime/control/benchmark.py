@@ -3,14 +3,15 @@ a folder per run with summary.json (metrics under `tracking`, the contact force'
 and figures.
 
     python -m runtime control [--out out/control] [--tasks circle,line] [--duration S] [--sensors FILE]
-    python -m runtime control --offsets [--only TEXT] [--out out/control] [--duration S]
+    python -m runtime control --offsets [--known-slope] [--only TEXT] [--out out/control] [--duration S]
 
 `--duration` cuts every task short (a smoke run; the table then says so).  `--sensors` runs every
 task on the C EKF of these sensors (a shipped set or a sensors file) instead of its own measurement;
 a task's `[sensors]` does so for that task.  `--offsets` runs the offset table instead
 (runtime/control/offsets.py): the LQR and the NMPC on the circle and the line against a plant with
 one constant mismatch or on an unmodelled slope, out/control/offsets.md and .csv; `--only` keeps the
-cases whose "task plant controller" contains TEXT.  A task with the NMPC (kind nmpc) also runs the
+cases whose "task plant controller" contains TEXT; `--known-slope` runs only the slope cases, the
+slope in the controller's model too (its slope feedforward).  A task with the NMPC (kind nmpc) also runs the
 C NMPC (kind nmpc-c) on the same settings, in the row after it, unless it lists nmpc-c itself or its
 horizon exceeds the C NMPC's capacity.
 """
@@ -117,6 +118,8 @@ def main(argv=()):
                         "the circle and the line against one constant mismatch or a slope at a time")
     parser.add_argument("--only", default="", help="with --offsets: the cases whose 'task plant controller' "
                         "contains this text")
+    parser.add_argument("--known-slope", action="store_true", help="with --offsets: only the slope cases, the "
+                        "slope known to the controller's model")
     parser.add_argument("--controllers", default=",".join(OFFSET_CONTROLLERS),
                         help="with --offsets: comma-separated controller kinds")
     parser.add_argument("--sensors", metavar="FILE", default=None,
@@ -134,7 +137,7 @@ def main(argv=()):
         unknown = sorted(set(kinds) - set(OFFSET_CONTROLLERS))
         if unknown:
             parser.error(f"--controllers: {unknown[0]!r} is not one of {', '.join(OFFSET_CONTROLLERS)}")
-        return offset_table(out, args.duration, args.only, kinds)
+        return offset_table(out, args.duration, args.only, kinds, args.known_slope)
     try:
         tasks = [load_task(name) for name in args.tasks.split(",")]
         if args.sensors is not None:
@@ -200,13 +203,14 @@ def _cut(task, duration):
         task.scenario, steps=max(1, round(min(duration, task.duration) / task.scenario.dt))))
 
 
-def offset_table(out, duration=None, only="", kinds=OFFSET_CONTROLLERS):
+def offset_table(out, duration=None, only="", kinds=OFFSET_CONTROLLERS, known_slope=False):
     """The offset cases (runtime/control/offsets.py) of the circle and the line for each controller of
-    `kinds`, those whose "task plant controller" contains `only`: out/offsets.md, .csv."""
+    `kinds`, those whose "task plant controller" contains `only` (with `known_slope`, the slope cases
+    known to the controller): out/offsets.md, .csv."""
     circle, line = load_task("circle"), load_task("line")
     runs = [(kind, case) for kind in kinds
             for case in offset_cases(_cut(with_controller(circle, kind), duration),
-                                     _cut(with_controller(line, kind), duration))
+                                     _cut(with_controller(line, kind), duration), known_slope)
             if only in f"{case.name} {case.change} {kind}"]
     if not runs:
         print(f"error: --only: no offset case contains {only!r}", file=sys.stderr)

@@ -19,6 +19,15 @@ LQR's Riccati cost-to-go at the end), so Gauss–Newton's Hessian is the exact o
 Why not a converged NLP solve per sample: fatrop on the same OCP through Opti took 281 ms per
 sample (p50, AMD EPYC), far above the 50 ms period; one RTI iteration takes ~1–2 ms and,
 warm-started every period, tracks the converged solution (docs/control.md).
+
+A slope in the model (`Params.slope`, along the plane's x axis) is fed forward in whichever
+direction the path runs, as the LQR's (runtime/control/slope.py): the prediction and the operating
+points are the flat model's, and the slope moves the operating point by (Δz*, Δu*) at the
+reference's heading, speed and curvature.  To first order the plant's error from the sloped
+operating point, z − Δz* under u − Δu*, moves as the flat model's from the flat one, so the NMPC
+solves from the measured state shifted by −Δz* (`shifted_state`: its attitude, pendulum and rates)
+for the flat model driven by u + d̂ − Δu*.  Its nodes' torques are the plant's, so the torque
+limits hold the feedforward's share as well.
 """
 import dataclasses
 import hashlib
@@ -31,11 +40,14 @@ import typing
 
 import numpy as np
 
+from .. import so3
 from ..casadi_model import load, parameter_vector
+from ..state import IDX_RP, IDX_RS, IDX_WP, IDX_WS, IDX_WY, rotations
 from .controller import DEFAULT_U_MAX, Controller
 from .geometry import cross_track_rate
 from . import lqr_design as design
 from .lqr import LqrGains, design_schedule
+from .slope import design_slope_schedule, slope_components
 from .ranges import NMPC_RANGES
 
 #: The NMPC's state: the robot's error coordinates, the cross-track error and its integral
@@ -197,8 +209,12 @@ class Nmpc(Controller):
         self.gains, self.n = gains, int(gains.horizon)
         self.node_periods = int(gains.node_periods)
         self.node_period = self.period * self.node_periods
-        self.schedule = design_schedule(params, rate, u_max, gains)
-        self._p = parameter_vector(params)
+        # The prediction is the flat model's; a slope in `params` is fed forward (see the module).
+        flat = params.replace(slope=0.0)
+        self.model_slope = np.array([params.slope, 0.0])
+        self.schedule = design_schedule(flat, rate, u_max, gains)
+        self._slope_schedule = design_slope_schedule(flat, self.schedule) if params.slope != 0.0 else None
+        self._p = parameter_vector(flat)
         q = gains.weights(u_max).q_diagonal()[:NZ_N]
         self._q_path = q
         self._q_heading = np.where(np.isin(np.arange(NZ_N), (design.Z_EY, design.Z_IY)), 0.0, q)
@@ -257,6 +273,7 @@ class Nmpc(Controller):
         self._guess, self._heading, self._u_last = None, 0.0, None
         self.integral = 0.0                     # ∫e_y dt [m s], the controller's own state
         self.disturbance = np.zeros(2)          # d̂ [N m]: the estimated constant offset of the torques
+        self._offset = np.zeros(2)              # d̂ − f [N m]: what the prediction adds to the torques
         self._last = None                       # (z, u, v, κ) of the last sample: what d̂ is estimated from
         self.restarts = 0
 
@@ -284,6 +301,23 @@ class Nmpc(Controller):
                     + wv * ((1 - wk) * a[i1[0], j0] + wk * a[i1[0], j1]))
         return mix(s.z_star)[:, :NZ_N], mix(s.u_star)[:-1]
 
+    def slope_feedforward(self, target, kappa):
+        """(Δz* (NZ,), Δu* (2,) [N m]): the operating point's move on the model's slope at the
+        target's heading and speed and the curvature kappa (runtime/control/slope.py); None on a
+        flat model."""
+        if self._slope_schedule is None:
+            return None
+        up, right = slope_components(self.model_slope, target.heading)
+        return self._slope_schedule.at(target.speed, kappa, up, right)
+
+    def _on_slope(self, x, target, kappa):
+        """(the state the NMPC solves from, Δu*): x shifted by −Δz* on the model's slope (see the
+        module), else x and 0."""
+        move = self.slope_feedforward(target, kappa)
+        if move is None:
+            return x, np.zeros(2)
+        return shifted_state(x, -move[0], target.heading), move[1]
+
     def compute(self, t, x, target):
         """The torques of one sample: solves the horizon's optimal control problem from state x for the
         target."""
@@ -293,15 +327,18 @@ class Nmpc(Controller):
             kappas = np.asarray(target.curvature_ahead, dtype=float)
         else:
             kappas = np.full(n + 1, float(target.curvature) if path else 0.0)
+        x, feedforward = self._on_slope(x, target, float(kappas[0]))
         z0 = design.error_coordinates(x, self.params.r, v, target.heading, target.cross_track if path else 0.0,
                                       (self.integral if path else 0.0, 0.0))[:NZ_N]
         zs, us = self._references(v, kappas)
         jumped = abs(_wrap(target.heading - self._heading)) > HEADING_JUMP_RAD
+        self._offset = self.disturbance - feedforward
         if not jumped:
             self._estimate_disturbance(z0)
-        # The plant is modelled as the model driven by u + d̂: the torques that hold the reference
-        # are u* − d̂, and every node of the prediction adds d̂ to its torques.
-        us = us - self.disturbance
+        self.disturbance = self._offset + feedforward
+        # The plant is modelled as the model driven by u + d̂ − Δu*: the torques that hold the
+        # reference are u* − d̂ + Δu*, and every node of the prediction adds d̂ − Δu* to its torques.
+        us = us - self._offset
         if self._guess is not None and jumped:
             self._guess = None                  # a corner: the last solution is in another frame
         self._heading = target.heading
@@ -338,20 +375,21 @@ class Nmpc(Controller):
         return U[0]
 
     def _estimate_disturbance(self, z):
-        """d̂ += gain · argmin_δ ‖B₁ δ − (z − Φ₁(z⁻, u⁻ + d̂))‖ over DISTURBANCE_ROWS: the last
-        sample's z⁻ and torques u⁻ predicted over one period by the model with the offset, against
-        the measured z; B₁ the prediction's torque Jacobian.  Clipped to ±u_max."""
+        """d̂ += gain · argmin_δ ‖B₁ δ − (z − Φ₁(z⁻, u⁻ + d̂ − f))‖ over DISTURBANCE_ROWS: the last
+        sample's z⁻ and torques u⁻ predicted over one period by the model with the offset (less this
+        sample's slope feedforward Δu*, as the C NMPC's), against the measured z; B₁ the
+        prediction's torque Jacobian.  d̂ − Δu* clipped to ±u_max."""
         gain = self.gains.disturbance_gain
         if self._last is None or gain == 0:
             return
         z_prev, u_prev, v, kappa = self._last
-        z_pred, _, B = (out.full() for out in self._one_period(z_prev, u_prev + self.disturbance, v, kappa, self._p))
+        z_pred, _, B = (out.full() for out in self._one_period(z_prev, u_prev + self._offset, v, kappa, self._p))
         residual = z[DISTURBANCE_ROWS] - z_pred[DISTURBANCE_ROWS, 0]
         B = B[DISTURBANCE_ROWS]
         if not (np.all(np.isfinite(residual)) and np.all(np.isfinite(B))):
             return
         step = np.linalg.solve(B.T @ B, B.T @ residual)
-        self.disturbance = np.clip(self.disturbance + gain * step, -self.u_max, self.u_max)
+        self._offset = np.clip(self._offset + gain * step, -self.u_max, self.u_max)
 
     def _iterate(self, z0, Z, U, zs, us, v, kappas, q, P, cold):
         # Cold start: iterate to convergence once (RTI's usual initialisation), then one per sample.
@@ -363,7 +401,7 @@ class Nmpc(Controller):
         """One Gauss–Newton QP around the nodes (Z (N+1, NZ_N), U (N, 2)); the new nodes.
         Raises _Diverged when the prediction overflows or the QP fails."""
         n, nz = self.n, NZ_N
-        z_next, A, B = (out.full() for out in self._nodes(Z[:n].T, (U + self.disturbance).T, v,
+        z_next, A, B = (out.full() for out in self._nodes(Z[:n].T, (U + self._offset).T, v,
                                                           kappas[:n].reshape(1, n), self._p))
         if not (np.all(np.isfinite(z_next)) and np.all(np.isfinite(A)) and np.all(np.isfinite(B))):
             raise _Diverged
@@ -398,6 +436,22 @@ class Nmpc(Controller):
             raise _Diverged
         Z_new = Z + c + (G @ dU)
         return Z_new, U + dU.reshape(n, 2)
+
+
+def shifted_state(x, dz, psi_ref):
+    """A state whose error coordinates (lqr_design.error_coordinates) against the heading ψ_ref are
+    those of x plus dz (NZ,) in the yoke's attitude, the pendulum and the rates (the position, the
+    cross-track error and the integrals are left): the shell's phase about the hinge is kept."""
+    x = np.array(x, dtype=float)
+    R_S, R_Y, R_P = (R.copy() for R in rotations(x))
+    Q_ref = design.reference_attitude(psi_ref)
+    E = so3.log(Q_ref.T @ R_S @ R_Y)
+    x[IDX_RS] = (Q_ref @ so3.exp(E + dz[design.Z_E]) @ R_Y.T).ravel()
+    x[IDX_RP] = (R_P @ so3.rot_y(dz[design.Z_TH_P])).ravel()
+    x[IDX_WS] += R_Y @ dz[design.Z_OM]
+    x[IDX_WY] += dz[design.Z_WY]
+    x[IDX_WP] += dz[design.Z_WP]
+    return x
 
 
 class NmpcC(Nmpc):
@@ -447,7 +501,7 @@ class NmpcC(Nmpc):
             raise ValueError(f"controller: the NMPC design is not valid for the C NMPC "
                              f"({ffi.string(lib.sr_status_string(status)).decode()})")
         self._ffi, self._lib, self._c = ffi, lib, c
-        self._model = Model(self.params)
+        self._model = Model(self.params.replace(slope=0.0))
         self._memory = ffi.new("sr_nmpc_memory *")
         self._target = ffi.new("sr_nmpc_target *")
         self._curvatures = ffi.new("double[]", self.n + 1)
@@ -468,16 +522,23 @@ class NmpcC(Nmpc):
         """The torques of one sample of `sr_nmpc_step` for state x and the target."""
         from ..errors import KernelError
         ffi, lib, c = self._ffi, self._lib, self._target
-        x = np.ascontiguousarray(x, dtype=np.float64)
         c.speed, c.heading = target.speed, target.heading
         c.path = target.cross_track is not None
         c.curvature_ahead = ffi.NULL
+        kappa = 0.0
         if c.path:
             c.curvature, c.cross_track = target.curvature, target.cross_track
+            kappa = float(target.curvature)
             ahead = target.curvature_ahead
             if ahead is not None and len(ahead) == self.n + 1:
                 self._curvatures[0:self.n + 1] = np.asarray(ahead, dtype=float).tolist()
                 c.curvature_ahead = self._curvatures
+                kappa = float(ahead[0])
+        # The slope's feedforward: the shifted state, and Δu* as a part of the torque offset the C
+        # prediction adds (see the module): d̂ − Δu* in, d̂ back.
+        x, feedforward = self._on_slope(x, target, kappa)
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        self._memory.disturbance[0:2] = (self.disturbance - feedforward).tolist()
         status = lib.sr_nmpc_step(self._c, self._memory, self._model._model, ffi.cast("double *", ffi.from_buffer(x)),
                                   c, ffi.cast("double *", ffi.from_buffer(self._u)))
         if status == lib.SR_ERR_MODEL:
@@ -486,5 +547,5 @@ class NmpcC(Nmpc):
             raise ValueError(f"controller {self.kind}: {ffi.string(lib.sr_status_string(status)).decode()} "
                              f"at t = {t:g} s")
         self.integral, self.restarts = self._memory.integral, self._memory.restarts
-        self.disturbance = np.array(list(self._memory.disturbance))
+        self.disturbance = np.array(list(self._memory.disturbance)) + feedforward
         return self._u.copy()

@@ -4,7 +4,8 @@ the controller's model by one constant mismatch, or stands on an unmodelled slop
 * a mass (m_S, m_b, m_h, m_P, by the paper's names) or a damping (k_S, k_Y, k_P) 20 % off, either way;
 * the pendulum's centre of mass c_P moved by 1 cm along one of its frame's axes, either way;
 * a slope of a quarter of the plant's climbing limit under u_max (runtime/control/climbing.py):
-  the line up, down and across it, and the circle (whose heading turns through every direction).
+  the line up, down and across it, and the circle (whose heading turns through every direction);
+  with `known_slope`, the slope is in the controller's model as well (its slope feedforward).
 
 Targets (docs/control.md, "Offset-free tracking"): second-half cross-track RMS ≤ 5 mm under every
 mismatch and on the line on the slope, ≤ 1 cm on the circle on the slope.
@@ -79,8 +80,9 @@ def slope_angle(params, u_max):
     return SLOPE_FRACTION * climbing_limit(params, u_max)
 
 
-def offset_cases(circle, line):
-    """The OffsetCase list for the two shipped tasks (runtime.control.task.Task, one controller each)."""
+def offset_cases(circle, line, known_slope=False):
+    """The OffsetCase list for the two shipped tasks (runtime.control.task.Task, one controller each);
+    `known_slope`: the slope cases only, the slope in the controller's model too."""
     cases = []
     for base in (circle, line):
         plant = base.plant_params
@@ -92,15 +94,19 @@ def offset_cases(circle, line):
                 shifted.append((f"c_P {label}{sign * 100 * CENTRE_SHIFT_M:+.0f} cm", {"c_P": tuple(c_P)}))
         scaled = [(f"{name} {sign * 100 * MISMATCH:+.0f} %", {name: getattr(plant.paper_params, name) * (1 + sign * MISMATCH)})
                   for name in MASSES + DAMPINGS for sign in (+1, -1)]
-        for change, overrides in scaled + shifted:
+        for change, overrides in ([] if known_slope else scaled + shifted):
             cases.append(OffsetCase(base.name, change, MISMATCH_TARGET_M,
                                     dataclasses.replace(base, plant_params=plant.with_changes(**overrides))))
         slope = slope_angle(plant, base.u_max)
         on_slope = dataclasses.replace(base, plant_params=plant.replace(slope=slope))
+        if known_slope:
+            on_slope = dataclasses.replace(on_slope, scenario=dataclasses.replace(
+                base.scenario, params=base.scenario.params.replace(slope=slope)))
+        known = ", known" if known_slope else ""
         if base.reference_spec["kind"] == "line":
             for where, psi in LINE_ON_SLOPE.items():
-                cases.append(OffsetCase(base.name, f"slope {math.degrees(slope):.3f} deg, {where}",
+                cases.append(OffsetCase(base.name, f"slope {math.degrees(slope):.3f} deg{known}, {where}",
                                         SLOPE_LINE_TARGET_M, _turned(on_slope, psi)))
         else:
-            cases.append(OffsetCase(base.name, f"slope {math.degrees(slope):.3f} deg", SLOPE_CIRCLE_TARGET_M, on_slope))
+            cases.append(OffsetCase(base.name, f"slope {math.degrees(slope):.3f} deg{known}", SLOPE_CIRCLE_TARGET_M, on_slope))
     return cases

@@ -8,6 +8,7 @@ import pytest
 from bindings._sr import lib
 from runtime.__main__ import main
 from runtime.control.benchmark import COLUMNS, controller_runs
+from runtime.control.offsets import offset_cases
 from runtime.control.task import load_task
 
 
@@ -34,6 +35,13 @@ def test_the_offset_table_writes_one_row_per_chosen_case_with_its_target(tmp_pat
     assert [r["task"] for r in rows] == ["circle", "line", "line", "line"]
     assert [float(r["target_m"]) for r in rows] == [0.01, 0.005, 0.005, 0.005]
     assert " of 4 runs meet their target" in (tmp_path / "offsets.md").read_text()
+
+
+def test_the_known_slope_offset_table_runs_only_the_slope_cases_with_the_slope_in_the_model():
+    cases = offset_cases(load_task("circle").with_controller("lqr"), load_task("line").with_controller("lqr"),
+                         known_slope=True)
+    assert [c.change.split(", ")[1] for c in cases] == ["known", "known", "known", "known"]
+    assert all(c.task.scenario.params.slope == c.task.plant_params.slope > 0 for c in cases)
 
 
 def test_the_offset_table_names_an_unknown_controller(tmp_path, capsys):
