@@ -199,10 +199,11 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativ
         return out
 
     def inertia(self, x):
-        """Generalized inertia M (5, 5), symmetric positive definite; kinetic energy ½νᵀMν; (B, 5, 5)
-        for x (B, 35)."""
-        if np.ndim(x) != 2:
-            return self._single(lib.sr_inertia, x, NV * NV).reshape(NV, NV)
+        """Generalized inertia M (5, 5), symmetric positive definite; kinetic energy ½νᵀMν."""
+        return self._single(lib.sr_inertia, x, NV * NV).reshape(NV, NV)
+
+    def inertia_batch(self, x):
+        """M (B, 5, 5) of the states x (B, 35)."""
         x = np.ascontiguousarray(self._valid_states(x))
         out = np.empty((x.shape[0], NV, NV))
         xp, op = _ptr(x), _ptr(out)

@@ -34,7 +34,8 @@ DT, STEPS = 0.01, 10_000
 
 # Libraries a firmware image may be asked to provide: libm and the mem* family.
 MATH = {"sin", "cos", "sincos", "tan", "asin", "acos", "atan", "atan2", "sqrt", "hypot", "exp", "log",
-        "pow", "fabs", "floor", "ceil", "fmod", "fma", "fmin", "fmax", "copysign"}
+        "pow", "fabs", "floor", "ceil", "fmod", "fma", "fmin", "fmax", "copysign", "nearbyint",
+        "remainder"}
 ALLOWED_EXTERNAL = MATH | {f + "f" for f in MATH} | {"memcpy", "memset", "memmove"}
 ALLOCATORS = {"malloc", "calloc", "realloc", "free", "aligned_alloc", "posix_memalign", "memalign",
               "valloc", "reallocarray", "strdup", "strndup"}

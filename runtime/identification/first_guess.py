@@ -19,7 +19,7 @@ import scipy.optimize
 import scipy.signal
 
 from ..model import Model
-from ..param_derivatives import NPI, PARAMETER_NAMES, base_parameters
+from ..param_derivatives import NPI, PARAMETER_NAMES, base_parameters, inertial_parameters
 from ..params import Params
 from ..state import IDX_NU, NV
 
@@ -86,7 +86,6 @@ def regressor_guess(t, x, u, params, free, bounds, weights=None, window=WINDOW_S
     lo, hi = (np.asarray(v, dtype=float) for v in bounds)
 
     def pi_of(theta):
-        from .fit import _pi_of
         p = p0.copy()
         p[idx] = theta
         return _pi_of(p)
@@ -141,3 +140,21 @@ def _physical(params, idx, theta, theta0, lo, hi):
             continue
         return p[idx].copy()
     return theta0.copy()
+
+
+def _pi_of(p):
+    """π of a parameter vector that need not pass the physical checks (a difference step may not)."""
+    values = dict(zip(PARAMETER_NAMES, p))
+    fields = {}
+    for body in ("Y", "P"):
+        c = np.array([values[f"c_{body}_{a}"] for a in "xyz"])
+        J = np.array([[values[f"J_{body}_{''.join(sorted(a + b, key='xyz'.index))}"] for b in "xyz"] for a in "xyz"])
+        fields[body] = (values[f"m_{body}"], c, J)
+    proxy = type("P", (), {})()
+    for k in ("m_S", "j_S", "k_S", "k_Y", "k_P", "j_mY", "j_mP"):
+        setattr(proxy, k, values[k])
+    for body, (m, c, J) in fields.items():
+        setattr(proxy, f"m_{body}", m)
+        setattr(proxy, f"c_{body}", c)
+        setattr(proxy, f"J_{body}", J)
+    return inertial_parameters(proxy)

@@ -37,7 +37,7 @@ from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_param
 from ..params import SHAPES, Params, flat_names
 from ..sensors import encoders_jacobian_batch, imu_partials_batch, position_jacobian_batch
 from ..state import IDX_E_NU, IDX_NU, NE, NV
-from .first_guess import regressor_guess
+from .first_guess import _pi_of, regressor_guess
 from .sensitivity import JACOBIANS, accel_sensitivity, step_sensitivity
 
 #: Where the fit starts the parameters: the regressor's linear least-squares first guess, or the nominal robot.
@@ -547,7 +547,7 @@ class _FullState:
             raise IdentifyError("sensors.process: a full-state fit weighs the velocities by the process noise; "
                                 "the sensor set declares none on some axis")
         model = Model(params)
-        Minv = np.linalg.inv(model.inertia(self.X[:-1]))
+        Minv = np.linalg.inv(model.inertia_batch(self.X[:-1]))
         # whitened by the inverse of each row's Cholesky factor: one batched product per evaluation
         self.white = np.linalg.inv(np.linalg.cholesky((Minv * (q2 * self.h)) @ np.swapaxes(Minv, 1, 2)))
         self.ncols = self.nf
@@ -755,24 +755,6 @@ def _dpi(params, idx):
         lo[i] -= e
         out[:, c] = (_pi_of(hi) - _pi_of(lo)) / (2 * e)
     return out
-
-
-def _pi_of(p):
-    """π of a parameter vector that need not pass the physical checks (a difference step may not)."""
-    values = dict(zip(PARAMETER_NAMES, p))
-    fields = {}
-    for body in ("Y", "P"):
-        c = np.array([values[f"c_{body}_{a}"] for a in "xyz"])
-        J = np.array([[values[f"J_{body}_{''.join(sorted(a + b, key='xyz'.index))}"] for b in "xyz"] for a in "xyz"])
-        fields[body] = (values[f"m_{body}"], c, J)
-    proxy = type("P", (), {})()
-    for k in ("m_S", "j_S", "k_S", "k_Y", "k_P", "j_mY", "j_mP"):
-        setattr(proxy, k, values[k])
-    for body, (m, c, J) in fields.items():
-        setattr(proxy, f"m_{body}", m)
-        setattr(proxy, f"c_{body}", c)
-        setattr(proxy, f"J_{body}", J)
-    return inertial_parameters(proxy)
 
 
 def _combinations(nominal, estimated, idx, cov, null, scale):

@@ -183,3 +183,16 @@ def test_the_gil_check_fails_for_the_same_call_holding_the_gil():
 
     assert not seen_midway(call, buf["status"])
     assert (buf["status"] == lib.SR_OK).all()
+
+
+def test_inertia_batch_equals_the_inertia_of_each_state(rng):
+    model = Model(Params.paper_simulation())
+    x = np.stack([initial_state(theta_Y=rng.uniform(-1, 1), theta_P=rng.uniform(-1, 1)) for _ in range(4)])
+    np.testing.assert_array_equal(model.inertia_batch(x), np.stack([model.inertia(s) for s in x]))
+
+
+def test_inertia_batch_names_the_bad_state():
+    x = np.stack([initial_state(), initial_state()])
+    x[1, IDX_QZ] = 1.0
+    with pytest.raises(ValueError, match=r"x"):
+        Model(Params.paper_simulation()).inertia_batch(x)
