@@ -15,24 +15,6 @@
 
 #define NCOL (SR_NE + SR_NU)
 
-/* B <- M^-1 B for the first n columns of B (SR_NV rows of NCOL), M = L L^T: all columns at once,
- * with the diagonal's reciprocals (five divisions instead of ten per column).  Inline, so that
- * the compiler sees n as a constant at each call (and vectorizes the 14 columns). */
-static inline void solve(const sr_real L[SR_NV * SR_NV], const sr_real inv[SR_NV], sr_real B[SR_NV][NCOL], int n)
-{
-    int i, k, c;
-    for (i = 0; i < SR_NV; ++i) {
-        for (k = 0; k < i; ++k)
-            for (c = 0; c < n; ++c) B[i][c] -= L[SR_NV * i + k] * B[k][c];
-        for (c = 0; c < n; ++c) B[i][c] *= inv[i];
-    }
-    for (i = SR_NV - 1; i >= 0; --i) {
-        for (k = i + 1; k < SR_NV; ++k)
-            for (c = 0; c < n; ++c) B[i][c] -= L[SR_NV * k + i] * B[k][c];
-        for (c = 0; c < n; ++c) B[i][c] *= inv[i];
-    }
-}
-
 /* The paper's robot: M = [A B; B^T D], D = diag(M_33, M_44), since M_34 = 0 (the yoke and the
  * pendulum rates do not couple; derive/codegen/joint_first.py proves it, and the generated terms
  * kernel writes M_34 as a literal 0).  As in sr_gen_accel, the joints go first: with
@@ -124,7 +106,7 @@ static int general_accel_jacobian(const sr_model *model, const sr_real x[SR_NX],
     status = sr_internal_cholesky(Mu, L, inv);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NV; ++i) a[i][0] = f[i];
-    solve(L, inv, a, 1);                                    /* a = nu' */
+    sr_internal_cholesky_solve(L, inv, NCOL, 1, &a[0][0]);                                    /* a = nu' */
     for (i = 0; i < SR_NV; ++i) acc[i] = a[i][0];
     for (i = 0; i < SR_NV; ++i) {
         for (k = 0; k < SR_NE; ++k) B[i][k] = df[SR_NE * i + k];
@@ -132,7 +114,7 @@ static int general_accel_jacobian(const sr_model *model, const sr_real x[SR_NX],
         for (k = 0; k < 5; ++k) /* the configuration directions d_xi_S, d_th_Y, d_th_P move M */
             for (j = 0; j < SR_NV; ++j) B[i][k] -= dM[15 * k + SR_UPPER[i][j]] * a[j][0];
     }
-    solve(L, inv, B, NCOL);
+    sr_internal_cholesky_solve(L, inv, NCOL, NCOL, &B[0][0]);
     for (i = 0; i < SR_NV; ++i) {
         for (k = 0; k < SR_NE; ++k) ja[SR_NE * i + k] = B[i][k];
         for (k = 0; k < SR_NU; ++k) jb[SR_NU * i + k] = B[i][SR_NE + k];

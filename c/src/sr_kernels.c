@@ -42,21 +42,12 @@ int sr_internal_cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real
 #ifndef SR_PAPER_ONLY
 static int general_accel(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV])
 {
-    sr_real Mu[15], f[SR_NV], L[SR_NV * SR_NV], inv[SR_NV], y[SR_NV];
-    int i, k, status = sr_gen_general_system(model->cg, x, u, Mu, f);
+    sr_real Mu[15], L[SR_NV * SR_NV], inv[SR_NV], y[SR_NV];
+    int i, status = sr_gen_general_system(model->cg, x, u, Mu, y);
     if (status != SR_OK) return status;
     status = sr_internal_cholesky(Mu, L, inv);
     if (status != SR_OK) return status;
-    for (i = 0; i < SR_NV; ++i) {
-        sr_real s = f[i];
-        for (k = 0; k < i; ++k) s -= L[SR_NV * i + k] * y[k];
-        y[i] = s * inv[i];
-    }
-    for (i = SR_NV - 1; i >= 0; --i) {
-        sr_real s = y[i];
-        for (k = i + 1; k < SR_NV; ++k) s -= L[SR_NV * k + i] * y[k];
-        y[i] = s * inv[i];
-    }
+    sr_internal_cholesky_solve(L, inv, 1, 1, y);
     if (!all_finite(y, SR_NV)) return SR_ERR_NONFINITE;
     for (i = 0; i < SR_NV; ++i) a[i] = y[i];
     return SR_OK;

@@ -40,4 +40,23 @@ static const unsigned char SR_UPPER[SR_NV][SR_NV] = {
  * accel kernel's test, else SR_ERR_SINGULAR. */
 int sr_internal_cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real inv[SR_NV]);
 
+/* B <- M^-1 B on the first n columns of B (SR_NV rows, row-major, ld entries per row), M = L L^T
+ * from sr_internal_cholesky: forward then back substitution, all columns at once.  Inline, so each
+ * caller's constant ld and n give it its own unrolled, vectorised copy. */
+static inline void sr_internal_cholesky_solve(const sr_real L[SR_NV * SR_NV], const sr_real inv[SR_NV], int ld, int n,
+                                              sr_real *B)
+{
+    int i, k, c;
+    for (i = 0; i < SR_NV; ++i) {
+        for (k = 0; k < i; ++k)
+            for (c = 0; c < n; ++c) B[ld * i + c] -= L[SR_NV * i + k] * B[ld * k + c];
+        for (c = 0; c < n; ++c) B[ld * i + c] *= inv[i];
+    }
+    for (i = SR_NV - 1; i >= 0; --i) {
+        for (k = i + 1; k < SR_NV; ++k)
+            for (c = 0; c < n; ++c) B[ld * i + c] -= L[SR_NV * k + i] * B[ld * k + c];
+        for (c = 0; c < n; ++c) B[ld * i + c] *= inv[i];
+    }
+}
+
 #endif /* SR_KERNELS_H */

@@ -71,7 +71,7 @@ int sr_sim_check(const sr_sim *sim)
 static int disturbance_accel(const sr_model *plant, const sr_real x[SR_NX], const sr_real w[SR_NV],
                              sr_real out[SR_NV])
 {
-    sr_real M[SR_NV * SR_NV], Mu[15], L[SR_NV * SR_NV], inv[SR_NV], z[SR_NV];
+    sr_real M[SR_NV * SR_NV], Mu[15], L[SR_NV * SR_NV], inv[SR_NV];
     int i, j, status = sr_inertia(plant, x, M);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NV; ++i) {
@@ -79,16 +79,8 @@ static int disturbance_accel(const sr_model *plant, const sr_real x[SR_NX], cons
     }
     status = sr_internal_cholesky(Mu, L, inv);
     if (status != SR_OK) return status;
-    for (i = 0; i < SR_NV; ++i) {
-        sr_real s = w[i];
-        for (j = 0; j < i; ++j) s -= L[i * SR_NV + j] * z[j];
-        z[i] = s * inv[i];
-    }
-    for (i = SR_NV - 1; i >= 0; --i) {
-        sr_real s = z[i];
-        for (j = i + 1; j < SR_NV; ++j) s -= L[j * SR_NV + i] * out[j];
-        out[i] = s * inv[i];
-    }
+    for (i = 0; i < SR_NV; ++i) out[i] = w[i];
+    sr_internal_cholesky_solve(L, inv, 1, 1, out);
     return SR_OK;
 }
 
