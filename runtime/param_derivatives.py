@@ -125,6 +125,29 @@ class ParamDerivativeMethods:
         self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
         return out
 
+    def step_jacobians(self, x, u=None, dt=0.01, method="lie-euler", columns=None):
+        """(F, Jp) at once: F of `step_jacobian` (12, 12) and the columns `columns` of
+        `step_param_jacobian` (12, len(columns); default all), at the same states; batches
+        x (B, 35), u (B, 2) or None give (B, 12, 12), (B, 12, len(columns)).  One pass of the
+        parameter stages carries F's columns too, so each stage's derivative kernel and
+        factorisation serve both (C: sr_step_jacobian_param_cols_batch); F equals `step_jacobian`'s
+        to rounding."""
+        choice(method, "method", STEP_METHODS, "integrator with a parameter Jacobian")
+        x, u = self._state_and_input(x, u)
+        dt = self._dt(dt)
+        cols = _column_list(np.arange(NPARAM) if columns is None else columns)
+        xb = np.ascontiguousarray(x.reshape(-1, x.shape[-1]))
+        ub = np.ascontiguousarray(u.reshape(-1, u.shape[-1]))
+        F = np.empty((xb.shape[0], NE, NE))
+        Jp = np.empty((xb.shape[0], NE, len(cols)))
+        failed = ffi.new("long *")
+        status = lib.sr_step_jacobian_param_cols_batch(self._model, getattr(lib, STEP_METHODS[method]), xb.shape[0],
+                                                       _ptr(xb), _ptr(ub), dt, len(cols),
+                                                       ffi.new("int[]", [int(c) for c in cols]), _ptr(F), _ptr(Jp),
+                                                       failed)
+        self._check(f"x[{failed[0]}]" if failed[0] >= 0 and x.ndim > 1 else "x", status)
+        return (F, Jp) if x.ndim > 1 else (F[0], Jp[0])
+
     def _columns(self, batch, x, u, rows, columns, step=()):
         """The columns `columns` of a parameter Jacobian with `rows` rows by the C batch `batch`, for
         one state or a batch; `step`: a step's (method code, dt)."""

@@ -515,6 +515,7 @@ int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 #define sr_step_param_jacobian_fd_batch sr_step_param_jacobian_fd_batch_f
 #define sr_step_param_jacobian_cols_batch sr_step_param_jacobian_cols_batch_f
 #define sr_accel_param_jacobian_cols_batch sr_accel_param_jacobian_cols_batch_f
+#define sr_step_jacobian_param_cols_batch sr_step_jacobian_param_cols_batch_f
 #define sr_regressor sr_regressor_f
 #define sr_regressor_batch sr_regressor_batch_f
 #endif
@@ -620,6 +621,17 @@ int sr_step_param_jacobian_batch(const sr_model *model, int method, long n, cons
  * all succeed); the rows before it are written. */
 int sr_step_param_jacobian_cols_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u,
                                       sr_real dt, int ncols, const int *cols, sr_real *Jp, long *failed_row);
+
+/** The step's state Jacobian F (sr_step_jacobian's, n x SR_NE x SR_NE row-major) and its parameter
+ * sensitivity on the columns cols[0..ncols) (sr_step_param_jacobian_cols_batch's Jp, n x SR_NE x
+ * ncols) at the same states, at once: F's columns run through the parameter columns' stages, so
+ * each stage's derivative kernel and factorisation serve both (what a fit that asks for both costs
+ * less than the two calls).  F equals sr_step_jacobian's to rounding, Jp those columns of
+ * sr_step_param_jacobian.  Checks and status codes as sr_step_param_jacobian_cols_batch (F too
+ * not NULL); the rows before a failing one are written. */
+int sr_step_jacobian_param_cols_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u,
+                                      sr_real dt, int ncols, const int *cols, sr_real *F, sr_real *Jp,
+                                      long *failed_row);
 
 /** sr_accel_param_jacobian_batch on the columns cols[0..ncols) (SR_P_*) only, in their order: J n x
  * SR_NV x ncols row-major, equal to those columns of sr_accel_param_jacobian.  Checks as

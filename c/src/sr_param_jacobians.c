@@ -15,7 +15,10 @@
  * and RKMK4's dexp^-1 on the SO(3) block, dk_S = P df_S + Q dth_S (sr_dexpinv.h).
  *
  * The columns are independent all the way: a sensitivity to a few parameters (the free ones of a
- * fit) runs the same stages on those columns only.
+ * fit) runs the same stages on those columns only.  The step's state Jacobian F is more columns of
+ * the same stages (the directions of the start state's error, which the actions move by A(th) as
+ * well): asked for with the parameter columns at the same states, it shares each stage's
+ * derivative kernel, factorisation and solve with them instead of running its own stages.
  */
 #include "sr_checks.h"
 #include "sr_dexpinv.h"
@@ -28,29 +31,124 @@
 #include <string.h>
 
 #define NP SR_NPARAM
+/* The state directions a step's F carries: every error direction but dq's.  Nothing in a step
+ * depends on where the robot stands, so F's dq columns are the identity's (as in
+ * sr_step_jacobians.c); carried column a is error direction a before SR_E_q, a + 2 after. */
+#define NS (SR_NE - 2)
+#define NW (NS + NP)
+#define state_row(a) ((a) < SR_E_q ? (a) : (a) + 2)
 
-typedef sr_real tangent_p[SR_NT][NP];   /* d(13-vector)/dp */
-typedef sr_real error_p[SR_NE][NP];     /* d(state error)/dp */
+typedef sr_real tangent_p[SR_NT][NW];   /* d(13-vector)/d(d, p), the carried columns */
+typedef sr_real error_p[SR_NE][NW];     /* d(state error)/d(d, p) */
 
-/* The columns computed: n of them; cols[c] the SR_P_* of column c, or cols NULL for all in order
- * (the whole bracket by one kernel); r_col the column of r, or -1. */
+/* d(pi)/dp_j of one parameter that moves only pi (runtime.param_derivatives.inertial_parameters):
+ * the n entries k[e] of pi it moves, by v[e] (a body's mass moves ten). */
 typedef struct {
-    int n, r_col;
+    int n;
+    unsigned char k[10];
+    sr_real v[10];
+} pi_column;
+
+/* The columns computed: n of them, the first ns (0 or NS) the start state's directions, then the
+ * parameters: cols[c] the SR_P_* of column ns + c, or cols NULL for all in order; r_col the column
+ * of r, or -1.  pi not NULL: every parameter column moves pi alone, pi[c] its d(pi)/dp, and the
+ * bracket comes from the regressor (see residual_columns). */
+typedef struct {
+    int n, ns, r_col;
     const int *cols;
+    const pi_column *pi;
 } colset;
 
-static const colset ALL_COLUMNS = {NP, SR_P_r, NULL};
+static const colset ALL_COLUMNS = {NP, 0, SR_P_r, NULL, NULL};
 
-/* The set of ncols columns cols (checked by the caller: 1 <= ncols <= NP, each an index of p). */
-static colset columns_of(int ncols, const int *cols)
+/* d(pi)/dp_j into d; 0 for a parameter that the regressor Y itself depends on (r, n_Y, n_P, g,
+ * slope), else 1.  A body's entries run m, c (3), J (xx yy zz xy xz yz), k in p and m, m c,
+ * J_O = J + m (|c|^2 I - c c^T) (the same six), k in pi. */
+static int pi_derivative(const sr_real p[NP], int j, pi_column *d)
+{
+    typedef char same_layout[(SR_P_k_Y - SR_P_m_Y == 10 && SR_P_k_P - SR_P_m_P == 10 && SR_PI_k_Y - SR_PI_m_Y == 10
+                              && SR_PI_k_P - SR_PI_m_P == 10) ? 1 : -1];
+    static const unsigned char single[][2] = {{SR_P_m_S, SR_PI_m_S}, {SR_P_j_S, SR_PI_j_S}, {SR_P_k_S, SR_PI_k_S},
+                                              {SR_P_j_mY, SR_PI_j_mY}, {SR_P_j_mP, SR_PI_j_mP}};
+    /* per axis a of c: the off-diagonal entries of J_O (xy 3, xz 4, yz 5) with the other axis, and
+     * the diagonal entries it enters squared */
+    static const unsigned char off[3][2][2] = {{{3, 1}, {4, 2}}, {{3, 0}, {5, 2}}, {{4, 0}, {5, 1}}};
+    int b, e, a;
+    sr_real m;
+    const sr_real *c;
+    (void)sizeof(same_layout);
+    d->n = 0;
+    for (e = 0; e < 5; ++e)
+        if (j == single[e][0]) {
+            d->n = 1;
+            d->k[0] = single[e][1];
+            d->v[0] = 1;
+            return 1;
+        }
+    if (j >= SR_P_m_Y && j <= SR_P_k_Y) b = 0;
+    else if (j >= SR_P_m_P && j <= SR_P_k_P) b = 1;
+    else return 0;
+    {
+        const int p0 = b ? SR_P_m_P : SR_P_m_Y, q0 = b ? SR_PI_m_P : SR_PI_m_Y, o = j - p0;
+        m = p[p0];
+        c = p + p0 + 1;
+        if (o == 0) {   /* the mass: m, m c and J_O */
+            d->k[0] = (unsigned char)q0;
+            d->v[0] = 1;
+            for (a = 0; a < 3; ++a) {
+                d->k[1 + a] = (unsigned char)(q0 + 1 + a);
+                d->v[1 + a] = c[a];
+            }
+            d->k[4] = (unsigned char)(q0 + 4);
+            d->v[4] = c[1] * c[1] + c[2] * c[2];
+            d->k[5] = (unsigned char)(q0 + 5);
+            d->v[5] = c[0] * c[0] + c[2] * c[2];
+            d->k[6] = (unsigned char)(q0 + 6);
+            d->v[6] = c[0] * c[0] + c[1] * c[1];
+            d->k[7] = (unsigned char)(q0 + 7);
+            d->v[7] = -c[0] * c[1];
+            d->k[8] = (unsigned char)(q0 + 8);
+            d->v[8] = -c[0] * c[2];
+            d->k[9] = (unsigned char)(q0 + 9);
+            d->v[9] = -c[1] * c[2];
+            d->n = 10;
+        } else if (o <= 3) {   /* c_a: m c_a, the two diagonal entries of J_O without a, two off-diagonal */
+            a = o - 1;
+            d->k[0] = (unsigned char)(q0 + o);
+            d->v[0] = m;
+            d->n = 1;
+            for (e = 0; e < 3; ++e)
+                if (e != a) {
+                    d->k[d->n] = (unsigned char)(q0 + 4 + e);
+                    d->v[d->n++] = 2 * m * c[a];
+                }
+            for (e = 0; e < 2; ++e) {
+                d->k[d->n] = (unsigned char)(q0 + 4 + off[a][e][0]);
+                d->v[d->n++] = -m * c[off[a][e][1]];
+            }
+        } else {   /* J's entries and k: their own */
+            d->n = 1;
+            d->k[0] = (unsigned char)(q0 + o);
+            d->v[0] = 1;
+        }
+    }
+    return 1;
+}
+
+/* The set of ns state columns then the ncols columns cols (checked by the caller: 1 <= ncols <= NP,
+ * each an index of p); pi[0..ncols) filled and used where every column moves pi alone. */
+static colset columns_of(const sr_model *model, int ns, int ncols, const int *cols, pi_column pi[NP])
 {
     colset s;
-    int c;
-    s.n = ncols;
+    int c, linear = 1;
+    s.n = ns + ncols;
+    s.ns = ns;
     s.cols = cols;
     s.r_col = -1;
     for (c = ncols - 1; c >= 0; --c)
-        if (cols[c] == SR_P_r) s.r_col = c;
+        if (cols[c] == SR_P_r) s.r_col = ns + c;
+    for (c = 0; c < ncols && linear; ++c) linear = pi_derivative(model->p, cols[c], pi + c);
+    s.pi = linear ? pi : NULL;
     return s;
 }
 
@@ -75,22 +173,40 @@ static const sr_real *general_constants(const sr_model *model, sr_real cg[SR_GEN
     return cg;
 }
 
-/* d(M nu' - f)/dp on the columns cs (dR row-major SR_NV x NP, its first cs->n columns), nu' = a held:
- * the generated bracket, its chosen columns moved to the front. */
+/* -d(M nu' - f)/d(d, p) with the state held on the columns cs (its first cs->n columns; the state
+ * columns 0), nu' = a held.  Where every column moves pi alone, from the regressor: M nu' - f =
+ * Y(x, nu') pi - B u with B of the gear ratios only, so the bracket is Y d(pi)/dp, and Y (about half
+ * the bracket's operations, SR_GEN_REGRESSOR_FLOPS) serves any number of columns at a few products
+ * each; otherwise the generated bracket, its chosen columns moved into place. */
 static int residual_columns(const sr_model *model, const colset *cs, const sr_real x[SR_NX], const sr_real a[SR_NV],
-                            sr_real dR[SR_NV * NP])
+                            sr_real D[SR_NV][NW])
 {
     sr_real all[SR_NV * NP];
-    int i, c, status;
-    if (!cs->cols) return sr_gen_general_param_residual_jacobian(model->p, x, a, dR);
+    int i, c, e, status;
+    if (cs->pi) {
+        sr_real Y[SR_NV * SR_NPI];
+        status = sr_gen_regressor(model->p, x, a, Y);
+        for (i = 0; i < SR_NV && status == SR_OK; ++i) {
+            for (c = 0; c < cs->ns; ++c) D[i][c] = 0;
+            for (c = cs->ns; c < cs->n; ++c) {
+                const pi_column *d = cs->pi + (c - cs->ns);
+                sr_real t = 0;
+                for (e = 0; e < d->n; ++e) t += Y[SR_NPI * i + d->k[e]] * d->v[e];
+                D[i][c] = -t;
+            }
+        }
+        return status;
+    }
     status = sr_gen_general_param_residual_jacobian(model->p, x, a, all);
-    for (i = 0; i < SR_NV && status == SR_OK; ++i)
-        for (c = 0; c < cs->n; ++c) dR[NP * i + c] = all[NP * i + cs->cols[c]];
+    for (i = 0; i < SR_NV && status == SR_OK; ++i) {
+        for (c = 0; c < cs->ns; ++c) D[i][c] = 0;
+        for (c = cs->ns; c < cs->n; ++c) D[i][c] = -all[NP * i + (cs->cols ? cs->cols[c - cs->ns] : c - cs->ns)];
+    }
     return status;
 }
 
 /* B <- M^-1 B on the first nc columns, M = L L^T (sr_internal_cholesky). */
-static void solve_columns(const sr_real L[SR_NV * SR_NV], const sr_real inv[SR_NV], int nc, sr_real B[SR_NV][NP])
+static void solve_columns(const sr_real L[SR_NV * SR_NV], const sr_real inv[SR_NV], int nc, sr_real B[SR_NV][NW])
 {
     int i, k, c;
     for (i = 0; i < SR_NV; ++i) {
@@ -110,10 +226,10 @@ static void solve_columns(const sr_real L[SR_NV * SR_NV], const sr_real inv[SR_N
  * and their state derivatives and one factorisation: Ja itself is never formed, and the solve runs
  * on the few columns only. */
 static int general_stage_rows(const sr_model *model, const colset *cs, const sr_real y[SR_NX],
-                              const sr_real u[SR_NU], const error_p dy, sr_real a[SR_NV], sr_real D[SR_NV][NP])
+                              const sr_real u[SR_NU], const error_p dy, sr_real a[SR_NV], sr_real D[SR_NV][NW])
 {
     sr_real Mu[15], f[SR_NV], df[SR_NV * SR_NE], dfdu[SR_NV * SR_NU], dM[5 * 15], L[SR_NV * SR_NV], inv[SR_NV];
-    sr_real g[SR_NV][SR_NE], dR[SR_NV * NP];
+    sr_real g[SR_NV][SR_NE];
     const int nc = cs->n;
     int i, j, k, c, status = sr_internal_general_accel_jacobian_terms(model, y, u, Mu, f, df, dfdu, dM);
     if (status == SR_OK) status = sr_internal_cholesky(Mu, L, inv);
@@ -128,13 +244,12 @@ static int general_stage_rows(const sr_model *model, const colset *cs, const sr_
         for (k = i + 1; k < SR_NV; ++k) t -= L[SR_NV * k + i] * a[k];
         a[i] = t * inv[i];
     }
-    status = residual_columns(model, cs, y, a, dR);
+    status = residual_columns(model, cs, y, a, D);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NV; ++i) {
         for (k = 0; k < SR_NE; ++k) g[i][k] = df[SR_NE * i + k];
         for (k = 0; k < 5; ++k)   /* the configuration directions d_xi_S, d_th_Y, d_th_P move M */
             for (j = 0; j < SR_NV; ++j) g[i][k] -= dM[15 * k + SR_UPPER[i][j]] * a[j];
-        for (c = 0; c < nc; ++c) D[i][c] = -dR[NP * i + c];
         for (k = 0; k < SR_NE; ++k) {
             const sr_real m = g[i][k];
             if (k == SR_E_q || k == SR_E_q + 1) continue;   /* nothing depends on q */
@@ -149,11 +264,11 @@ static int general_stage_rows(const sr_model *model, const colset *cs, const sr_
  * kernels' constants given; J row-major SR_NV x NP, its first cs->n columns written. */
 static int accel_param_jacobian(const sr_model *model, const sr_real *constants, const colset *cs,
                                 const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real a[SR_NV],
-                                sr_real J[SR_NV][NP])
+                                sr_real J[SR_NV][NW])
 {
-    sr_real Mu[15], f[SR_NV], L[SR_NV * SR_NV], inv[SR_NV], dR[SR_NV * NP];
+    sr_real Mu[15], f[SR_NV], L[SR_NV * SR_NV], inv[SR_NV];
     const int nc = cs->n;
-    int i, k, c, status;
+    int i, k, status;
     status = sr_gen_general_system(constants, x, u, Mu, f);
     if (status == SR_OK) status = sr_internal_cholesky(Mu, L, inv);
     if (status != SR_OK) return status;
@@ -167,10 +282,8 @@ static int accel_param_jacobian(const sr_model *model, const sr_real *constants,
         for (k = i + 1; k < SR_NV; ++k) s -= L[SR_NV * k + i] * a[k];
         a[i] = s * inv[i];
     }
-    status = residual_columns(model, cs, x, a, dR);
+    status = residual_columns(model, cs, x, a, J);
     if (status != SR_OK) return status;
-    for (i = 0; i < SR_NV; ++i)
-        for (c = 0; c < nc; ++c) J[i][c] = -dR[NP * i + c];
     solve_columns(L, inv, nc, J);   /* J = -M^-1 dR */
     return SR_OK;
 }
@@ -178,17 +291,18 @@ static int accel_param_jacobian(const sr_model *model, const sr_real *constants,
 int sr_accel_param_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                             sr_real J[SR_NV * SR_NPARAM])
 {
-    sr_real a[SR_NV], j[SR_NV][NP], cg[SR_GEN_GENERAL_NCONST];
-    int status = arg_model(model, READS(WHOLE));
+    sr_real a[SR_NV], j[SR_NV][NW], cg[SR_GEN_GENERAL_NCONST];
+    int i, status = arg_model(model, READS(WHOLE));
     if (status != SR_OK) return status;
     if (!x || !J) return SR_ERR_NULL;
     status = sr_internal_check_state(model, x);
     if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
     if (status == SR_OK)
         status = accel_param_jacobian(model, general_constants(model, cg), &ALL_COLUMNS, x, u ? u : sr_zero_u, a, j);
+    for (i = 0; i < SR_NV && status == SR_OK; ++i)
+        if (!all_finite(j[i], NP)) status = SR_ERR_NONFINITE;
     if (status != SR_OK) return status;
-    if (!all_finite_long(&j[0][0], SR_NV * NP)) return SR_ERR_NONFINITE;
-    memcpy(J, j, sizeof j);
+    for (i = 0; i < SR_NV; ++i) memcpy(J + NP * i, j[i], NP * sizeof(sr_real));
     return SR_OK;
 }
 
@@ -212,9 +326,10 @@ int sr_accel_param_jacobian_batch(const sr_model *model, long n, const sr_real *
 
 /* ---- one step ------------------------------------------------------------------------------- */
 
-/* dy = B(th) dth on the first nc columns: the error of y = x . exp(th) along p with x held (q_z
- * does not move). */
-static void action_rows(int nc, const sr_real th[SR_NT], const tangent_p dth, error_p dy)
+/* dy = A(th) [I | 0] + B(th) dth on the first nc columns, the first ns of them the start state's
+ * directions: the error of y = x . exp(th) (q_z does not move); A(th) = diag(Exp(th_S)^T, 1, 1, I_2,
+ * I_5), Exp(th_S) = I + D. */
+static void action_rows(int ns, int nc, const sr_real th[SR_NT], const sr_real D[9], const tangent_p dth, error_p dy)
 {
     const size_t row = (size_t)nc * sizeof(sr_real);
     sr_real Jr[9];
@@ -228,6 +343,23 @@ static void action_rows(int nc, const sr_real th[SR_NT], const tangent_p dth, er
     memcpy(dy[SR_E_th_P], dth[SR_T_P], row);
     for (i = 0; i < 2; ++i) memcpy(dy[SR_E_q + i], dth[SR_T_Q + i], row);
     for (i = 0; i < SR_NV; ++i) memcpy(dy[SR_E_nu + i], dth[SR_T_V + i], row);
+    if (!ns) return;
+    for (i = 0; i < 3; ++i) {
+        int j;
+        for (j = 0; j < 3; ++j) dy[SR_E_xi_S + i][j] += D[3 * j + i];
+        dy[SR_E_xi_S + i][i] += 1;
+    }
+    for (i = SR_E_th_Y; i < NS; ++i) dy[state_row(i)][i] += 1;
+}
+
+/* The start state's own error on the carried columns: the identity on the first ns, 0 on the
+ * others (the parameters move nothing at the start). */
+static void start_rows(int ns, int nc, error_p dy)
+{
+    int i, c;
+    for (i = 0; i < SR_NE; ++i)
+        for (c = 0; c < nc; ++c) dy[i][c] = 0;
+    for (c = 0; c < ns; ++c) dy[state_row(c)][c] = 1;
 }
 
 /* The vector field f at y and df = J_f(y) dy + df/dp(y) on the columns cs (dy NULL: y is the
@@ -238,7 +370,7 @@ static int field_rows(const sr_model *model, const sr_real *constants, const col
     const sr_real *R = y + SR_X_R_S, *w = y + SR_X_w_S, r = model->p[SR_P_r];
     const int nc = cs->n;
     const size_t row = (size_t)nc * sizeof(sr_real);
-    sr_real a[SR_NV], Jp[SR_NV][NP], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], p[2][3], wxp[2][3];
+    sr_real a[SR_NV], Jp[SR_NV][NW], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], p[2][3], wxp[2][3];
     int i, j, c, status;
     const int general_stage = dy && model->general;
     sr_internal_kinematics(model, y, f);
@@ -290,7 +422,9 @@ static int rkmk4_param(const sr_model *model, const colset *cs, const sr_real x[
     const sr_real *constants = general_constants(model, cg);
     tangent_p dK, dth, dsum;
     error_p dstage;
-    int s, i, c, status = field_rows(model, constants, cs, x, u, NULL, K[0], dK);
+    int s, i, c, status;
+    if (cs->ns) start_rows(cs->ns, nc, dstage);
+    status = field_rows(model, constants, cs, x, u, cs->ns ? (const sr_real(*)[NW])dstage : NULL, K[0], dK);
     for (i = 0; i < SR_NT; ++i)
         for (c = 0; c < nc; ++c) dsum[i][c] = b[0] * dK[i][c];
     for (s = 1; s < 4 && status == SR_OK; ++s) {
@@ -300,10 +434,10 @@ static int rkmk4_param(const sr_model *model, const colset *cs, const sr_real x[
             for (c = 0; c < nc; ++c) dth[i][c] = hs * dK[i][c];
         so3_exp_minus_identity(th + SR_T_S, D);
         act_increment(x, D, th, NULL, y);   /* the stepper's stage state */
-        action_rows(nc, th, (const sr_real(*)[NP])dth, dstage);
-        status = field_rows(model, constants, cs, y, u, (const sr_real(*)[NP])dstage, K[s], dK);
+        action_rows(cs->ns, nc, th, D, (const sr_real(*)[NW])dth, dstage);
+        status = field_rows(model, constants, cs, y, u, (const sr_real(*)[NW])dstage, K[s], dK);
         if (status == SR_OK) {   /* k_S = dexp^-1(th, f_S): dk_S = P df_S + Q dth_S */
-            sr_real P[9], Q[9], kS[3], dS[3][NP];
+            sr_real P[9], Q[9], kS[3], dS[3][NW];
             int j;
             dexpinv_and_derivatives(th, K[s], kS, P, Q);
             for (i = 0; i < 3; ++i)
@@ -324,7 +458,8 @@ static int rkmk4_param(const sr_model *model, const colset *cs, const sr_real x[
         th[i] = 0;
         for (s = 0; s < 4; ++s) th[i] += b[s] * K[s][i];
     }
-    action_rows(nc, th, (const sr_real(*)[NP])dsum, dy);
+    if (cs->ns) so3_exp_minus_identity(th + SR_T_S, D);
+    action_rows(cs->ns, nc, th, D, (const sr_real(*)[NW])dsum, dy);
     return SR_OK;
 }
 
@@ -332,15 +467,18 @@ static int rkmk4_param(const sr_model *model, const colset *cs, const sr_real x[
 static int lie_euler_param(const sr_model *model, const colset *cs, const sr_real x[SR_NX], const sr_real u[SR_NU],
                            sr_real h, error_p dy)
 {
-    sr_real f[SR_NT], th[SR_NT], cg[SR_GEN_GENERAL_NCONST];
+    sr_real f[SR_NT], th[SR_NT], D[9], cg[SR_GEN_GENERAL_NCONST];
     tangent_p df;
-    int i, c, status = field_rows(model, general_constants(model, cg), cs, x, u, NULL, f, df);
+    int i, c, status;
+    if (cs->ns) start_rows(cs->ns, cs->n, dy);
+    status = field_rows(model, general_constants(model, cg), cs, x, u, cs->ns ? (const sr_real(*)[NW])dy : NULL, f, df);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NT; ++i) {
         th[i] = h * f[i];
         for (c = 0; c < cs->n; ++c) df[i][c] *= h;
     }
-    action_rows(cs->n, th, (const sr_real(*)[NP])df, dy);
+    if (cs->ns) so3_exp_minus_identity(th + SR_T_S, D);
+    action_rows(cs->ns, cs->n, th, D, (const sr_real(*)[NW])df, dy);
     return SR_OK;
 }
 
@@ -360,14 +498,15 @@ int sr_step_param_jacobian(const sr_model *model, int method, const sr_real x[SR
                            sr_real dt, sr_real Jp[SR_NE * SR_NPARAM])
 {
     error_p dy;
-    int status = arg_model(model, READS(WHOLE));
+    int i, status = arg_model(model, READS(WHOLE));
     if (status != SR_OK) return status;
     if (!x || !Jp) return SR_ERR_NULL;
     if ((method != SR_LIE_EULER && method != SR_RKMK4) || arg_dt(dt) != SR_OK) return SR_ERR_ARG;
     status = step_param(model, &ALL_COLUMNS, method, x, u, dt, dy);
+    for (i = 0; i < SR_NE && status == SR_OK; ++i)
+        if (!all_finite(dy[i], NP)) status = SR_ERR_NONFINITE;
     if (status != SR_OK) return status;
-    if (!all_finite_long(&dy[0][0], SR_NE * NP)) return SR_ERR_NONFINITE;
-    memcpy(Jp, dy, sizeof dy);
+    for (i = 0; i < SR_NE; ++i) memcpy(Jp + NP * i, dy[i], NP * sizeof(sr_real));
     return SR_OK;
 }
 
@@ -395,6 +534,7 @@ int sr_step_param_jacobian_cols_batch(const sr_model *model, int method, long n,
                                       sr_real dt, int ncols, const int *cols, sr_real *Jp, long *failed_row)
 {
     colset cs;
+    pi_column pi[NP];
     error_p dy;
     long i;
     int k, c, status = arg_model(model, READS(WHOLE));
@@ -403,7 +543,7 @@ int sr_step_param_jacobian_cols_batch(const sr_model *model, int method, long n,
     if (status == SR_OK) status = arg_rows(n, x && Jp);
     if (status == SR_OK && ((method != SR_LIE_EULER && method != SR_RKMK4) || arg_dt(dt) != SR_OK)) status = SR_ERR_ARG;
     if (status != SR_OK) return status;
-    cs = columns_of(ncols, cols);
+    cs = columns_of(model, 0, ncols, cols, pi);
     for (i = 0; i < n; ++i) {
         sr_real *out = Jp + i * SR_NE * ncols;
         status = step_param(model, &cs, method, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt, dy);
@@ -419,11 +559,45 @@ int sr_step_param_jacobian_cols_batch(const sr_model *model, int method, long n,
     return SR_OK;
 }
 
+int sr_step_jacobian_param_cols_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u,
+                                      sr_real dt, int ncols, const int *cols, sr_real *F, sr_real *Jp,
+                                      long *failed_row)
+{
+    colset cs;
+    pi_column pi[NP];
+    error_p dy;
+    long i;
+    int k, c, status = arg_model(model, READS(WHOLE));
+    if (failed_row) *failed_row = -1;
+    if (status == SR_OK) status = arg_columns(ncols, cols);
+    if (status == SR_OK) status = arg_rows(n, x && F && Jp);
+    if (status == SR_OK && ((method != SR_LIE_EULER && method != SR_RKMK4) || arg_dt(dt) != SR_OK)) status = SR_ERR_ARG;
+    if (status != SR_OK) return status;
+    cs = columns_of(model, NS, ncols, cols, pi);
+    for (i = 0; i < n; ++i) {
+        sr_real *f = F + i * SR_NE * SR_NE, *out = Jp + i * SR_NE * ncols;
+        status = step_param(model, &cs, method, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt, dy);
+        for (k = 0; k < SR_NE && status == SR_OK; ++k) {
+            if (!all_finite(dy[k], NS + ncols)) status = SR_ERR_NONFINITE;
+            for (c = 0; c < NS; ++c) f[SR_NE * k + state_row(c)] = dy[k][c];
+            f[SR_NE * k + SR_E_q] = (sr_real)(k == SR_E_q);   /* nothing depends on q: see NS */
+            f[SR_NE * k + SR_E_q + 1] = (sr_real)(k == SR_E_q + 1);
+            for (c = 0; c < ncols; ++c) out[k * ncols + c] = dy[k][NS + c];
+        }
+        if (status != SR_OK) {
+            if (failed_row) *failed_row = i;
+            return status;
+        }
+    }
+    return SR_OK;
+}
+
 int sr_accel_param_jacobian_cols_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, int ncols,
                                        const int *cols, sr_real *J, long *failed_row)
 {
     colset cs;
-    sr_real a[SR_NV], j[SR_NV][NP], cg[SR_GEN_GENERAL_NCONST];
+    pi_column pi[NP];
+    sr_real a[SR_NV], j[SR_NV][NW], cg[SR_GEN_GENERAL_NCONST];
     const sr_real *constants;
     long i;
     int k, c, status = arg_model(model, READS(WHOLE));
@@ -431,7 +605,7 @@ int sr_accel_param_jacobian_cols_batch(const sr_model *model, long n, const sr_r
     if (status == SR_OK) status = arg_columns(ncols, cols);
     if (status == SR_OK) status = arg_rows(n, x && J);
     if (status != SR_OK) return status;
-    cs = columns_of(ncols, cols);
+    cs = columns_of(model, 0, ncols, cols, pi);
     constants = general_constants(model, cg);
     for (i = 0; i < n; ++i) {
         const sr_real *ui = u ? u + i * SR_NU : NULL;

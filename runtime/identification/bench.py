@@ -1,7 +1,9 @@
 """`python -m runtime identify-bench` (`make bench`): what the analytic parameter sensitivities buy a
-fit.  The same fit of the same log, once with the analytic step sensitivities of the C library and
-once with central differences computed in C, batched (`Model.step_param_jacobian_fd`): both wall
-and CPU times, their ratio, the evaluations each took, and how far apart the two optima are
+fit.  The same fit of the same log, once with the analytic Jacobians of the C library and once with
+central differences computed in C, batched, for the parameter columns (`Model.step_param_jacobian_fd`,
+the state Jacobians analytic in both: the headline ratio); a sensor-log fit also runs a third time
+with differences for every Jacobian ("fd-all", its state Jacobians too; a full-state fit has none).
+Wall and CPU times, the ratios, the evaluations each took, and how far apart the optima are
 (docs/identification.md, "Measured").
 
 The log is `coverage.simulated_log`: the battery-geared robot with the named entries planted within
@@ -32,13 +34,15 @@ DEFAULT_PARAMS = ("k_S,k_Y,k_P,m_P,J_P_yy,j_mY",
 
 def compare(log, nominal, names, rounds=1, **options):
     """{"analytic": {...}, "fd": {...}, "speedup_wall", "speedup_cpu", "max_difference_sigma",
-    "max_difference_relative"}: the fit of `log` by each Jacobian source of `identify` (`JACOBIANS`),
-    run in turns `rounds` times, each with its best wall and CPU time, its estimate, sigma and
-    evaluations; the optima's largest difference in the analytic fit's sigmas and relative to the
-    estimate."""
+    "max_difference_relative"}: the fit of `log` by each Jacobian source of `identify` (`JACOBIANS`;
+    without "fd-all" for a full-state fit, which has no state Jacobian), run in turns `rounds` times,
+    each with its best wall and CPU time, its estimate, sigma and evaluations; the optima's largest
+    difference in the analytic fit's sigmas and relative to the estimate.  With "fd-all" also
+    "speedup_cpu_fd_all" and its optimum's distance "max_difference_sigma_fd_all"."""
     out = {}
+    sources = [s for s in JACOBIANS if s != "fd-all" or not options.get("full_state")]
     for _ in range(rounds):
-        for source in JACOBIANS:
+        for source in sources:
             started, cpu = time.perf_counter(), time.process_time()
             fit = identify(log, nominal, names, jacobian=source, **options)
             wall, cpu = time.perf_counter() - started, time.process_time() - cpu
@@ -54,6 +58,9 @@ def compare(log, nominal, names, rounds=1, **options):
     out["speedup_cpu"] = out["fd"]["cpu_s"] / out["analytic"]["cpu_s"]
     out["max_difference_sigma"] = float(np.nanmax(in_sigma)) if np.isfinite(in_sigma).any() else None
     out["max_difference_relative"] = float(np.max(np.abs(a - f) / np.maximum(np.abs(a), 1e-300)))
+    if "fd-all" in out:
+        out["speedup_cpu_fd_all"] = out["fd-all"]["cpu_s"] / out["analytic"]["cpu_s"]
+        out["max_difference_sigma_fd_all"] = float(np.nanmax(np.abs(a - np.array(out["fd-all"]["estimate"])) / sigma))
     return out
 
 
@@ -89,12 +96,14 @@ def main(argv):
         comparisons.append({"params": names, "truth": {n: float(truth.as_array()[PARAMETER_NAMES.index(n)])
                                                        for n in fitted}, **result})
         print(f"{len(fitted)} entries ({names}):")
-        for source in JACOBIANS:
+        for source in (s for s in JACOBIANS if s in result):
             r = result[source]
             print(f"  {source:>8}: {r['wall_s']:.2f} s wall, {r['cpu_s']:.2f} s CPU, {r['nfev']} evaluations")
         print(f"  analytic faster by {result['speedup_wall']:.1f}x (wall), {result['speedup_cpu']:.1f}x (CPU); optima "
               f"{result['max_difference_sigma']:.2g} sigma apart at most ({result['max_difference_relative']:.2g} "
               "relative)")
+        if "fd-all" in result:
+            print(f"  against differences for every Jacobian (fd-all): {result['speedup_cpu_fd_all']:.1f}x (CPU)")
     date = datetime.datetime.now().isoformat(timespec="seconds")
     record = {"date": date, "cpu": cpu_name(), "log": {"robot": "battery-geared", "duration_s": args.duration,
                                                        "seed": args.seed, "mode": "sensors" if args.sensors

@@ -38,7 +38,7 @@ from ..params import SHAPES, Params, flat_names
 from ..sensors import encoders_jacobian_batch, imu_partials_batch, position_jacobian_batch
 from ..state import IDX_E_NU, IDX_NU, NE, NV
 from .first_guess import _pi_of, regressor_guess
-from .sensitivity import JACOBIANS, accel_sensitivity, step_sensitivity
+from .sensitivity import JACOBIANS, accel_sensitivity, accel_state_jacobian, step_jacobians, step_sensitivity
 
 #: Where the fit starts the parameters: the regressor's linear least-squares first guess, or the nominal robot.
 STARTS = ("regressor", "nominal")
@@ -297,13 +297,12 @@ class _Problem:
         k0, k1 = self.starts[s], self.ends[s]
         steps = k1 - k0
         X = model.simulate(x0, d.h, steps, u=d.u[k0:k1], method=self.method, energy_tol=None)
-        F, _ = model.step_jacobian(X[:-1], d.u[k0:k1], d.h, self.method)
-        Jp = step_sensitivity(model, X[:-1], d.u[k0:k1], d.h, self.method, self.idx, self.jacobian)
+        F, Jp = step_jacobians(model, X[:-1], d.u[k0:k1], d.h, self.method, self.idx, self.jacobian)
         last = s == self.S - 1
         nodes = np.arange(k0, k1 + 1 if last else k1)
         Xn = X[:len(nodes)]
         nudot = model.accel(Xn, d.u[nodes])
-        Ja, _ = model.accel_jacobian(Xn, d.u[nodes])
+        Ja = accel_state_jacobian(model, Xn, d.u[nodes], self.jacobian)
         Jpa = accel_sensitivity(model, Xn, d.u[nodes], self.idx, self.jacobian)
         G = np.empty((steps + 1, NE, NE + self.nf))     # [Φ_k | S_k]: one product per step
         G[0] = np.hstack([np.eye(NE), np.zeros((NE, self.nf))])
@@ -599,7 +598,7 @@ def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, 
     `full_state`, to the log's truth by the one-step prediction error.  `segment` [s]: the
     multiple-shooting segments' length; `x_guess` (n_imu, 35) and `bias_guess` (6,) replace the
     EKF's start guess.  `progress()` is called once per evaluation.  `jacobian`: the parameter
-    sensitivities' source (`JACOBIANS`: "analytic", or "fd", finite differences in C).  `start`
+    sensitivities' source (`JACOBIANS`: "analytic", or "fd"/"fd-all", differences in C).  `start`
     (`STARTS`): the parameters' start, "regressor" the linear least-squares first guess
     (runtime.identification.first_guess) from the start guess's states (the log's truth for a
     full-state fit), "nominal" the robot's values.  Returns a `Fit`."""
