@@ -205,22 +205,6 @@ static int residual_columns(const sr_model *model, const colset *cs, const sr_re
     return status;
 }
 
-/* B <- M^-1 B on the first nc columns, M = L L^T (sr_internal_cholesky). */
-static void solve_columns(const sr_real L[SR_NV * SR_NV], const sr_real inv[SR_NV], int nc, sr_real B[SR_NV][NW])
-{
-    int i, k, c;
-    for (i = 0; i < SR_NV; ++i) {
-        for (k = 0; k < i; ++k)
-            for (c = 0; c < nc; ++c) B[i][c] -= L[SR_NV * i + k] * B[k][c];
-        for (c = 0; c < nc; ++c) B[i][c] *= inv[i];
-    }
-    for (i = SR_NV - 1; i >= 0; --i) {
-        for (k = i + 1; k < SR_NV; ++k)
-            for (c = 0; c < nc; ++c) B[i][c] -= L[SR_NV * k + i] * B[k][c];
-        for (c = 0; c < nc; ++c) B[i][c] *= inv[i];
-    }
-}
-
 /* A general robot's stage: nu' = a and its whole derivative along the stage's dy on the columns
  * cs, D = Ja dy + d(nu')/dp = M^-1 ((df - (dM) a) dy - d(M nu' - f)/dp), from one kernel for M, f
  * and their state derivatives and one factorisation: Ja itself is never formed, and the solve runs
@@ -256,7 +240,7 @@ static int general_stage_rows(const sr_model *model, const colset *cs, const sr_
             for (c = 0; c < nc; ++c) D[i][c] += m * dy[k][c];
         }
     }
-    solve_columns(L, inv, nc, D);
+    sr_internal_cholesky_solve(L, inv, NW, nc, &D[0][0]);
     return SR_OK;
 }
 
@@ -268,23 +252,15 @@ static int accel_param_jacobian(const sr_model *model, const sr_real *constants,
 {
     sr_real Mu[15], f[SR_NV], L[SR_NV * SR_NV], inv[SR_NV];
     const int nc = cs->n;
-    int i, k, status;
+    int i, status;
     status = sr_gen_general_system(constants, x, u, Mu, f);
     if (status == SR_OK) status = sr_internal_cholesky(Mu, L, inv);
     if (status != SR_OK) return status;
-    for (i = 0; i < SR_NV; ++i) {   /* a = M^-1 f */
-        sr_real s = f[i];
-        for (k = 0; k < i; ++k) s -= L[SR_NV * i + k] * a[k];
-        a[i] = s * inv[i];
-    }
-    for (i = SR_NV - 1; i >= 0; --i) {
-        sr_real s = a[i];
-        for (k = i + 1; k < SR_NV; ++k) s -= L[SR_NV * k + i] * a[k];
-        a[i] = s * inv[i];
-    }
+    for (i = 0; i < SR_NV; ++i) a[i] = f[i];
+    sr_internal_cholesky_solve(L, inv, 1, 1, a);   /* a = M^-1 f */
     status = residual_columns(model, cs, x, a, J);
     if (status != SR_OK) return status;
-    solve_columns(L, inv, nc, J);   /* J = -M^-1 dR */
+    sr_internal_cholesky_solve(L, inv, NW, nc, &J[0][0]);   /* J = -M^-1 dR */
     return SR_OK;
 }
 
