@@ -27,7 +27,10 @@ reference's heading, speed and curvature.  To first order the plant's error from
 operating point, z − Δz* under u − Δu*, moves as the flat model's from the flat one, so the NMPC
 solves from the measured state shifted by −Δz* (`shifted_state`: its attitude, pendulum and rates)
 for the flat model driven by u + d̂ − Δu*.  Its nodes' torques are the plant's, so the torque
-limits hold the feedforward's share as well.
+limits hold the feedforward's share as well.  With `slope_estimate_s` > 0 the slope is the LQR's
+online estimate instead (runtime/control/slope.py's `SlopeEstimator`: the world's slope vector and a
+torque offset d from the measured rates against the flat model's one-period prediction), fed
+through the same path, and d joins the prediction's offset: u + d̂ + d − Δu*.
 """
 import dataclasses
 import hashlib
@@ -556,8 +559,8 @@ class NmpcC(Nmpc):
                 self._curvatures[0:self.n + 1] = np.asarray(ahead, dtype=float).tolist()
                 c.curvature_ahead = self._curvatures
                 kappa = float(ahead[0])
-        # The slope's feedforward: the shifted state, and Δu* as a part of the torque offset the C
-        # prediction adds (see the module): d̂ − Δu* in, d̂ back.
+        # The slope's feedforward: the shifted state, and Δu* (less the estimate's torque offset) as
+        # a part of the torque offset the C prediction adds (see the module): d̂ − Δu* in, d̂ back.
         x, feedforward = self._on_slope(x, target, kappa)
         x = np.ascontiguousarray(x, dtype=np.float64)
         self._memory.disturbance[0:2] = (self.disturbance - feedforward).tolist()
