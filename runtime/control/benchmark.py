@@ -35,7 +35,7 @@ from ..state import IDX_Q
 from .closed_loop import simulate_closed_loop, simulate_on_sensors
 from .geometry import heading, wrap_angle
 from .metrics import tracking_metrics
-from .offsets import OFFSET_CONTROLLERS, offset_cases, with_controller
+from .offsets import DEFAULT_OFFSET_CONTROLLERS, OFFSET_CONTROLLERS, offset_cases, with_controller
 from .plots import plot_estimate, plot_run
 from .ranges import NMPC_C_RANGES
 from .task import load_task, shipped_tasks
@@ -120,8 +120,8 @@ def main(argv=()):
                         "contains this text")
     parser.add_argument("--known-slope", action="store_true", help="with --offsets: only the slope cases, the "
                         "slope known to the controller's model")
-    parser.add_argument("--controllers", default=",".join(OFFSET_CONTROLLERS),
-                        help="with --offsets: comma-separated controller kinds")
+    parser.add_argument("--controllers", default=",".join(DEFAULT_OFFSET_CONTROLLERS),
+                        help=f"with --offsets: comma-separated controller kinds of {', '.join(OFFSET_CONTROLLERS)}")
     parser.add_argument("--sensors", metavar="FILE", default=None,
                         help="run every task on the C EKF of these sensors (a shipped set or a sensors file)")
     args = parser.parse_args(list(argv))
@@ -203,7 +203,7 @@ def _cut(task, duration):
         task.scenario, steps=max(1, round(min(duration, task.duration) / task.scenario.dt))))
 
 
-def offset_table(out, duration=None, only="", kinds=OFFSET_CONTROLLERS, known_slope=False):
+def offset_table(out, duration=None, only="", kinds=DEFAULT_OFFSET_CONTROLLERS, known_slope=False):
     """The offset cases (runtime/control/offsets.py) of the circle and the line for each controller of
     `kinds`, those whose "task plant controller" contains `only` (with `known_slope`, the slope cases
     known to the controller): out/offsets.md, .csv."""

@@ -27,7 +27,10 @@ reference's heading, speed and curvature.  To first order the plant's error from
 operating point, z − Δz* under u − Δu*, moves as the flat model's from the flat one, so the NMPC
 solves from the measured state shifted by −Δz* (`shifted_state`: its attitude, pendulum and rates)
 for the flat model driven by u + d̂ − Δu*.  Its nodes' torques are the plant's, so the torque
-limits hold the feedforward's share as well.
+limits hold the feedforward's share as well.  With `slope_estimate_s` > 0 the slope is the LQR's
+online estimate instead (runtime/control/slope.py's `SlopeEstimator`: the world's slope vector and a
+torque offset d from the measured rates against the flat model's one-period prediction), fed
+through the same path, and d joins the prediction's offset: u + d̂ + d − Δu*.
 """
 import dataclasses
 import hashlib
@@ -47,7 +50,7 @@ from .controller import DEFAULT_U_MAX, Controller
 from .geometry import cross_track_rate
 from . import lqr_design as design
 from .lqr import LqrGains, design_schedule
-from .slope import design_slope_schedule, slope_components
+from .slope import SlopeEstimator, design_slope_schedule, slope_components
 from .ranges import NMPC_RANGES
 
 #: The NMPC's state: the robot's error coordinates, the cross-track error and its integral
@@ -213,7 +216,11 @@ class Nmpc(Controller):
         flat = params.replace(slope=0.0)
         self.model_slope = np.array([params.slope, 0.0])
         self.schedule = design_schedule(flat, rate, u_max, gains)
-        self._slope_schedule = design_slope_schedule(flat, self.schedule) if params.slope != 0.0 else None
+        self._slope_schedule = design_slope_schedule(flat, self.schedule) \
+            if params.slope != 0.0 or gains.slope_estimate_s > 0.0 else None
+        # The online estimate (slope_estimate_s > 0): the LQR's (runtime/control/slope.py), on the flat model.
+        self._estimator = SlopeEstimator(flat, self.period, gains.slope_estimate_s) \
+            if gains.slope_estimate_s > 0.0 else None
         self._p = parameter_vector(flat)
         q = gains.weights(u_max).q_diagonal()[:NZ_N]
         self._q_path = q
@@ -276,6 +283,19 @@ class Nmpc(Controller):
         self._offset = np.zeros(2)              # d̂ − f [N m]: what the prediction adds to the torques
         self._last = None                       # (z, u, v, κ) of the last sample: what d̂ is estimated from
         self.restarts = 0
+        self._applied = np.zeros(2)             # the torques held since the last sample (the slope estimate's)
+        if self._estimator is not None:
+            self._estimator.reset()
+
+    @property
+    def slope(self):
+        """The world's slope vector α (cos β, sin β) [rad] the feedforward uses: the estimate when the
+        controller estimates one (against the flat model: the whole slope), else the model's."""
+        return self.model_slope if self._estimator is None else self._estimator.slope
+
+    def after_limits(self, raw, u):
+        """Keeps the torques applied: the slope estimate's next prediction holds them."""
+        self._applied = np.array(u, dtype=float)
 
     def preview_distances(self, target):
         """The horizon's nodes along the path at the reference speed: v T k, k = 0 .. N [m]."""
@@ -302,21 +322,26 @@ class Nmpc(Controller):
         return mix(s.z_star)[:, :NZ_N], mix(s.u_star)[:-1]
 
     def slope_feedforward(self, target, kappa):
-        """(Δz* (NZ,), Δu* (2,) [N m]): the operating point's move on the model's slope at the
-        target's heading and speed and the curvature kappa (runtime/control/slope.py); None on a
-        flat model."""
+        """(Δz* (NZ,), Δu* (2,) [N m]): the operating point's move on the slope `self.slope` (the
+        model's or the estimate) at the target's heading and speed and the curvature kappa
+        (runtime/control/slope.py); None on a flat model without an estimate."""
         if self._slope_schedule is None:
             return None
-        up, right = slope_components(self.model_slope, target.heading)
+        up, right = slope_components(self.slope, target.heading)
         return self._slope_schedule.at(target.speed, kappa, up, right)
 
     def _on_slope(self, x, target, kappa):
-        """(the state the NMPC solves from, Δu*): x shifted by −Δz* on the model's slope (see the
-        module), else x and 0."""
+        """(the state the NMPC solves from, Δu* − d): x shifted by −Δz* on the slope (see the module),
+        else x and 0.  With the online estimate, first updates it from the measured x, and its torque
+        offset d (the plant moving as the model under u + d) joins the prediction's offset."""
+        if self._estimator is not None:
+            self._estimator.update(x, self._applied)
         move = self.slope_feedforward(target, kappa)
         if move is None:
             return x, np.zeros(2)
-        return shifted_state(x, -move[0], target.heading), move[1]
+        if self._estimator is None:
+            return shifted_state(x, -move[0], target.heading), move[1]
+        return shifted_state(x, -move[0], target.heading), move[1] - self._estimator.torque_offset
 
     def compute(self, t, x, target):
         """The torques of one sample: solves the horizon's optimal control problem from state x for the
@@ -534,8 +559,8 @@ class NmpcC(Nmpc):
                 self._curvatures[0:self.n + 1] = np.asarray(ahead, dtype=float).tolist()
                 c.curvature_ahead = self._curvatures
                 kappa = float(ahead[0])
-        # The slope's feedforward: the shifted state, and Δu* as a part of the torque offset the C
-        # prediction adds (see the module): d̂ − Δu* in, d̂ back.
+        # The slope's feedforward: the shifted state, and Δu* (less the estimate's torque offset) as
+        # a part of the torque offset the C prediction adds (see the module): d̂ − Δu* in, d̂ back.
         x, feedforward = self._on_slope(x, target, kappa)
         x = np.ascontiguousarray(x, dtype=np.float64)
         self._memory.disturbance[0:2] = (self.disturbance - feedforward).tolist()

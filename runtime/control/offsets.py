@@ -21,17 +21,20 @@ from .climbing import climbing_limit
 
 #: The controllers the offset table runs (the PID has no integral on the path); nmpc-c is the NMPC's
 #: formulation in C (runtime/control/nmpc.py's NmpcC), which runs the table many times faster;
-#: lqr-slope is the task's LQR with its online slope estimate on (runtime/control/slope.py).
-OFFSET_CONTROLLERS = ("lqr", "lqr-slope", "nmpc", "nmpc-c")
-#: The slope estimate's time constant [s] of the lqr-slope runs.
+#: a kind ending in -slope is that controller with its online slope estimate on (runtime/control/slope.py).
+OFFSET_CONTROLLERS = ("lqr", "lqr-slope", "nmpc", "nmpc-slope", "nmpc-c", "nmpc-c-slope")
+#: Those the table runs by default: the Python NMPC's estimate is the C NMPC's formulation (its tests
+#: hold them equal), so only the C one runs it.
+DEFAULT_OFFSET_CONTROLLERS = ("lqr", "lqr-slope", "nmpc", "nmpc-c", "nmpc-c-slope")
+#: The slope estimate's time constant [s] of the -slope runs.
 SLOPE_ESTIMATE_S = 5.0
 
 
 def with_controller(task, kind):
     """The task with only its controller of `kind`; nmpc-c takes the settings of the task's nmpc,
-    lqr-slope those of its lqr with `slope_estimate_s` = SLOPE_ESTIMATE_S."""
-    if kind == "lqr-slope":
-        task = task.with_controller("lqr")
+    a kind ending in -slope those of its controller with `slope_estimate_s` = SLOPE_ESTIMATE_S."""
+    if kind.endswith("-slope"):
+        task = with_controller(task, kind[:-len("-slope")])
         spec = task.controllers[0]
         gains = dataclasses.replace(spec.gains, slope_estimate_s=SLOPE_ESTIMATE_S)
         return dataclasses.replace(task, controllers=(dataclasses.replace(spec, gains=gains),))

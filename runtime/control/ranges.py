@@ -41,7 +41,6 @@ LQR_RANGES = {
 #: `NmpcGains`: the LQR's and the horizon's.
 NMPC_RANGES = {
     **LQR_RANGES,
-    "slope_estimate_s": Range(0, 0, "s", "the NMPC has no slope estimate (an LQR setting): 0 only"),
     "torque_step_n_m": Range(1e-6, 1e6, "N m", "a torque change worth the full cost"),
     "disturbance_gain": Range(0, 1, "", "the share of the torque offset's update taken per sample (0: no estimate)"),
     "horizon": Range(1, 200, "", "nodes of the horizon: the QP has 2N unknowns and a dense (2N)^2 Hessian",

@@ -1,5 +1,7 @@
-"""The NMPC's (Python and C) feedforward of a slope in its model, in any direction: it holds a line
-across a quarter-limit slope that the flat prediction leaves centimetres off."""
+"""The NMPC's (Python and C) slope, in any direction: fed forward when its model knows it, estimated
+online when it does not; either holds a line across a quarter-limit slope that the flat prediction
+leaves centimetres off."""
+import dataclasses
 import math
 
 import numpy as np
@@ -19,6 +21,8 @@ SPEED = 0.2
 SLOPE = 0.25 * climbing_limit(PARAMS, 0.5)
 #: One operating point (straight, 0.2 m/s) and a short horizon keep the design and the run cheap.
 GAINS = nmpc.NmpcGains(v_min=SPEED, n_speeds=1, kappa_max=0.0, n_curvatures=1, horizon=10)
+ESTIMATING = dataclasses.replace(GAINS, slope_estimate_s=5.0)
+TARGET_M = 0.005
 
 
 def _rolling(psi):
@@ -26,14 +30,29 @@ def _rolling(psi):
                          w_Y=SPEED / PARAMS.r, r=PARAMS.r)
 
 
-@pytest.mark.parametrize("cls", [nmpc.Nmpc, nmpc.NmpcC])
-def test_the_feedforward_of_a_known_slope_holds_a_line_across_it(cls):
-    # Heading +y, the slope rising towards +x (on the right): the model knows the slope.
-    plant = PARAMS.replace(slope=SLOPE)
-    controller = cls(plant, rate=20.0, gains=GAINS)
+def _across_the_slope(controller):
+    """Second-half cross-track RMS [m] of 12 s heading +y on the slope rising towards +x (on the
+    right), and the controller after the run."""
     x0 = _rolling(math.pi / 2)
     reference = line_path(x0[IDX_Q][:2], math.pi / 2, 0.0, 10.0, SPEED)
-    result = simulate_closed_loop(plant, controller, reference, x0, 12.0, 0.005, method="rkmk4")
+    result = simulate_closed_loop(PARAMS.replace(slope=SLOPE), controller, reference, x0, 12.0, 0.005,
+                                  method="rkmk4")
     e = reference.cross_track(result.trajectory[len(result.trajectory) // 2:, IDX_Q])
-    assert np.sqrt(np.mean(e ** 2)) < 0.005
+    return float(np.sqrt(np.mean(e ** 2)))
 
+
+def test_the_feedforward_of_a_known_slope_holds_a_line_across_it():
+    # The Python NMPC shares the feedforward's path (its estimate's test runs it).
+    assert _across_the_slope(nmpc.NmpcC(PARAMS.replace(slope=SLOPE), rate=20.0, gains=GAINS)) < TARGET_M
+
+
+@pytest.mark.parametrize("cls", [nmpc.Nmpc, nmpc.NmpcC])
+def test_the_online_estimate_holds_a_line_across_an_unknown_slope(cls):
+    # The model is flat; the estimate's slope goes through the known slope's feedforward.
+    controller = cls(PARAMS, rate=20.0, gains=ESTIMATING)
+    assert _across_the_slope(controller) < TARGET_M
+    assert np.linalg.norm(controller.slope - (SLOPE, 0.0)) < 0.1 * SLOPE
+
+
+def test_without_the_estimate_the_flat_nmpc_leaves_the_line_across_the_slope():
+    assert _across_the_slope(nmpc.NmpcC(PARAMS, rate=20.0, gains=GAINS)) > 2 * TARGET_M

@@ -62,5 +62,7 @@ def test_the_ramp_tasks_stand_on_half_the_climbing_limit_known_and_estimated():
         limit = climbing_limit(task.plant_params, task.u_max)
         assert math.isclose(task.plant_params.slope, limit / 2, rel_tol=1e-12)
         assert task.reference_spec["speed"] == 0.2
-    assert known.scenario.params.slope == known.plant_params.slope and known.gains.slope_estimate_s == 0.0
-    assert estimated.scenario.params.slope == 0.0 and estimated.gains.slope_estimate_s > 0.0
+    assert known.scenario.params.slope == known.plant_params.slope
+    assert all(c.gains.slope_estimate_s == 0.0 for c in known.controllers)
+    assert estimated.scenario.params.slope == 0.0
+    assert all(c.gains.slope_estimate_s > 0.0 for c in estimated.controllers)

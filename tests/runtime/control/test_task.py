@@ -19,8 +19,8 @@ def test_the_six_tasks_of_issue_20_ship():
     for name in shipped_tasks():
         if load_task(name).sensors is not None:
             continue                    # on the estimator: the LQR and the C NMPC (test_on_sensors.py)
-        if name.startswith("ramp"):     # the slope's feedforward and estimate are the LQR's
-            assert load_task(name).controller_kinds == ("lqr",)
+        if name.startswith("ramp"):     # the slope's feedforward and estimate: the LQR's and the NMPC's
+            assert load_task(name).controller_kinds == ("lqr", "nmpc")
             continue
         assert load_task(name).controller_kinds == ("pid", "lqr", "nmpc")
         assert load_task(name).with_controller("nmpc").rate == 20.0

@@ -31,8 +31,8 @@ ABSURD = {
     "NMPC horizon 1e12": (lambda d: d["controller"][2].update(horizon=1e12), "controller[2].horizon"),
     "NMPC node_periods 1e12": (lambda d: d["controller"][2].update(node_periods=1e12), "controller[2].node_periods"),
     "u_max 1e200": (lambda d: d["controller"][0].update(u_max=1e200), "controller[0].u_max"),
-    "a slope estimate for the NMPC, which has none": (lambda d: d["controller"][2].update(slope_estimate_s=5.0),
-                                                      "controller[2].slope_estimate_s"),
+    "NMPC slope estimate over 1e9 s": (lambda d: d["controller"][2].update(slope_estimate_s=1e9),
+                                       "controller[2].slope_estimate_s"),
 }
 
 
