@@ -63,14 +63,15 @@ def noise_covariance(model, z_star, v, A, densities, period):
     return out
 
 
-def wander(params, densities, v, kappa=0.0, path=True, rate=50.0, u_max=0.5, gains=None):
+def wander(params, densities, v, kappa=0.0, path=True, rate=50.0, u_max=0.5, gains=None, tight=False):
     """The Wander of the LQR designed with `gains` (an LqrGains; None: the shipped ones) at the torque
     bound u_max [N·m] at (v, κ) under the white torque of densities (5,) [N·m/√Hz] (a sensor set's
-    `process.generalized()`)."""
+    `process.generalized()`); `tight`: with the tight path gain fully scheduled in, as the law applies
+    it (runtime/control/lqr.py, `tight_gain`: the integrators keep the path gain's columns)."""
     from scipy.linalg import solve_discrete_lyapunov
     from ..model import Model
     from . import lqr_design as design
-    from .lqr import LqrGains
+    from .lqr import LqrGains, tight_gain
     gains = LqrGains() if gains is None else gains
     densities = np.asarray(densities, dtype=float)
     if densities.shape != (5,) or not np.all(np.isfinite(densities)) or np.any(densities < 0):
@@ -79,6 +80,8 @@ def wander(params, densities, v, kappa=0.0, path=True, rate=50.0, u_max=0.5, gai
     z, u = design.operating_point(model, v, kappa)
     A, B = design.linearization(model, z, u, v, kappa)
     K = design.gains(A, B, 1.0 / rate, gains.weights(u_max), path=path)
+    if tight and path:
+        K = tight_gain(K, design.gains(A, B, 1.0 / rate, gains.tight_weights(u_max)))
     Ad, Bd = design.discretize(A, B, 1.0 / rate)
     Qd = noise_covariance(model, z, v, A, densities, 1.0 / rate)
     keep = np.arange(design.NZ) if path else np.array([i for i in range(design.NZ)
