@@ -701,7 +701,14 @@ int sr_regressor_batch(const sr_model *model, long n, const sr_real *x, const sr
  * into a circle, is a transient the loop is already removing, and integrating it would force an
  * overshoot of the same area.  So a steady offset of any size is integrated away, and nothing winds up
  * while a torque is held at its limit.  The curvature of the operating point follows the
- * reference's at most kappa_rate per second (a figure eight's switch of turn direction). */
+ * reference's at most kappa_rate per second (a figure eight's switch of turn direction).
+ * Near the path the law moves toward tighter gains, which hold the path closer under the
+ * process noise but would saturate the torques on a transient (a start from rest, a large
+ * offset): on path references with tight_band > 0 the gain's columns 0..9 are
+ * (1 - w) K_path + w K_tight, with the weight w <= 1 - |e_y - e_y*| / tight_band, rising by at
+ * most period / tight_rise per sample and not at all after a sample that clipped a torque,
+ * falling at once.  The integral columns stay K_path's, so moving w moves no torque through the
+ * integrals (the integrators carry over unchanged between the gains). */
 /** @{ */
 #define SR_LQR_NZ 12               /**< entries of the error coordinates z */
 #ifndef SR_LQR_MAX_SPEEDS
@@ -738,6 +745,9 @@ typedef struct sr_lqr {
     sr_real u_max;                                  /**< torque limit on both motors [N m], > 0 */
     sr_real kappa_rate;                             /**< [1/(m s)], >= 0 */
     sr_real steady_rate;                           /**< [m/s], >= 0: the integral of e_y advances only while |de_y/dt| <= this */
+    sr_real K_tight[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_NU * SR_LQR_NZ]; /**< tighter gains for path references, scheduled in near the path (their integral columns are not read) */
+    sr_real tight_band;                            /**< [m], >= 0: K_tight's weight is at most 1 - |e_y| / tight_band; 0: K_tight unused */
+    sr_real tight_rise;                            /**< [s], > 0 when tight_band > 0: K_tight's weight rises from 0 to 1 in no less than this */
 } sr_lqr;
 
 /** What to track at this sample (from the reference). */
@@ -755,10 +765,12 @@ typedef struct sr_lqr_memory {
     sr_real kappa;         /**< the operating point's curvature [1/m] */
     int started;           /**< 0 until the first sample */
     int saturated;         /**< out: the last sample clipped a torque */
+    sr_real tight;         /**< K_tight's weight in [0, 1] at the last sample */
 } sr_lqr_memory;
 
 /** Checks a schedule: sizes in range, grids strictly increasing, every entry finite, period
- * and u_max > 0, kappa_rate and steady_rate >= 0.  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
+ * and u_max > 0, kappa_rate, steady_rate and tight_band >= 0, tight_rise > 0 when tight_band > 0
+ * (K_tight is read only then).  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
 int sr_lqr_check(const sr_lqr *lqr);
 
 /** Zeroes the memory.  Returns SR_OK or SR_ERR_NULL. */

@@ -10,11 +10,15 @@
 
 #include <string.h>
 
+/* z[SR_LQR_Z_INTEGRALS..] are the integrators: their gains are K_path's at any tight weight. */
+#define SR_LQR_Z_INTEGRALS 10
+
 static int valid_sizes(const sr_lqr *lqr)
 {
     return lqr->n_speeds >= 1 && lqr->n_speeds <= SR_LQR_MAX_SPEEDS && lqr->n_curvatures >= 1
         && lqr->n_curvatures <= SR_LQR_MAX_CURVATURES && lqr->period > 0 && lqr->u_max > 0
-        && lqr->kappa_rate >= 0 && lqr->steady_rate >= 0;
+        && lqr->kappa_rate >= 0 && lqr->steady_rate >= 0 && lqr->tight_band >= 0
+        && (lqr->tight_band == 0 || lqr->tight_rise > 0);
 }
 
 int sr_lqr_check(const sr_lqr *lqr)
@@ -22,7 +26,7 @@ int sr_lqr_check(const sr_lqr *lqr)
     int i, n;
     if (!lqr) return SR_ERR_NULL;
     if (!all_finite(&lqr->period, 1) || !all_finite(&lqr->u_max, 1) || !all_finite(&lqr->kappa_rate, 1)
-        || !all_finite(&lqr->steady_rate, 1))
+        || !all_finite(&lqr->steady_rate, 1) || !all_finite(&lqr->tight_band, 1) || !all_finite(&lqr->tight_rise, 1))
         return SR_ERR_NONFINITE;
     if (!valid_sizes(lqr)) return SR_ERR_ARG;
     n = lqr->n_speeds * lqr->n_curvatures;
@@ -30,7 +34,8 @@ int sr_lqr_check(const sr_lqr *lqr)
         return SR_ERR_NONFINITE;
     for (i = 0; i < n; ++i)
         if (!all_finite(lqr->z_star[i], SR_LQR_NZ) || !all_finite(lqr->u_star[i], SR_NU)
-            || !all_finite(lqr->K_path[i], SR_NU * SR_LQR_NZ) || !all_finite(lqr->K_heading[i], SR_NU * SR_LQR_NZ))
+            || !all_finite(lqr->K_path[i], SR_NU * SR_LQR_NZ) || !all_finite(lqr->K_heading[i], SR_NU * SR_LQR_NZ)
+            || (lqr->tight_band > 0 && !all_finite(lqr->K_tight[i], SR_NU * SR_LQR_NZ)))
             return SR_ERR_NONFINITE;
     for (i = 1; i < lqr->n_speeds; ++i)
         if (!(lqr->speeds[i] > lqr->speeds[i - 1])) return SR_ERR_ARG;
@@ -115,14 +120,15 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
                    sr_real u_raw[SR_NU])
 {
     sr_real z[SR_LQR_NZ], dz[SR_LQR_NZ], out[SR_NU], raw[SR_NU], kappa, step, wv, wk;
-    sr_real weight[4], k_int[SR_NU][2], step_int[2];
+    sr_real weight[4], k_int[SR_NU][2], step_int[2], tight = 0;
     int status = arg_model(model, READS(STATE)), i0, i1, j0, j1, k, j, n, point[4], clipped = 0;
     if (status != SR_OK) return status;
     if (!lqr || !x || !target || !memory || !u) return SR_ERR_NULL;
     if (!valid_sizes(lqr)) return SR_ERR_ARG;
     status = sr_internal_check_state(model, x);
     if (status != SR_OK) return status;
-    if (!valid_target(target) || !all_finite(memory->integrals, 2) || !all_finite(&memory->kappa, 1))
+    if (!valid_target(target) || !all_finite(memory->integrals, 2) || !all_finite(&memory->kappa, 1)
+        || !all_finite(&memory->tight, 1))
         return SR_ERR_NONFINITE;
 
     /* The operating point's curvature follows the reference's at a bounded rate. */
@@ -144,13 +150,25 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
     for (j = 0; j < SR_LQR_NZ; ++j)
         dz[j] = z[j] - (weight[0] * lqr->z_star[point[0]][j] + weight[1] * lqr->z_star[point[1]][j]
                         + weight[2] * lqr->z_star[point[2]][j] + weight[3] * lqr->z_star[point[3]][j]);
+    /* The tight gains' weight: bounded by how near the path the robot is, rising slowly (a transient
+     * must have died down) and held after a clipped torque (the tight gains would clip it further). */
+    if (target->path && lqr->tight_band > 0) {
+        sr_real bound = 1 - SR_FABS(dz[9]) / lqr->tight_band, prev = memory->tight;
+        sr_real rise = memory->saturated ? prev : prev + lqr->period / lqr->tight_rise;
+        bound = bound < 0 ? 0 : bound;
+        tight = rise < bound ? rise : bound;
+        tight = tight > 1 ? 1 : tight;
+    }
     for (k = 0; k < SR_NU; ++k) {
         sr_real acc = 0;
         k_int[k][0] = k_int[k][1] = 0;
         for (i0 = 0; i0 < 4; ++i0) {
             const sr_real *K = (target->path ? lqr->K_path : lqr->K_heading)[point[i0]] + k * SR_LQR_NZ;
+            const sr_real *T = lqr->K_tight[point[i0]] + k * SR_LQR_NZ;
             sr_real kdz = 0;
             for (j = 0; j < SR_LQR_NZ; ++j) kdz += K[j] * dz[j];
+            if (tight > 0)
+                for (j = 0; j < SR_LQR_Z_INTEGRALS; ++j) kdz += tight * (T[j] - K[j]) * dz[j];
             acc += weight[i0] * (lqr->u_star[point[i0]][k] - kdz);
             k_int[k][0] += weight[i0] * K[10];
             k_int[k][1] += weight[i0] * K[11];
@@ -177,6 +195,7 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
     memory->kappa = kappa;
     memory->started = 1;
     memory->saturated = clipped;
+    memory->tight = tight;
     memcpy(u, out, sizeof out);
     if (u_raw) memcpy(u_raw, raw, sizeof raw);
     return SR_OK;

@@ -201,6 +201,39 @@ static void test_the_operating_curvature_follows_a_jump_at_its_rate(void)
     CHECK_NEAR(mem.kappa, 0.5 - 0.3 * 0.02, 8 * TEST_EPS);
 }
 
+static void test_the_tight_gains_weigh_in_as_the_error_allows_and_are_checked(void)
+{
+    sr_model m;
+    sr_lqr lqr;
+    sr_lqr_memory mem;
+    sr_real x[SR_NX], u[SR_NU], raw[SR_NU];
+    sr_lqr_target t = {SR_C(0.2), 0, 0, SR_C(0.005), 1};
+    paper_simulation_model(&m);
+    empty_schedule(&lqr, 1);
+    lqr.K_tight[0][9] = SR_C(10.0);                      /* yoke torque per metre of e_y */
+    lqr.K_tight[0][10] = SR_C(1e6);                      /* an integral column: never read */
+    lqr.tight_band = SR_C(0.02);
+    lqr.tight_rise = SR_C(0.04);                         /* two samples from 0 to 1 */
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_OK);
+    sr_lqr_reset(&mem);
+    mem.integrals[0] = SR_C(1.0);
+    reference_state(0.2, 0.0, 0.3, x);
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &t, &mem, u, raw), SR_OK);
+    CHECK_NEAR(mem.tight, 0.5, TEST_EPS);                /* the rise: one period / tight_rise */
+    CHECK_NEAR(raw[0], -0.5 * 10.0 * 0.005, 8 * TEST_EPS);
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &t, &mem, u, raw), SR_OK);
+    CHECK_NEAR(mem.tight, 0.75, TEST_EPS);               /* the bound 1 - |e_y| / tight_band */
+    lqr.tight_rise = 0;
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_ARG);
+    lqr.tight_rise = SR_C(0.04);
+    lqr.K_tight[0][3] = (sr_real)NAN;
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_NONFINITE);
+    lqr.tight_band = 0;                                  /* off: K_tight is not read */
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_OK);
+    lqr.tight_band = SR_C(-0.01);
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_ARG);
+}
+
 static void test_bad_input_gives_status_and_leaves_outputs_untouched(void)
 {
     sr_model m;
@@ -256,5 +289,6 @@ void suite_control(void)
     RUN_TEST(test_the_cross_track_integral_acts_at_any_offset_and_holds_only_against_a_clipped_torque);
     RUN_TEST(test_the_cross_track_integral_holds_while_the_error_moves);
     RUN_TEST(test_the_operating_curvature_follows_a_jump_at_its_rate);
+    RUN_TEST(test_the_tight_gains_weigh_in_as_the_error_allows_and_are_checked);
     RUN_TEST(test_bad_input_gives_status_and_leaves_outputs_untouched);
 }

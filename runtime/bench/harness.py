@@ -269,7 +269,8 @@ def check_harness(result, model, X, U, step_dt=0.01):
         g = controller.gains
         check("C lqr_control vs the NumPy law (runtime.control.lqr_law)", "lqr_control",
               lambda i: numpy_law(controller.schedule, model.params.r, X[i], target, np.zeros(2), None,
-                                  controller.period, controller.u_max, g.kappa_rate, g.steady_rate_m_s)[1], 1e-10)
+                                  controller.period, controller.u_max, g.kappa_rate, g.steady_rate_m_s,
+                                  tight_band=g.tight_band_m, tight_rise=g.tight_rise_s)[1], 1e-10)
     if "casadi_generated_reference_accel" in result:
         check("CasADi-generated reference vs reference", "casadi_generated_reference_accel", lambda i: accel[i], 1e-10)
     for value in result.values():

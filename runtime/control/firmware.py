@@ -91,7 +91,10 @@ def header(task, controller):
         "    /* K_path */ {" + ",\n     ".join(_array(s.K_path[i, j]) for i, j in points) + "},",
         "    /* K_heading */ {" + ",\n     ".join(_array(s.K_heading[i, j]) for i, j in points) + "},",
         f"    /* period, u_max, kappa_rate, steady_rate */ {_real(controller.period)}, "
-        f"{_real(controller.u_max)}, {_real(controller.gains.kappa_rate)}, {_real(controller.gains.steady_rate_m_s)}",
+        f"{_real(controller.u_max)}, {_real(controller.gains.kappa_rate)}, {_real(controller.gains.steady_rate_m_s)},",
+        "    /* K_tight */ " + ("{" + ",\n     ".join(_array(s.K_tight[i, j]) for i, j in points) + "}"
+                               if s.K_tight is not None else "{{0}}") + ",",
+        f"    /* tight_band, tight_rise */ {_real(controller._c.tight_band)}, {_real(controller._c.tight_rise)}",
         "};",
         "",
         "#endif /* LQR_TASK_H */",

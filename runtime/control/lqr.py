@@ -52,6 +52,9 @@ class LqrGains:
     smoothing_m: float = 0.5          # ... along the path from the nearest point (0: the curvature there)
     steady_rate_m_s: float = 0.002   # ∫e_y advances only while |ė_y| ≤ this [m/s]
     slope_estimate_s: float = 0.0     # the slope estimate's time constant [s] (0: the model's slope only)
+    tight_cross_track_m: float = 0.05  # e_y of the tight path gains (the other sizes as above)
+    tight_band_m: float = 0.05        # their weight is at most 1 − |e_y| / tight_band_m (0: no tight gains)
+    tight_rise_s: float = 10.0        # ... and rises from 0 to 1 in no less than this [s]
     #: The ranges of the settings (runtime/control/ranges.py: those of a task file's keys).
     RANGES: typing.ClassVar[dict] = LQR_RANGES
 
@@ -61,6 +64,10 @@ class LqrGains:
             raise ValueError(f"v_max: must exceed v_min = {self.v_min!r} when n_speeds > 1, got {self.v_max!r}")
         if self.n_curvatures > 1 and not self.kappa_max > 0:
             raise ValueError(f"kappa_max: must be > 0 when n_curvatures > 1, got {self.kappa_max!r}")
+
+    def tight_weights(self, u_max):
+        """The tight path gains' Riccati weights: these bounds with the cross-track error `tight_cross_track_m`."""
+        return dataclasses.replace(self.weights(u_max), cross_track_m=self.tight_cross_track_m)
 
     def weights(self, u_max):
         """These bounds as the design's Riccati weights, with the torque bound `u_max` [N m]."""
@@ -92,6 +99,7 @@ def _design(params, rate, u_max, gains):
     nv, nk = len(speeds), len(curvatures)
     z_star, u_star = np.zeros((nv, nk, design.NZ)), np.zeros((nv, nk, 2))
     K_path, K_heading = np.zeros((nv, nk, 2, design.NZ)), np.zeros((nv, nk, 2, design.NZ))
+    K_tight = np.zeros((nv, nk, 2, design.NZ)) if gains.tight_band_m > 0 else None
     weights = gains.weights(u_max)
     # Each curvature's operating point starts from its neighbour's, outward from the straightest.
     order = np.argsort(np.abs(curvatures), kind="stable")
@@ -108,11 +116,23 @@ def _design(params, rate, u_max, gains):
             A, B = design.linearization(model, z_star[i, j], u_star[i, j], v, curvatures[j])
             K_path[i, j] = design.gains(A, B, 1.0 / rate, weights, path=True)
             K_heading[i, j] = design.gains(A, B, 1.0 / rate, weights, path=False)
-    return Schedule(speeds, curvatures, z_star, u_star, K_path, K_heading)
+            if K_tight is not None:
+                K_tight[i, j] = tight_gain(K_path[i, j], design.gains(A, B, 1.0 / rate, gains.tight_weights(u_max)))
+    return Schedule(speeds, curvatures, z_star, u_star, K_path, K_heading, K_tight)
 
 
-def to_c(schedule, period, u_max, kappa_rate, steady_rate):
-    """The schedule as the C struct `sr_lqr` (cffi), checked by `sr_lqr_check`."""
+def tight_gain(K_path, K_riccati):
+    """The tight path gain as the C law reads it: the tight design's K on the robot's and the path's
+    coordinates, the shipped K_path's on the integrators (the law never moves the integrals' gains, so
+    scheduling the tight gain in or out moves no torque through them)."""
+    K = np.array(K_riccati, dtype=float)
+    K[:, design.Z_IY:] = np.asarray(K_path)[:, design.Z_IY:]
+    return K
+
+
+def to_c(schedule, period, u_max, kappa_rate, steady_rate, tight_band=0.0, tight_rise=1.0):
+    """The schedule as the C struct `sr_lqr` (cffi), checked by `sr_lqr_check`; the tight gains are
+    scheduled in within `tight_band` [m] of the path, over `tight_rise` [s], when the schedule has them."""
     nv, nk = len(schedule.speeds), len(schedule.curvatures)
     if nv > lib.SR_LQR_MAX_SPEEDS or nk > lib.SR_LQR_MAX_CURVATURES:
         raise ValueError(f"controller: the design grid has {nv} speeds and {nk} curvatures; the C controller "
@@ -128,7 +148,11 @@ def to_c(schedule, period, u_max, kappa_rate, steady_rate):
             c.u_star[n][0:2] = schedule.u_star[i, j].tolist()
             c.K_path[n][0:2 * design.NZ] = schedule.K_path[i, j].ravel().tolist()
             c.K_heading[n][0:2 * design.NZ] = schedule.K_heading[i, j].ravel().tolist()
+            if schedule.K_tight is not None:
+                c.K_tight[n][0:2 * design.NZ] = schedule.K_tight[i, j].ravel().tolist()
     c.period, c.u_max, c.kappa_rate, c.steady_rate = period, u_max, kappa_rate, steady_rate
+    c.tight_band = tight_band if schedule.K_tight is not None else 0.0
+    c.tight_rise = tight_rise
     status = lib.sr_lqr_check(c)
     if status != lib.SR_OK:
         raise ValueError(f"controller: the LQR schedule is not valid for the C controller "
@@ -158,7 +182,8 @@ class Lqr(Controller):
         flat = params.replace(slope=0.0)
         self.model_slope = np.array([params.slope, 0.0])
         self.schedule = schedule if schedule is not None else design_schedule(flat, rate, u_max, gains)
-        self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate, gains.steady_rate_m_s)
+        self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate, gains.steady_rate_m_s,
+                       gains.tight_band_m, gains.tight_rise_s)
         self._model = Model(flat)
         self._slope_schedule = None
         if params.slope != 0.0 or gains.slope_estimate_s > 0.0:
@@ -202,6 +227,11 @@ class Lqr(Controller):
         if target.curvature_ahead is not None and len(target.curvature_ahead):
             return float(np.mean(target.curvature_ahead))
         return float(target.curvature)
+
+    @property
+    def tight_weight(self):
+        """The tight path gains' weight in [0, 1] at the last sample (0 without them)."""
+        return float(self._memory.tight)
 
     @property
     def integrals(self):

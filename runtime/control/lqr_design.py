@@ -242,13 +242,15 @@ def gains(A, B, period, weights=Weights(), path=True):
 
 @dataclasses.dataclass(frozen=True)
 class Schedule:
-    """Operating points on a grid: z_star (nv, nk, NZ), u_star (nv, nk, 2), K_path / K_heading (nv, nk, 2, NZ)."""
+    """Operating points on a grid: z_star (nv, nk, NZ), u_star (nv, nk, 2), K_path / K_heading (nv, nk, 2, NZ),
+    and K_tight (nv, nk, 2, NZ) or None: the tighter path gains scheduled in near the path."""
     speeds: np.ndarray
     curvatures: np.ndarray
     z_star: np.ndarray
     u_star: np.ndarray
     K_path: np.ndarray
     K_heading: np.ndarray
+    K_tight: np.ndarray = None
 
     def at(self, v, kappa):
         """(z*, u*, K_path, K_heading) bilinearly interpolated, clamped to the grid."""
@@ -265,3 +267,9 @@ class Schedule:
             return ((1 - wv) * ((1 - wk) * a[i0, j0] + wk * a[i0, j1])
                     + wv * ((1 - wk) * a[i1, j0] + wk * a[i1, j1]))
         return mix(self.z_star), mix(self.u_star), mix(self.K_path), mix(self.K_heading)
+
+    def tight_at(self, v, kappa):
+        """K_tight bilinearly interpolated as `at` interpolates the others (None without tight gains)."""
+        if self.K_tight is None:
+            return None
+        return dataclasses.replace(self, K_path=self.K_tight).at(v, kappa)[2]

@@ -4,7 +4,10 @@ the benchmark check `sr_lqr_control` against (runtime/control/lqr_design.py hold
 One sample: the operating point's curvature follows the reference's at `kappa_rate`, (z*, u*, K)
 interpolated bilinearly in (v_ref, κ) (Schedule.at), u = u* − K (z − z*), clipped to ±u_max; each
 integral advances at any error unless its step would push a clipped torque further past its limit,
-and ∫e_y only while the error is steady (|ė_y| ≤ `steady_rate`).
+and ∫e_y only while the error is steady (|ė_y| ≤ `steady_rate`).  On a path, with tight gains
+(`tight_band` > 0), the gain's robot and path columns move toward K_tight by the weight
+w = min(1 − |e_y − e_y*| / tight_band, w_before + period / tight_rise) clamped to [0, 1], which does
+not rise after a clipped sample; the integrators' columns stay K_path's.
 """
 import numpy as np
 
@@ -12,8 +15,9 @@ from . import lqr_design as design
 from .geometry import cross_track_rate
 
 
-def numpy_law(schedule, r, x, target, integrals, kappa_before, period, u_max, kappa_rate, steady_rate):
-    """(u_raw, u, integrals after, κ of the operating point) of one sample."""
+def numpy_law(schedule, r, x, target, integrals, kappa_before, period, u_max, kappa_rate, steady_rate,
+              tight_before=0.0, clipped_before=False, tight_band=0.0, tight_rise=1.0):
+    """(u_raw, u, integrals after, κ of the operating point, the tight gains' weight) of one sample."""
     path = target.cross_track is not None
     kappa = target.curvature if path else 0.0
     if kappa_before is not None:
@@ -24,6 +28,13 @@ def numpy_law(schedule, r, x, target, integrals, kappa_before, period, u_max, ka
                                  integrals)
     dz = z - z_star
     K = K_path if path else K_heading
+    weight = 0.0
+    if path and tight_band > 0:
+        rise = tight_before if clipped_before else tight_before + period / tight_rise
+        weight = float(np.clip(min(rise, 1.0 - abs(dz[design.Z_EY]) / tight_band), 0.0, 1.0))
+        robot_and_path = slice(0, design.Z_IY)
+        K = K.copy()
+        K[:, robot_and_path] += weight * (schedule.tight_at(target.speed, kappa)[:, robot_and_path] - K[:, robot_and_path])
     raw = u_star - K @ dz
     u = np.clip(raw, -u_max, u_max)
     e_y = dz[design.Z_EY]
@@ -32,4 +43,4 @@ def numpy_law(schedule, r, x, target, integrals, kappa_before, period, u_max, ka
     pushes = np.any(-K[:, design.Z_IY:] * steps * (raw - u)[:, None] > 0, axis=0)
     moving = abs(cross_track_rate(x, r, target.heading)) > steady_rate
     advance = ~pushes & np.array([not moving, True])
-    return raw, u, np.asarray(integrals, dtype=float) + np.where(advance, steps, 0.0), kappa
+    return raw, u, np.asarray(integrals, dtype=float) + np.where(advance, steps, 0.0), kappa, weight

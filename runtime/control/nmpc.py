@@ -177,6 +177,7 @@ class NmpcGains(LqrGains):
     horizon: float = 30               # N nodes
     node_periods: float = 2           # controller periods per node: the horizon is N × node_periods / rate
     iterations: float = 1             # real-time iterations per sample
+    tight_band_m: float = 0.0         # the LQR's tight gains: not the NMPC's
     #: The ranges of the settings (runtime/control/ranges.py: those of a task file's keys).
     RANGES: typing.ClassVar[dict] = NMPC_RANGES
 

@@ -63,14 +63,15 @@ def noise_covariance(model, z_star, v, A, densities, period):
     return out
 
 
-def wander(params, densities, v, kappa=0.0, path=True, rate=50.0, u_max=0.5, gains=None):
+def wander(params, densities, v, kappa=0.0, path=True, rate=50.0, u_max=0.5, gains=None, tight=False):
     """The Wander of the LQR designed with `gains` (an LqrGains; None: the shipped ones) at the torque
     bound u_max [N·m] at (v, κ) under the white torque of densities (5,) [N·m/√Hz] (a sensor set's
-    `process.generalized()`)."""
+    `process.generalized()`); `tight`: with the tight path gain fully scheduled in, as the law applies
+    it (runtime/control/lqr.py, `tight_gain`: the integrators keep the path gain's columns)."""
     from scipy.linalg import solve_discrete_lyapunov
     from ..model import Model
     from . import lqr_design as design
-    from .lqr import LqrGains
+    from .lqr import LqrGains, tight_gain
     gains = LqrGains() if gains is None else gains
     densities = np.asarray(densities, dtype=float)
     if densities.shape != (5,) or not np.all(np.isfinite(densities)) or np.any(densities < 0):
@@ -79,6 +80,8 @@ def wander(params, densities, v, kappa=0.0, path=True, rate=50.0, u_max=0.5, gai
     z, u = design.operating_point(model, v, kappa)
     A, B = design.linearization(model, z, u, v, kappa)
     K = design.gains(A, B, 1.0 / rate, gains.weights(u_max), path=path)
+    if tight and path:
+        K = tight_gain(K, design.gains(A, B, 1.0 / rate, gains.tight_weights(u_max)))
     Ad, Bd = design.discretize(A, B, 1.0 / rate)
     Qd = noise_covariance(model, z, v, A, densities, 1.0 / rate)
     keep = np.arange(design.NZ) if path else np.array([i for i in range(design.NZ)
@@ -111,8 +114,8 @@ def band_hold_fraction(w, band_rad, duration_s, rate=50.0, runs=2000, seed=0):
 
 def main(argv=()):
     """`python -m runtime noise-floor`: the LQR's steady wander on the shipped tasks' operating points
-    under the sensor set's process noise: on the paths at the shipped gains and tighter cross-track
-    weights, on the heading step at the shipped gains, a tighter heading weight, and with the torque
+    under the sensor set's process noise: on the paths at the shipped gains, tighter cross-track
+    weights and with the shipped tight gains fully scheduled in, on the heading step at the shipped gains, a tighter heading weight, and with the torque
     nearly free (the floor no gains go below)."""
     parser = argparse.ArgumentParser(prog="python -m runtime noise-floor")
     parser.add_argument("--sensors", default="default", help="a shipped sensor set or a sensors file")
@@ -132,15 +135,16 @@ def main(argv=()):
     params = load_task("circle").scenario.params
     shipped, floor = ("shipped", LqrGains(), 0.5), ("attitude_rad 0.001, torque weight 50 N·m", LqrGains(attitude_rad=0.001), 50.0)
     on_path = (shipped, ("cross_track_m 0.05", LqrGains(cross_track_m=0.05), 0.5),
-               ("cross_track_m 0.02", LqrGains(cross_track_m=0.02), 0.5))
+               ("cross_track_m 0.02", LqrGains(cross_track_m=0.02), 0.5),
+               ("shipped, tight gains scheduled in", LqrGains(), 0.5, True))
     heading = (shipped, ("attitude_rad 0.03", LqrGains(attitude_rad=0.03), 0.5), floor)
     cases = (("circle R = 2 m", 0.5, True, on_path), ("line", 0.0, True, on_path), ("heading step", 0.0, False, heading))
     print("| case | gains | cross-track σ [mm] | heading σ [°] | torque σ (yoke, pendulum) [N·m] "
           f"| heading within ±3° for {args.hold:g} s |")
     print("|---|---|---:|---:|---|---:|")
     for label, kappa, path, settings in cases:
-        for name, gains, weight in settings:
-            w = wander(params, densities, 0.3, kappa, path, u_max=weight, gains=gains)
+        for name, gains, weight, *tight in settings:
+            w = wander(params, densities, 0.3, kappa, path, u_max=weight, gains=gains, tight=bool(tight))
             hold = "" if path else f"{100 * band_hold_fraction(w, HEADING_BAND_RAD, args.hold):.0f} %"
             print(f"| {label} | {name} | {1000 * w.cross_track_m:.1f} | {math.degrees(w.heading_rad):.2f} | "
                   f"{w.torque_n_m[0]:.3f}, {w.torque_n_m[1]:.3f} | {hold} |")

@@ -25,7 +25,7 @@ PID_RANGES = {**{name: _PID_GAIN for name in ("k_v", "k_vi", "k_y", "k_psi", "k_
 LQR_RANGES = {
     **{name: _ERROR_SIZE for name in ("tilt_rad", "attitude_rad", "pendulum_rad", "rolling_rate_rad_s", "rate_rad_s",
                                       "joint_rate_rad_s", "cross_track_m", "cross_track_integral_m_s",
-                                      "speed_integral_rad")},
+                                      "speed_integral_rad", "tight_cross_track_m")},
     "v_min": Range(0, 10, "m/s", "the design grid's speeds"), "v_max": Range(0, 10, "m/s", "the design grid's speeds"),
     "n_speeds": Range(1, lib.SR_LQR_MAX_SPEEDS, "", "the C controller's grid holds SR_LQR_MAX_SPEEDS", whole=True),
     "kappa_max": Range(0, 100, "1/m", "a turn of 1 cm radius at most"),
@@ -36,11 +36,14 @@ LQR_RANGES = {
     "smoothing_m": Range(0, 100, "m", "a smoothing window along the path"),
     "steady_rate_m_s": Range(0, 10, "m/s", "a rate of the cross-track error"),
     "slope_estimate_s": Range(0, 1e4, "s", "the slope estimate's time constant (0: no estimate)"),
+    "tight_band_m": Range(0, 100, "m", "how near the path the tight gains act (0: not at all)"),
+    "tight_rise_s": Range(1e-3, 1e4, "s", "how slowly the tight gains come in"),
 }
 
 #: `NmpcGains`: the LQR's and the horizon's.
 NMPC_RANGES = {
     **LQR_RANGES,
+    "tight_band_m": Range(0, 0, "m", "the NMPC has no tight gains (an LQR setting): 0 only"),
     "torque_step_n_m": Range(1e-6, 1e6, "N m", "a torque change worth the full cost"),
     "disturbance_gain": Range(0, 1, "", "the share of the torque offset's update taken per sample (0: no estimate)"),
     "horizon": Range(1, 200, "", "nodes of the horizon: the QP has 2N unknowns and a dense (2N)^2 Hessian",

@@ -47,10 +47,10 @@ def c_error(x, target, integrals=(0.0, 0.0)):
 
 
 
-def python_law(sched, x, target, integrals, kappa_before):
+def python_law(sched, x, target, integrals, kappa_before, tight_before=0.0, clipped_before=False):
     gains = lqr.LqrGains()
     return numpy_law(sched, PARAMS.r, x, target, integrals, kappa_before, 1 / RATE, U_MAX, gains.kappa_rate,
-                     gains.steady_rate_m_s)
+                     gains.steady_rate_m_s, tight_before, clipped_before, gains.tight_band_m, gains.tight_rise_s)
 
 
 @pytest.mark.parametrize("path", [False, True])
@@ -80,12 +80,13 @@ def test_c_law_equals_the_numpy_law_over_a_run_of_samples(path):
     controller = lqr.Lqr(PARAMS, RATE, U_MAX, schedule=sched)
     for trial in range(20):
         controller.reset(None)
-        integrals, kappa = np.zeros(2), None
+        integrals, kappa, tight, clipped = np.zeros(2), None, 0.0, False
         for _ in range(10):
             x, target = random_state(rng), random_target(rng, path)
             raw = controller.compute(0.0, x, target)
             u = np.array(list(controller._u))
-            raw_np, u_np, integrals, kappa = python_law(sched, x, target, integrals, kappa)
+            raw_np, u_np, integrals, kappa, tight = python_law(sched, x, target, integrals, kappa, tight, clipped)
+            clipped = bool(np.any(u_np != raw_np))
             assert np.allclose(raw, raw_np, rtol=1e-12, atol=1e-12)
             assert np.allclose(u, u_np, rtol=1e-12, atol=1e-12)
             assert np.array_equal(np.abs(u) == U_MAX, np.abs(u_np) == U_MAX)
