@@ -8,9 +8,10 @@ The filter (runtime.ekf, C in c/src/sr_ekf.c) assumes what the log's sensor set 
 (`ekf_noise`); between two samples it predicts under the torques the log says were applied (a
 torque row holds until the next); samples of one time are applied IMU first, then encoders,
 fixes and heading.  A fix that arrives after the instant it measures (`t_measured` < `t`) is marked
-at that instant and applied on arrival as a delayed fix (runtime.ekf, `mark_position`).  The IMU update runs while the filter's `accel` standard deviation includes what the
-process noise adds to the accelerometer's reading (`ekf_noise`), since the filter's measurement
-model sees the applied torques only.
+at that instant and applied on arrival as a delayed fix (runtime.ekf, `mark_position`).  The
+filter models the process noise as a torque held over each IMU period, which the accelerometer
+reads and the next predict steps with (`ekf_noise`'s "held": the sample's noise and the process
+noise correlated, c/include/sr_ekf.h, "Held disturbance").
 """
 import dataclasses
 import math
@@ -90,7 +91,7 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
     params = params if params is not None else claimed_params(log)
     model = Model(params)
     sensors = log.sensors
-    noise = noise if noise is not None else ekf_noise(sensors, params)
+    noise = noise if noise is not None else ekf_noise(sensors, params, accel_axes="held")
     events = [(log.imu, "imu"), (log.encoders, "encoders"), (log.fixes, "fixes"), (log.heading, "heading")]
     events = [(table, kind) for table, kind in events if table is not None and len(table)]
     start = {"accel": log.imu.select("accel_x", "accel_y", "accel_z")[:START_SAMPLES],
