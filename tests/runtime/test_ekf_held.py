@@ -202,3 +202,9 @@ def test_with_the_held_disturbance_the_imus_innovations_have_the_size_the_filter
     assert 5.0 < mean_imu_nis(model, held) < 7.2                    # chi-square with 6: mean 6
     blind = dataclasses.replace(held, torque_hold=0.0)               # the same numbers, no correlation
     assert mean_imu_nis(model, blind) > 12
+
+
+@pytest.mark.parametrize("hold", [-0.005, float("nan"), float("inf"), "5 ms"])
+def test_a_bad_torque_hold_is_a_value_error_naming_it(hold):
+    with pytest.raises(ValueError, match="^torque_hold:"):
+        dataclasses.replace(NOISE, torque_hold=hold)
