@@ -134,11 +134,11 @@ class SensorSimulation:
 ACCEL_AXES = ("held", "largest", "each")
 
 
-def ekf_noise(sensors, params, x0=None, accel_axes="largest"):
+def ekf_noise(sensors, params, x0=None, accel_axes="largest", hold=None):
     """The EkfNoise a sensor set declares.  `accel_axes` "held": the filter models the process
-    noise as the truth draws it, a torque held over each IMU period whose acceleration the
-    accelerometer reads (`torque_hold` the IMU's period, `accel` its white noise alone; the filter
-    carries the correlation, runtime.ekf).  Otherwise the accelerometer's standard deviation adds
+    noise as `SensorSimulation` draws it, a torque held over each step of `hold` seconds (None: the
+    IMU's period) whose acceleration the accelerometer reads (`torque_hold`; `accel` the white
+    noise alone; the filter carries the correlation, runtime.ekf).  Otherwise the accelerometer's standard deviation adds
     to its white noise what the process noise puts into its reading at the IMU's rate (at x0: the
     robot at rest by default), the filter's measurement model seeing the applied torques only:
     "each", axis by axis; "largest", the largest axis's on all three, the default (each axis's own
@@ -150,7 +150,9 @@ def ekf_noise(sensors, params, x0=None, accel_axes="largest"):
     x0 = initial_state(r=params.r) if x0 is None else x0
     spec = sensors.imu
     if accel_axes == "held":
-        return _noise(sensors, accel=(spec.accel_noise,) * 3, torque_hold=1.0 / spec.rate)
+        if hold is not None and not (isinstance(hold, (int, float)) and math.isfinite(hold) and hold > 0):
+            raise ValueError(f"hold: expected a finite number of seconds > 0, got {hold!r}")
+        return _noise(sensors, accel=(spec.accel_noise,) * 3, torque_hold=1.0 / spec.rate if hold is None else hold)
     _, _, Hn = imu_partials(model, x0, np.zeros(5), mount=spec.mount)
     Minv = np.linalg.inv(model.inertia(x0))
     q2 = sensors.process.generalized() ** 2 * spec.rate             # (q/√dt)² at the IMU's period

@@ -192,15 +192,25 @@ static int torque_noise(const sr_model *model, const sr_real x[SR_NX], const sr_
     return SR_OK;
 }
 
-/* A held disturbance a (sr_ekf.h, "Held disturbance") in the predict, instead of the torque noise:
- * e' = Phi e + Gm a with Gm = dt on nu's rows, so x_nu += dt a_hat and
- * P' += Phi C Gm^T + Gm C^T Phi^T + Gm A Gm^T (Phi = diag(F, I)). */
-static void step_held(const sr_ekf_held *h, const sr_real F[NE * NE], sr_real dt, sr_real xn[SR_NX], sr_real *Pn)
+/* How long of the predict's dt a held disturbance still drives: the rest of its period, at most dt
+ * (0: none held). */
+static sr_real held_for(const sr_ekf_held *h, sr_real dt)
 {
-    sr_real Y[NB * SR_NV];
+    return !h->pending ? 0 : h->remaining < dt ? h->remaining : dt;
+}
+
+/* A held disturbance a (sr_ekf.h, "Held disturbance") over g of the predict, in place of the torque
+ * noise there: e' = Phi e + Gm a with Gm = g on nu's rows, a' = a, so x_nu += g a_hat,
+ * P' += Phi C Gm^T + Gm C^T Phi^T + Gm A Gm^T (Phi = diag(F, I)) and next->cross = Phi C + Gm A.
+ * next is the held disturbance after the predict: spent when its period is. */
+static void step_held(const sr_ekf_held *h, const sr_real F[NE * NE], sr_real g, sr_real dt, sr_real xn[SR_NX],
+                      sr_real *Pn, sr_ekf_held *next)
+{
+    sr_real *Y = next->cross;
     int i, j, k;
+    *next = *h;
     if (!h->pending) return;
-    for (i = 0; i < SR_NV; ++i) xn[SR_X_w_S + i] += dt * h->mean[i];
+    for (i = 0; i < SR_NV; ++i) xn[SR_X_w_S + i] += g * h->mean[i];
     for (i = 0; i < NB; ++i)
         for (j = 0; j < SR_NV; ++j) {
             sr_real s = 0;
@@ -208,35 +218,41 @@ static void step_held(const sr_ekf_held *h, const sr_real F[NE * NE], sr_real dt
                 for (k = 0; k < NE; ++k) s += F[NE * i + k] * h->cross[SR_NV * k + j];
             else
                 s = h->cross[SR_NV * i + j];
-            Y[SR_NV * i + j] = dt * s;
+            Y[SR_NV * i + j] = s;   /* Phi C */
         }
     for (i = 0; i < NB; ++i)
         for (j = 0; j < SR_NV; ++j) {
-            Pn[NB * i + SR_EB_nu + j] += Y[SR_NV * i + j];
-            Pn[NB * (SR_EB_nu + j) + i] += Y[SR_NV * i + j];
+            Pn[NB * i + SR_EB_nu + j] += g * Y[SR_NV * i + j];
+            Pn[NB * (SR_EB_nu + j) + i] += g * Y[SR_NV * i + j];
         }
     for (i = 0; i < SR_NV; ++i)
-        for (j = 0; j < SR_NV; ++j) Pn[NB * (SR_EB_nu + i) + SR_EB_nu + j] += dt * dt * h->cov[SR_NV * i + j];
+        for (j = 0; j < SR_NV; ++j) {
+            Pn[NB * (SR_EB_nu + i) + SR_EB_nu + j] += g * g * h->cov[SR_NV * i + j];
+            Y[SR_NV * (SR_EB_nu + i) + j] += g * h->cov[SR_NV * i + j];
+        }
+    next->remaining = h->remaining - g;
+    if (!(next->remaining > SR_C(1e-9) * dt)) memset(next, 0, sizeof *next);
 }
 
-/* After the predict: the waiting fixes' C_j gain Gm Cov(a, z_j), and a is spent. */
-static void release_held(sr_ekf *ekf, sr_real dt)
+/* After the predict: the waiting fixes' C_j gain Gm Cov(a, z_j) (g of the held a), and the held
+ * disturbance is what step_held left. */
+static void release_held(sr_ekf *ekf, sr_real g, const sr_ekf_held *next)
 {
     int i, b, k;
-    if (!ekf->held.pending) return;
-    for (k = 0; k < SR_EKF_NDELAYED; ++k) {
+    for (k = 0; k < SR_EKF_NDELAYED && ekf->held.pending; ++k) {
         if (!ekf->delayed[k].marked) continue;
         for (i = 0; i < SR_NV; ++i)
             for (b = 0; b < 2; ++b)
-                ekf->delayed[k].C[2 * (SR_EB_nu + i) + b] += dt * ekf->held.fix[2 * SR_NV * k + 2 * i + b];
+                ekf->delayed[k].C[2 * (SR_EB_nu + i) + b] += g * ekf->held.fix[2 * SR_NV * k + 2 * i + b];
     }
-    memset(&ekf->held, 0, sizeof ekf->held);
+    ekf->held = *next;
 }
 
 int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real u[SR_NU], sr_real dt,
                    const sr_ekf_process *process)
 {
-    sr_real xn[SR_NX], F[NE * NE], Qnu[SR_NV * SR_NV], T[NE * NB], Pn[NB * NB];
+    sr_real xn[SR_NX], F[NE * NE], Qnu[SR_NV * SR_NV], T[NE * NB], Pn[NB * NB], g, white;
+    sr_ekf_held next;
     int status = arg_model(model, READS(WHOLE)), i, j, k, dq_identity = 1, cols[NE], ncols = 0;
     if (status != SR_OK) return status;
     if (!ekf || !process) return SR_ERR_NULL;
@@ -245,7 +261,10 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
     status = check_filter(model, ekf);
     /* The state and u are checked: the step and F at once, RKMK4's from the same stages. */
     if (status == SR_OK) status = sr_internal_step_and_jacobian(model, method, ekf->x, u, dt, xn, F);
-    if (status == SR_OK && !ekf->held.pending) status = torque_noise(model, ekf->x, process, dt, Qnu);
+    /* A held disturbance drives g of dt; the torque noise the rest (white, a share of Q_nu). */
+    g = held_for(&ekf->held, dt);
+    white = (dt - g) / dt;
+    if (status == SR_OK && white > 0) status = torque_noise(model, ekf->x, process, dt, Qnu);
     if (status != SR_OK) return status;
 
     /* F P F^T with F = [[F_d, 0], [0, I]] blockwise: T = F_d [P_dd P_db] (the cross terms F_d P_db come
@@ -291,8 +310,8 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
             for (k = 0; k < NE; ++k) s += T[NB * i + k] * F[NE * j + k];
             Pn[NB * i + j] = Pn[NB * j + i] = s;
         }
-    for (i = 0; i < SR_NV && !ekf->held.pending; ++i)
-        for (j = 0; j < SR_NV; ++j) Pn[NB * (SR_EB_nu + i) + SR_EB_nu + j] += Qnu[SR_NV * i + j];
+    for (i = 0; i < SR_NV && white > 0; ++i)
+        for (j = 0; j < SR_NV; ++j) Pn[NB * (SR_EB_nu + i) + SR_EB_nu + j] += white * Qnu[SR_NV * i + j];
     /* The cross terms F P_db (in T already); the bias block only gains its random walk. */
     for (i = 0; i < NE; ++i)
         for (j = NE; j < NB; ++j) Pn[NB * i + j] = Pn[NB * j + i] = T[NB * i + j];
@@ -302,7 +321,7 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
         Pn[NB * (SR_EB_b_g + i) + SR_EB_b_g + i] += dt * process->gyro_bias_rw * process->gyro_bias_rw;
         Pn[NB * (SR_EB_b_a + i) + SR_EB_b_a + i] += dt * process->accel_bias_rw * process->accel_bias_rw;
     }
-    step_held(&ekf->held, F, dt, xn, Pn);
+    step_held(&ekf->held, F, g, dt, xn, Pn, &next);
     if (!all_finite(Pn, NB * NB)) return SR_ERR_NONFINITE;
     memcpy(ekf->x, xn, sizeof xn);
     memcpy(ekf->P, Pn, sizeof Pn);
@@ -321,7 +340,7 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
         }
         memcpy(Ck, t, sizeof t);
     }
-    release_held(ekf, dt);
+    release_held(ekf, g, &next);
     return SR_OK;
 }
 
@@ -616,6 +635,7 @@ int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[S
             return status;
         }
         h->pending = 1;
+        h->remaining = hold;
     }
     /* Cov(e, r)^T = H P + Hn C^T, B = H C + Hn A, S = H Cov(e, r) + Hn B^T + R. */
     for (i = 0; i < SR_NIMU; ++i) {

@@ -21,8 +21,9 @@ clones are not revised), then the clone is dropped.  Nothing of the C's projecte
 Held disturbance (`update_imu_held`): the acceleration a = M⁻¹ w of the torque held over the
 period is appended to the augmented state after the clones (prior 0, M⁻¹ D² M⁻¹ / hold) and the
 sample reads it through ∂y/∂ν̇; its gain revises the current error and a (not the clones); later
-samples move the current error alone; the next predict is the linear map e ← Φ e + dt a on ν's
-rows without the torque noise, then a is dropped.
+samples move the current error alone; each predict within its period is the linear map e ← Φ e + g a
+on ν's rows (g: the part of dt in the period), a ← a, with the torque noise over dt − g only; a is
+dropped when its period ends.
 """
 import numpy as np
 
@@ -64,6 +65,7 @@ class EkfReference:
         self.P_aug = np.array(P0, dtype=float)
         self.clones = {}
         self.held = None                  # the held disturbance's mean (NV,), its block last in P_aug
+        self.held_remaining = 0.0         # how much of its period is left [s]
         self.accepted = dict.fromkeys(KINDS, 0)
         self.gated = dict.fromkeys(KINDS, 0)
         self.nis = dict.fromkeys(KINDS, 0.0)
@@ -126,17 +128,21 @@ class EkfReference:
         u = np.asarray(u, dtype=float)
         F, _ = self.model.casadi_step_jacobian(self.x, u, dt, self.method)
         if self.held is not None:
-            Q = self.process_noise(dt, (0.0, 0.0, 0.0), gyro_bias_rw, accel_bias_rw)
+            g = min(dt, self.held_remaining)
+            Q = self.process_noise(dt, torque_psd, gyro_bias_rw, accel_bias_rw)
+            Q[IDX_E_NU, IDX_E_NU] *= (dt - g) / dt
             self.x = self.model.step(self.x, u, dt, self.method)
-            self.x[IDX_NU] += dt * self.held
+            self.x[IDX_NU] += g * self.held
             n = len(self.P_aug)
             T = np.eye(n)
             T[:NE, :NE] = F
-            T[IDX_E_NU, n - NV:] = dt * np.eye(NV)
+            T[IDX_E_NU, n - NV:] = g * np.eye(NV)
             self.P_aug = T @ self.P_aug @ T.T
             self.P = self.P + Q
-            self.P_aug = self.P_aug[:n - NV, :n - NV]
-            self.held = None
+            self.held_remaining -= g
+            if not self.held_remaining > 1e-9 * dt:
+                self.P_aug = self.P_aug[:n - NV, :n - NV]
+                self.held = None
             return
         Q = self.process_noise(dt, torque_psd, gyro_bias_rw, accel_bias_rw)
         self.x = self.model.step(self.x, u, dt, self.method)
@@ -234,7 +240,7 @@ class EkfReference:
             n = len(self.P_aug)
             P_aug = np.zeros((n + NV, n + NV))
             P_aug[:n, :n], P_aug[n:, n:] = self.P_aug, Qa
-            self.P_aug, self.held = P_aug, np.zeros(NV)
+            self.P_aug, self.held, self.held_remaining = P_aug, np.zeros(NV), hold
         n = len(self.P_aug)
         H_aug = np.zeros((6, n))
         H_aug[:, :NB], H_aug[:, n - NV:] = H, Hn

@@ -79,9 +79,9 @@ def two_outliers(samples):
     return samples
 
 
-def filters(model, first, reference=EkfReference):
+def filters(model, first, reference=EkfReference, noise=HELD):
     probe, _ = started(model, first)
-    ekf = Ekf(model, probe.x, P0=probe.P, noise=HELD, recover_after=POLICY)
+    ekf = Ekf(model, probe.x, P0=probe.P, noise=noise, recover_after=POLICY)
     return ekf, reference(model, probe.x, probe.biases, probe.P, recover_after=POLICY)
 
 
@@ -104,6 +104,14 @@ def test_the_c_filter_with_the_held_disturbance_equals_the_numpy_reference(model
     assert ekf.counters["position"]["accepted"] >= 1
 
 
+def test_a_disturbance_held_over_two_predicts_equals_the_numpy_reference(model):
+    # a simulation step of 10 ms under 200 Hz samples: two IMU samples read the same a
+    first, samples = make_run(model, 0.4, fix_every=20, latency=10)
+    noise = dataclasses.replace(HELD, torque_hold=2 * DT)
+    ekf, ref = filters(model, first, noise=noise)
+    assert worst_relative_difference(run_c(ekf, samples), run_reference_held(ref, samples, noise)) <= TOL
+
+
 class NoCrossTermInPredict(EkfReference):
     """The predict steps with a's covariance but forgets its correlation with the error."""
     def predict(self, u, dt, torque_psd, gyro_bias_rw=0.0, accel_bias_rw=0.0):
@@ -124,8 +132,11 @@ class MeanNotStepped(EkfReference):
 
 class TorqueNoiseTwice(EkfReference):
     """The predict adds the torque noise on top of the held a."""
-    def process_noise(self, dt, torque_psd, gyro_bias_rw, accel_bias_rw):
-        return super().process_noise(dt, (0.01,) * 3, gyro_bias_rw, accel_bias_rw)
+    def predict(self, u, dt, torque_psd, gyro_bias_rw=0.0, accel_bias_rw=0.0):
+        held = self.held is not None
+        super().predict(u, dt, torque_psd, gyro_bias_rw, accel_bias_rw)
+        if held:
+            self.P = self.P + self.process_noise(dt, torque_psd, 0.0, 0.0)
 
 
 class AccelerometerBlindToA(EkfReference):
@@ -208,3 +219,17 @@ def test_with_the_held_disturbance_the_imus_innovations_have_the_size_the_filter
 def test_a_bad_torque_hold_is_a_value_error_naming_it(hold):
     with pytest.raises(ValueError, match="^torque_hold:"):
         dataclasses.replace(NOISE, torque_hold=hold)
+
+
+def test_the_held_rule_holds_the_disturbance_over_the_given_step_and_names_a_bad_one(model):
+    held = ekf_noise(SensorSet.default(), model.params, accel_axes="held", hold=0.01)
+    assert held.torque_hold == 0.01 and held.accel == (SensorSet.default().imu.accel_noise,) * 3
+    with pytest.raises(ValueError, match="^hold:"):
+        ekf_noise(SensorSet.default(), model.params, accel_axes="held", hold=0.0)
+
+
+def test_a_short_circle_estimated_with_the_held_rule_meets_the_targets():
+    from runtime.estimation.consistency import run_once
+    from .estimation.test_tasks import short
+    metrics = run_once(short("circle"), None, seed=1, accel_noise="held")["metrics"]
+    assert metrics["position_rms_m"] <= 0.01 and metrics["tilt_rms_deg"] <= 0.3
