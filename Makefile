@@ -64,10 +64,10 @@ estimation-figures: $(STAMP)
 CONSISTENCY_RUNS ?= 50
 consistency: $(STAMP)
 	for task in circle figure8 line; do \
-	  $(PY) -m runtime consistency $$task --runs $(CONSISTENCY_RUNS) --out out/consistency/$$task-default; \
+	  $(PY) -m runtime consistency $$task --runs $(CONSISTENCY_RUNS) --accel-noise held --out out/consistency/$$task-default; \
 	  cp out/consistency/$$task-default/consistency.png docs/figures/consistency-$$task-default.png; \
 	done
-	$(PY) -m runtime consistency circle --runs 20 --sensors imu-encoders --out out/consistency/circle-imu-encoders
+	$(PY) -m runtime consistency circle --runs 20 --sensors imu-encoders --accel-noise held --out out/consistency/circle-imu-encoders
 	cp out/consistency/circle-imu-encoders/consistency.png docs/figures/consistency-circle-imu-encoders.png
 
 # Every controller on every benchmark task: out/control/table.md, table.csv, a folder per run; then the

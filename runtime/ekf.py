@@ -62,7 +62,11 @@ class EkfNoise:
     Per-sample standard deviations of the readings, the biases' spread per run, their random
     walks (0: constant over the run), and the process noise: white generalized torques on the
     shell (each axis) and on both joints, one spectral density [N·m/√Hz].  `accel` is one number
-    for the accelerometer's three axes or three (x, y, z of the sensor), kept as three."""
+    for the accelerometer's three axes or three (x, y, z of the sensor), kept as three.
+    `torque_hold` [s] > 0: the torque disturbance is held over that period after each IMU sample,
+    whose accelerometer reads the acceleration it gives (`sr_ekf_update_imu_held`: the sample's
+    noise and the next predict's process noise correlated, `accel` then the readings' own noise);
+    0: the accelerometer is taken to read the applied torques' acceleration alone."""
     gyro: float = 0.003                                   # rad/s, per axis and sample
     accel: float | tuple = 0.02                           # m/s², per sample: one for all axes, or (x, y, z)
     gyro_bias: float = 0.005                              # rad/s, 1σ of b_g per axis at the start
@@ -73,6 +77,7 @@ class EkfNoise:
     position: float = 0.01                                # m, per axis of a fix
     heading: float = 0.05                                 # rad
     torque_psd: float = 0.01                              # N·m/√Hz
+    torque_hold: float = 0.0                              # s, 0: the disturbance not read by the IMU
 
     def __post_init__(self):
         accel = self.accel
@@ -89,7 +94,7 @@ class EkfNoise:
             if field.name == "accel":
                 continue
             _noise_number(getattr(self, field.name), field.name,
-                          zero_ok=field.name.endswith("_rw") or field.name == "torque_psd")
+                          zero_ok=field.name.endswith("_rw") or field.name in ("torque_psd", "torque_hold"))
 
 
 def _noise_number(value, name, zero_ok):
@@ -188,8 +193,13 @@ class Ekf:
         torque = np.zeros(NU) if u is None else _vector(u, "u", NU)
         self._before = self._ekf.accepted[0] + self._ekf.recovered[0]
         m = self.mount
-        status = lib.sr_ekf_update_imu_axes(self._ekf, self.model._model, _ptr(y), _ptr(torque), BODIES[m.body],
-                                            _ptr(self._imu_mount), _ptr(self._imu_sigma), self.gate["imu"])
+        if self.noise.torque_hold > 0:
+            status = lib.sr_ekf_update_imu_held(self._ekf, self.model._model, _ptr(y), _ptr(torque), BODIES[m.body],
+                                                _ptr(self._imu_mount), _ptr(self._imu_sigma), self._process,
+                                                self.noise.torque_hold, self.gate["imu"])
+        else:
+            status = lib.sr_ekf_update_imu_axes(self._ekf, self.model._model, _ptr(y), _ptr(torque), BODIES[m.body],
+                                                _ptr(self._imu_mount), _ptr(self._imu_sigma), self.gate["imu"])
         return self._applied("imu", status, "the innovation covariance or the inertia is not positive definite")
 
     def update_encoders(self, y):

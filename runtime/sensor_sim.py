@@ -131,28 +131,39 @@ class SensorSimulation:
 
 
 #: How `ekf_noise` spreads the process noise's share over the accelerometer's axes.
-ACCEL_AXES = ("largest", "each")
+ACCEL_AXES = ("held", "largest", "each")
 
 
-def ekf_noise(sensors, params, x0=None, accel_axes="largest"):
-    """The EkfNoise a sensor set declares.  The accelerometer's standard deviation adds to its
-    white noise what the process noise puts into its reading at the IMU's rate (at x0: the robot
-    at rest by default), because the filter's measurement model sees the applied torques only:
-    `accel_axes` "each", axis by axis; "largest", the largest axis's on all three, the default
-    (each axis's own makes the filter overconfident in the tilt: that share of the reading is
-    correlated with the process noise, which the filter does not model; docs/estimation.md,
-    "Consistency").  The biases' random walks are the IMU's."""
+def ekf_noise(sensors, params, x0=None, accel_axes="largest", hold=None):
+    """The EkfNoise a sensor set declares.  `accel_axes` "held": the filter models the process
+    noise as `SensorSimulation` draws it, a torque held over each step of `hold` seconds (None: the
+    IMU's period) whose acceleration the accelerometer reads (`torque_hold`; `accel` the white
+    noise alone; the filter carries the correlation, runtime.ekf).  Otherwise the accelerometer's standard deviation adds
+    to its white noise what the process noise puts into its reading at the IMU's rate (at x0: the
+    robot at rest by default), the filter's measurement model seeing the applied torques only:
+    "each", axis by axis; "largest", the largest axis's on all three, the default (each axis's own
+    makes the filter overconfident in the tilt: that share of the reading is correlated with the
+    process noise; docs/estimation.md, "Consistency").  The biases' random walks are the IMU's."""
     if accel_axes not in ACCEL_AXES:
         raise ValueError(f"accel_axes: expected one of {', '.join(ACCEL_AXES)}, got {accel_axes!r}")
     model = Model(params)
     x0 = initial_state(r=params.r) if x0 is None else x0
     spec = sensors.imu
+    if accel_axes == "held":
+        if hold is not None and not (isinstance(hold, (int, float)) and math.isfinite(hold) and hold > 0):
+            raise ValueError(f"hold: expected a finite number of seconds > 0, got {hold!r}")
+        return _noise(sensors, accel=(spec.accel_noise,) * 3, torque_hold=1.0 / spec.rate if hold is None else hold)
     _, _, Hn = imu_partials(model, x0, np.zeros(5), mount=spec.mount)
     Minv = np.linalg.inv(model.inertia(x0))
     q2 = sensors.process.generalized() ** 2 * spec.rate             # (q/√dt)² at the IMU's period
     cov = Hn[3:] @ Minv @ np.diag(q2) @ Minv.T @ Hn[3:].T
     share = np.diag(cov) if accel_axes == "each" else np.full(3, np.max(np.diag(cov)))
-    return EkfNoise(gyro=spec.gyro_noise, accel=tuple(np.sqrt(spec.accel_noise ** 2 + share)),
+    return _noise(sensors, accel=tuple(np.sqrt(spec.accel_noise ** 2 + share)))
+
+
+def _noise(sensors, **accel):
+    spec = sensors.imu
+    return EkfNoise(gyro=spec.gyro_noise, **accel,
                     gyro_bias=spec.gyro_bias, accel_bias=spec.accel_bias,
                     gyro_bias_rw=spec.gyro_bias_rw, accel_bias_rw=spec.accel_bias_rw,
                     encoder=sensors.encoders.step / math.sqrt(12),

@@ -56,6 +56,25 @@
  * states and covariances to re-run; per waiting slot and predict one
  * 12 x 12 by 12 x 2 product, per update an m x 2 and an SR_NEB x 2 product.
  *
+ * Held disturbance (sr_ekf_update_imu_held).  A truth stepped under a white torque w drawn once per
+ * period T and held over it (Q_a = M^-1 diag(psd^2) M^-1 / T for a = M^-1 w, so that T^2 Q_a is the
+ * predict's Q_d over T) moves nu by a t over the time t it acts, and its accelerometer reads nu' + a
+ * within the period.  The first such sample of a period appends a to the filter's error, prior
+ * (mean 0, Cov Q_a at the prior x, independent of e), and every sample of the period applies
+ * with the joint Jacobian (H, Hn), Hn = dy/d(nu') of sr_imu_partials (zero on the gyroscope's
+ * rows): r = y - h - Hn a_hat, Cov(e, r) = P H^T + C Hn^T, B = Cov(a, r)^T = H C + Hn A,
+ * S = H Cov(e, r) + Hn B^T + R (C = Cov(e, a), A = Cov(a)).  The error moves by the update above
+ * with these C^T and S; a by a_hat += B^T S^-1 r, A -= B^T S^-1 B, Cov(a, z_j) -= B^T S^-1 Cov(r, z_j),
+ * and C <- G (C - K B), all times lambda in a recovery.  Other updates move C as they move a slot's
+ * cross-covariance (C <- G (C - K Cov(r, a)), Cov(r, a) = H C, or Cov(z_j, a) for a delayed fix)
+ * and leave a_hat and A (a is not revised by them: as the delayed fixes' z); a fix marked meanwhile
+ * takes Cov(a, z) = (H C)^T.  A predict of dt steps g = min(dt, the period left) with the held a
+ * in place of its torque noise, the rest of dt with the torque noise (times (dt - g)/dt):
+ * x_nu += g a_hat, P <- Phi P Phi^T + Phi C Gm^T + Gm C^T Phi^T + Gm A Gm^T (Gm = g on nu's rows)
+ * plus the biases' walks, C <- Phi C + Gm A, C_j <- Phi C_j + Gm Cov(a, z_j); a is dropped when its
+ * period ends.  A gated sample leaves everything as it was.  In a linear filter this is the exact
+ * filter of the augmented state (e, a), with a revised by the IMU samples only.
+ *
  * Checks, in the library's order (docs/robustness.md): the model (SR_ERR_NULL, SR_ERR_MODEL), the
  * other pointers (SR_ERR_NULL), the arguments (SR_ERR_ARG: method, dt, a standard deviation or a
  * noise density not finite and > 0 (>= 0 for the process noise), gate not > 0 or NaN, body; the
@@ -86,6 +105,7 @@ extern "C" {
 #define sr_ekf_mark_position sr_ekf_mark_position_f
 #define sr_ekf_update_position_delayed sr_ekf_update_position_delayed_f
 #define sr_ekf_set_recovery sr_ekf_set_recovery_f
+#define sr_ekf_update_imu_held sr_ekf_update_imu_held_f
 #endif
 
 #ifndef SR_EKF_NDELAYED
@@ -111,6 +131,17 @@ typedef struct sr_ekf_delayed {
     int marked;                           /**< 1 while the slot waits for its fix */
 } sr_ekf_delayed;
 
+/** The torque disturbance an IMU sample has read and the predicts of its period will step with
+ * (sr_ekf_update_imu_held; see the file's description): a = M^-1 w, its estimate and covariances. */
+typedef struct sr_ekf_held {
+    sr_real mean[SR_NV];                        /**< the estimate of a [rad/s^2] */
+    sr_real cov[SR_NV * SR_NV];                 /**< Cov(a), row-major */
+    sr_real cross[SR_NEB * SR_NV];              /**< Cov(e, a) with the error e, SR_NEB x SR_NV row-major */
+    sr_real fix[SR_EKF_NDELAYED * SR_NV * 2];   /**< Cov(a, z_j) per delayed slot j (SR_NV x 2 row-major at 2 SR_NV j) */
+    sr_real remaining;                          /**< how much of its period is left [s] */
+    int pending;                                /**< 1 from the sample that read a to the end of its period */
+} sr_ekf_held;
+
 /** The filter's state, owned by the caller; fill it with sr_ekf_init or sr_ekf_init_diagonal. */
 typedef struct sr_ekf {
     sr_real x[SR_NX];                 /**< the state estimate (layout of spherical_robot.h) */
@@ -123,6 +154,7 @@ typedef struct sr_ekf {
     long streak[SR_EKF_NKINDS];       /**< samples refused in a row, per kind (0 once one is applied) */
     long recover_after[SR_EKF_NKINDS]; /**< the recovery policy per kind: 0 off (the start), else n of sr_ekf_set_recovery */
     sr_ekf_delayed delayed[SR_EKF_NDELAYED]; /**< the delayed fixes waiting, by slot */
+    sr_ekf_held held;                 /**< the disturbance read by sr_ekf_update_imu_held, until its period ends */
 } sr_ekf;
 
 /** The process noise of sr_ekf_predict (all >= 0 and finite). */
@@ -164,6 +196,18 @@ int sr_ekf_update_imu(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIM
  * horizontal ones only): one number for the three would be too wide on some or too narrow on others. */
 int sr_ekf_update_imu_axes(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
                            int body, const sr_real mount[SR_NMOUNT], const sr_real sigma[SR_NIMU], sr_real gate);
+
+/** sr_ekf_update_imu_axes for a robot driven by the white torque disturbance of *process held
+ * constant over periods of hold > 0 [s], the first starting at this sample (a simulation's step,
+ * or the IMU's period): the accelerometer reads the acceleration a = M^-1 w that the same w gives
+ * nu over the predicts of that period, so the sample's noise and their process noise are correlated (see the
+ * file's description, "Held disturbance").  sigma[SR_NIMU] is the readings' own noise (white, per
+ * sample) without any share of the disturbance.  process and hold: SR_ERR_NULL, SR_ERR_ARG as
+ * sr_ekf_predict's; SR_ERR_SINGULAR where M is not positive definite.  A sample while a is held
+ * (within its period) reads the same a. */
+int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
+                           int body, const sr_real mount[SR_NMOUNT], const sr_real sigma[SR_NIMU],
+                           const sr_ekf_process *process, sr_real hold, sr_real gate);
 
 /** One encoder sample y = (theta_Y, theta_P) [rad], standard deviation sigma each (e.g. a count's
  * quantisation, 2 pi / (counts sqrt(12))), gated at gate; the innovations are wrapped into (-pi, pi]. */

@@ -192,10 +192,67 @@ static int torque_noise(const sr_model *model, const sr_real x[SR_NX], const sr_
     return SR_OK;
 }
 
+/* How long of the predict's dt a held disturbance still drives: the rest of its period, at most dt
+ * (0: none held). */
+static sr_real held_for(const sr_ekf_held *h, sr_real dt)
+{
+    return !h->pending ? 0 : h->remaining < dt ? h->remaining : dt;
+}
+
+/* A held disturbance a (sr_ekf.h, "Held disturbance") over g of the predict, in place of the torque
+ * noise there: e' = Phi e + Gm a with Gm = g on nu's rows, a' = a, so x_nu += g a_hat,
+ * P' += Phi C Gm^T + Gm C^T Phi^T + Gm A Gm^T (Phi = diag(F, I)) and next->cross = Phi C + Gm A.
+ * next is the held disturbance after the predict: spent when its period is. */
+static void step_held(const sr_ekf_held *h, const sr_real F[NE * NE], sr_real g, sr_real dt, sr_real xn[SR_NX],
+                      sr_real *Pn, sr_ekf_held *next)
+{
+    sr_real *Y = next->cross;
+    int i, j, k;
+    *next = *h;
+    if (!h->pending) return;
+    for (i = 0; i < SR_NV; ++i) xn[SR_X_w_S + i] += g * h->mean[i];
+    for (i = 0; i < NB; ++i)
+        for (j = 0; j < SR_NV; ++j) {
+            sr_real s = 0;
+            if (i < NE)
+                for (k = 0; k < NE; ++k) s += F[NE * i + k] * h->cross[SR_NV * k + j];
+            else
+                s = h->cross[SR_NV * i + j];
+            Y[SR_NV * i + j] = s;   /* Phi C */
+        }
+    for (i = 0; i < NB; ++i)
+        for (j = 0; j < SR_NV; ++j) {
+            Pn[NB * i + SR_EB_nu + j] += g * Y[SR_NV * i + j];
+            Pn[NB * (SR_EB_nu + j) + i] += g * Y[SR_NV * i + j];
+        }
+    for (i = 0; i < SR_NV; ++i)
+        for (j = 0; j < SR_NV; ++j) {
+            Pn[NB * (SR_EB_nu + i) + SR_EB_nu + j] += g * g * h->cov[SR_NV * i + j];
+            Y[SR_NV * (SR_EB_nu + i) + j] += g * h->cov[SR_NV * i + j];
+        }
+    next->remaining = h->remaining - g;
+    if (!(next->remaining > SR_C(1e-9) * dt)) memset(next, 0, sizeof *next);
+}
+
+/* After the predict: the waiting fixes' C_j gain Gm Cov(a, z_j) (g of the held a), and the held
+ * disturbance is what step_held left. */
+static void release_held(sr_ekf *ekf, sr_real g, const sr_ekf_held *next)
+{
+    int i, b, k;
+    for (k = 0; k < SR_EKF_NDELAYED && ekf->held.pending; ++k) {
+        if (!ekf->delayed[k].marked) continue;
+        for (i = 0; i < SR_NV; ++i)
+            for (b = 0; b < 2; ++b)
+                ekf->delayed[k].C[2 * (SR_EB_nu + i) + b] += g * ekf->held.fix[2 * SR_NV * k + 2 * i + b];
+    }
+    ekf->held = *next;
+}
+
 int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real u[SR_NU], sr_real dt,
                    const sr_ekf_process *process)
 {
-    sr_real xn[SR_NX], F[NE * NE], Qnu[SR_NV * SR_NV], T[NE * NB], Pn[NB * NB];
+    sr_real xn[SR_NX], F[NE * NE], Qnu[SR_NV * SR_NV], T[NE * NB], Pn[NB * NB], g, white;
+    sr_ekf_held next;
     int status = arg_model(model, READS(WHOLE)), i, j, k, dq_identity = 1, cols[NE], ncols = 0;
     if (status != SR_OK) return status;
     if (!ekf || !process) return SR_ERR_NULL;
@@ -204,7 +261,10 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
     status = check_filter(model, ekf);
     /* The state and u are checked: the step and F at once, RKMK4's from the same stages. */
     if (status == SR_OK) status = sr_internal_step_and_jacobian(model, method, ekf->x, u, dt, xn, F);
-    if (status == SR_OK) status = torque_noise(model, ekf->x, process, dt, Qnu);
+    /* A held disturbance drives g of dt; the torque noise the rest (white, a share of Q_nu). */
+    g = held_for(&ekf->held, dt);
+    white = (dt - g) / dt;
+    if (status == SR_OK && white > 0) status = torque_noise(model, ekf->x, process, dt, Qnu);
     if (status != SR_OK) return status;
 
     /* F P F^T with F = [[F_d, 0], [0, I]] blockwise: T = F_d [P_dd P_db] (the cross terms F_d P_db come
@@ -250,8 +310,8 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
             for (k = 0; k < NE; ++k) s += T[NB * i + k] * F[NE * j + k];
             Pn[NB * i + j] = Pn[NB * j + i] = s;
         }
-    for (i = 0; i < SR_NV; ++i)
-        for (j = 0; j < SR_NV; ++j) Pn[NB * (SR_EB_nu + i) + SR_EB_nu + j] += Qnu[SR_NV * i + j];
+    for (i = 0; i < SR_NV && white > 0; ++i)
+        for (j = 0; j < SR_NV; ++j) Pn[NB * (SR_EB_nu + i) + SR_EB_nu + j] += white * Qnu[SR_NV * i + j];
     /* The cross terms F P_db (in T already); the bias block only gains its random walk. */
     for (i = 0; i < NE; ++i)
         for (j = NE; j < NB; ++j) Pn[NB * i + j] = Pn[NB * j + i] = T[NB * i + j];
@@ -261,6 +321,7 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
         Pn[NB * (SR_EB_b_g + i) + SR_EB_b_g + i] += dt * process->gyro_bias_rw * process->gyro_bias_rw;
         Pn[NB * (SR_EB_b_a + i) + SR_EB_b_a + i] += dt * process->accel_bias_rw * process->accel_bias_rw;
     }
+    step_held(&ekf->held, F, g, dt, xn, Pn, &next);
     if (!all_finite(Pn, NB * NB)) return SR_ERR_NONFINITE;
     memcpy(ekf->x, xn, sizeof xn);
     memcpy(ekf->P, Pn, sizeof Pn);
@@ -279,7 +340,46 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
         }
         memcpy(Ck, t, sizeof t);
     }
+    release_held(ekf, g, &next);
     return SR_OK;
+}
+
+/* A held disturbance a (sr_ekf.h, "Held disturbance") through an applied sample, e <- G (e - K r): its
+ * cross-covariance moves as a waiting fix's, C <- G (C - K Wa) with Wa = Cov(r, a) (m x SR_NV); a
+ * itself is not revised; a recovery's lambda scales all of its covariances. */
+static void carry_held(sr_ekf_held *h, int m, const sr_real *KT, const sr_real *Wa, const sr_real Jr[9],
+                       sr_real inflate)
+{
+    sr_real t[3 * SR_NV];
+    int a, b, i;
+    if (!h->pending) return;
+    for (a = 0; a < NB; ++a)
+        for (b = 0; b < SR_NV; ++b) {
+            sr_real s = h->cross[SR_NV * a + b];
+            for (i = 0; i < m; ++i) s -= KT[NB * i + a] * Wa[SR_NV * i + b];
+            h->cross[SR_NV * a + b] = inflate * s;
+        }
+    for (i = 0; i < SR_NV * SR_NV; ++i) h->cov[i] *= inflate;
+    for (i = 0; i < SR_EKF_NDELAYED * SR_NV * 2; ++i) h->fix[i] *= inflate;
+    for (i = 0; i < 3; ++i)
+        for (b = 0; b < SR_NV; ++b)
+            t[SR_NV * i + b] = Jr[3 * i] * h->cross[SR_NV * SR_EB_xi_S + b]
+                             + Jr[3 * i + 1] * h->cross[SR_NV * (SR_EB_xi_S + 1) + b]
+                             + Jr[3 * i + 2] * h->cross[SR_NV * (SR_EB_xi_S + 2) + b];
+    memcpy(h->cross + SR_NV * SR_EB_xi_S, t, sizeof t);
+}
+
+/* Cov(r, a) = H C (m x SR_NV) of a sample that does not read a, from its sparse rows. */
+static void held_of_sample(const sr_ekf_held *h, int m, const int *nnz, const int *col, const sr_real *val,
+                           sr_real *Wa)
+{
+    int i, b, k;
+    for (i = 0; i < m && h->pending; ++i)
+        for (b = 0; b < SR_NV; ++b) {
+            sr_real s = 0;
+            for (k = 0; k < nnz[i]; ++k) s += val[NB * i + k] * h->cross[SR_NV * col[NB * i + k] + b];
+            Wa[SR_NV * i + b] = s;
+        }
 }
 
 /* Applies an m-entry sample with innovation r, the transposed cross-covariance CT = Cov(e, r)^T
@@ -289,7 +389,7 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
  * gain and the Joseph terms are kept transposed (m rows of NB), so that every inner loop runs along
  * a row of NB contiguous numbers.  The filter is written only on SR_OK. */
 static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_real *r, const sr_real *CT,
-                 const sr_real *S, sr_real gate, const sr_real *W, int released)
+                 const sr_real *S, sr_real gate, const sr_real *W, int released, const sr_real *Wa)
 {
     sr_real L[MAXM * MAXM], KT[MAXM * NB], DT[MAXM * NB], Pn[NB * NB];
     sr_real z[MAXM], e[NB], xn[SR_NX], Jr[9], T[3 * NB], nis = 0, inflate = 1;
@@ -424,6 +524,7 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
                              + Jr[3 * i + 2] * Cj[2 * (SR_EB_xi_S + 2) + b];
         memcpy(Cj + 2 * SR_EB_xi_S, t, sizeof t);
     }
+    carry_held(&ekf->held, m, KT, Wa, Jr, inflate);
     return SR_OK;
 }
 
@@ -432,7 +533,7 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
 static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_real *r, const sr_real *H,
                   const sr_real *Rd, sr_real gate)
 {
-    sr_real CT[MAXM * NB], S[MAXM * MAXM] = {0}, val[MAXM * NB], W[SR_EKF_NDELAYED * MAXM * 2];
+    sr_real CT[MAXM * NB], S[MAXM * MAXM] = {0}, val[MAXM * NB], W[SR_EKF_NDELAYED * MAXM * 2], Wa[MAXM * SR_NV];
     int col[MAXM * NB], nnz[MAXM], a, i, j, k;
 
     /* H is sparse: an IMU row reads at most 13 of the 18 columns (never q, and one bias block),
@@ -471,7 +572,8 @@ static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_
                 W[MAXM * 2 * j + 2 * i + a] = s;
             }
     }
-    return apply(ekf, model, kind, m, r, CT, S, gate, W, -1);
+    held_of_sample(&ekf->held, m, nnz, col, val, Wa);
+    return apply(ekf, model, kind, m, r, CT, S, gate, W, -1, Wa);
 }
 
 int sr_ekf_update_imu_axes(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
@@ -495,6 +597,124 @@ int sr_ekf_update_imu_axes(sr_ekf *ekf, const sr_model *model, const sr_real y[S
         Rd[i] = sigma[i] * sigma[i];
     }
     return update(ekf, model, SR_EKF_IMU, SR_NIMU, r, H, Rd, gate);
+}
+
+int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
+                           int body, const sr_real mount[SR_NMOUNT], const sr_real sigma[SR_NIMU],
+                           const sr_ekf_process *process, sr_real hold, sr_real gate)
+{
+    sr_real yh[SR_NIMU], H[SR_NIMU * NB], Hn[SR_NIMU * SR_NV], r[SR_NIMU], yd[SR_NIMU], Hd[SR_NIMU * NB];
+    sr_real CT[SR_NIMU * NB], S[SR_NIMU * SR_NIMU], L[SR_NIMU * SR_NIMU], B[SR_NIMU * SR_NV];
+    sr_real X[SR_NIMU * SR_NV], Sr[SR_NIMU], col[SR_NIMU], W[SR_EKF_NDELAYED * MAXM * 2];
+    const sr_real zero[SR_NV] = {0};
+    sr_ekf_held before, *h;
+    long applied, recovered;
+    sr_real inflate;
+    int status = arg_model(model, READS(WHOLE)), a, b, i, j, k;
+    if (status != SR_OK) return status;
+    if (!ekf || !y || !mount || !sigma || !process) return SR_ERR_NULL;
+    before = ekf->held;
+    status = sr_check_mount(body, mount);
+    if (status != SR_OK) return status;
+    for (i = 0; i < SR_NIMU; ++i)
+        if (!positive(sigma[i])) return SR_ERR_ARG;
+    if (!valid_gate(gate) || !valid_process(process) || arg_dt(hold) != SR_OK) return SR_ERR_ARG;
+    if (!all_finite(y, SR_NIMU) || (u && !all_finite(u, SR_NU))) return SR_ERR_NONFINITE;
+    status = check_filter(model, ekf);
+    if (status == SR_OK) status = sr_imu_jacobian(model, ekf->x, u, body, mount, ekf->bias, yh, H);
+    /* The reading is linear in nu': Hn is the same at any nu', zero included. */
+    if (status == SR_OK) status = sr_imu_partials(model, ekf->x, zero, body, mount, ekf->bias, yd, Hd, Hn);
+    if (status != SR_OK) return status;
+
+    h = &ekf->held;
+    if (!h->pending) {   /* a's prior: mean 0, Q_a = M^-1 D^2 M^-1 / hold, independent of e */
+        memset(h, 0, sizeof *h);
+        status = torque_noise(model, ekf->x, process, 1 / hold, h->cov);
+        if (status != SR_OK) {
+            *h = before;
+            return status;
+        }
+        h->pending = 1;
+        h->remaining = hold;
+    }
+    /* Cov(e, r)^T = H P + Hn C^T, B = H C + Hn A, S = H Cov(e, r) + Hn B^T + R. */
+    for (i = 0; i < SR_NIMU; ++i) {
+        sr_real pred = yh[i];
+        for (b = 0; b < SR_NV; ++b) pred += Hn[SR_NV * i + b] * h->mean[b];
+        r[i] = y[i] - pred;
+        for (a = 0; a < NB; ++a) {
+            sr_real s = 0;
+            for (k = 0; k < NB; ++k) s += H[NB * i + k] * ekf->P[NB * k + a];
+            for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * h->cross[SR_NV * a + k];
+            CT[NB * i + a] = s;
+        }
+        for (b = 0; b < SR_NV; ++b) {
+            sr_real s = 0;
+            for (k = 0; k < NB; ++k) s += H[NB * i + k] * h->cross[SR_NV * k + b];
+            for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * h->cov[SR_NV * k + b];
+            B[SR_NV * i + b] = s;
+        }
+    }
+    for (i = 0; i < SR_NIMU; ++i)
+        for (j = 0; j < SR_NIMU; ++j) {
+            sr_real s = i == j ? sigma[i] * sigma[i] : 0;
+            for (k = 0; k < NB; ++k) s += H[NB * i + k] * CT[NB * j + k];
+            for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * B[SR_NV * j + k];
+            S[SR_NIMU * i + j] = s;
+        }
+    for (i = 0; i < SR_NIMU; ++i)   /* symmetric to the last bit: the Cholesky reads one triangle */
+        for (j = 0; j < i; ++j) S[SR_NIMU * i + j] = S[SR_NIMU * j + i] = SR_C(0.5) * (S[SR_NIMU * i + j] + S[SR_NIMU * j + i]);
+    /* Cov(r, z_j) = H C_j + Hn Cov(a, z_j) for every waiting fix. */
+    for (j = 0; j < SR_EKF_NDELAYED; ++j) {
+        const sr_real *Cj = ekf->delayed[j].C;
+        if (!ekf->delayed[j].marked) continue;
+        for (i = 0; i < SR_NIMU; ++i)
+            for (a = 0; a < 2; ++a) {
+                sr_real s = 0;
+                for (k = 0; k < NB; ++k) s += H[NB * i + k] * Cj[2 * k + a];
+                for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * h->fix[2 * SR_NV * j + 2 * k + a];
+                W[MAXM * 2 * j + 2 * i + a] = s;
+            }
+    }
+    /* S^-1 r and X = S^-1 B for a's own revision after the error's. */
+    status = cholesky(SR_NIMU, S, L);
+    if (status != SR_OK) {
+        *h = before;
+        return status;
+    }
+    memcpy(Sr, r, sizeof Sr);
+    solve_both(SR_NIMU, L, Sr);
+    for (b = 0; b < SR_NV; ++b) {
+        for (i = 0; i < SR_NIMU; ++i) col[i] = B[SR_NV * i + b];
+        solve_both(SR_NIMU, L, col);
+        for (i = 0; i < SR_NIMU; ++i) X[SR_NV * i + b] = col[i];
+    }
+    recovered = ekf->recovered[SR_EKF_IMU];
+    applied = ekf->accepted[SR_EKF_IMU] + recovered;
+    status = apply(ekf, model, SR_EKF_IMU, SR_NIMU, r, CT, S, gate, W, -1, B);
+    if (status != SR_OK || ekf->accepted[SR_EKF_IMU] + ekf->recovered[SR_EKF_IMU] == applied) {
+        ekf->held = before;   /* refused (or failed): a as before the sample */
+        return status;
+    }
+    /* apply moved C and scaled A and Cov(a, z_j) by lambda; a's own revision, times lambda. */
+    inflate = ekf->recovered[SR_EKF_IMU] > recovered ? ekf->nis[SR_EKF_IMU] / gate : 1;
+    for (a = 0; a < SR_NV; ++a) {
+        for (i = 0; i < SR_NIMU; ++i) h->mean[a] += B[SR_NV * i + a] * Sr[i];
+        for (b = 0; b < SR_NV; ++b) {
+            sr_real s = 0;
+            for (i = 0; i < SR_NIMU; ++i) s += B[SR_NV * i + a] * X[SR_NV * i + b];
+            h->cov[SR_NV * a + b] -= inflate * s;
+        }
+        for (j = 0; j < SR_EKF_NDELAYED; ++j) {
+            if (!ekf->delayed[j].marked) continue;
+            for (b = 0; b < 2; ++b) {
+                sr_real s = 0;
+                for (i = 0; i < SR_NIMU; ++i) s += X[SR_NV * i + a] * W[MAXM * 2 * j + 2 * i + b];
+                h->fix[2 * SR_NV * j + 2 * a + b] -= inflate * s;
+            }
+        }
+    }
+    return SR_OK;
 }
 
 int sr_ekf_update_imu(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
@@ -600,6 +820,13 @@ int sr_ekf_mark_position(sr_ekf *ekf, const sr_model *model, int slot)
             }
     }
     memcpy(d->Z + 4 * slot, Z + 4 * slot, 4 * sizeof(sr_real));
+    /* Cov(a, z) = (H C)^T with a held disturbance: a moves the error over the next predict. */
+    for (a = 0; a < SR_NV; ++a)
+        for (i = 0; i < 2; ++i) {
+            sr_real s = 0;
+            for (k = 0; k < NB && ekf->held.pending; ++k) s += H[NB * i + k] * ekf->held.cross[SR_NV * k + a];
+            ekf->held.fix[2 * SR_NV * slot + 2 * a + i] = s;
+        }
     memcpy(d->yh, yh, sizeof yh);
     memcpy(d->C, C, sizeof C);
     d->marked = 1;
@@ -609,7 +836,7 @@ int sr_ekf_mark_position(sr_ekf *ekf, const sr_model *model, int slot)
 int sr_ekf_update_position_delayed(sr_ekf *ekf, const sr_model *model, int slot, const sr_real y[2], sr_real sigma,
                                    sr_real gate)
 {
-    sr_real r[2], CT[2 * NB], S[4], W[SR_EKF_NDELAYED * MAXM * 2];
+    sr_real r[2], CT[2 * NB], S[4], W[SR_EKF_NDELAYED * MAXM * 2], Wa[2 * SR_NV];
     const sr_ekf_delayed *d;
     int status = arg_model(model, READS(WHOLE)), a, j;
     if (status != SR_OK) return status;
@@ -630,7 +857,10 @@ int sr_ekf_update_position_delayed(sr_ekf *ekf, const sr_model *model, int slot,
     /* Cov(r, z_j) = Cov(z, z_j): the fix's noise is independent of the others. */
     for (j = 0; j < SR_EKF_NDELAYED; ++j)
         if (j != slot && ekf->delayed[j].marked) memcpy(W + MAXM * 2 * j, d->Z + 4 * j, 4 * sizeof(sr_real));
-    return apply(ekf, model, SR_EKF_POSITION, 2, r, CT, S, gate, W, slot);
+    /* Cov(r, a) = Cov(z, a): the fix's noise is independent of the held disturbance. */
+    for (j = 0; j < 2; ++j)
+        for (a = 0; a < SR_NV; ++a) Wa[SR_NV * j + a] = ekf->held.fix[2 * SR_NV * slot + 2 * a + j];
+    return apply(ekf, model, SR_EKF_POSITION, 2, r, CT, S, gate, W, slot, Wa);
 }
 
 int sr_ekf_set_recovery(sr_ekf *ekf, int kind, long n)

@@ -241,6 +241,44 @@ static void test_a_late_fix_corrects_the_estimate_by_what_it_said_when_it_measur
     CHECK(fabs((double)(fresh.x[SR_X_q] - ekf.x[SR_X_q])) > 0.005);
 }
 
+static void test_a_held_disturbance_is_read_by_the_imu_sample_and_spent_by_the_next_predict(void)
+{
+    /* An accelerometer reading off along x: the held update estimates a (pending), the predict moves
+     * nu by dt a_hat on top of the step and drops a; a refused or bad sample leaves all as it was. */
+    sr_ekf ekf, plain, before;
+    sr_model m;
+    sr_ekf_process q = {{SR_C(0.01), SR_C(0.01), SR_C(0.01)}, 0, 0};
+    sr_real mount[SR_NMOUNT] = {0, 0, SR_C(-0.05), 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    sr_real y[SR_NIMU], a_hat[SR_NV], moved = 0;
+    const sr_real sigma[SR_NIMU] = {SR_C(0.003), SR_C(0.003), SR_C(0.003), SR_C(0.02), SR_C(0.02), SR_C(0.02)};
+    const sr_real dt = SR_C(0.005);
+    int i;
+    start(&ekf, &m, 0.01);
+    CHECK_STATUS(sr_imu_measure_u(&m, ekf.x, NULL, SR_BODY_yoke, mount, ekf.bias, y), SR_OK);
+    y[SR_IMU_accel] += SR_C(0.2);
+    before = ekf;
+    CHECK_STATUS(sr_ekf_update_imu_held(&ekf, &m, y, NULL, SR_BODY_yoke, mount, sigma, NULL, dt, chi2_2), SR_ERR_NULL);
+    CHECK_STATUS(sr_ekf_update_imu_held(&ekf, &m, y, NULL, SR_BODY_yoke, mount, sigma, &q, 0, chi2_2), SR_ERR_ARG);
+    CHECK_STATUS(sr_ekf_update_imu_held(&ekf, &m, y, NULL, SR_BODY_yoke, mount, sigma, &q, (sr_real)NAN, chi2_2),
+                 SR_ERR_ARG);
+    CHECK_STATUS(sr_ekf_update_imu_held(&ekf, &m, y, NULL, SR_BODY_yoke, mount, sigma, &q, dt, SR_C(1e-6)), SR_OK);
+    CHECK(ekf.gated[SR_EKF_IMU] == 1 && !ekf.held.pending);
+    CHECK(memcmp(ekf.x, before.x, sizeof ekf.x) == 0 && memcmp(ekf.P, before.P, sizeof ekf.P) == 0);
+    ekf = before;
+    CHECK_STATUS(sr_ekf_update_imu_held(&ekf, &m, y, NULL, SR_BODY_yoke, mount, sigma, &q, dt, (sr_real)INFINITY),
+                 SR_OK);
+    CHECK(ekf.held.pending == 1);
+    for (i = 0; i < SR_NV; ++i) moved += ekf.held.mean[i] * ekf.held.mean[i];
+    CHECK(moved > 0);
+    memcpy(a_hat, ekf.held.mean, sizeof a_hat);
+    plain = ekf;
+    plain.held.pending = 0;   /* the same filter without the held a */
+    CHECK_STATUS(sr_ekf_predict(&ekf, &m, SR_RKMK4, NULL, dt, &q), SR_OK);
+    CHECK_STATUS(sr_ekf_predict(&plain, &m, SR_RKMK4, NULL, dt, &q), SR_OK);
+    CHECK(!ekf.held.pending);
+    for (i = 0; i < SR_NV; ++i) CHECK_NEAR(ekf.x[SR_X_w_S + i] - plain.x[SR_X_w_S + i], dt * a_hat[i], 8 * TEST_EPS);
+}
+
 static void test_bad_input_gives_a_status_and_writes_nothing(void)
 {
     sr_ekf ekf, before;
@@ -307,5 +345,6 @@ void suite_ekf(void)
     RUN_TEST(test_each_imu_reading_has_its_own_standard_deviation);
     RUN_TEST(test_a_fix_marked_and_applied_at_once_is_the_plain_fix);
     RUN_TEST(test_a_late_fix_corrects_the_estimate_by_what_it_said_when_it_measured);
+    RUN_TEST(test_a_held_disturbance_is_read_by_the_imu_sample_and_spent_by_the_next_predict);
     RUN_TEST(test_bad_input_gives_a_status_and_writes_nothing);
 }

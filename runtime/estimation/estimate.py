@@ -8,9 +8,12 @@ The filter (runtime.ekf, C in c/src/sr_ekf.c) assumes what the log's sensor set 
 (`ekf_noise`); between two samples it predicts under the torques the log says were applied (a
 torque row holds until the next); samples of one time are applied IMU first, then encoders,
 fixes and heading.  A fix that arrives after the instant it measures (`t_measured` < `t`) is marked
-at that instant and applied on arrival as a delayed fix (runtime.ekf, `mark_position`).  The IMU update runs while the filter's `accel` standard deviation includes what the
-process noise adds to the accelerometer's reading (`ekf_noise`), since the filter's measurement
-model sees the applied torques only.
+at that instant and applied on arrival as a delayed fix (runtime.ekf, `mark_position`).  The
+accelerometer's noise is `ekf_noise`'s rule `accel_noise`: by default ("largest") its σ includes
+what the process noise adds to the reading; "held" models the process noise as a torque held over
+each torque row's period (the simulation's step), which the accelerometer reads and the predicts
+of that period step with (the samples' noise and the process noise correlated, c/include/sr_ekf.h,
+"Held disturbance").
 """
 import dataclasses
 import math
@@ -76,21 +79,32 @@ def moving_at_start(log):
     return bool(np.any(np.abs(gyro) > 5 * imu.gyro_noise / math.sqrt(START_SAMPLES) + 3 * imu.gyro_bias))
 
 
-def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progress=None, covariance_every=None):
+def torque_period(log):
+    """The period of the log's torque rows [s] (their median spacing; None for a single row): the
+    step over which a simulated truth holds its torque disturbance."""
+    t = log.torques.t
+    return float(np.median(np.diff(t))) if len(t) > 1 else None
+
+
+def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progress=None, covariance_every=None,
+                 accel_noise="largest"):
     """Run the filter over `log` (runtime.estimation.logs.Log) for the robot `params` (None: the one
     the log claims, else the paper's simulation robot), started by the start rule (the first
     START_SAMPLES accelerometer samples, the first encoder sample, the first fix and heading if the
     log has them; the heading known to 10° around `heading` [rad], None: `start_heading`).  A robot
     already moving at the start (`moving_at_start`) starts with speeds of σ MOVING_RATE_SIGMA
     instead of at rest.  `progress(done, total)` is called every 1000 times.  `covariance_every` = k
-    (a whole number >= 1) keeps the whole covariance at every k-th row (`Estimate.P`)."""
+    (a whole number >= 1) keeps the whole covariance at every k-th row (`Estimate.P`).  `accel_noise`:
+    `ekf_noise`'s accelerometer rule ("largest", "each", "held") when `noise` is None."""
     if covariance_every is not None and (isinstance(covariance_every, bool) or not isinstance(
             covariance_every, (int, np.integer)) or covariance_every < 1):
         raise ValueError(f"covariance_every: expected a whole number >= 1, got {covariance_every!r}")
     params = params if params is not None else claimed_params(log)
     model = Model(params)
     sensors = log.sensors
-    noise = noise if noise is not None else ekf_noise(sensors, params)
+    if noise is None:
+        hold = torque_period(log) if accel_noise == "held" else None
+        noise = ekf_noise(sensors, params, accel_axes=accel_noise, hold=hold)
     events = [(log.imu, "imu"), (log.encoders, "encoders"), (log.fixes, "fixes"), (log.heading, "heading")]
     events = [(table, kind) for table, kind in events if table is not None and len(table)]
     start = {"accel": log.imu.select("accel_x", "accel_y", "accel_z")[:START_SAMPLES],

@@ -17,11 +17,18 @@ Recovery (`recover_after`): a sample refused after that many refusals of its kin
 applied with P_aug and R multiplied by λ = NIS / gate before the update, literally.  On arrival the fix measures its
 clone, H_aug reads that clone's q; the gain changes the current error only (Larsen's update: the
 clones are not revised), then the clone is dropped.  Nothing of the C's projected bookkeeping.
+
+Held disturbance (`update_imu_held`): the acceleration a = M⁻¹ w of the torque held over the
+period is appended to the augmented state after the clones (prior 0, M⁻¹ D² M⁻¹ / hold) and the
+sample reads it through ∂y/∂ν̇; its gain revises the current error and a (not the clones); later
+samples move the current error alone; each predict within its period is the linear map e ← Φ e + g a
+on ν's rows (g: the part of dt in the period), a ← a, with the torque noise over dt − g only; a is
+dropped when its period ends.
 """
 import numpy as np
 
 from .. import sensors
-from ..state import IDX_E_NU, IDX_E_XI_S, NE
+from ..state import IDX_E_NU, IDX_E_XI_S, IDX_NU, NE, NV
 
 NB = NE + 6
 KINDS = ("imu", "encoders", "position", "heading")
@@ -57,6 +64,8 @@ class EkfReference:
         self.b = np.array(bias, dtype=float)
         self.P_aug = np.array(P0, dtype=float)
         self.clones = {}
+        self.held = None                  # the held disturbance's mean (NV,), its block last in P_aug
+        self.held_remaining = 0.0         # how much of its period is left [s]
         self.accepted = dict.fromkeys(KINDS, 0)
         self.gated = dict.fromkeys(KINDS, 0)
         self.nis = dict.fromkeys(KINDS, 0.0)
@@ -83,7 +92,8 @@ class EkfReference:
         """A fix measured now that arrives later: a clone of x and of the error."""
         self.drop(slot)
         n = len(self.P_aug)
-        T = np.vstack([np.eye(n), np.eye(NB, n)])
+        k = n - (NV if self.held is not None else 0)     # before the held disturbance's block
+        T = np.vstack([np.eye(n)[:k], np.eye(NB, n), np.eye(n)[k:]])
         self.P_aug = T @ self.P_aug @ T.T
         self.clones[slot] = self.x.copy()
 
@@ -113,9 +123,27 @@ class EkfReference:
         return Phi @ self.P @ Phi.T + Q
 
     def predict(self, u, dt, torque_psd, gyro_bias_rw=0.0, accel_bias_rw=0.0):
-        """x ← step(x, u, dt); P ← Φ P Φᵀ + Q, F at the prior x."""
+        """x ← step(x, u, dt); P ← Φ P Φᵀ + Q, F at the prior x; with a held disturbance a, the
+        step also moves ν by dt a, and a replaces the torque noise."""
         u = np.asarray(u, dtype=float)
         F, _ = self.model.casadi_step_jacobian(self.x, u, dt, self.method)
+        if self.held is not None:
+            g = min(dt, self.held_remaining)
+            Q = self.process_noise(dt, torque_psd, gyro_bias_rw, accel_bias_rw)
+            Q[IDX_E_NU, IDX_E_NU] *= (dt - g) / dt
+            self.x = self.model.step(self.x, u, dt, self.method)
+            self.x[IDX_NU] += g * self.held
+            n = len(self.P_aug)
+            T = np.eye(n)
+            T[:NE, :NE] = F
+            T[IDX_E_NU, n - NV:] = g * np.eye(NV)
+            self.P_aug = T @ self.P_aug @ T.T
+            self.P = self.P + Q
+            self.held_remaining -= g
+            if not self.held_remaining > 1e-9 * dt:
+                self.P_aug = self.P_aug[:n - NV, :n - NV]
+                self.held = None
+            return
         Q = self.process_noise(dt, torque_psd, gyro_bias_rw, accel_bias_rw)
         self.x = self.model.step(self.x, u, dt, self.method)
         P = self.propagate(F, Q)
@@ -198,6 +226,50 @@ class EkfReference:
         yh, H = sensors.imu_jacobian(self.model, self.x, u, mount=mount, bias=self.b)
         R = np.diag(np.concatenate([np.full(3, sigma_gyro), np.broadcast_to(sigma_accel, (3,))]) ** 2)
         return self._update("imu", np.asarray(y) - yh, H, R, gate)
+
+    def update_imu_held(self, y, u, mount, sigma, torque_psd, hold, gate):
+        """One IMU sample (6,) under the torques u that also reads the torque disturbance held over
+        `hold` seconds (appended unless one is held already); `sigma` (6,) the readings' own noise."""
+        yh, H = sensors.imu_jacobian(self.model, self.x, u, mount=mount, bias=self.b)
+        _, _, Hn = sensors.imu_partials(self.model, self.x, np.zeros(NV), mount=mount, bias=self.b)
+        new = self.held is None
+        if new:
+            Minv = np.linalg.inv(self.model.inertia(self.x))
+            s_, y_, p_ = torque_psd
+            Qa = Minv @ np.diag([s_ * s_, s_ * s_, s_ * s_, y_ * y_, p_ * p_]) @ Minv.T / hold
+            n = len(self.P_aug)
+            P_aug = np.zeros((n + NV, n + NV))
+            P_aug[:n, :n], P_aug[n:, n:] = self.P_aug, Qa
+            self.P_aug, self.held, self.held_remaining = P_aug, np.zeros(NV), hold
+        n = len(self.P_aug)
+        H_aug = np.zeros((6, n))
+        H_aug[:, :NB], H_aug[:, n - NV:] = H, Hn
+        r = np.asarray(y) - yh - Hn @ self.held
+        R = np.diag(np.asarray(sigma, dtype=float) ** 2)
+        S = H_aug @ self.P_aug @ H_aug.T + R
+        nis = float(r @ np.linalg.solve(S, r))
+        self.nis["imu"] = nis
+        lam = self.admission("imu", nis, gate)
+        if lam is None:
+            if new:
+                self.P_aug, self.held = self.P_aug[:n - NV, :n - NV], None
+            return False
+        if lam != 1.0:
+            self.P_aug = lam * self.P_aug
+            R = lam * R
+            S = H_aug @ self.P_aug @ H_aug.T + R
+        rows = np.r_[0:NB, n - NV:n]
+        K = np.linalg.solve(S, H_aug @ self.P_aug[:, rows]).T
+        T = np.eye(n)
+        T[rows] -= K @ H_aug
+        self.P_aug = T @ self.P_aug @ T.T
+        self.P_aug[np.ix_(rows, rows)] += K @ R @ K.T
+        e = K[:NB] @ r
+        self.held = self.held + K[NB:] @ r
+        self.inject(e)
+        self.reset(e)
+        self.admitted("imu", lam)
+        return True
 
     def update_encoders(self, y, sigma, gate):
         """One encoder sample (θ_Y, θ_P)."""
