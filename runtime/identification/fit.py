@@ -404,7 +404,7 @@ class _Problem:
         js = np.unique(d.interval[k0:last_node + 1])
         P = np.zeros((NE, 5 * len(js)))
         enters = np.full(len(js), np.iinfo(int).max)
-        Minv = np.linalg.inv(np.array([model.inertia(x) for x in X]))
+        Minv = np.linalg.inv(model.inertia_batch(X))
         later = d.interval[k0 + 1:last_node + 1]
         for c, j in enumerate(js):
             after = np.flatnonzero(later > j)
