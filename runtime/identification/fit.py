@@ -12,10 +12,11 @@ under the logged torques, its predicted IMU, encoder and fix readings are compar
 and its end state with the next segment's start.  The differences are whitened by their
 covariance: the sensors' declared noise plus what the process noise (the sensor set's torque
 disturbance) does to the readings and to the end state inside the segment, linearised along the
-segment.  SciPy's `least_squares` (trust-region reflective, bounds) minimises the whitened sum of
-squares with the analytic Jacobian: the step and parameter Jacobians of the C library chained along
-each segment, and the sensors' Jacobians.  A full-state log (its truth table) is fitted by the
-one-step prediction error of the velocities instead, whitened by the process noise.
+segment.  Levenberg–Marquardt steps on the normal equations of the sparse Jacobian
+(`levenberg_marquardt`) minimise the whitened sum of squares with the analytic Jacobian: the step
+and parameter Jacobians of the C library chained along each segment, and the sensors' Jacobians.
+A full-state log (its truth table) is fitted by the one-step prediction error of the velocities
+instead, whitened by the process noise, with SciPy's `least_squares`.
 
 The Fisher information JᵀJ of the whitened residuals at the optimum, with the start states and the
 biases eliminated (Schur complement), gives the parameters' covariance and 95 % intervals; its
@@ -38,7 +39,8 @@ from ..params import SHAPES, Params, flat_names
 from ..sensors import encoders_jacobian_batch, imu_partials_batch, position_jacobian_batch
 from ..state import IDX_E_NU, IDX_NU, NE, NV
 from .first_guess import _pi_of, regressor_guess
-from .sensitivity import JACOBIANS, accel_sensitivity, accel_state_jacobian, step_jacobians, step_sensitivity
+from .sensitivity import JACOBIANS, accel_sensitivity, accel_state_jacobian, step_jacobians, step_sensitivity,
+                          step_state_jacobian
 
 #: Where the fit starts the parameters: the regressor's linear least-squares first guess, or the nominal robot.
 STARTS = ("regressor", "nominal")
@@ -55,9 +57,6 @@ Z95 = float(scipy.stats.norm.ppf(0.975))
 #: Standard deviation [rad, m, rad/s] of the weak prior on the first segment's start state: it fixes
 #: what no sensor sees (the position without fixes, the heading without fixes or a magnetometer).
 GAUGE_SIGMA = 10.0
-#: Largest Jacobian (entries, after each segment's compression) solved densely; beyond it the
-#: trust-region steps use LSMR on the sparse Jacobian.
-DENSE_LIMIT = 2e6
 #: Smallest standard deviation of an end-state difference, for a sensor set without process noise.
 DEFECT_FLOOR = 1e-7
 
@@ -287,23 +286,29 @@ class _Problem:
             out.append(self.segment_block(model, s, starts[s], nxt, b))
         return out
 
-    def segment_block(self, model, s, start, nxt, b):
+    def segment_block(self, model, s, start, nxt, b, sensitivities=True):
         """One segment's block: simulated from start = (x0, D) under the logged torques; the
         end-state difference to nxt = (x0 of the next segment, its D) unless nxt is None.  The
         readings are ordered by time, at one time IMU, encoders, fix; `rows` keeps, per reading row,
-        its node, kind (0 IMU, 1 encoders, 2 fix), ∂y/∂x, ∂y/∂ν̇ and noise σ."""
+        its node, kind (0 IMU, 1 encoders, 2 fix), ∂y/∂x, ∂y/∂ν̇ and noise σ.  Without
+        `sensitivities` the parameters' columns are left zero (the start-state fit holds them)."""
         d = self.data
         x0, D = start
         k0, k1 = self.starts[s], self.ends[s]
         steps = k1 - k0
         X = model.simulate(x0, d.h, steps, u=d.u[k0:k1], method=self.method, energy_tol=None)
-        F, Jp = step_jacobians(model, X[:-1], d.u[k0:k1], d.h, self.method, self.idx, self.jacobian)
+        if sensitivities:
+            F, Jp = step_jacobians(model, X[:-1], d.u[k0:k1], d.h, self.method, self.idx, self.jacobian)
+        else:
+            F = step_state_jacobian(model, X[:-1], d.u[k0:k1], d.h, self.method, self.jacobian)
+            Jp = np.zeros((steps, NE, self.nf))
         last = s == self.S - 1
         nodes = np.arange(k0, k1 + 1 if last else k1)
         Xn = X[:len(nodes)]
         nudot = model.accel(Xn, d.u[nodes])
         Ja = accel_state_jacobian(model, Xn, d.u[nodes], self.jacobian)
-        Jpa = accel_sensitivity(model, Xn, d.u[nodes], self.idx, self.jacobian)
+        Jpa = (accel_sensitivity(model, Xn, d.u[nodes], self.idx, self.jacobian) if sensitivities
+               else np.zeros((len(nodes), NV, self.nf)))
         G = np.empty((steps + 1, NE, NE + self.nf))     # [Φ_k | S_k]: one product per step
         G[0] = np.hstack([np.eye(NE), np.zeros((NE, self.nf))])
         for k in range(steps):
@@ -372,7 +377,7 @@ class _Problem:
                 if key not in cache:
                     cache.clear()
                     start = self._dretract(model, x_ref, dv)
-                    blk = self.segment_block(model, s, start, None, b)
+                    blk = self.segment_block(model, s, start, None, b, sensitivities=False)
                     if not white:       # the readings weighed as the joint fit weighs them
                         white["w"] = self.covariances([blk], first=s)[0]
                     r, J = self.whiten(white["w"], blk["r"]), self.whiten(white["w"], blk["x"])
@@ -402,7 +407,7 @@ class _Problem:
         js = np.unique(d.interval[k0:last_node + 1])
         P = np.zeros((NE, 5 * len(js)))
         enters = np.full(len(js), np.iinfo(int).max)
-        Minv = np.linalg.inv(np.array([model.inertia(x) for x in X]))
+        Minv = np.linalg.inv(model.inertia_batch(X))
         later = d.interval[k0 + 1:last_node + 1]
         for c, j in enumerate(js):
             after = np.flatnonzero(later > j)
@@ -639,25 +644,99 @@ def _identify(log, params, free, segment, method, full_state, max_nfev, progress
         z0 = np.clip(prob.z0(), np.where(np.isfinite(lo), lo + 1e-12 * np.maximum(1, abs(lo)), lo),
                      np.where(np.isfinite(hi), hi - 1e-12 * np.maximum(1, abs(hi)), hi))
 
-    def fun(z):
-        return prob.assemble(z)[0]
+    if full_state:
+        opts = dict(jac=lambda z: prob.assemble(z)[1].toarray(), bounds=(lo, hi), method="trf", x_scale="jac",
+                    max_nfev=max_nfev, xtol=1e-8, ftol=1e-8, gtol=1e-10)
+        sol = scipy.optimize.least_squares(lambda z: prob.assemble(z)[0], z0, **opts)
+    else:
+        def evaluate(z):
+            r, J, _ = prob.assemble(z)
+            return r, J
 
-    # a dense trust-region solve while J is small, LSMR on the sparse J beyond
-    dense = full_state or prob.ncols * (prob.S * (prob.nf + 7 + 2 * NE) + NE) <= DENSE_LIMIT
-
-    def jac(z):
-        return prob.assemble(z)[1].toarray() if dense else prob.assemble(z)[1]
-
-    opts = dict(jac=jac, bounds=(lo, hi), method="trf", x_scale="jac", max_nfev=max_nfev,
-                xtol=1e-8, ftol=1e-8, gtol=1e-10)
-    if not dense:
-        opts.update(tr_solver="lsmr", tr_options={"atol": 1e-12, "btol": 1e-12, "maxiter": 2000})
-    sol = scipy.optimize.least_squares(fun, z0, **opts)
-    if not full_state:              # the covariance at the optimum, then a short refinement
-        prob.chol = None
+        sol = levenberg_marquardt(evaluate, z0, lo, hi, max_nfev)
+        prob.chol = None            # the covariance at the optimum, then a short refinement
         prob._cache = (None, None)
-        sol = scipy.optimize.least_squares(fun, sol.x, **{**opts, "max_nfev": max(3, max_nfev // 2)})
+        sol = levenberg_marquardt(evaluate, sol.x, lo, hi, max(3, max_nfev // 2))
     return _report(prob, sol, free, params, full_state)
+
+
+@dataclasses.dataclass
+class Solution:
+    """What `levenberg_marquardt` returns: the point `x`, its `cost` ½‖r‖², the evaluations `nfev`,
+    `status` (0 the evaluations ran out, 2 the cost stopped falling, 3 the step became negligible,
+    4 no step lowers the cost) and a `message`."""
+    x: np.ndarray
+    cost: float
+    nfev: int
+    status: int
+    message: str
+
+
+def levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, ftol=1e-8, xtol=1e-8, damping=1e-2):
+    """Minimise ½‖r(z)‖² for lo <= z <= hi by Levenberg–Marquardt steps on the normal equations
+    (JᵀJ + λ diag(d²)) δ = −Jᵀr, d the largest column norms of J seen so far (the scaling
+    SciPy's x_scale="jac" uses), λ adapted by the gain ratio (Nielsen's rule), a step leaving the
+    bounds projected onto them and the entries on a bound that the gradient pushes outwards held.
+    `evaluate(z)` -> (r, J sparse); an `IdentifyError` (a candidate robot the model refuses)
+    counts as a rejected step.  The multiple-shooting Jacobian has a
+    dozen global columns and a band of start-state columns, so JᵀJ is small and nearly block
+    tridiagonal and one Cholesky factorisation of it costs milliseconds; SciPy's dense
+    trust-region solver instead takes an SVD of the whole Jacobian at every iteration, most of the
+    fit's time."""
+    z = np.array(z0, dtype=float)
+    r, J = evaluate(z)
+    nfev = 1
+    cost = 0.5 * float(r @ r)
+    d = np.zeros(len(z))
+    lam, nu = damping, 2.0
+    status, message = 0, "the maximum number of evaluations is reached"
+    fresh = True
+    while nfev < max_nfev:
+        if fresh:
+            A = (J.T @ J).toarray()
+            g = J.T @ r
+            d = np.maximum(d, np.sqrt(np.diag(A)))
+            d[d == 0] = 1.0
+            fresh = False
+        # entries on a bound that the gradient pushes outwards are held (the active set)
+        free = ~(((z <= lo) & (g > 0)) | ((z >= hi) & (g < 0)))
+        try:
+            c = scipy.linalg.cho_factor(A[np.ix_(free, free)] + lam * np.diag(d[free] ** 2), check_finite=False)
+        except np.linalg.LinAlgError:
+            lam, nu = lam * nu, 2 * nu
+            continue
+        step = np.zeros(len(z))
+        step[free] = -scipy.linalg.cho_solve(c, g[free], check_finite=False)
+        step = np.clip(z + step, lo, hi) - z
+        predicted = -float(g @ step + 0.5 * step @ (A @ step))
+        if np.linalg.norm(d * step) <= xtol * (xtol + np.linalg.norm(d * z)):
+            status, message = 3, "the step became negligible"
+            break
+        if predicted <= 0 and lam <= 1e16:      # the projection turned the step uphill: a shorter one
+            lam, nu = lam * nu, 2 * nu
+            continue
+        try:
+            r_new, J_new = evaluate(z + step)
+            cost_new = 0.5 * float(r_new @ r_new)
+        except IdentifyError:
+            cost_new = math.inf
+        nfev += 1
+        rho = (cost - cost_new) / predicted if predicted > 0 else -1.0
+        if rho > 1e-3:
+            reduction = cost - cost_new
+            z, r, J, cost = z + step, r_new, J_new, cost_new
+            fresh = True
+            lam *= max(1 / 3, 1 - (2 * rho - 1) ** 3)
+            nu = 2.0
+            if reduction <= ftol * cost:
+                status, message = 2, "the cost stopped falling"
+                break
+        else:
+            lam, nu = lam * nu, 2 * nu
+            if lam > 1e16:
+                status, message = 4, "no step lowers the cost"
+                break
+    return Solution(x=z, cost=cost, nfev=nfev, status=status, message=message)
 
 
 def first_guess(log, params, free, prob, full_state, x_guess):

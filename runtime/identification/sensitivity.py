@@ -37,9 +37,16 @@ def step_jacobians(model, x, u, h, method, idx, jacobian):
     differences too ("fd-all")."""
     if jacobian == "analytic":
         return model.step_jacobians(x, u, h, method, columns=idx)
-    F = differenced_state_jacobian(model, x, u, h, method) if jacobian == "fd-all" else \
-        model.step_jacobian(x, u, h, method)[0]
-    return F, model.step_param_jacobian_fd(x, u, h, method, columns=idx)
+    return step_state_jacobian(model, x, u, h, method, jacobian), model.step_param_jacobian_fd(x, u, h, method,
+                                                                                              columns=idx)
+
+
+def step_state_jacobian(model, x, u, h, method, jacobian):
+    """The steps' state Jacobians F (B, 12, 12) alone, of the `jacobian` source: by differences for
+    "fd-all", else the analytic `Model.step_jacobian`."""
+    if jacobian == "fd-all":
+        return differenced_state_jacobian(model, x, u, h, method)
+    return model.step_jacobian(x, u, h, method)[0]
 
 
 def accel_state_jacobian(model, x, u, jacobian):

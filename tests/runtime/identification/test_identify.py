@@ -158,3 +158,15 @@ def test_the_coverage_command_counts_the_fits_whose_interval_holds_the_truth(tmp
     first = result["trials"][0]
     assert first["inside"] == (np.abs(np.subtract(first["estimate"], first["truth"]))
                                <= 1.959964 * np.array(first["sigma"])).tolist()
+
+
+def test_the_start_fits_segments_skip_the_parameter_sensitivities_and_nothing_else(short_log):
+    x, b = fitmod._start_guess(short_log, NOMINAL)
+    prob = fitmod._Problem(short_log, NOMINAL, free_parameters("k_S,m_P"), 0.5, "rkmk4", x, b)
+    model = prob.model(prob.theta_start)
+    start = prob._dretract(model, prob.xref[0], np.zeros(12))
+    full = prob.segment_block(model, 0, start, None, b)
+    held = prob.segment_block(model, 0, start, None, b, sensitivities=False)
+    np.testing.assert_array_equal(held["r"], full["r"])
+    np.testing.assert_array_equal(held["x"], full["x"])
+    assert np.any(full["th"] != 0) and not np.any(held["th"])
