@@ -39,8 +39,8 @@ from ..params import SHAPES, Params, flat_names
 from ..sensors import encoders_jacobian_batch, imu_partials_batch, position_jacobian_batch
 from ..state import IDX_E_NU, IDX_NU, NE, NV
 from .first_guess import _pi_of, regressor_guess
-from .sensitivity import JACOBIANS, accel_sensitivity, accel_state_jacobian, step_jacobians, step_sensitivity,
-                          step_state_jacobian
+from .sensitivity import (JACOBIANS, accel_sensitivity, accel_state_jacobian, step_jacobians, step_sensitivity,
+                          step_state_jacobian)
 
 #: Where the fit starts the parameters: the regressor's linear least-squares first guess, or the nominal robot.
 STARTS = ("regressor", "nominal")
