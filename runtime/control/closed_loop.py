@@ -88,8 +88,10 @@ def _target(reference, controller, t, y):
 
 #: How `simulate_on_sensors` steps the plant, its sensors and the filter between the controller's
 #: samples: "python", runtime/sensor_sim.py's SensorSimulation (the reference), or "c", the same in
-#: one C call per controller period (runtime/sensor_sim_c.py), with the same readings.
-ENGINES = ("python", "c")
+#: one C call per controller period (runtime/sensor_sim_c.py), with the same readings, or "c-loop", the
+#: controller and the reference's target in C too (runtime/control/loop_c.py: the LQR on a path, one
+#: C call per chunk of samples).
+ENGINES = ("python", "c", "c-loop")
 
 
 def simulate_on_sensors(plant_params, controller, reference, x0, duration, dt, estimator, sensors, method="rkmk4",
@@ -107,6 +109,9 @@ def simulate_on_sensors(plant_params, controller, reference, x0, duration, dt, e
         raise ValueError(f"duration: {duration:g} s is shorter than one controller period")
     steps = samples * per
     sim = SensorSimulation(Model(plant_params), sensors, dt, steps, method, seed)
+    if engine == "c-loop":
+        from .loop_c import run
+        return run(sim, controller, reference, x0, estimator, per, samples, record_samples, progress)
     if engine == "c":
         return _on_sensors_c(sim, controller, reference, x0, estimator, per, samples, progress, record_samples)
     traj = np.empty((steps + 1, x0.size))

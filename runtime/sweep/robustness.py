@@ -351,6 +351,13 @@ def with_nominal(inputs, groups):
     return out
 
 
+def engine(controller, reference):
+    """How a run is simulated: the whole loop in C where it runs the controller ("c-loop": the LQR),
+    else the plant, sensors and filter in C under the controller's Python ("c")."""
+    from ..control.loop_c import supports
+    return "c-loop" if supports(controller, reference) else "c"
+
+
 def run_one(spec, inputs):
     """The outcome {OUTCOMES: value} of one run with these inputs (a row of `draw`)."""
     from ..control.benchmark import estimate_errors
@@ -378,10 +385,11 @@ def run_one(spec, inputs):
     x0[IDX_RS] = (rot_z(float(inputs["dpsi0_rad"])) @ x0[IDX_RS].reshape(3, 3)).ravel()
     s = task.scenario
     estimator = SensorEkf(s.params, task.sensors, x0, s.method)
+    controller = task.controller()
     try:
-        result = simulate_on_sensors(plant, task.controller(), reference, x0, task.duration, s.dt, estimator,
-                                     task.sensors, s.method, int(inputs["sensor_seed"]), engine="c",
-                                     record_samples=False)
+        result = simulate_on_sensors(plant, controller, reference, x0, task.duration, s.dt, estimator,
+                                     task.sensors, s.method, int(inputs["sensor_seed"]),
+                                     engine=engine(controller, reference), record_samples=False)
     except KernelError as exc:
         out["status"] = exc.status
         return out
