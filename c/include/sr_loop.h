@@ -37,6 +37,7 @@ extern "C" {
 #define sr_path_check sr_path_check_f
 #define sr_path_target sr_path_target_f
 #define sr_path_curvature_ahead sr_path_curvature_ahead_f
+#define sr_path_cross_track sr_path_cross_track_f
 #define sr_loop_lqr sr_loop_lqr_f
 #endif
 
@@ -75,6 +76,13 @@ int sr_path_target(sr_path *path, const sr_real position[2], sr_lqr_target *targ
  * (n >= 0).  Returns SR_OK, SR_ERR_NULL (with n > 0), SR_ERR_ARG (n < 0, a hint out of range) or
  * SR_ERR_NONFINITE (a distance). */
 int sr_path_curvature_ahead(const sr_path *path, const sr_real *distances, int n, sr_real *out);
+
+/** The signed cross-track errors out[i] of n positions (rows of positions, stride >= 2 numbers apart,
+ * x and y first), matched in order: each searched around the last match as sr_path_target does
+ * (the first around path->hint), path->hint left at the last.  *first (may be NULL): the first
+ * position's nearest sample.  Returns SR_OK, SR_ERR_NULL (with n > 0), SR_ERR_ARG (n < 0, stride < 2,
+ * a hint out of range) or SR_ERR_NONFINITE (a position: out and the hint as far as it got). */
+int sr_path_cross_track(sr_path *path, const sr_real *positions, long n, long stride, sr_real *out, long *first);
 
 /** Controller samples first..first+count-1 of the LQR on the path, closed on the filter *ekf of
  * the run *sim (see the file's description); per plant steps per sample.  x[SR_NX]: the plant's

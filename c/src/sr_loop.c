@@ -66,6 +66,21 @@ int sr_path_target(sr_path *path, const sr_real position[2], sr_lqr_target *targ
     return SR_OK;
 }
 
+int sr_path_cross_track(sr_path *path, const sr_real *positions, long n, long stride, sr_real *out, long *first)
+{
+    sr_lqr_target target;
+    long i;
+    if (!path || (n > 0 && (!positions || !out))) return SR_ERR_NULL;
+    if (n < 0 || stride < 2) return SR_ERR_ARG;
+    for (i = 0; i < n; ++i) {
+        int status = sr_path_target(path, positions + i * stride, &target);
+        if (status != SR_OK) return status;
+        out[i] = target.cross_track;
+        if (i == 0 && first) *first = path->hint;
+    }
+    return SR_OK;
+}
+
 /* The curvature at arc length value: linear between samples, held beyond the ends (NumPy's interp). */
 static sr_real curvature_at(const sr_path *path, sr_real value)
 {

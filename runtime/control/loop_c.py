@@ -50,6 +50,24 @@ def c_path(reference, keep):
     return c
 
 
+def track(reference, positions):
+    """(signed cross-track errors (n,) [m], progress [m]) of positions (n, >= 2) matched in order on
+    the path `reference` (from its start), in one C call (sr_path_cross_track): what
+    `Path.cross_track` gives, and the arc length from the first position's nearest sample to the
+    last one's."""
+    positions = np.ascontiguousarray(positions, dtype=np.float64)
+    if positions.ndim != 2 or positions.shape[1] < 2 or len(positions) == 0:
+        raise ValueError(f"positions: expected an (n, >= 2) array with n >= 1, got shape {positions.shape}")
+    keep = []
+    path = c_path(reference, keep)
+    path.hint = 0
+    out, first = np.empty(len(positions)), ffi.new("long *")
+    status = lib.sr_path_cross_track(path, _ptr(positions), len(positions), positions.shape[1], _ptr(out), first)
+    if status != lib.SR_OK:
+        raise ValueError(f"positions: {ffi.string(lib.sr_status_string(status)).decode()}")
+    return out, float(reference.s[path.hint] - reference.s[first[0]])
+
+
 def _ptr(arr):
     return ffi.cast("double *", ffi.from_buffer(arr))
 

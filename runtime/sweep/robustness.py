@@ -334,8 +334,11 @@ def judge(reference, t, positions, rms_limit, coverage):
     length over the run, success) of the positions (n, 2) at times t (n,) on a path reference.
     Success: the RMS within `rms_limit` and the progress at least `coverage`: a run that stalls on
     the path fails however close it stays, and so does one that runs far off it."""
-    rms, largest = second_half_stats(t, reference.cross_track(positions))
-    fraction = progress(reference, positions) / (abs(reference.speed) * (t[-1] - t[0]))
+    from ..control.loop_c import track
+    # The path's own search (Path.cross_track, `progress`) in one C call: the same samples matched.
+    cross_track, travelled = track(reference, positions)
+    rms, largest = second_half_stats(t, cross_track)
+    fraction = travelled / (abs(reference.speed) * (t[-1] - t[0]))
     return rms, largest, fraction, bool(rms <= rms_limit and fraction >= coverage)
 
 

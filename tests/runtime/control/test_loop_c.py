@@ -11,7 +11,7 @@ from runtime.control.closed_loop import simulate_on_sensors
 from runtime.control.estimator import SensorEkf
 from runtime.control.geometry import heading
 from runtime.control.lqr import Lqr
-from runtime.control.loop_c import c_path, supports
+from runtime.control.loop_c import c_path, supports, track
 from runtime.control.reference import Path
 from runtime.state import IDX_Q
 from runtime.sweep.robustness import _task
@@ -120,3 +120,16 @@ def test_a_controller_with_python_of_its_own_is_not_run_in_c():
         simulate_on_sensors(s.params, sloped, task.reference(), s.x0, 0.1, s.dt,
                             SensorEkf(s.params, task.sensors, s.x0, s.method), task.sensors, s.method, 1,
                             engine="c-loop")
+
+
+def test_a_track_of_positions_equals_the_paths_own_matching():
+    from runtime.sweep.robustness import progress
+    x0 = _task("circle", "lqr", "default").scenario.x0
+    path = _winding_path(x0, 0.3)
+    rng = np.random.default_rng(1)
+    s = np.linspace(0.1, 1.9, 300)
+    positions = np.stack([np.interp(s, path.s, path.points[:, 0]), np.interp(s, path.s, path.points[:, 1]),
+                          np.zeros_like(s)], 1) + rng.normal(0.0, 0.02, (300, 3))
+    cross_track, travelled = track(path, positions)
+    np.testing.assert_allclose(cross_track, path.cross_track(positions), rtol=1e-12, atol=1e-15)
+    assert travelled == progress(path, positions) > 1.5
