@@ -84,15 +84,15 @@ int sr_path_curvature_ahead(const sr_path *path, const sr_real *distances, int n
  * a hint out of range) or SR_ERR_NONFINITE (a position: out and the hint as far as it got). */
 int sr_path_cross_track(sr_path *path, const sr_real *positions, long n, long stride, sr_real *out, long *first);
 
-/** Controller samples first..first+count-1 of the LQR on the path, closed on the filter *ekf of
- * the run *sim (see the file's description); per plant steps per sample.  x[SR_NX]: the plant's
+/** Controller samples first..first+count-1 of the LQR on the path, closed on the filter ekf of
+ * the run sim (see the file's description); per plant steps per sample.  x[SR_NX]: the plant's
  * state, overwritten with the state after the last sample; u[SR_NU]: the torques held before sample
  * first (zeros at the start), overwritten with the last sample's.  preview: n_preview distances [m]
- * (NULL with 0).  Outputs (each NULL or count rows): traj count*per x SR_NX (the plant after each
- * step), torques count x SR_NU, estimates count x SR_NX (what the controller read), applied count
- * (the run's samples applied by the end of each controller sample).  *saturated (may be NULL) is
- * increased by the samples at which a torque reached u_max within a relative 1e-9.  *done: the
- * samples completed; *failed_in: where an error stopped the run (SR_LOOP_*).  Returns SR_OK,
+ * (NULL with 0).  Outputs (each NULL or count rows): traj (count times per) x SR_NX (the plant after
+ * each step), torques count x SR_NU, estimates count x SR_NX (what the controller read), applied count
+ * (the run's samples applied by the end of each controller sample).  saturated (may be NULL) is
+ * increased by the samples at which a torque reached u_max within a relative 1e-9.  done: the
+ * samples completed; failed_in: where an error stopped the run (SR_LOOP_*).  Returns SR_OK,
  * SR_ERR_NULL, SR_ERR_ARG (per < 1, count < 0, n_preview < 0, steps beyond the run, an invalid
  * schedule's sizes), sr_sim_check's or sr_path_check's status, or the first failing call's. */
 int sr_loop_lqr(sr_sim *sim, const sr_model *plant, sr_ekf *ekf, const sr_model *model, const sr_lqr *lqr,
