@@ -161,11 +161,16 @@ def _on_sensors_c(sim, controller, reference, x0, estimator, per, samples, progr
     controller.reset(estimator.at(0.0, u))
     if hasattr(reference, "reset"):
         reference.reset()
+    # A path's target and preview read in C, as the whole C loop reads them.
+    from .loop_c import PathTargets
+    from .reference import Path
+    target_of = PathTargets(reference, controller) if type(reference) is Path else \
+        (lambda t, y: _target(reference, controller, t, y))
     started = time.perf_counter()
     for k in tqdm(range(samples), disable=not progress or None, unit="sample", leave=False):
         t = k * controller.period
         y = estimates[k] = estimator.at(t, u)
-        u = controller.update(t, y, _target(reference, controller, t, y))
+        u = controller.update(t, y, target_of(t, y))
         torques[k * per:(k + 1) * per] = u
         before = run.applied
         run.advance(k * per, per, x, u, traj[k * per + 1:(k + 1) * per + 1])

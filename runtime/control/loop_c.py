@@ -10,6 +10,7 @@ estimate's position, the operating curvature the mean over the controller's prev
 the run advanced one period.  That loop stays the reference it is tested against.  Controllers
 with Python of their own per sample (the slope's feedforward or estimate) are not supported.
 """
+import dataclasses
 import time
 
 import numpy as np
@@ -18,9 +19,9 @@ from bindings._sr import ffi, lib
 
 from ..errors import KernelError
 from ..sensor_sim_c import SensorRunC
-from ..state import NU
+from ..state import IDX_Q, NU
 from .lqr import Lqr
-from .reference import SEARCH_AHEAD_M, SEARCH_BACK_M, Path
+from .reference import SEARCH_AHEAD_M, SEARCH_BACK_M, Path, Target
 
 #: Controller samples per C call (a progress bar moves between calls).
 CHUNK = 500
@@ -48,6 +49,38 @@ def c_path(reference, keep):
         raise ValueError(f"reference: the path is not valid for the C loop "
                          f"({ffi.string(lib.sr_status_string(status)).decode()})")
     return c
+
+
+class PathTargets:
+    """`targets(t, y)` -> the Target of the path `reference` at the estimate y, with the curvature
+    ahead at `controller`'s preview distances: what closed_loop.py's Python target gives, read in C
+    (sr_path_target, sr_path_curvature_ahead) for the closed loop whose controller stays in Python.
+    The reference's hint follows."""
+
+    def __init__(self, reference, controller):
+        self.reference, self.controller = reference, controller
+        self._keep = []
+        self._path = c_path(reference, self._keep)
+        self._target = ffi.new("sr_lqr_target *")
+        self._preview = hasattr(controller, "preview_distances")
+        self._distances, self._ahead = None, None
+
+    def __call__(self, t, y):
+        """The target at time t [s] for the estimate y (35,)."""
+        y = np.ascontiguousarray(y, dtype=np.float64)
+        status = lib.sr_path_target(self._path, _ptr(y) + IDX_Q.start, self._target)
+        if status != lib.SR_OK:
+            raise ValueError(f"reference: {ffi.string(lib.sr_status_string(status)).decode()} at t = {t:g} s")
+        self.reference._hint = int(self._path.hint)
+        c = self._target
+        target = Target(c.speed, c.heading, c.curvature, c.cross_track)
+        if not self._preview:
+            return target
+        distances = np.ascontiguousarray(self.controller.preview_distances(target), dtype=np.float64)
+        if self._ahead is None or len(self._ahead) != len(distances):
+            self._ahead = np.empty(len(distances))
+        lib.sr_path_curvature_ahead(self._path, _ptr(distances), len(distances), _ptr(self._ahead))
+        return dataclasses.replace(target, curvature_ahead=tuple(self._ahead.tolist()))
 
 
 def track(reference, positions):

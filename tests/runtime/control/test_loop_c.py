@@ -133,3 +133,16 @@ def test_a_track_of_positions_equals_the_paths_own_matching():
     cross_track, travelled = track(path, positions)
     np.testing.assert_allclose(cross_track, path.cross_track(positions), rtol=1e-12, atol=1e-15)
     assert travelled == progress(path, positions) > 1.5
+
+
+def test_the_c_nmpcs_loop_with_the_targets_read_in_c_equals_the_python_loop():
+    task = _task("figure8", "nmpc-c", "default").with_sensors(_sensors())
+    s = task.scenario
+    x0 = s.x0.copy()
+    x0[IDX_Q.start] += 0.04
+
+    def run(engine):
+        return simulate_on_sensors(s.params, task.controller(), task.reference(), x0, 0.3, s.dt,
+                                   SensorEkf(s.params, task.sensors, x0, s.method), task.sensors, s.method, 5,
+                                   engine=engine)
+    assert_same_run(run("python"), run("c"))
