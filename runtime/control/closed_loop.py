@@ -88,8 +88,10 @@ def _target(reference, controller, t, y):
 
 #: How `simulate_on_sensors` steps the plant, its sensors and the filter between the controller's
 #: samples: "python", runtime/sensor_sim.py's SensorSimulation (the reference), or "c", the same in
-#: one C call per controller period (runtime/sensor_sim_c.py), with the same readings.
-ENGINES = ("python", "c")
+#: one C call per controller period (runtime/sensor_sim_c.py), with the same readings, or "c-loop", the
+#: controller and the reference's target in C too (runtime/control/loop_c.py: the LQR on a path, one
+#: C call per chunk of samples).
+ENGINES = ("python", "c", "c-loop")
 
 
 def simulate_on_sensors(plant_params, controller, reference, x0, duration, dt, estimator, sensors, method="rkmk4",
@@ -107,6 +109,9 @@ def simulate_on_sensors(plant_params, controller, reference, x0, duration, dt, e
         raise ValueError(f"duration: {duration:g} s is shorter than one controller period")
     steps = samples * per
     sim = SensorSimulation(Model(plant_params), sensors, dt, steps, method, seed)
+    if engine == "c-loop":
+        from .loop_c import run
+        return run(sim, controller, reference, x0, estimator, per, samples, record_samples, progress)
     if engine == "c":
         return _on_sensors_c(sim, controller, reference, x0, estimator, per, samples, progress, record_samples)
     traj = np.empty((steps + 1, x0.size))
@@ -156,11 +161,16 @@ def _on_sensors_c(sim, controller, reference, x0, estimator, per, samples, progr
     controller.reset(estimator.at(0.0, u))
     if hasattr(reference, "reset"):
         reference.reset()
+    # A path's target and preview read in C, as the whole C loop reads them.
+    from .loop_c import PathTargets
+    from .reference import Path
+    target_of = PathTargets(reference, controller) if type(reference) is Path else \
+        (lambda t, y: _target(reference, controller, t, y))
     started = time.perf_counter()
     for k in tqdm(range(samples), disable=not progress or None, unit="sample", leave=False):
         t = k * controller.period
         y = estimates[k] = estimator.at(t, u)
-        u = controller.update(t, y, _target(reference, controller, t, y))
+        u = controller.update(t, y, target_of(t, y))
         torques[k * per:(k + 1) * per] = u
         before = run.applied
         run.advance(k * per, per, x, u, traj[k * per + 1:(k + 1) * per + 1])

@@ -334,8 +334,11 @@ def judge(reference, t, positions, rms_limit, coverage):
     length over the run, success) of the positions (n, 2) at times t (n,) on a path reference.
     Success: the RMS within `rms_limit` and the progress at least `coverage`: a run that stalls on
     the path fails however close it stays, and so does one that runs far off it."""
-    rms, largest = second_half_stats(t, reference.cross_track(positions))
-    fraction = progress(reference, positions) / (abs(reference.speed) * (t[-1] - t[0]))
+    from ..control.loop_c import track
+    # The path's own search (Path.cross_track, `progress`) in one C call: the same samples matched.
+    cross_track, travelled = track(reference, positions)
+    rms, largest = second_half_stats(t, cross_track)
+    fraction = travelled / (abs(reference.speed) * (t[-1] - t[0]))
     return rms, largest, fraction, bool(rms <= rms_limit and fraction >= coverage)
 
 
@@ -349,6 +352,13 @@ def with_nominal(inputs, groups):
     for group in groups:
         out.update(GROUPS[group])
     return out
+
+
+def engine(controller, reference):
+    """How a run is simulated: the whole loop in C where it runs the controller ("c-loop": the LQR),
+    else the plant, sensors and filter in C under the controller's Python ("c")."""
+    from ..control.loop_c import supports
+    return "c-loop" if supports(controller, reference) else "c"
 
 
 def run_one(spec, inputs):
@@ -378,10 +388,11 @@ def run_one(spec, inputs):
     x0[IDX_RS] = (rot_z(float(inputs["dpsi0_rad"])) @ x0[IDX_RS].reshape(3, 3)).ravel()
     s = task.scenario
     estimator = SensorEkf(s.params, task.sensors, x0, s.method)
+    controller = task.controller()
     try:
-        result = simulate_on_sensors(plant, task.controller(), reference, x0, task.duration, s.dt, estimator,
-                                     task.sensors, s.method, int(inputs["sensor_seed"]), engine="c",
-                                     record_samples=False)
+        result = simulate_on_sensors(plant, controller, reference, x0, task.duration, s.dt, estimator,
+                                     task.sensors, s.method, int(inputs["sensor_seed"]),
+                                     engine=engine(controller, reference), record_samples=False)
     except KernelError as exc:
         out["status"] = exc.status
         return out

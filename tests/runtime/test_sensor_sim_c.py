@@ -87,7 +87,7 @@ def test_the_sample_list_may_be_left_out():
 def test_an_unknown_engine_is_a_value_error_naming_it():
     task = _task("line", "lqr", "default")
     s = task.scenario
-    with pytest.raises(ValueError, match="engine: expected one of python, c, got 'fortran'"):
+    with pytest.raises(ValueError, match="engine: expected one of python, c, c-loop, got 'fortran'"):
         simulate_on_sensors(s.params, task.controller(), task.reference(), s.x0, 0.1, s.dt,
                             SensorEkf(s.params, task.sensors, s.x0, s.method), task.sensors, s.method, 1,
                             engine="fortran")
