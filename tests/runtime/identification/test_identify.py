@@ -168,5 +168,7 @@ def test_the_start_fits_segments_skip_the_parameter_sensitivities_and_nothing_el
     full = prob.segment_block(model, 0, start, None, b)
     held = prob.segment_block(model, 0, start, None, b, sensitivities=False)
     np.testing.assert_array_equal(held["r"], full["r"])
-    np.testing.assert_array_equal(held["x"], full["x"])
+    # the state columns: the step's F alone against F from the one pass with the sensitivities,
+    # two kernels that differ only in rounding
+    np.testing.assert_allclose(held["x"], full["x"], rtol=1e-10, atol=1e-10 * np.abs(full["x"]).max())
     assert np.any(full["th"] != 0) and not np.any(held["th"])
