@@ -111,7 +111,8 @@ def simulate_on_sensors(plant_params, controller, reference, x0, duration, dt, e
     sim = SensorSimulation(Model(plant_params), sensors, dt, steps, method, seed)
     if engine == "c-loop":
         from .loop_c import run
-        return run(sim, controller, reference, x0, estimator, per, samples, record_samples, progress)
+        return ClosedLoopResult(**run(sim, controller, reference, x0, estimator, per, samples, record_samples,
+                                      progress))
     if engine == "c":
         return _on_sensors_c(sim, controller, reference, x0, estimator, per, samples, progress, record_samples)
     traj = np.empty((steps + 1, x0.size))

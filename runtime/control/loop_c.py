@@ -107,11 +107,11 @@ def _ptr(arr):
 
 def run(sim, controller, reference, x0, estimator, per, samples, record_samples, progress=False):
     """The closed loop of `samples` controller samples of `per` plant steps each on the run `sim`
-    (a SensorSimulation) with the filter of `estimator` (a SensorEkf): a ClosedLoopResult.  Its
+    (a SensorSimulation) with the filter of `estimator` (a SensorEkf): the fields of closed_loop.py's
+    ClosedLoopResult, as a dict (closed_loop builds the result: it imports this module).  Its
     `solve_s` is the loop's own time spread evenly over the samples (the controller is not timed
     apart from the plant in C)."""
     from tqdm.auto import tqdm
-    from .closed_loop import ClosedLoopResult
     if not supports(controller, reference):
         raise ValueError(f"engine: the C loop runs the LQR on a path reference without slope feedforward, "
                          f"got {controller.kind} on {type(reference).__name__}")
@@ -156,7 +156,7 @@ def run(sim, controller, reference, x0, estimator, per, samples, record_samples,
     steps_torques[-1] = steps_torques[-2]
     ticks = np.arange(samples) * controller.period
     counts = np.diff(applied, prepend=0)
-    return ClosedLoopResult(time=np.arange(len(traj)) * sim.dt, trajectory=traj, torques=steps_torques,
-                            control_time=ticks, saturated_fraction=controller.saturated_fraction,
-                            solve_s=np.asarray(controller.solve_s), wall_time_s=wall, estimates=estimates,
-                            samples=sim_c.samples(ticks, counts) if record_samples else None)
+    return dict(time=np.arange(len(traj)) * sim.dt, trajectory=traj, torques=steps_torques,
+                control_time=ticks, saturated_fraction=controller.saturated_fraction,
+                solve_s=np.asarray(controller.solve_s), wall_time_s=wall, estimates=estimates,
+                samples=sim_c.samples(ticks, counts) if record_samples else None)
