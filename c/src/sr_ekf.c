@@ -4,13 +4,19 @@
 #include "sr_argcheck.h"
 #include "sr_checks.h"
 #include "sr_so3.h"
+#include "sr_kernels.h"
 #include "sr_step_jacobians.h"
+#include "sr_unchecked.h"
 
 #include <string.h>
 
 #define NB SR_NEB
 #define NE SR_NE
 #define MAXM SR_NIMU /* the largest sample */
+/* The stride of the update's rows (gain, cross-covariance, Joseph terms, new covariance): NB
+ * padded with zeros to a multiple of four, so that every row operation is whole vectors of two or
+ * four numbers, without a remainder. */
+#define NBP (NB + 3 - (NB + 3) % 4)
 
 #ifdef SR_USE_FLOAT
 #define SR_FMOD fmodf
@@ -18,9 +24,9 @@
 #define SR_FMOD fmod
 #endif
 
-/* The Joseph form by pairs of columns (apply) needs an even NB, the predict's pairs of rows an
- * even NE; the predict's skip of the dq columns, that they are the two before nu. */
-typedef char layout_fits[(NB % 2 == 0 && NE % 2 == 0 && SR_E_nu == SR_E_q + 2) ? 1 : -1];
+/* The predict's pairs of rows need an even NE; its skip of the dq columns, that they are the two
+ * before nu. */
+typedef char layout_fits[(NE % 2 == 0 && SR_E_nu == SR_E_q + 2) ? 1 : -1];
 
 static const sr_real pi_ = SR_C(3.14159265358979323846);
 
@@ -40,7 +46,7 @@ static sr_real angle_difference(sr_real a, sr_real b)
 static inline void row_minus(sr_real a, const sr_real *restrict x, sr_real *restrict y)
 {
     int k;
-    for (k = 0; k < NB; ++k) y[k] -= a * x[k];
+    for (k = 0; k < NBP; ++k) y[k] -= a * x[k];
 }
 
 static inline void row_plus(sr_real a, const sr_real *restrict x, sr_real *restrict y)
@@ -54,7 +60,7 @@ static inline void rows_minus2(sr_real a, const sr_real *restrict x, sr_real b, 
                                sr_real *restrict y)
 {
     int k;
-    for (k = 0; k < NB; ++k) y[k] -= a * x[k] + b * z[k];
+    for (k = 0; k < NBP; ++k) y[k] -= a * x[k] + b * z[k];
 }
 
 static inline void rows_plus2(sr_real a, const sr_real *restrict x, sr_real b, const sr_real *restrict z,
@@ -175,7 +181,7 @@ static int torque_noise(const sr_model *model, const sr_real x[SR_NX], const sr_
     sr_real M[SR_NV * SR_NV], L[SR_NV * SR_NV], Z[SR_NV * SR_NV], col[SR_NV];
     const sr_real d[SR_NV] = {q->torque_psd[0], q->torque_psd[0], q->torque_psd[0], q->torque_psd[1],
                               q->torque_psd[2]};
-    int status = sr_inertia(model, x, M), i, j, k;
+    int status = sr_internal_inertia(model, x, M), i, j, k;
     if (status == SR_OK) status = cholesky(SR_NV, M, L);
     if (status != SR_OK) return status;
     for (j = 0; j < SR_NV; ++j) {
@@ -184,10 +190,10 @@ static int torque_noise(const sr_model *model, const sr_real x[SR_NX], const sr_
         for (i = 0; i < SR_NV; ++i) Z[SR_NV * i + j] = col[i];
     }
     for (i = 0; i < SR_NV; ++i)
-        for (j = 0; j < SR_NV; ++j) {
+        for (j = i; j < SR_NV; ++j) {
             sr_real s = 0;
             for (k = 0; k < SR_NV; ++k) s += Z[SR_NV * i + k] * Z[SR_NV * j + k];
-            Q[SR_NV * i + j] = dt * s;
+            Q[SR_NV * i + j] = Q[SR_NV * j + i] = dt * s;
         }
     return SR_OK;
 }
@@ -248,10 +254,10 @@ static void release_held(sr_ekf *ekf, sr_real g, const sr_ekf_held *next)
     ekf->held = *next;
 }
 
-int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real u[SR_NU], sr_real dt,
+SR_LANES_CLONES int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real u[SR_NU], sr_real dt,
                    const sr_ekf_process *process)
 {
-    sr_real xn[SR_NX], F[NE * NE], Qnu[SR_NV * SR_NV], T[NE * NB], Pn[NB * NB], g, white;
+    sr_real xn[SR_NX], F[NE * NE], Qnu[SR_NV * SR_NV], T[NE * NBP], Pp[NE * NBP], Pn[NB * NB], g, white;
     sr_ekf_held next;
     int status = arg_model(model, READS(WHOLE)), i, j, k, dq_identity = 1, cols[NE], ncols = 0;
     if (status != SR_OK) return status;
@@ -278,27 +284,32 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
     }
     for (k = 0; k < NE; ++k)   /* the columns summed */
         if (!dq_identity || (k != SR_E_q && k != SR_E_q + 1)) cols[ncols++] = k;
+    /* P's first NE rows padded to NBP (whole vectors, no remainder). */
+    for (i = 0; i < NE; ++i) {
+        memcpy(Pp + NBP * i, ekf->P + NB * i, NB * sizeof(sr_real));
+        for (j = NB; j < NBP; ++j) Pp[NBP * i + j] = 0;
+    }
     for (i = 0; i < NE; ++i) {
         if (dq_identity && (i == SR_E_q || i == SR_E_q + 1))
-            memcpy(T + NB * i, ekf->P + NB * i, NB * sizeof(sr_real));
+            memcpy(T + NBP * i, Pp + NBP * i, NBP * sizeof(sr_real));
         else
-            memset(T + NB * i, 0, NB * sizeof(sr_real));
+            memset(T + NBP * i, 0, NBP * sizeof(sr_real));
     }
     /* Two rows of T and two rows of P a pass: each load serves two products. */
     for (i = 0; i < NE; i += 2) {
-        sr_real *T0 = T + NB * i, *T1 = T0 + NB;
+        sr_real *T0 = T + NBP * i, *T1 = T0 + NBP;
         const sr_real *F0 = F + NE * i, *F1 = F0 + NE;
         for (k = 0; k + 1 < ncols; k += 2) {
             const sr_real a0 = F0[cols[k]], a1 = F0[cols[k + 1]], b0 = F1[cols[k]], b1 = F1[cols[k + 1]];
-            const sr_real *P0 = ekf->P + NB * cols[k], *P1 = ekf->P + NB * cols[k + 1];
-            for (j = 0; j < NB; ++j) {
+            const sr_real *P0 = Pp + NBP * cols[k], *P1 = Pp + NBP * cols[k + 1];
+            for (j = 0; j < NBP; ++j) {
                 T0[j] += a0 * P0[j] + a1 * P1[j];
                 T1[j] += b0 * P0[j] + b1 * P1[j];
             }
         }
         for (; k < ncols; ++k) {
-            const sr_real a0 = F0[cols[k]], b0 = F1[cols[k]], *Pk = ekf->P + NB * cols[k];
-            for (j = 0; j < NB; ++j) {
+            const sr_real a0 = F0[cols[k]], b0 = F1[cols[k]], *Pk = Pp + NBP * cols[k];
+            for (j = 0; j < NBP; ++j) {
                 T0[j] += a0 * Pk[j];
                 T1[j] += b0 * Pk[j];
             }
@@ -307,14 +318,14 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
     for (i = 0; i < NE; ++i)
         for (j = i; j < NE; ++j) {
             sr_real s = 0;
-            for (k = 0; k < NE; ++k) s += T[NB * i + k] * F[NE * j + k];
+            for (k = 0; k < NE; ++k) s += T[NBP * i + k] * F[NE * j + k];
             Pn[NB * i + j] = Pn[NB * j + i] = s;
         }
     for (i = 0; i < SR_NV && white > 0; ++i)
         for (j = 0; j < SR_NV; ++j) Pn[NB * (SR_EB_nu + i) + SR_EB_nu + j] += white * Qnu[SR_NV * i + j];
     /* The cross terms F P_db (in T already); the bias block only gains its random walk. */
     for (i = 0; i < NE; ++i)
-        for (j = NE; j < NB; ++j) Pn[NB * i + j] = Pn[NB * j + i] = T[NB * i + j];
+        for (j = NE; j < NB; ++j) Pn[NB * i + j] = Pn[NB * j + i] = T[NBP * i + j];
     for (i = NE; i < NB; ++i)
         for (j = NE; j < NB; ++j) Pn[NB * i + j] = ekf->P[NB * i + j];
     for (i = 0; i < 3; ++i) {
@@ -346,7 +357,7 @@ int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real
 
 /* A held disturbance a (sr_ekf.h, "Held disturbance") through an applied sample, e <- G (e - K r): its
  * cross-covariance moves as a waiting fix's, C <- G (C - K Wa) with Wa = Cov(r, a) (m x SR_NV); a
- * itself is not revised; a recovery's lambda scales all of its covariances. */
+ * itself is not revised; a recovery's lambda scales all of its covariances.  KT as in apply (m rows of NBP). */
 static void carry_held(sr_ekf_held *h, int m, const sr_real *KT, const sr_real *Wa, const sr_real Jr[9],
                        sr_real inflate)
 {
@@ -356,7 +367,7 @@ static void carry_held(sr_ekf_held *h, int m, const sr_real *KT, const sr_real *
     for (a = 0; a < NB; ++a)
         for (b = 0; b < SR_NV; ++b) {
             sr_real s = h->cross[SR_NV * a + b];
-            for (i = 0; i < m; ++i) s -= KT[NB * i + a] * Wa[SR_NV * i + b];
+            for (i = 0; i < m; ++i) s -= KT[NBP * i + a] * Wa[SR_NV * i + b];
             h->cross[SR_NV * a + b] = inflate * s;
         }
     for (i = 0; i < SR_NV * SR_NV; ++i) h->cov[i] *= inflate;
@@ -383,16 +394,18 @@ static void held_of_sample(const sr_ekf_held *h, int m, const int *nnz, const in
 }
 
 /* Applies an m-entry sample with innovation r, the transposed cross-covariance CT = Cov(e, r)^T
- * (m x NB, row-major) and innovation covariance S (m x m, stride m): gate, gain, the covariance
+ * (m rows of NBP, zero padded) and innovation covariance S (m x m, stride m): gate, gain, the covariance
  * update, injection, reset; W[j] (m x 2, stride 2, at MAXM * 2 j) is Cov(r, z_j) for every waiting
  * slot j (not `released`, the slot this sample comes from, freed whether applied or gated).  The
- * gain and the Joseph terms are kept transposed (m rows of NB), so that every inner loop runs along
- * a row of NB contiguous numbers.  The filter is written only on SR_OK. */
-static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_real *r, const sr_real *CT,
+ * gain and the Joseph terms are kept transposed (m rows of NBP), so that every inner loop runs along
+ * a row of NBP contiguous numbers.  The filter is written only on SR_OK.  SR_LANES_CLONES: with
+ * -DSR_CLONES also compiled for AVX2 (four numbers a vector, the same bits: no FMA, no contraction),
+ * as are update and the predict. */
+static SR_LANES_CLONES int apply(sr_ekf *ekf, int kind, int m, const sr_real *r, const sr_real *CT,
                  const sr_real *S, sr_real gate, const sr_real *W, int released, const sr_real *Wa)
 {
-    sr_real L[MAXM * MAXM], KT[MAXM * NB], DT[MAXM * NB], Pn[NB * NB];
-    sr_real z[MAXM], e[NB], xn[SR_NX], Jr[9], T[3 * NB], nis = 0, inflate = 1;
+    sr_real L[MAXM * MAXM], KT[MAXM * NBP], DT[MAXM * NBP], Pn[NB * NBP];
+    sr_real z[MAXM], e[NBP], xn[SR_NX], Jr[9], T[3 * NB], nis = 0, inflate = 1;
     int a, b, i, j, k, status, recovering = 0;
 
     status = cholesky(m, S, L);
@@ -418,86 +431,89 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
     /* K^T = S^-1 C^T = L^-T L^-1 C^T, both substitutions on all NB columns at once, by the pivots'
      * reciprocals (a division per pivot, not per entry); e = K r. */
     for (i = 0; i < m; ++i) {
-        sr_real *Ki = KT + NB * i;
+        sr_real *Ki = KT + NBP * i;
         const sr_real d = 1 / L[m * i + i];
-        for (a = 0; a < NB; ++a) Ki[a] = CT[NB * i + a];
+        for (a = 0; a < NBP; ++a) Ki[a] = CT[NBP * i + a];
         for (k = 0; k + 1 < i; k += 2)
-            rows_minus2(L[m * i + k], KT + NB * k, L[m * i + k + 1], KT + NB * (k + 1), Ki);
-        if (k < i) row_minus(L[m * i + k], KT + NB * k, Ki);
-        for (a = 0; a < NB; ++a) Ki[a] *= d;
+            rows_minus2(L[m * i + k], KT + NBP * k, L[m * i + k + 1], KT + NBP * (k + 1), Ki);
+        if (k < i) row_minus(L[m * i + k], KT + NBP * k, Ki);
+        for (a = 0; a < NBP; ++a) Ki[a] *= d;
     }
     for (i = m - 1; i >= 0; --i) {
-        sr_real *Ki = KT + NB * i;
+        sr_real *Ki = KT + NBP * i;
         const sr_real d = 1 / L[m * i + i];
         for (k = i + 1; k + 1 < m; k += 2)
-            rows_minus2(L[m * k + i], KT + NB * k, L[m * (k + 1) + i], KT + NB * (k + 1), Ki);
-        if (k < m) row_minus(L[m * k + i], KT + NB * k, Ki);
-        for (a = 0; a < NB; ++a) Ki[a] *= d;
+            rows_minus2(L[m * k + i], KT + NBP * k, L[m * (k + 1) + i], KT + NBP * (k + 1), Ki);
+        if (k < m) row_minus(L[m * k + i], KT + NBP * k, Ki);
+        for (a = 0; a < NBP; ++a) Ki[a] *= d;
     }
-    for (a = 0; a < NB; ++a) e[a] = 0;
+    for (a = 0; a < NBP; ++a) e[a] = 0;
     for (i = 0; i < m; ++i)
-        for (a = 0; a < NB; ++a) e[a] += KT[NB * i + a] * r[i];
+        for (a = 0; a < NBP; ++a) e[a] += KT[NBP * i + a] * r[i];
     /* The Joseph form (I - K H) P (I - K H)^T + K R K^T, expanded with C = P H^T and S = H P H^T + R:
      * P - K C^T - C K^T + K S K^T = P - K C^T - (C - K S) K^T.  The same polynomial in K (exact
      * for any gain, so an error in K enters only to second order), in O(NB^2 m) on the upper
      * triangle instead of the products of 18 x 18 matrices.  For a delayed fix the same
      * expression is the covariance of e - K r with C its cross-covariance.  D^T = C^T - S K^T. */
     for (i = 0; i < m; ++i) {
-        sr_real *Di = DT + NB * i;
-        for (a = 0; a < NB; ++a) Di[a] = CT[NB * i + a];
+        sr_real *Di = DT + NBP * i;
+        for (a = 0; a < NBP; ++a) Di[a] = CT[NBP * i + a];
         for (j = 0; j + 1 < m; j += 2)
-            rows_minus2(S[m * j + i], KT + NB * j, S[m * (j + 1) + i], KT + NB * (j + 1), Di);
-        if (j < m) row_minus(S[m * j + i], KT + NB * j, Di);
+            rows_minus2(S[m * j + i], KT + NBP * j, S[m * (j + 1) + i], KT + NBP * (j + 1), Di);
+        if (j < m) row_minus(S[m * j + i], KT + NBP * j, Di);
     }
-    /* Row a from the pair of columns that holds the diagonal: two columns a statement, which
-     * compilers turn into one vector operation (the entry left of an odd diagonal is computed and
-     * then overwritten by the copy of the upper triangle). */
+    /* Row a from the group of four columns that holds the diagonal: four columns a statement
+     * group, which compilers turn into vector operations (the entries left of the diagonal are
+     * computed and then overwritten by the copy of the upper triangle; the padding is zero). */
     for (a = 0; a < NB; ++a) {
-        sr_real *row = Pn + NB * a;
-        const int b0 = a - a % 2;
-        for (b = b0; b < NB; b += 2) {
-            row[b] = ekf->P[NB * a + b];
-            row[b + 1] = ekf->P[NB * a + b + 1];
-        }
+        sr_real *row = Pn + NBP * a;
+        const int b0 = a - a % 4;
+        for (b = b0; b < NB; ++b) row[b] = ekf->P[NB * a + b];
+        for (b = NB; b < NBP; ++b) row[b] = 0;
         for (i = 0; i + 1 < m; i += 2) {   /* two entries of the sample a pass: half the row's loads and stores */
-            const sr_real ka = KT[NB * i + a], da = DT[NB * i + a], *Ci = CT + NB * i, *Ki = KT + NB * i;
-            const sr_real kb = KT[NB * (i + 1) + a], db = DT[NB * (i + 1) + a], *Cj = Ci + NB, *Kj = Ki + NB;
-            for (b = b0; b < NB; b += 2) {
+            const sr_real ka = KT[NBP * i + a], da = DT[NBP * i + a], *Ci = CT + NBP * i, *Ki = KT + NBP * i;
+            const sr_real kb = KT[NBP * (i + 1) + a], db = DT[NBP * (i + 1) + a], *Cj = Ci + NBP, *Kj = Ki + NBP;
+            for (b = b0; b < NBP; b += 4) {
                 row[b] -= (ka * Ci[b] + da * Ki[b]) + (kb * Cj[b] + db * Kj[b]);
                 row[b + 1] -= (ka * Ci[b + 1] + da * Ki[b + 1]) + (kb * Cj[b + 1] + db * Kj[b + 1]);
+                row[b + 2] -= (ka * Ci[b + 2] + da * Ki[b + 2]) + (kb * Cj[b + 2] + db * Kj[b + 2]);
+                row[b + 3] -= (ka * Ci[b + 3] + da * Ki[b + 3]) + (kb * Cj[b + 3] + db * Kj[b + 3]);
             }
         }
         for (; i < m; ++i) {
-            const sr_real ka = KT[NB * i + a], da = DT[NB * i + a], *Ci = CT + NB * i, *Ki = KT + NB * i;
-            for (b = b0; b < NB; b += 2) {
+            const sr_real ka = KT[NBP * i + a], da = DT[NBP * i + a], *Ci = CT + NBP * i, *Ki = KT + NBP * i;
+            for (b = b0; b < NBP; b += 4) {
                 row[b] -= ka * Ci[b] + da * Ki[b];
                 row[b + 1] -= ka * Ci[b + 1] + da * Ki[b + 1];
+                row[b + 2] -= ka * Ci[b + 2] + da * Ki[b + 2];
+                row[b + 3] -= ka * Ci[b + 3] + da * Ki[b + 3];
             }
         }
     }
     for (a = 0; a < NB; ++a)
-        for (b = a + 1; b < NB; ++b) Pn[NB * b + a] = Pn[NB * a + b];
-    for (a = 0; a < NB * NB && recovering; ++a) Pn[a] *= inflate;
+        for (b = a + 1; b < NB; ++b) Pn[NBP * b + a] = Pn[NBP * a + b];
+    for (a = 0; a < NB * NBP && recovering; ++a) Pn[a] *= inflate;
 
     /* Injection, then the reset of the shell's block by Jr(e_xi). */
-    status = sr_retract(model, ekf->x, e, xn);
-    if (status != SR_OK) return status;
+    /* The state was checked by the call: the retraction without its checks. */
+    if (!all_finite(e, NB)) return SR_ERR_NONFINITE;
+    sr_internal_retract(ekf->x, e, xn);
     so3_right_jacobian(e + SR_EB_xi_S, Jr);
     for (i = 0; i < 3; ++i)
         for (b = 0; b < NB; ++b)
-            T[NB * i + b] = Jr[3 * i] * Pn[NB * (SR_EB_xi_S) + b] + Jr[3 * i + 1] * Pn[NB * (SR_EB_xi_S + 1) + b]
-                          + Jr[3 * i + 2] * Pn[NB * (SR_EB_xi_S + 2) + b];
+            T[NB * i + b] = Jr[3 * i] * Pn[NBP * (SR_EB_xi_S) + b] + Jr[3 * i + 1] * Pn[NBP * (SR_EB_xi_S + 1) + b]
+                          + Jr[3 * i + 2] * Pn[NBP * (SR_EB_xi_S + 2) + b];
     for (i = 0; i < 3; ++i) {
-        for (b = 3; b < NB; ++b) Pn[NB * (SR_EB_xi_S + i) + b] = Pn[NB * b + SR_EB_xi_S + i] = T[NB * i + b];
+        for (b = 3; b < NB; ++b) Pn[NBP * (SR_EB_xi_S + i) + b] = Pn[NBP * b + SR_EB_xi_S + i] = T[NB * i + b];
         for (j = i; j < 3; ++j) {
             const sr_real s = T[NB * i] * Jr[3 * j] + T[NB * i + 1] * Jr[3 * j + 1] + T[NB * i + 2] * Jr[3 * j + 2];
-            Pn[NB * i + j] = Pn[NB * j + i] = s;
+            Pn[NBP * i + j] = Pn[NBP * j + i] = s;
         }
     }
-    if (!all_finite(Pn, NB * NB) || !all_finite(e, NB)) return SR_ERR_NONFINITE;
+    if (!all_finite(Pn, NB * NBP) || !all_finite(xn, SR_NX)) return SR_ERR_NONFINITE;
     memcpy(ekf->x, xn, sizeof xn);
     for (i = 0; i < SR_NBIAS; ++i) ekf->bias[i] += e[SR_EB_b_g + i];
-    memcpy(ekf->P, Pn, sizeof Pn);
+    for (a = 0; a < NB; ++a) memcpy(ekf->P + NB * a, Pn + NBP * a, NB * sizeof(sr_real));
     if (recovering)
         ekf->recovered[kind] += 1;
     else
@@ -514,7 +530,7 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
         for (a = 0; a < NB; ++a)
             for (b = 0; b < 2; ++b) {
                 sr_real s = Cj[2 * a + b];
-                for (i = 0; i < m; ++i) s -= KT[NB * i + a] * Wj[2 * i + b];
+                for (i = 0; i < m; ++i) s -= KT[NBP * i + a] * Wj[2 * i + b];
                 Cj[2 * a + b] = inflate * s;
             }
         for (i = 0; i < SR_EKF_NDELAYED * 4 && recovering; ++i) ekf->delayed[j].Z[i] *= inflate;
@@ -530,10 +546,10 @@ static int apply(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_r
 
 /* The update of sr_ekf.h for an m-entry sample with innovation r, Jacobian H (m x NB) and noise
  * variances Rd. */
-static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_real *r, const sr_real *H,
+static SR_LANES_CLONES int update(sr_ekf *ekf, int kind, int m, const sr_real *r, const sr_real *H,
                   const sr_real *Rd, sr_real gate)
 {
-    sr_real CT[MAXM * NB], S[MAXM * MAXM] = {0}, val[MAXM * NB], W[SR_EKF_NDELAYED * MAXM * 2], Wa[MAXM * SR_NV];
+    sr_real CT[MAXM * NBP], S[MAXM * MAXM] = {0}, val[MAXM * NB], W[SR_EKF_NDELAYED * MAXM * 2], Wa[MAXM * SR_NV];
     int col[MAXM * NB], nnz[MAXM], a, i, j, k;
 
     /* H is sparse: an IMU row reads at most 13 of the 18 columns (never q, and one bias block),
@@ -548,8 +564,8 @@ static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_
             }
     }
     for (i = 0; i < m; ++i) {
-        sr_real *Ci = CT + NB * i;
-        for (a = 0; a < NB; ++a) Ci[a] = 0;
+        sr_real *Ci = CT + NBP * i;
+        for (a = 0; a < NBP; ++a) Ci[a] = 0;
         for (k = 0; k + 1 < nnz[i]; k += 2)
             rows_plus2(val[NB * i + k], ekf->P + NB * col[NB * i + k], val[NB * i + k + 1],
                        ekf->P + NB * col[NB * i + k + 1], Ci);
@@ -558,7 +574,7 @@ static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_
     for (i = 0; i < m; ++i)
         for (j = i; j < m; ++j) {
             sr_real s = i == j ? Rd[i] : 0;
-            for (k = 0; k < nnz[i]; ++k) s += val[NB * i + k] * CT[NB * j + col[NB * i + k]];
+            for (k = 0; k < nnz[i]; ++k) s += val[NB * i + k] * CT[NBP * j + col[NB * i + k]];
             S[m * i + j] = S[m * j + i] = s;
         }
     /* Cov(r, z_j) = H C_j for every waiting fix. */
@@ -573,7 +589,7 @@ static int update(sr_ekf *ekf, const sr_model *model, int kind, int m, const sr_
             }
     }
     held_of_sample(&ekf->held, m, nnz, col, val, Wa);
-    return apply(ekf, model, kind, m, r, CT, S, gate, W, -1, Wa);
+    return apply(ekf, kind, m, r, CT, S, gate, W, -1, Wa);
 }
 
 int sr_ekf_update_imu_axes(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
@@ -590,13 +606,14 @@ int sr_ekf_update_imu_axes(sr_ekf *ekf, const sr_model *model, const sr_real y[S
     if (!valid_gate(gate)) return SR_ERR_ARG;
     if (!all_finite(y, SR_NIMU) || (u && !all_finite(u, SR_NU))) return SR_ERR_NONFINITE;
     status = check_filter(model, ekf);
-    if (status == SR_OK) status = sr_imu_jacobian(model, ekf->x, u, body, mount, ekf->bias, yh, H);
+    /* The state, biases, mount and u are checked: the Jacobian without its checks. */
+    if (status == SR_OK) status = sr_internal_imu_jacobian(model, ekf->x, u, body, mount, ekf->bias, yh, H);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NIMU; ++i) {
         r[i] = y[i] - yh[i];
         Rd[i] = sigma[i] * sigma[i];
     }
-    return update(ekf, model, SR_EKF_IMU, SR_NIMU, r, H, Rd, gate);
+    return update(ekf, SR_EKF_IMU, SR_NIMU, r, H, Rd, gate);
 }
 
 int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
@@ -604,7 +621,7 @@ int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[S
                            const sr_ekf_process *process, sr_real hold, sr_real gate)
 {
     sr_real yh[SR_NIMU], H[SR_NIMU * NB], Hn[SR_NIMU * SR_NV], r[SR_NIMU], yd[SR_NIMU], Hd[SR_NIMU * NB];
-    sr_real CT[SR_NIMU * NB], S[SR_NIMU * SR_NIMU], L[SR_NIMU * SR_NIMU], B[SR_NIMU * SR_NV];
+    sr_real CT[SR_NIMU * NBP] = {0}, S[SR_NIMU * SR_NIMU], L[SR_NIMU * SR_NIMU], B[SR_NIMU * SR_NV];
     sr_real X[SR_NIMU * SR_NV], Sr[SR_NIMU], col[SR_NIMU], W[SR_EKF_NDELAYED * MAXM * 2];
     const sr_real zero[SR_NV] = {0};
     sr_ekf_held before, *h;
@@ -621,7 +638,8 @@ int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[S
     if (!valid_gate(gate) || !valid_process(process) || arg_dt(hold) != SR_OK) return SR_ERR_ARG;
     if (!all_finite(y, SR_NIMU) || (u && !all_finite(u, SR_NU))) return SR_ERR_NONFINITE;
     status = check_filter(model, ekf);
-    if (status == SR_OK) status = sr_imu_jacobian(model, ekf->x, u, body, mount, ekf->bias, yh, H);
+    /* The state, biases, mount and u are checked: the Jacobian without its checks. */
+    if (status == SR_OK) status = sr_internal_imu_jacobian(model, ekf->x, u, body, mount, ekf->bias, yh, H);
     /* The reading is linear in nu': Hn is the same at any nu', zero included. */
     if (status == SR_OK) status = sr_imu_partials(model, ekf->x, zero, body, mount, ekf->bias, yd, Hd, Hn);
     if (status != SR_OK) return status;
@@ -646,7 +664,7 @@ int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[S
             sr_real s = 0;
             for (k = 0; k < NB; ++k) s += H[NB * i + k] * ekf->P[NB * k + a];
             for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * h->cross[SR_NV * a + k];
-            CT[NB * i + a] = s;
+            CT[NBP * i + a] = s;
         }
         for (b = 0; b < SR_NV; ++b) {
             sr_real s = 0;
@@ -658,7 +676,7 @@ int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[S
     for (i = 0; i < SR_NIMU; ++i)
         for (j = 0; j < SR_NIMU; ++j) {
             sr_real s = i == j ? sigma[i] * sigma[i] : 0;
-            for (k = 0; k < NB; ++k) s += H[NB * i + k] * CT[NB * j + k];
+            for (k = 0; k < NB; ++k) s += H[NB * i + k] * CT[NBP * j + k];
             for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * B[SR_NV * j + k];
             S[SR_NIMU * i + j] = s;
         }
@@ -691,7 +709,7 @@ int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[S
     }
     recovered = ekf->recovered[SR_EKF_IMU];
     applied = ekf->accepted[SR_EKF_IMU] + recovered;
-    status = apply(ekf, model, SR_EKF_IMU, SR_NIMU, r, CT, S, gate, W, -1, B);
+    status = apply(ekf, SR_EKF_IMU, SR_NIMU, r, CT, S, gate, W, -1, B);
     if (status != SR_OK || ekf->accepted[SR_EKF_IMU] + ekf->recovered[SR_EKF_IMU] == applied) {
         ekf->held = before;   /* refused (or failed): a as before the sample */
         return status;
@@ -743,13 +761,13 @@ static int check_simple(const sr_ekf *ekf, const sr_model *model, const sr_real 
 int sr_ekf_update_encoders(sr_ekf *ekf, const sr_model *model, const sr_real y[2], sr_real sigma, sr_real gate)
 {
     sr_real yh[2], H[2 * NB], r[2], Rd[2];
-    int status = check_simple(ekf, model, y, 2, sigma, gate);
-    if (status == SR_OK) status = sr_encoders_jacobian(model, ekf->x, yh, H);
+    const int status = check_simple(ekf, model, y, 2, sigma, gate);
     if (status != SR_OK) return status;
+    sr_internal_encoders_jacobian(ekf->x, yh, H);
     r[0] = angle_difference(y[0], yh[0]);
     r[1] = angle_difference(y[1], yh[1]);
     Rd[0] = Rd[1] = sigma * sigma;
-    return update(ekf, model, SR_EKF_ENCODERS, 2, r, H, Rd, gate);
+    return update(ekf, SR_EKF_ENCODERS, 2, r, H, Rd, gate);
 }
 
 int sr_ekf_update_position(sr_ekf *ekf, const sr_model *model, const sr_real y[2], sr_real sigma, sr_real gate)
@@ -761,7 +779,7 @@ int sr_ekf_update_position(sr_ekf *ekf, const sr_model *model, const sr_real y[2
     r[0] = y[0] - yh[0];
     r[1] = y[1] - yh[1];
     Rd[0] = Rd[1] = sigma * sigma;
-    return update(ekf, model, SR_EKF_POSITION, 2, r, H, Rd, gate);
+    return update(ekf, SR_EKF_POSITION, 2, r, H, Rd, gate);
 }
 
 int sr_ekf_update_heading(sr_ekf *ekf, const sr_model *model, sr_real y, int body, const sr_real mount[SR_NMOUNT],
@@ -778,7 +796,7 @@ int sr_ekf_update_heading(sr_ekf *ekf, const sr_model *model, sr_real y, int bod
     if (status != SR_OK) return status;
     r = angle_difference(y, yh);
     Rd = sigma * sigma;
-    return update(ekf, model, SR_EKF_HEADING, 1, &r, H, &Rd, gate);
+    return update(ekf, SR_EKF_HEADING, 1, &r, H, &Rd, gate);
 }
 
 int sr_ekf_mark_position(sr_ekf *ekf, const sr_model *model, int slot)
@@ -836,7 +854,7 @@ int sr_ekf_mark_position(sr_ekf *ekf, const sr_model *model, int slot)
 int sr_ekf_update_position_delayed(sr_ekf *ekf, const sr_model *model, int slot, const sr_real y[2], sr_real sigma,
                                    sr_real gate)
 {
-    sr_real r[2], CT[2 * NB], S[4], W[SR_EKF_NDELAYED * MAXM * 2], Wa[2 * SR_NV];
+    sr_real r[2], CT[2 * NBP] = {0}, S[4], W[SR_EKF_NDELAYED * MAXM * 2], Wa[2 * SR_NV];
     const sr_ekf_delayed *d;
     int status = arg_model(model, READS(WHOLE)), a, j;
     if (status != SR_OK) return status;
@@ -849,7 +867,7 @@ int sr_ekf_update_position_delayed(sr_ekf *ekf, const sr_model *model, int slot,
     r[1] = y[1] - d->yh[1];
     for (a = 0; a < NB; ++a) {
         CT[a] = d->C[2 * a];
-        CT[NB + a] = d->C[2 * a + 1];
+        CT[NBP + a] = d->C[2 * a + 1];
     }
     memcpy(S, d->Z + 4 * slot, sizeof S);
     S[0] += sigma * sigma;
@@ -860,7 +878,7 @@ int sr_ekf_update_position_delayed(sr_ekf *ekf, const sr_model *model, int slot,
     /* Cov(r, a) = Cov(z, a): the fix's noise is independent of the held disturbance. */
     for (j = 0; j < 2; ++j)
         for (a = 0; a < SR_NV; ++a) Wa[SR_NV * j + a] = ekf->held.fix[2 * SR_NV * slot + 2 * a + j];
-    return apply(ekf, model, SR_EKF_POSITION, 2, r, CT, S, gate, W, slot, Wa);
+    return apply(ekf, SR_EKF_POSITION, 2, r, CT, S, gate, W, slot, Wa);
 }
 
 int sr_ekf_set_recovery(sr_ekf *ekf, int kind, long n)

@@ -7,6 +7,7 @@
 #include "sr_checks.h"
 #include "sr_so3.h"
 #include "sr_argcheck.h"
+#include "sr_unchecked.h"
 
 #include <string.h>
 
@@ -54,6 +55,8 @@ static void local(const sr_real x[SR_NX], const sr_real y[SR_NX], sr_real d[SR_N
     d[SR_E_q + 1] = y[SR_X_q + 1] - x[SR_X_q + 1];
     for (i = 0; i < SR_NV; ++i) d[SR_E_nu + i] = y[SR_X_w_S + i] - x[SR_X_w_S + i];
 }
+
+void sr_internal_retract(const sr_real x[SR_NX], const sr_real d[SR_NE], sr_real y[SR_NX]) { retract(x, d, y); }
 
 int sr_retract(const sr_model *model, const sr_real x[SR_NX], const sr_real d[SR_NE], sr_real y[SR_NX])
 {

@@ -5,6 +5,7 @@
 #include "sr_checks.h"
 #include "sr_jacobians.h"
 #include "sr_kernels.h"
+#include "sr_unchecked.h"
 
 #include <string.h>
 
@@ -130,15 +131,22 @@ int sr_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real
                     const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU],
                     sr_real H[SR_NIMU * SR_NEB])
 {
+    const int status = check_imu(model, READS(STATE) | READS(JACOBIAN), x, y && H, u, SR_NU, body, mount, &bias);
+    if (status != SR_OK) return status;
+    return sr_internal_imu_jacobian(model, x, u, body, mount, bias, y, H);
+}
+
+int sr_internal_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int body,
+                             const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU],
+                             sr_real H[SR_NIMU * SR_NEB])
+{
     sr_real a[SR_NV], sc[SR_GEN_NSC], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], yy[SR_NIMU], HH[SR_NIMU * SR_NEB], Hn[SR_NIMU * SR_NV];
     int status, i, j, k;
-    status = check_imu(model, READS(STATE) | READS(JACOBIAN), x, y && H, u, SR_NU, body, mount, &bias);
-    if (status != SR_OK) return status;
     status = sr_internal_accel_jacobian(model, x, u ? u : sr_zero_u, a, Ja, Jb);
     if (status != SR_OK) return status;
     if (!all_finite(a, SR_NV) || !all_finite(Ja, SR_NV * SR_NE)) return SR_ERR_NONFINITE;
     sensor_constants(model, sc);
-    status = imu_jacobian_kernel(body, sc, x, a, mount, bias, yy, HH, Hn);
+    status = imu_jacobian_kernel(body, sc, x, a, mount, bias ? bias : zero_bias, yy, HH, Hn);
     if (status != SR_OK) return status;
     /* Only the accelerometer reads nu_dot (the gyroscope's rows of Hn are zero by derivation). */
     for (i = SR_IMU_accel; i < SR_IMU_accel + 3; ++i)
@@ -191,9 +199,14 @@ int sr_encoders_jacobian(const sr_model *model, const sr_real x[SR_NX], sr_real 
 {
     const int status = check_inputs(model, READS(STATE), x, y && H, 0, 0, NULL);
     if (status != SR_OK) return status;
+    sr_internal_encoders_jacobian(x, y, H);
+    return SR_OK;
+}
+
+void sr_internal_encoders_jacobian(const sr_real x[SR_NX], sr_real y[2], sr_real H[2 * SR_NEB])
+{
     sr_gen_encoders_jacobian(H);
     encoder_angles(x, y);
-    return SR_OK;
 }
 
 int sr_position_measure(const sr_model *model, const sr_real x[SR_NX], sr_real y[2])
