@@ -23,7 +23,7 @@ from .controller import DEFAULT_U_MAX, Controller
 from .ranges import LQR_RANGES
 from . import lqr_design as design
 from .lqr_design import Schedule
-from .slope import SlopeEstimator, design_slope_schedule, slope_components
+from .slope import SlopeFeedforward, slope_components
 
 
 @dataclasses.dataclass(frozen=True)
@@ -170,7 +170,7 @@ def c_target(target):
     return t
 
 
-class Lqr(Controller):
+class Lqr(SlopeFeedforward, Controller):
     """The C controller `sr_lqr_control` (c/sr_control.c) on a schedule designed here."""
     kind = "lqr"
 
@@ -180,17 +180,11 @@ class Lqr(Controller):
         # A slope in the model is fed forward in whichever direction the path runs: the schedule is
         # the flat one, and the slope's direction (the model's +x) is a world vector.
         flat = params.replace(slope=0.0)
-        self.model_slope = np.array([params.slope, 0.0])
         self.schedule = schedule if schedule is not None else design_schedule(flat, rate, u_max, gains)
         self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate, gains.steady_rate_m_s,
                        gains.tight_band_m, gains.tight_rise_s)
         self._model = Model(flat)
-        self._slope_schedule = None
-        if params.slope != 0.0 or gains.slope_estimate_s > 0.0:
-            self._slope_schedule = design_slope_schedule(flat, self.schedule)
-        self._estimator = SlopeEstimator(flat, self.period, gains.slope_estimate_s) \
-            if gains.slope_estimate_s > 0.0 else None
-        self._applied = np.zeros(2)
+        self._init_slope(params, flat, self.schedule, gains)
         self._memory = ffi.new("sr_lqr_memory *")
         self._u, self._raw = np.zeros(2), np.zeros(2)
 
@@ -198,19 +192,7 @@ class Lqr(Controller):
         """Starts a run at x0: zeroes the controller's memory (integrals, operating curvature)."""
         super().reset(x0)
         lib.sr_lqr_reset(self._memory)
-        self._applied = np.zeros(2)
-        if self._estimator is not None:
-            self._estimator.reset()
-
-    @property
-    def slope(self):
-        """The world's slope vector α (cos β, sin β) [rad] the feedforward uses: the estimate when the
-        controller estimates one (against the flat model: the whole slope), else the model's."""
-        return self.model_slope if self._estimator is None else self._estimator.slope
-
-    def after_limits(self, raw, u):
-        """Keeps the torques applied: the slope estimate's next prediction holds them."""
-        self._applied = np.array(u, dtype=float)
+        self._reset_slope()
 
     def preview_distances(self, target):
         """Where the path's curvature is read (runtime/control/closed_loop.py fills

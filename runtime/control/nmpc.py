@@ -50,7 +50,7 @@ from .controller import DEFAULT_U_MAX, Controller
 from .geometry import cross_track_rate
 from . import lqr_design as design
 from .lqr import LqrGains, design_schedule
-from .slope import SlopeEstimator, design_slope_schedule, slope_components
+from .slope import SlopeFeedforward, slope_components
 from .ranges import NMPC_RANGES
 
 #: The NMPC's state: the robot's error coordinates, the cross-track error and its integral
@@ -204,7 +204,7 @@ def _wrap(angle):
     return (angle + np.pi) % (2 * np.pi) - np.pi
 
 
-class Nmpc(Controller):
+class Nmpc(SlopeFeedforward, Controller):
     """Real-time-iteration NMPC (see the module's docstring); `rate` 20 Hz by default."""
     kind = "nmpc"
 
@@ -215,13 +215,9 @@ class Nmpc(Controller):
         self.node_period = self.period * self.node_periods
         # The prediction is the flat model's; a slope in `params` is fed forward (see the module).
         flat = params.replace(slope=0.0)
-        self.model_slope = np.array([params.slope, 0.0])
         self.schedule = design_schedule(flat, rate, u_max, gains)
-        self._slope_schedule = design_slope_schedule(flat, self.schedule) \
-            if params.slope != 0.0 or gains.slope_estimate_s > 0.0 else None
-        # The online estimate (slope_estimate_s > 0): the LQR's (runtime/control/slope.py), on the flat model.
-        self._estimator = SlopeEstimator(flat, self.period, gains.slope_estimate_s) \
-            if gains.slope_estimate_s > 0.0 else None
+        # The online estimate (slope_estimate_s > 0) is the LQR's (runtime/control/slope.py), on the flat model.
+        self._init_slope(params, flat, self.schedule, gains)
         self._p = parameter_vector(flat)
         q = gains.weights(u_max).q_diagonal()[:NZ_N]
         self._q_path = q
@@ -284,19 +280,7 @@ class Nmpc(Controller):
         self._offset = np.zeros(2)              # d̂ − f [N m]: what the prediction adds to the torques
         self._last = None                       # (z, u, v, κ) of the last sample: what d̂ is estimated from
         self.restarts = 0
-        self._applied = np.zeros(2)             # the torques held since the last sample (the slope estimate's)
-        if self._estimator is not None:
-            self._estimator.reset()
-
-    @property
-    def slope(self):
-        """The world's slope vector α (cos β, sin β) [rad] the feedforward uses: the estimate when the
-        controller estimates one (against the flat model: the whole slope), else the model's."""
-        return self.model_slope if self._estimator is None else self._estimator.slope
-
-    def after_limits(self, raw, u):
-        """Keeps the torques applied: the slope estimate's next prediction holds them."""
-        self._applied = np.array(u, dtype=float)
+        self._reset_slope()
 
     def preview_distances(self, target):
         """The horizon's nodes along the path at the reference speed: v T k, k = 0 .. N [m]."""

@@ -161,3 +161,36 @@ class SlopeEstimator:
                 self.slope, self.torque_offset = theta[:2], theta[2:]
         self._last = np.array(x, dtype=float)
         return self.slope
+
+
+class SlopeFeedforward:
+    """What a controller on the flat model carries for a slope (the LQR's and the NMPC's): the
+    model's slope vector, the feedforward's schedule when the model has a slope or the controller
+    estimates one, the online estimate (`slope_estimate_s` > 0) and the torques held since the last
+    sample, which the estimate's next prediction needs.  A mixin before `Controller`."""
+
+    def _init_slope(self, params, flat, schedule, gains):
+        """Sets the slope's parts from the robot `params`, its `flat` copy, the flat design's
+        `schedule` and the controller's `gains`; after `Controller.__init__` (it reads the period)."""
+        self.model_slope = np.array([params.slope, 0.0])
+        self._slope_schedule = design_slope_schedule(flat, schedule) \
+            if params.slope != 0.0 or gains.slope_estimate_s > 0.0 else None
+        self._estimator = SlopeEstimator(flat, self.period, gains.slope_estimate_s) \
+            if gains.slope_estimate_s > 0.0 else None
+        self._applied = np.zeros(2)
+
+    def _reset_slope(self):
+        """Starts a run: no torque held yet, the estimate forgotten."""
+        self._applied = np.zeros(2)
+        if self._estimator is not None:
+            self._estimator.reset()
+
+    @property
+    def slope(self):
+        """The world's slope vector α (cos β, sin β) [rad] the feedforward uses: the estimate when the
+        controller estimates one (against the flat model: the whole slope), else the model's."""
+        return self.model_slope if self._estimator is None else self._estimator.slope
+
+    def after_limits(self, raw, u):
+        """Keeps the torques applied: the slope estimate's next prediction holds them."""
+        self._applied = np.array(u, dtype=float)
