@@ -5,7 +5,8 @@
 #include "sr_checks.h"
 #include "sr_so3.h"
 #include "sr_kernels.h"
-#include "sr_step_jacobians.h"
+#include "sr_jacobians.h"
+#include "sr_steppers.h"
 #include "sr_unchecked.h"
 
 #include <string.h>
@@ -254,6 +255,18 @@ static void release_held(sr_ekf *ekf, sr_real g, const sr_ekf_held *next)
     ekf->held = *next;
 }
 
+/* x_next = the step of `method` (sr_step's bits) and F the transition matrix: the Lie-Euler step's
+ * Jacobian at x, whatever the method (sr_ekf.h, "Transition matrix"), one evaluation of the
+ * accelerations' Jacobian instead of one per stage.  x valid, u finite, method and dt valid. */
+static int step_and_transition(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                               sr_real dt, sr_real x_next[SR_NX], sr_real F[NE * NE])
+{
+    int status = sr_internal_advance(model, method, x, u, dt, NULL, x_next);
+    if (status == SR_OK && !all_finite(x_next, SR_NX)) status = SR_ERR_NONFINITE;
+    if (status == SR_OK) status = sr_internal_step_jacobian_lie_euler(model, x, u, dt, F, NULL);
+    return status;
+}
+
 SR_LANES_CLONES int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real u[SR_NU], sr_real dt,
                    const sr_ekf_process *process)
 {
@@ -265,8 +278,8 @@ SR_LANES_CLONES int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int metho
     if (arg_method(method) != SR_OK || arg_dt(dt) != SR_OK || !valid_process(process)) return SR_ERR_ARG;
     if (u && !all_finite(u, SR_NU)) return SR_ERR_NONFINITE;
     status = check_filter(model, ekf);
-    /* The state and u are checked: the step and F at once, RKMK4's from the same stages. */
-    if (status == SR_OK) status = sr_internal_step_and_jacobian(model, method, ekf->x, u, dt, xn, F);
+    /* The state and u are checked: the step of `method`, and F (sr_ekf.h, "Transition matrix"). */
+    if (status == SR_OK) status = step_and_transition(model, method, ekf->x, u ? u : sr_zero_u, dt, xn, F);
     /* A held disturbance drives g of dt; the torque noise the rest (white, a share of Q_nu). */
     g = held_for(&ekf->held, dt);
     white = (dt - g) / dt;

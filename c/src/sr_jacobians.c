@@ -350,20 +350,13 @@ int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, con
     return SR_OK;
 }
 
-int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
-                               sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
+int sr_internal_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                        sr_real dt, sr_real F[SR_NE * SR_NE], sr_real *G)
 {
     const sr_real *w, *R;
     sr_real a[SR_NV], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], phi[3], D[9], Jr[9], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
     sr_real v[2][3], r;
-    int status = arg_model(model, READS(JACOBIAN) | READS(STATE)), i, j;
-    if (status != SR_OK) return status;
-    if (!x || !F || !G) return SR_ERR_NULL;
-    if (arg_dt(dt) != SR_OK) return SR_ERR_ARG;
-    status = sr_internal_check_state(model, x);
-    if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
-    if (status != SR_OK) return status;
-    status = sr_internal_accel_jacobian(model, x, u ? u : sr_zero_u, a, Ja, Jb);   /* checked above */
+    int status = sr_internal_accel_jacobian(model, x, u, a, Ja, Jb), i, j;
     if (status != SR_OK) return status;
     w = x + SR_X_w_S;
     R = x + SR_X_R_S;
@@ -407,8 +400,21 @@ int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], co
     }
     if (!all_finite(f, SR_NE * SR_NE) || !all_finite(g, SR_NE * SR_NU)) return SR_ERR_NONFINITE;
     memcpy(F, f, sizeof f);
-    memcpy(G, g, sizeof g);
+    if (G) memcpy(G, g, sizeof g);
     return SR_OK;
+}
+
+int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
+                               sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
+{
+    int status = arg_model(model, READS(JACOBIAN) | READS(STATE));
+    if (status != SR_OK) return status;
+    if (!x || !F || !G) return SR_ERR_NULL;
+    if (arg_dt(dt) != SR_OK) return SR_ERR_ARG;
+    status = sr_internal_check_state(model, x);
+    if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
+    if (status != SR_OK) return status;
+    return sr_internal_step_jacobian_lie_euler(model, x, u ? u : sr_zero_u, dt, F, G);   /* checked above */
 }
 
 int sr_step_jacobian_lie_euler_batch(const sr_model *model, long n, const sr_real *x, const sr_real *u, sr_real dt,

@@ -12,6 +12,7 @@
 #ifdef SR_USE_FLOAT /* float symbols carry _f, as in spherical_robot.h */
 #define sr_internal_accel_jacobian sr_internal_accel_jacobian_f
 #define sr_internal_accel_jacobian_along sr_internal_accel_jacobian_along_f
+#define sr_internal_step_jacobian_lie_euler sr_internal_step_jacobian_lie_euler_f
 #endif
 
 /* sr_accel_jacobian without the checks (x valid, u not NULL): Ja, Jb and the accelerations a
@@ -29,5 +30,11 @@ enum { SR_J_XI = 0, SR_J_TH_Y = 3, SR_J_TH_P = 4, SR_J_NU = 5, SR_J_READ = 10, S
 int sr_internal_accel_jacobian_along(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                                      const sr_real V[SR_J_READ][SR_J_NC], sr_real a[SR_NV],
                                      sr_real out[SR_NV][SR_J_NC], sr_real Jb[SR_NV * SR_NU]);
+
+/* F and G of sr_step_jacobian_lie_euler without the checks (x valid, u not NULL; G may be NULL):
+ * one evaluation of the accelerations' Jacobian.  Outputs written only on SR_OK; SR_ERR_NONFINITE
+ * if either is not finite.  The filter's transition matrix (sr_ekf.h). */
+int sr_internal_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                        sr_real dt, sr_real F[SR_NE * SR_NE], sr_real *G);
 
 #endif /* SR_JACOBIANS_H */

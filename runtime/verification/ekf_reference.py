@@ -1,8 +1,8 @@
 """The error-state EKF of c/include/sr_ekf.h written out in NumPy, from the equations: the check
 that the C filter (runtime.ekf) computes what the documentation says (docs/estimation.md).
 
-It takes the model's pieces from the runtime (the step `Model.step`, its Jacobian by CasADi's AD of
-the exported steps `Model.casadi_step_jacobian`, the inertia, the sensors of runtime.sensors, the
+It takes the model's pieces from the runtime (the step `Model.step`, the transition matrix as the
+Lie–Euler step's Jacobian by CasADi's AD of the exported step `Model.casadi_step_jacobian`, the inertia, the sensors of runtime.sensors, the
 retraction `Model.retract`) and writes the filter in its textbook form, without the C's
 shortcuts: the full 18 × 18 transition, the inverse of M, the gain through a solve with S, the
 Joseph form as the product (I − K H) P (I − K H)ᵀ + K R Kᵀ, the reset as G P Gᵀ with G the
@@ -123,10 +123,12 @@ class EkfReference:
         return Phi @ self.P @ Phi.T + Q
 
     def predict(self, u, dt, torque_psd, gyro_bias_rw=0.0, accel_bias_rw=0.0):
-        """x ← step(x, u, dt); P ← Φ P Φᵀ + Q, F at the prior x; with a held disturbance a, the
-        step also moves ν by dt a, and a replaces the torque noise."""
+        """x ← step(x, u, dt) by the filter's method; P ← Φ P Φᵀ + Q with F the Lie–Euler step's
+        Jacobian at the prior x whatever the method (the filter's transition matrix,
+        docs/estimation.md); with a held disturbance a, the step also moves ν by dt a, and a
+        replaces the torque noise."""
         u = np.asarray(u, dtype=float)
-        F, _ = self.model.casadi_step_jacobian(self.x, u, dt, self.method)
+        F, _ = self.model.casadi_step_jacobian(self.x, u, dt, "lie-euler")
         if self.held is not None:
             g = min(dt, self.held_remaining)
             Q = self.process_noise(dt, torque_psd, gyro_bias_rw, accel_bias_rw)
