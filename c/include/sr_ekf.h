@@ -10,8 +10,11 @@
  * Predict (one sample of dt, torques u held):
  *   x <- step(x, u, dt)                     sr_step with the given method
  *   P_dd <- F P_dd F^T + Q_d,  P_db <- F P_db,  P_bb <- P_bb + Q_b
- * F = d step / d d (sr_step_jacobian at the prior x); the biases do not enter the step, so only
- * the 12 x 12 block and the cross terms move.  Q_d is white generalized torque noise w on nu
+ * Transition matrix: F is the Lie-Euler step's Jacobian at the prior x (sr_step_jacobian_lie_euler),
+ * whatever the method the mean steps with: one evaluation of the accelerations' Jacobian instead
+ * of one per stage, and within O(dt^2) of the method's own step Jacobian, far below the process
+ * noise at the sample rates of a filter (docs/estimation.md, "Transition matrix").  The biases
+ * do not enter the step, so only the 12 x 12 block and the cross terms move.  Q_d is white generalized torque noise w on nu
  * (M nu' = f + w; spectral densities: the shell's three axes, the yoke joint, the pendulum joint,
  * process->torque_psd [N m/sqrt(Hz)]), Q_d = dt M^-1 diag(psd^2) M^-1 in the nu block, M the
  * inertia at the prior x; Q_b = dt diag(rw^2) for the biases' random walks.
@@ -176,9 +179,10 @@ int sr_ekf_init(sr_ekf *ekf, const sr_model *model, const sr_real x0[SR_NX], con
 int sr_ekf_init_diagonal(sr_ekf *ekf, const sr_model *model, const sr_real x0[SR_NX], const sr_real bias[SR_NBIAS],
                          const sr_real sigma[SR_NEB]);
 
-/** One prediction over dt > 0 under the torques u (NULL: zero) by the stepping method
- * (SR_LIE_EULER, SR_RKMK4 or SR_CF4, optionally | SR_PROJECT for the step; F is the Jacobian of the
- * method without projection), process noise *process (see the file's description). */
+/** One prediction over dt > 0 under the torques u (NULL: zero): the mean by the stepping method
+ * (SR_LIE_EULER, SR_RKMK4 or SR_CF4, optionally | SR_PROJECT), the covariance by the Lie-Euler
+ * step's Jacobian (the file's "Transition matrix"), process noise *process (see the file's
+ * description). */
 int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real u[SR_NU], sr_real dt,
                    const sr_ekf_process *process);
 

@@ -174,22 +174,22 @@ static int valid_process(const sr_ekf_process *q)
     return q->gyro_bias_rw >= 0 && isfinite(q->gyro_bias_rw) && q->accel_bias_rw >= 0 && isfinite(q->accel_bias_rw);
 }
 
-/* Q_nu = dt M^-1 D^2 M^-1 (D = diag of the torque densities): Z = M^-1 D by a Cholesky solve,
- * Q = dt Z Z^T. */
+/* Q_nu = dt M^-1 D^2 M^-1 (D = diag of the torque densities): Z = M^-1 D by the library's Cholesky
+ * solve on all five columns at once, Q = dt Z Z^T. */
 static int torque_noise(const sr_model *model, const sr_real x[SR_NX], const sr_ekf_process *q, sr_real dt,
                         sr_real Q[SR_NV * SR_NV])
 {
-    sr_real M[SR_NV * SR_NV], L[SR_NV * SR_NV], Z[SR_NV * SR_NV], col[SR_NV];
+    sr_real M[SR_NV * SR_NV], Mu[15], L[SR_NV * SR_NV], inv[SR_NV], Z[SR_NV * SR_NV] = {0};
     const sr_real d[SR_NV] = {q->torque_psd[0], q->torque_psd[0], q->torque_psd[0], q->torque_psd[1],
                               q->torque_psd[2]};
     int status = sr_internal_inertia(model, x, M), i, j, k;
-    if (status == SR_OK) status = cholesky(SR_NV, M, L);
     if (status != SR_OK) return status;
-    for (j = 0; j < SR_NV; ++j) {
-        for (i = 0; i < SR_NV; ++i) col[i] = i == j ? d[j] : 0;
-        solve_both(SR_NV, L, col);
-        for (i = 0; i < SR_NV; ++i) Z[SR_NV * i + j] = col[i];
-    }
+    for (i = 0; i < SR_NV; ++i)
+        for (j = i; j < SR_NV; ++j) Mu[SR_UPPER[i][j]] = M[SR_NV * i + j];
+    status = sr_internal_cholesky(Mu, L, inv);
+    if (status != SR_OK) return status;
+    for (i = 0; i < SR_NV; ++i) Z[SR_NV * i + i] = d[i];
+    sr_internal_cholesky_solve(L, inv, SR_NV, SR_NV, Z);
     for (i = 0; i < SR_NV; ++i)
         for (j = i; j < SR_NV; ++j) {
             sr_real s = 0;

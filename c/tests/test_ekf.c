@@ -123,6 +123,41 @@ static void test_predict_leaves_the_bias_block_alone_and_moves_the_cross_terms(v
     CHECK(nonzero > 0);
 }
 
+static void test_the_mean_steps_by_the_method_and_the_covariance_by_the_lie_euler_jacobian(void)
+{
+    /* Without process noise, from P = p I: x <- sr_step(RKMK4) bit for bit, P_dd <- p F F^T with F
+     * the Lie-Euler step's Jacobian at the prior x (sr_ekf.h, "Transition matrix"); RKMK4's own
+     * Jacobian differs from it by far more than the tolerance. */
+    sr_ekf ekf;
+    sr_model m;
+    const sr_ekf_process q = {{0, 0, 0}, 0, 0};
+    const sr_real u[2] = {SR_C(0.3), SR_C(-0.1)};
+    const double dt = 0.005, p = 1e-4;
+    sr_real x0[SR_NX], x1[SR_NX], F[SR_NE * SR_NE], Fk[SR_NE * SR_NE], G[SR_NE * SR_NU];
+    double worst = 0, apart = 0;
+    int i, j, k;
+    start(&ekf, &m, sqrt(p));
+    for (i = 0; i < SR_NV; ++i) ekf.x[SR_X_w_S + i] = (sr_real)(0.4 - 0.3 * i);
+    memcpy(x0, ekf.x, sizeof x0);
+    CHECK_STATUS(sr_step(&m, SR_RKMK4, x0, u, (sr_real)dt, x1), SR_OK);
+    CHECK_STATUS(sr_step_jacobian_lie_euler(&m, x0, u, (sr_real)dt, F, G), SR_OK);
+    CHECK_STATUS(sr_step_jacobian(&m, SR_RKMK4, x0, u, (sr_real)dt, Fk, G), SR_OK);
+    CHECK_STATUS(sr_ekf_predict(&ekf, &m, SR_RKMK4, u, (sr_real)dt, &q), SR_OK);
+    CHECK(memcmp(ekf.x, x1, sizeof x1) == 0);
+    for (i = 0; i < SR_NE; ++i)
+        for (j = 0; j < SR_NE; ++j) {
+            double want = 0, other = 0;
+            for (k = 0; k < SR_NE; ++k) {
+                want += p * F[SR_NE * i + k] * F[SR_NE * j + k];
+                other += p * Fk[SR_NE * i + k] * Fk[SR_NE * j + k];
+            }
+            worst = fmax(worst, fabs(ekf.P[SR_NEB * i + j] - want));
+            apart = fmax(apart, fabs(other - want));
+        }
+    CHECK(worst <= 64 * TEST_EPS * p);
+    CHECK(apart > 100 * 64 * TEST_EPS * p);   /* 1 % of p here */
+}
+
 static void test_the_bias_variances_grow_by_their_random_walk_over_dt(void)
 {
     /* P_bb <- P_bb + dt diag(rw^2): the biases do not enter the step, only their random walk. */
@@ -340,6 +375,7 @@ void suite_ekf(void)
     RUN_TEST(test_after_n_refusals_in_a_row_the_next_outlier_is_admitted_with_the_prior_inflated);
     RUN_TEST(test_encoder_innovations_wrap_around_pi);
     RUN_TEST(test_predict_leaves_the_bias_block_alone_and_moves_the_cross_terms);
+    RUN_TEST(test_the_mean_steps_by_the_method_and_the_covariance_by_the_lie_euler_jacobian);
     RUN_TEST(test_the_bias_variances_grow_by_their_random_walk_over_dt);
     RUN_TEST(test_a_constant_gyro_offset_at_rest_is_learnt_as_the_gyro_bias);
     RUN_TEST(test_each_imu_reading_has_its_own_standard_deviation);
