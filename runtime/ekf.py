@@ -31,7 +31,7 @@ from bindings._sr import ffi, lib
 from .errors import KernelError
 from .model import Model
 from .sensors import DEFAULT_MOUNT, BODIES, Mount, NEB
-from .so3 import exp as so3_exp, hat, rot_x, rot_y
+from .so3 import exp as so3_exp, rot_x, rot_y
 from .state import IDX_E_NU, IDX_E_Q, IDX_E_TH_P, IDX_E_TH_Y, IDX_E_XI_S, NU, initial_state
 from .validation import check_finite, choice, real_array
 
@@ -373,21 +373,14 @@ def start_from_measurements(model, accel, *, encoders=None, fix=None, heading=No
     R_S = R_B @ Q_B.T
     x0 = initial_state(theta[0], theta[1], R_S=R_S, q=(position[0], position[1], r), r=r)
 
-    # The tilt is read through the accelerometer's bias: its world-frame error (R_true = Exp(ε) R̂)
-    # is ε = A (b_a + n̄) with A = [up]× R̂_B R_m / g, b_a the bias (whose estimate 0 makes it the
-    # bias's error) and n̄ the samples' mean noise.  So ε and the bias's error are correlated,
-    # Cov(ε, δb_a) = A σ_b² (without it the prior claims to know the combination of tilt and bias
-    # that the accelerometer cannot tell apart, twice too well).
-    A = hat(up) @ R_B @ R_m / g if g > 0 else np.zeros((3, 3))
-    noise_mean = max(noise.accel) ** 2 / samples
+    tilt = math.sqrt(max(noise.accel) ** 2 / samples + noise.accel_bias ** 2) / g if g > 0 else 1.0
     yaw = heading_sigma if heading is None else noise.heading
-    world = (noise_mean + noise.accel_bias ** 2) * A @ A.T + yaw ** 2 * np.outer(up, up)
-    if not g > 0:
-        world += np.eye(3) - np.outer(up, up)          # no gravity: the tilt unknown, 1 rad
+    e1 = np.cross(up, [0.0, 1.0, 0.0]) if abs(up[1]) < 0.9 else np.cross(up, [1.0, 0.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    U = np.column_stack([e1, np.cross(up, e1), up])
+    world = U @ np.diag([tilt ** 2, tilt ** 2, yaw ** 2]) @ U.T
     P0 = np.zeros((NEB, NEB))
     P0[IDX_E_XI_S, IDX_E_XI_S] = R_S.T @ world @ R_S       # the shell's error is in its own axes
-    P0[IDX_E_XI_S, IDX_EB_BA] = noise.accel_bias ** 2 * R_S.T @ A
-    P0[IDX_EB_BA, IDX_E_XI_S] = P0[IDX_E_XI_S, IDX_EB_BA].T
     joint = noise.encoder if encoders is not None else 1.0
     P0[IDX_E_TH_Y, IDX_E_TH_Y] = P0[IDX_E_TH_P, IDX_E_TH_P] = joint ** 2
     P0[IDX_E_Q, IDX_E_Q] = noise.position ** 2 * np.eye(2)
