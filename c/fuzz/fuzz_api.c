@@ -5,7 +5,8 @@
  * step, a method and small step counts, calls every function of spherical_robot.h (the
  * controller's sr_lqr_* with a fuzzed gain schedule, target and memory) and of sr_sensors.h
  * (a fuzzed body, mount, nu_dot and biases) and of sr_ekf.h (a fuzzed start, process noise,
- * samples, noise levels, one per reading for sr_ekf_update_imu_axes, gates and delayed-fix slots)
+ * samples, noise levels, one per reading for sr_ekf_update_imu_axes and sr_ekf_update_imu_held, holds,
+ * gates and delayed-fix slots)
  * and of sr_nmpc.h (a fuzzed box QP; a fuzzed NMPC design of a short horizon, target and
  * curvatures ahead) and checks their
  * contract (abort() on a violation, so libFuzzer and the plain driver both report it with the
@@ -700,6 +701,14 @@ static void fuzz_ekf(reader *r, const sr_model *model, const sr_real x[SR_NX], c
         EXPECT_STATUS("sr_ekf_update_imu_axes", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
                       SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
         check_ekf("sr_ekf_update_imu_axes", status, &ekf, &before);
+        /* the held disturbance: a fuzzed hold (zero, negative, NaN, huge) and process noise; a
+         * disturbance held on from an earlier sample then rides through the next predicts */
+        memcpy(&before, &ekf, sizeof ekf);
+        status = sr_ekf_update_imu_held(&ekf, model, y, u, body, mount, sigma_axes, &q,
+                                        pick(r, 0.005 + 0.02 * fabs(unit(r))), gate);
+        EXPECT_STATUS("sr_ekf_update_imu_held", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT, SR_ERR_SINGULAR);
+        check_ekf("sr_ekf_update_imu_held", status, &ekf, &before);
         memcpy(&before, &ekf, sizeof ekf);
         status = sr_ekf_update_encoders(&ekf, model, y, noise, gate);
         EXPECT_STATUS("sr_ekf_update_encoders", status, SR_OK, SR_ERR_ARG, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
@@ -730,6 +739,10 @@ static void fuzz_ekf(reader *r, const sr_model *model, const sr_real x[SR_NX], c
     check_ekf("sr_ekf_update_imu_axes(NULL)", status, &ekf, &before);
     EXPECT_STATUS("sr_ekf_update_position_delayed(NULL)",
                   sr_ekf_update_position_delayed(&ekf, model, 0, NULL, SR_C(0.01), SR_C(1.0)), SR_ERR_NULL);
+    memcpy(&before, &ekf, sizeof ekf);
+    status = sr_ekf_update_imu_held(&ekf, model, y, u, SR_BODY_yoke, mount, sigma_axes, NULL, SR_C(0.005), SR_C(13.8));
+    EXPECT_STATUS("sr_ekf_update_imu_held(NULL)", status, SR_ERR_NULL);
+    check_ekf("sr_ekf_update_imu_held(NULL)", status, &ekf, &before);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
