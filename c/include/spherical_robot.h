@@ -748,6 +748,7 @@ typedef struct sr_lqr {
     sr_real K_tight[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_NU * SR_LQR_NZ]; /**< tighter gains for path references, scheduled in near the path (their integral columns are not read) */
     sr_real tight_band;                            /**< [m], >= 0: K_tight's weight is at most 1 - |e_y| / tight_band; 0: K_tight unused */
     sr_real tight_rise;                            /**< [s], > 0 when tight_band > 0: K_tight's weight rises from 0 to 1 in no less than this */
+    sr_real world_share;                           /**< in [0, 1]: the share of the integral of e_y held as a world vector along the path's left normal (it cancels a pull that turns with the heading, such as a slope's on a turning path); 0: all of it along the path */
 } sr_lqr;
 
 /** What to track at this sample (from the reference). */
@@ -766,6 +767,7 @@ typedef struct sr_lqr_memory {
     int started;           /**< 0 until the first sample */
     int saturated;         /**< out: the last sample clipped a torque */
     sr_real tight;         /**< K_tight's weight in [0, 1] at the last sample */
+    sr_real world[2];      /**< the world part of the integral of e_y (x, y) [m s]: z[10] is integrals[0] plus its component along the path's left normal */
 } sr_lqr_memory;
 
 /** Checks a schedule: sizes in range, grids strictly increasing, every entry finite, period

@@ -18,7 +18,7 @@ static int valid_sizes(const sr_lqr *lqr)
     return lqr->n_speeds >= 1 && lqr->n_speeds <= SR_LQR_MAX_SPEEDS && lqr->n_curvatures >= 1
         && lqr->n_curvatures <= SR_LQR_MAX_CURVATURES && lqr->period > 0 && lqr->u_max > 0
         && lqr->kappa_rate >= 0 && lqr->steady_rate >= 0 && lqr->tight_band >= 0
-        && (lqr->tight_band == 0 || lqr->tight_rise > 0);
+        && (lqr->tight_band == 0 || lqr->tight_rise > 0) && lqr->world_share >= 0 && lqr->world_share <= 1;
 }
 
 int sr_lqr_check(const sr_lqr *lqr)
@@ -26,7 +26,8 @@ int sr_lqr_check(const sr_lqr *lqr)
     int i, n;
     if (!lqr) return SR_ERR_NULL;
     if (!all_finite(&lqr->period, 1) || !all_finite(&lqr->u_max, 1) || !all_finite(&lqr->kappa_rate, 1)
-        || !all_finite(&lqr->steady_rate, 1) || !all_finite(&lqr->tight_band, 1) || !all_finite(&lqr->tight_rise, 1))
+        || !all_finite(&lqr->steady_rate, 1) || !all_finite(&lqr->tight_band, 1) || !all_finite(&lqr->tight_rise, 1)
+        || !all_finite(&lqr->world_share, 1))
         return SR_ERR_NONFINITE;
     if (!valid_sizes(lqr)) return SR_ERR_ARG;
     n = lqr->n_speeds * lqr->n_curvatures;
@@ -120,7 +121,7 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
                    sr_real u_raw[SR_NU])
 {
     sr_real z[SR_LQR_NZ], dz[SR_LQR_NZ], out[SR_NU], raw[SR_NU], kappa, step, wv, wk;
-    sr_real weight[4], k_int[SR_NU][2], step_int[2], tight = 0;
+    sr_real weight[4], k_int[SR_NU][2], step_int[2], tight = 0, normal[2], integrals[2];
     int status = arg_model(model, READS(STATE)), i0, i1, j0, j1, k, j, n, point[4], clipped = 0;
     if (status != SR_OK) return status;
     if (!lqr || !x || !target || !memory || !u) return SR_ERR_NULL;
@@ -128,7 +129,7 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
     status = sr_internal_check_state(model, x);
     if (status != SR_OK) return status;
     if (!valid_target(target) || !all_finite(memory->integrals, 2) || !all_finite(&memory->kappa, 1)
-        || !all_finite(&memory->tight, 1))
+        || !all_finite(&memory->tight, 1) || !all_finite(memory->world, 2))
         return SR_ERR_NONFINITE;
 
     /* The operating point's curvature follows the reference's at a bounded rate. */
@@ -146,7 +147,13 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
     point[2] = i1 * n + j0; weight[2] = wv * (1 - wk);
     point[3] = i1 * n + j1; weight[3] = wv * wk;
 
-    error_coordinates(model, x, target, memory->integrals, z);
+    /* z[10] reads the world part along the path's left normal (-sin psi, cos psi): a pull fixed in
+     * the world (a slope) turns against a turning path, and only a world vector can hold it. */
+    normal[0] = -SR_SIN(target->heading);
+    normal[1] = SR_COS(target->heading);
+    integrals[0] = memory->integrals[0] + (target->path ? normal[0] * memory->world[0] + normal[1] * memory->world[1] : 0);
+    integrals[1] = memory->integrals[1];
+    error_coordinates(model, x, target, integrals, z);
     for (j = 0; j < SR_LQR_NZ; ++j)
         dz[j] = z[j] - (weight[0] * lqr->z_star[point[0]][j] + weight[1] * lqr->z_star[point[1]][j]
                         + weight[2] * lqr->z_star[point[2]][j] + weight[3] * lqr->z_star[point[3]][j]);
@@ -190,7 +197,14 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
         int advance = j == 1 || SR_FABS(cross_track_rate(model, x, target->heading)) <= lqr->steady_rate;
         for (k = 0; k < SR_NU; ++k)
             if (out[k] != raw[k] && -k_int[k][j] * step_int[j] * (raw[k] - out[k]) > 0) advance = 0;
-        if (advance) memory->integrals[j] += step_int[j];
+        if (!advance) continue;
+        if (j == 0) {       /* split between the path's and the world's part: together they move z[10] by the step */
+            memory->integrals[0] += (1 - lqr->world_share) * step_int[0];
+            memory->world[0] += lqr->world_share * step_int[0] * normal[0];
+            memory->world[1] += lqr->world_share * step_int[0] * normal[1];
+        } else {
+            memory->integrals[1] += step_int[1];
+        }
     }
     memory->kappa = kappa;
     memory->started = 1;

@@ -158,6 +158,36 @@ static void test_the_cross_track_integral_acts_at_any_offset_and_holds_only_agai
     CHECK_NEAR(mem.integrals[0], 2 * 0.02 * 0.3, 8 * TEST_EPS);
 }
 
+static void test_a_world_share_of_the_cross_track_integral_is_held_along_the_paths_normal(void)
+{
+    sr_model m;
+    sr_lqr lqr;
+    sr_lqr_memory mem;
+    sr_real x[SR_NX], u[SR_NU], raw[SR_NU];
+    const sr_lqr_target along_x = {SR_C(0.2), 0, 0, SR_C(0.3), 1};
+    paper_simulation_model(&m);
+    empty_schedule(&lqr, 1);
+    lqr.steady_rate = SR_C(0.01);
+    lqr.K_path[0][10] = SR_C(-1.0);             /* u_Y = I: free */
+    lqr.world_share = SR_C(0.25);
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_OK);
+    sr_lqr_reset(&mem);
+    reference_state(0.2, 0.0, 0.3, x);
+    /* Heading +x: the left normal is +y; a quarter of the step goes to the world's y. */
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &along_x, &mem, u, raw), SR_OK);
+    CHECK_NEAR(mem.integrals[0], 0.75 * 0.02 * 0.3, 8 * TEST_EPS);
+    CHECK_NEAR(mem.world[0], 0.0, 8 * TEST_EPS);
+    CHECK_NEAR(mem.world[1], 0.25 * 0.02 * 0.3, 8 * TEST_EPS);
+    /* ... and z[10] reads both: u_Y = I + n . W = 0.02 * 0.3 at the next sample. */
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &along_x, &mem, u, raw), SR_OK);
+    CHECK_NEAR(u[0], 0.02 * 0.3, 8 * TEST_EPS);
+    lqr.world_share = SR_C(1.5);
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_ARG);
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &along_x, &mem, u, raw), SR_ERR_ARG);
+    lqr.world_share = SR_C(-0.1);
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_ARG);
+}
+
 static void test_the_cross_track_integral_holds_while_the_error_moves(void)
 {
     sr_model m;
@@ -287,6 +317,7 @@ void suite_control(void)
     RUN_TEST(test_the_law_at_a_grid_point_is_u_star_minus_K_dz);
     RUN_TEST(test_between_two_speeds_the_law_interpolates_linearly_and_clamps_outside);
     RUN_TEST(test_the_cross_track_integral_acts_at_any_offset_and_holds_only_against_a_clipped_torque);
+    RUN_TEST(test_a_world_share_of_the_cross_track_integral_is_held_along_the_paths_normal);
     RUN_TEST(test_the_cross_track_integral_holds_while_the_error_moves);
     RUN_TEST(test_the_operating_curvature_follows_a_jump_at_its_rate);
     RUN_TEST(test_the_tight_gains_weigh_in_as_the_error_allows_and_are_checked);

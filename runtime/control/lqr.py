@@ -40,7 +40,7 @@ class LqrGains:
     rate_rad_s: float = 0.5           # Ω_y, Ω_z
     joint_rate_rad_s: float = 2.0     # ω_Y, ω_P
     cross_track_m: float = 0.15       # e_y
-    cross_track_integral_m_s: float = 2.0    # ∫e_y dt: removes a steady offset within about 20 s
+    cross_track_integral_m_s: float = 1.0    # ∫e_y dt: removes a steady offset within about 10 s
     speed_integral_rad: float = 0.5   # ∫(Ω_x − Ω_x*) dt
     v_min: float = 0.1                # the design grid's speeds [m/s]: v_min .. v_max in n_speeds
     v_max: float = 0.5
@@ -50,11 +50,12 @@ class LqrGains:
     kappa_rate: float = 0.3           # how fast the operating point follows the path's curvature [1/(m s)]
     preview_m: float = 0.3            # the path's curvature is averaged over preview_m ± smoothing_m [m]
     smoothing_m: float = 0.5          # ... along the path from the nearest point (0: the curvature there)
-    steady_rate_m_s: float = 0.002   # ∫e_y advances only while |ė_y| ≤ this [m/s]
+    steady_rate_m_s: float = 0.01    # ∫e_y advances only while |ė_y| ≤ this [m/s] (above the wander's rate)
     slope_estimate_s: float = 0.0     # the slope estimate's time constant [s] (0: the model's slope only)
-    tight_cross_track_m: float = 0.05  # e_y of the tight path gains (the other sizes as above)
-    tight_band_m: float = 0.05        # their weight is at most 1 − |e_y| / tight_band_m (0: no tight gains)
+    tight_cross_track_m: float = 0.03  # e_y of the tight path gains (the other sizes as above)
+    tight_band_m: float = 0.1         # their weight is at most 1 − |e_y| / tight_band_m (0: no tight gains)
     tight_rise_s: float = 10.0        # ... and rises from 0 to 1 in no less than this [s]
+    world_share: float = 0.0          # the share of ∫e_y held as a world vector along the path's normal
     #: The ranges of the settings (runtime/control/ranges.py: those of a task file's keys).
     RANGES: typing.ClassVar[dict] = LQR_RANGES
 
@@ -130,9 +131,10 @@ def tight_gain(K_path, K_riccati):
     return K
 
 
-def to_c(schedule, period, u_max, kappa_rate, steady_rate, tight_band=0.0, tight_rise=1.0):
+def to_c(schedule, period, u_max, kappa_rate, steady_rate, tight_band=0.0, tight_rise=1.0, world_share=0.0):
     """The schedule as the C struct `sr_lqr` (cffi), checked by `sr_lqr_check`; the tight gains are
-    scheduled in within `tight_band` [m] of the path, over `tight_rise` [s], when the schedule has them."""
+    scheduled in within `tight_band` [m] of the path, over `tight_rise` [s], when the schedule has them;
+    `world_share` of the cross-track integral is held in the world frame."""
     nv, nk = len(schedule.speeds), len(schedule.curvatures)
     if nv > lib.SR_LQR_MAX_SPEEDS or nk > lib.SR_LQR_MAX_CURVATURES:
         raise ValueError(f"controller: the design grid has {nv} speeds and {nk} curvatures; the C controller "
@@ -153,6 +155,7 @@ def to_c(schedule, period, u_max, kappa_rate, steady_rate, tight_band=0.0, tight
     c.period, c.u_max, c.kappa_rate, c.steady_rate = period, u_max, kappa_rate, steady_rate
     c.tight_band = tight_band if schedule.K_tight is not None else 0.0
     c.tight_rise = tight_rise
+    c.world_share = world_share
     status = lib.sr_lqr_check(c)
     if status != lib.SR_OK:
         raise ValueError(f"controller: the LQR schedule is not valid for the C controller "
@@ -182,7 +185,7 @@ class Lqr(SlopeFeedforward, Controller):
         flat = params.replace(slope=0.0)
         self.schedule = schedule if schedule is not None else design_schedule(flat, rate, u_max, gains)
         self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate, gains.steady_rate_m_s,
-                       gains.tight_band_m, gains.tight_rise_s)
+                       gains.tight_band_m, gains.tight_rise_s, gains.world_share)
         self._model = Model(flat)
         self._init_slope(params, flat, self.schedule, gains)
         self._memory = ffi.new("sr_lqr_memory *")
@@ -217,8 +220,14 @@ class Lqr(SlopeFeedforward, Controller):
 
     @property
     def integrals(self):
-        """The controller's two integrals, z[10] and z[11] of the C controller's error coordinates."""
+        """The controller's two integrals: the path's part of z[10] and z[11] of the C controller's
+        error coordinates."""
         return np.array(list(self._memory.integrals))
+
+    @property
+    def world_integral(self):
+        """The world part of ∫e_y (x, y) [m s]: z[10] adds its component along the path's left normal."""
+        return np.array(list(self._memory.world))
 
     def compute(self, t, x, target):
         """The torques of one sample of the C controller (sr_lqr_control) for state x and the target."""

@@ -7,7 +7,10 @@ integral advances at any error unless its step would push a clipped torque furth
 and ∫e_y only while the error is steady (|ė_y| ≤ `steady_rate`).  On a path, with tight gains
 (`tight_band` > 0), the gain's robot and path columns move toward K_tight by the weight
 w = min(1 − |e_y − e_y*| / tight_band, w_before + period / tight_rise) clamped to [0, 1], which does
-not rise after a clipped sample; the integrators' columns stay K_path's.
+not rise after a clipped sample; the integrators' columns stay K_path's.  A share `world_share` of
+∫e_y is held as a world vector W along the path's left normal n(ψ) = (−sin ψ, cos ψ): z[10] reads
+I + n·W, and a step s of ∫e_y adds (1 − share) s to I and share·s·n to W (pass the integrals as
+(I, ∫speed, W_x, W_y) to carry W).
 """
 import numpy as np
 
@@ -16,16 +19,21 @@ from .geometry import cross_track_rate
 
 
 def numpy_law(schedule, r, x, target, integrals, kappa_before, period, u_max, kappa_rate, steady_rate,
-              tight_before=0.0, clipped_before=False, tight_band=0.0, tight_rise=1.0):
-    """(u_raw, u, integrals after, κ of the operating point, the tight gains' weight) of one sample."""
+              tight_before=0.0, clipped_before=False, tight_band=0.0, tight_rise=1.0, world_share=0.0):
+    """(u_raw, u, integrals after, κ of the operating point, the tight gains' weight) of one sample;
+    `integrals` (2,) or (4,) with the world part W, returned in the same form."""
     path = target.cross_track is not None
+    held = np.zeros(4)
+    held[:len(integrals)] = integrals
+    normal = np.array([-np.sin(target.heading), np.cos(target.heading)])
+    z_integrals = np.array([held[0] + (normal @ held[2:] if path else 0.0), held[1]])
     kappa = target.curvature if path else 0.0
     if kappa_before is not None:
         step = kappa_rate * period
         kappa = kappa_before + np.clip(kappa - kappa_before, -step, step)
     z_star, u_star, K_path, K_heading = schedule.at(target.speed, kappa)
     z = design.error_coordinates(x, r, target.speed, target.heading, target.cross_track if path else 0.0,
-                                 integrals)
+                                 z_integrals)
     dz = z - z_star
     K = K_path if path else K_heading
     weight = 0.0
@@ -43,4 +51,6 @@ def numpy_law(schedule, r, x, target, integrals, kappa_before, period, u_max, ka
     pushes = np.any(-K[:, design.Z_IY:] * steps * (raw - u)[:, None] > 0, axis=0)
     moving = abs(cross_track_rate(x, r, target.heading)) > steady_rate
     advance = ~pushes & np.array([not moving, True])
-    return raw, u, np.asarray(integrals, dtype=float) + np.where(advance, steps, 0.0), kappa, weight
+    steps = np.where(advance, steps, 0.0)
+    after = held + np.concatenate([[(1 - world_share) * steps[0], steps[1]], world_share * steps[0] * normal])
+    return raw, u, after[:len(integrals)], kappa, weight

@@ -38,11 +38,12 @@ LQR_RANGES = {
     "slope_estimate_s": Range(0, 1e4, "s", "the slope estimate's time constant (0: no estimate)"),
     "tight_band_m": Range(0, 100, "m", "how near the path the tight gains act (0: not at all)"),
     "tight_rise_s": Range(1e-3, 1e4, "s", "how slowly the tight gains come in"),
+    "world_share": Range(0, 1, "", "the share of the cross-track integral held in the world frame"),
 }
 
 #: `NmpcGains`: the LQR's and the horizon's.
 NMPC_RANGES = {
-    **LQR_RANGES,
+    **{name: rng for name, rng in LQR_RANGES.items() if name != "world_share"},
     "tight_band_m": Range(0, 0, "m", "the NMPC has no tight gains (an LQR setting): 0 only"),
     "torque_step_n_m": Range(1e-6, 1e6, "N m", "a torque change worth the full cost"),
     "disturbance_gain": Range(0, 1, "", "the share of the torque offset's update taken per sample (0: no estimate)"),

@@ -12,7 +12,7 @@ from runtime.control import lqr_design as design
 from runtime.control.reference import Target
 from runtime.model import Model
 from runtime.params import Params
-from runtime.state import initial_state
+from runtime.state import IDX_WS, initial_state
 from runtime.control.lqr_law import numpy_law
 
 PARAMS = Params.paper_simulation()
@@ -47,10 +47,11 @@ def c_error(x, target, integrals=(0.0, 0.0)):
 
 
 
-def python_law(sched, x, target, integrals, kappa_before, tight_before=0.0, clipped_before=False):
+def python_law(sched, x, target, integrals, kappa_before, tight_before=0.0, clipped_before=False, world_share=None):
     gains = lqr.LqrGains()
     return numpy_law(sched, PARAMS.r, x, target, integrals, kappa_before, 1 / RATE, U_MAX, gains.kappa_rate,
-                     gains.steady_rate_m_s, tight_before, clipped_before, gains.tight_band_m, gains.tight_rise_s)
+                     gains.steady_rate_m_s, tight_before, clipped_before, gains.tight_band_m, gains.tight_rise_s,
+                     gains.world_share if world_share is None else world_share)
 
 
 @pytest.mark.parametrize("path", [False, True])
@@ -92,6 +93,50 @@ def test_c_law_equals_the_numpy_law_over_a_run_of_samples(path):
             assert np.array_equal(np.abs(u) == U_MAX, np.abs(u_np) == U_MAX)
             assert np.allclose(controller.integrals, integrals, rtol=1e-12, atol=1e-14)
             assert np.isclose(controller._memory.kappa, kappa, rtol=0, atol=1e-15)
+
+
+def test_c_law_equals_the_numpy_law_with_part_of_the_cross_track_integral_in_the_world_frame():
+    rng = np.random.default_rng(3)
+    sched = schedule()
+    controller = lqr.Lqr(PARAMS, RATE, U_MAX, lqr.LqrGains(world_share=0.3, steady_rate_m_s=10.0), schedule=sched)
+    controller.reset(None)
+    integrals, kappa = np.zeros(4), None
+    for _ in range(30):
+        x, target = random_state(rng), random_target(rng, True)
+        x[IDX_WS] *= 0.1                  # slow enough that the torques stay free and every sample integrates
+        raw = controller.compute(0.0, x, target)
+        raw_np, _, integrals, kappa, _ = numpy_law(sched, PARAMS.r, x, target, integrals, kappa, 1 / RATE, U_MAX,
+                                                   controller.gains.kappa_rate, 10.0, world_share=0.3)
+        assert np.allclose(raw, raw_np, rtol=1e-12, atol=1e-12)
+        assert np.allclose(controller.integrals, integrals[:2], rtol=1e-12, atol=1e-14)
+        assert np.allclose(controller.world_integral, integrals[2:], rtol=1e-12, atol=1e-14)
+    assert np.abs(controller.world_integral).min() > 0
+
+
+def test_the_world_part_of_the_cross_track_integral_turns_with_the_path():
+    # 1 s at e_y = -2 cm heading +x, then heading -x: a pull fixed in the world (a slope) now pushes
+    # the other way, and the world part reads the integral with the opposite sign.
+    def after_one_second(share):
+        controller = lqr.Lqr(PARAMS, RATE, U_MAX, lqr.LqrGains(world_share=share, steady_rate_m_s=10.0),
+                             schedule=schedule())
+        controller.reset(None)
+        for k in range(50):
+            controller.compute(k / RATE, _rolling(0.0), Target(0.2, 0.0, 0.0, -0.02))
+        assert controller.saturated_fraction == 0.0 and controller._memory.saturated == 0
+        return controller
+    turned = Target(0.2, np.pi, 0.0, -0.02)
+    in_world, along_path, flipped_path = after_one_second(1.0), after_one_second(0.0), after_one_second(0.0)
+    assert np.isclose(in_world.world_integral[1], -0.02, rtol=1e-12) and in_world.integrals[0] == 0.0
+    unflipped = along_path.compute(1.0, _rolling(np.pi), turned)
+    flipped_path._memory.integrals[0] *= -1
+    flipped = flipped_path.compute(1.0, _rolling(np.pi), turned)
+    assert np.abs(flipped - unflipped).max() > 1e-3
+    assert np.allclose(in_world.compute(1.0, _rolling(np.pi), turned), flipped, rtol=1e-12, atol=1e-14)
+
+
+def _rolling(psi, speed=0.2):
+    return initial_state(R_S=so3.rot_z(psi - np.pi / 2), w_S=(-speed / PARAMS.r, 0.0, 0.0), w_Y=speed / PARAMS.r,
+                         r=PARAMS.r)
 
 
 def test_the_law_comparison_fails_for_a_gain_perturbed_by_one_part_in_a_million():
