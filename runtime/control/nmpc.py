@@ -176,7 +176,7 @@ class NmpcGains(LqrGains):
     torque_step_n_m: float = 0.1      # a change of torque from one node to the next worth the full cost
     cross_track_integral_m_s: float = 2.0    # ∫e_y: faster than the LQR's (the horizon sees its overshoot)
     steady_rate_m_s: float = 0.005    # ∫e_y advances only while |ė_y| ≤ this [m/s] (the horizon sees the overshoot)
-    disturbance_gain: float = 0.0     # the share of the torque offset's one-sample update taken (0: no estimate)
+    disturbance_gain: float = 0.05    # the share of the offsets' one-sample update taken (0: no estimate)
     horizon: float = 30               # N nodes
     node_periods: float = 2           # controller periods per node: the horizon is N × node_periods / rate
     iterations: float = 1             # real-time iterations per sample
