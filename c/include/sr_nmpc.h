@@ -13,11 +13,13 @@
  * point); its sensitivities are sr_step_jacobian's, chained through the lift and that projection.
  *
  * Offset-free: the plant is modelled as the model driven by u + d, d a constant offset of the two
- * torques estimated online from the model's one-period prediction error (the last sample's z and
- * torques, with d, predicted by one node of one period against the measured z, on the pendulum
- * and the rates: d += disturbance_gain * the least-squares torque step that explains the
- * difference, clipped to +-u_max).  Every node adds d to its torques and the reference torques
- * are u* - d.  The cross-track integral acts at any offset; it holds while a torque is at its
+ * torques, whose shell rates (z[4..6]) gain a constant acceleration a besides: what a slope's pull,
+ * a heavier body or a moved centre of mass add that the motors' torques cannot explain.  Both are
+ * estimated online from the model's one-period prediction error (the last sample's z and torques,
+ * with d and a, predicted by one node of one period against the measured z, on the pendulum and
+ * the rates: (d, a) += disturbance_gain * the least-squares step that explains the difference,
+ * d clipped to +-u_max).  Every node adds d to its torques and a times its period to its shell
+ * rates, and the reference torques are u* - d.  The cross-track integral acts at any offset; it holds while a torque is at its
  * bound (anti-windup) and while the error moves faster than steady_rate (a transient).
  *
  * Self-contained C99: no dynamic allocation, no mutable globals.  Every buffer is sized by the
@@ -137,6 +139,7 @@ typedef struct sr_nmpc_memory {
     sr_real heading;                /**< the last sample's reference heading [rad] */
     sr_real integral;               /**< the cross-track integral [m s] */
     sr_real disturbance[SR_NU];     /**< the estimated torque offset d [N m] */
+    sr_real shell_accel[3];         /**< the estimated acceleration a of the shell's rates z[4..6] [rad/s^2] */
     sr_real z_last[SR_NMPC_NZ];     /**< the last sample's error coordinates (what d is estimated from) */
     sr_real v_last;                 /**< the last sample's reference speed [m/s] */
     sr_real kappa_last;             /**< the last sample's curvature at the foot point [1/m] */

@@ -14,6 +14,7 @@
 #define NE SR_NE
 #define Z_EY 9
 #define Z_IY 10
+#define Z_SHELL 4 /* the shell's rates in the yoke's frame, z[4..6] */
 /* The share of u_max below which a torque counts as free for the integral's anti-windup. */
 #define FREE_SHARE SR_C(0.999)
 #define PI_ SR_C(3.14159265358979323846)
@@ -62,6 +63,7 @@ int sr_nmpc_reset(sr_nmpc_memory *memory)
     memory->qp_iterations = memory->saturated = 0;
     memory->u_last[0] = memory->u_last[1] = 0;
     memory->disturbance[0] = memory->disturbance[1] = 0;
+    memory->shell_accel[0] = memory->shell_accel[1] = memory->shell_accel[2] = 0;
     memory->have_last = 0;
     return SR_OK;
 }
@@ -329,6 +331,7 @@ static int iteration(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model,
         ud[0] = m->U[k * SR_NU] + m->disturbance[0];
         ud[1] = m->U[k * SR_NU + 1] + m->disturbance[1];
         if (node(model, m->Z + k * NZ, ud, v, m->kappa[k], T, zp, m->A[k], m->B[k]) != SR_OK) return 1;
+        for (j = 0; j < 3; ++j) zp[Z_SHELL + j] += T * m->shell_accel[j];
         for (j = 0; j < NZ; ++j) m->gap[k * NZ + j] = zp[j] - m->Z[(k + 1) * NZ + j];
     }
     /* The free response c (delta U = 0): c_0 = z0 - Z_0, c_{k+1} = A_k c_k + gap_k. */
@@ -456,40 +459,50 @@ static int iterate(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, c
     return 0;
 }
 
-/* The rows of z the torque offset is estimated from: the pendulum and the rates (3 .. 8), which do
- * not depend on where the reference's nearest point falls. */
+/* The rows of z the offsets are estimated from: the pendulum and the rates (3 .. 8), which do not
+ * depend on where the reference's nearest point falls. */
 #define D_FIRST 3
 #define D_LAST 8
 
-/* d += gain * argmin |B1 delta - (z - Phi_1(z_last, u_last + d))| over rows D_FIRST .. D_LAST: the
- * last sample predicted over one period against the measured z, B1 the prediction's torque
- * Jacobian; clipped to +-u_max.  Leaves d as it is when the prediction fails. */
+/* (d, a) += gain * argmin |B1 delta + period (0, alpha, 0) - r|, r = z - Phi_1(z_last, u_last + d)
+ * - period (0, a, 0), over rows D_FIRST .. D_LAST: the last sample predicted over one period against
+ * the measured z, B1 the prediction's torque Jacobian, alpha the shell rates' acceleration (rows
+ * Z_SHELL ..).  alpha is free on the shell's rows, so they are fitted exactly: delta is the
+ * least-squares fit of the other rows (the pendulum, the joints' rates), alpha what is left on the
+ * shell's.  d is clipped to +-u_max.  Leaves d and a as they are when the prediction fails. */
 static void estimate_disturbance(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, const sr_real z[NZ])
 {
-    sr_real ud[SR_NU], zp[NZ], BtB[3] = {0, 0, 0}, Btr[2] = {0, 0}, det, step[2];
+    sr_real ud[SR_NU], zp[NZ], res[NZ], BtB[3] = {0, 0, 0}, Btr[2] = {0, 0}, det, step[2], alpha[3];
     const sr_real *B = m->B[0];
     int i, j;
     ud[0] = m->u_last[0] + m->disturbance[0];
     ud[1] = m->u_last[1] + m->disturbance[1];
     /* A[0], B[0] are scratch here: the iteration overwrites them. */
     if (node(model, m->z_last, ud, m->v_last, m->kappa_last, d->period, zp, m->A[0], m->B[0]) != SR_OK) return;
+    for (j = 0; j < 3; ++j) zp[Z_SHELL + j] += d->period * m->shell_accel[j];
+    for (i = D_FIRST; i <= D_LAST; ++i) res[i] = z[i] - zp[i];
     for (i = D_FIRST; i <= D_LAST; ++i) {
-        const sr_real res = z[i] - zp[i], b0 = B[i * SR_NU], b1 = B[i * SR_NU + 1];
+        const sr_real b0 = B[i * SR_NU], b1 = B[i * SR_NU + 1];
+        if (i >= Z_SHELL && i < Z_SHELL + 3) continue;
         BtB[0] += b0 * b0;
         BtB[1] += b0 * b1;
         BtB[2] += b1 * b1;
-        Btr[0] += b0 * res;
-        Btr[1] += b1 * res;
+        Btr[0] += b0 * res[i];
+        Btr[1] += b1 * res[i];
     }
     det = BtB[0] * BtB[2] - BtB[1] * BtB[1];
     if (!(det > 0) || !all_finite(&det, 1)) return;
     step[0] = (BtB[2] * Btr[0] - BtB[1] * Btr[1]) / det;
     step[1] = (BtB[0] * Btr[1] - BtB[1] * Btr[0]) / det;
-    if (!all_finite(step, SR_NU)) return;
+    for (j = 0; j < 3; ++j)
+        alpha[j] = (res[Z_SHELL + j] - B[(Z_SHELL + j) * SR_NU] * step[0] - B[(Z_SHELL + j) * SR_NU + 1] * step[1])
+                 / d->period;
+    if (!all_finite(step, SR_NU) || !all_finite(alpha, 3)) return;
     for (j = 0; j < SR_NU; ++j) {
         const sr_real dj = m->disturbance[j] + d->disturbance_gain * step[j];
         m->disturbance[j] = dj > d->u_max ? d->u_max : (dj < -d->u_max ? -d->u_max : dj);
     }
+    for (j = 0; j < 3; ++j) m->shell_accel[j] += d->disturbance_gain * alpha[j];
 }
 
 static sr_real wrap(sr_real angle)

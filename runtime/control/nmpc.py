@@ -60,6 +60,9 @@ Z_E = design.Z_E
 #: The coordinates the torque offset is estimated from: the pendulum and the rates, which do not
 #: depend on where the reference's nearest point falls (the attitude and e_y do, by its quantisation).
 DISTURBANCE_ROWS = slice(design.Z_TH_P, design.Z_WP + 1)
+#: The shell's rates in the yoke's frame: where the estimated acceleration acts (a slope's pull, a
+#: body unlike the model's: what the torques cannot explain).
+SHELL_ROWS = slice(design.Z_OM.start, design.Z_OM.stop)
 
 
 def _casadi():
@@ -173,7 +176,7 @@ class NmpcGains(LqrGains):
     torque_step_n_m: float = 0.1      # a change of torque from one node to the next worth the full cost
     cross_track_integral_m_s: float = 2.0    # ∫e_y: faster than the LQR's (the horizon sees its overshoot)
     steady_rate_m_s: float = 0.005    # ∫e_y advances only while |ė_y| ≤ this [m/s] (the horizon sees the overshoot)
-    disturbance_gain: float = 0.0     # the share of the torque offset's one-sample update taken (0: no estimate)
+    disturbance_gain: float = 0.05    # the share of the offsets' one-sample update taken (0: no estimate)
     horizon: float = 30               # N nodes
     node_periods: float = 2           # controller periods per node: the horizon is N × node_periods / rate
     iterations: float = 1             # real-time iterations per sample
@@ -277,6 +280,7 @@ class Nmpc(SlopeFeedforward, Controller):
         self._guess, self._heading, self._u_last = None, 0.0, None
         self.integral = 0.0                     # ∫e_y dt [m s], the controller's own state
         self.disturbance = np.zeros(2)          # d̂ [N m]: the estimated constant offset of the torques
+        self.shell_accel = np.zeros(3)          # â [rad/s²]: the estimated acceleration of the shell's rates
         self._offset = np.zeros(2)              # d̂ − f [N m]: what the prediction adds to the torques
         self._last = None                       # (z, u, v, κ) of the last sample: what d̂ is estimated from
         self.restarts = 0
@@ -394,12 +398,20 @@ class Nmpc(SlopeFeedforward, Controller):
             return
         z_prev, u_prev, v, kappa = self._last
         z_pred, _, B = (out.full() for out in self._one_period(z_prev, u_prev + self._offset, v, kappa, self._p))
-        residual = z[DISTURBANCE_ROWS] - z_pred[DISTURBANCE_ROWS, 0]
-        B = B[DISTURBANCE_ROWS]
-        if not (np.all(np.isfinite(residual)) and np.all(np.isfinite(B))):
+        z_pred = z_pred[:, 0]
+        z_pred[SHELL_ROWS] += self.period * self.shell_accel
+        residual = z - z_pred
+        if not (np.all(np.isfinite(residual[DISTURBANCE_ROWS])) and np.all(np.isfinite(B[DISTURBANCE_ROWS]))):
             return
-        step = np.linalg.solve(B.T @ B, B.T @ residual)
+        # â is free on the shell's rows, so the least squares fits them exactly: the torque step is
+        # the fit of the other rows (the pendulum, the joints' rates), â what is left on the shell's.
+        rows = [i for i in range(DISTURBANCE_ROWS.start, DISTURBANCE_ROWS.stop) if not SHELL_ROWS.start <= i < SHELL_ROWS.stop]
+        step = np.linalg.solve(B[rows].T @ B[rows], B[rows].T @ residual[rows])
+        alpha = (residual[SHELL_ROWS] - B[SHELL_ROWS] @ step) / self.period
+        if not (np.all(np.isfinite(step)) and np.all(np.isfinite(alpha))):
+            return
         self._offset = np.clip(self._offset + gain * step, -self.u_max, self.u_max)
+        self.shell_accel = self.shell_accel + gain * alpha
 
     def _iterate(self, z0, Z, U, zs, us, v, kappas, q, P, cold):
         # Cold start: iterate to convergence once (RTI's usual initialisation), then one per sample.
@@ -416,6 +428,7 @@ class Nmpc(SlopeFeedforward, Controller):
         if not (np.all(np.isfinite(z_next)) and np.all(np.isfinite(A)) and np.all(np.isfinite(B))):
             raise _Diverged
         z_next = z_next.T
+        z_next[:, SHELL_ROWS] += self.node_period * self.shell_accel
         A = A.reshape(nz, n, nz).transpose(1, 0, 2)      # A[k]: nz×nz
         B = B.reshape(nz, n, 2).transpose(1, 0, 2)       # B[k]: nz×2
         gaps = z_next - Z[1:]
@@ -558,4 +571,5 @@ class NmpcC(Nmpc):
                              f"at t = {t:g} s")
         self.integral, self.restarts = self._memory.integral, self._memory.restarts
         self.disturbance = np.array(list(self._memory.disturbance)) + feedforward
+        self.shell_accel = np.array(list(self._memory.shell_accel))
         return self._u.copy()

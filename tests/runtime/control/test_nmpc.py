@@ -142,14 +142,16 @@ def test_a_diverged_prediction_falls_back_to_the_reference_torques(monkeypatch):
 
 
 def circle_offset_against_a_heavier_plant(integral_m_s):
-    """Mean cross-track error over the last 10 s of the circle, plant 10 % heavier, no noise."""
+    """Mean cross-track error over the last 10 s of the circle, plant 10 % heavier, no noise, the
+    integral alone (no offset estimate)."""
     from runtime.control.benchmark import run_task
     from runtime.control.closed_loop import Noise
     from runtime.control.task import load_task
     from runtime.state import IDX_Q
     task = load_task("circle-mismatch").with_controller("nmpc")
     spec = task.controllers[0]
-    spec = dataclasses.replace(spec, gains=dataclasses.replace(spec.gains, cross_track_integral_m_s=integral_m_s))
+    spec = dataclasses.replace(spec, gains=dataclasses.replace(spec.gains, cross_track_integral_m_s=integral_m_s,
+                                                                      disturbance_gain=0.0))
     result, reference, _ = run_task(dataclasses.replace(task, controllers=(spec,), noise=Noise()))
     late = result.time >= result.time[-1] - 10.0
     return float(np.mean(reference.cross_track(result.trajectory[late][::20, IDX_Q][:, :2])))

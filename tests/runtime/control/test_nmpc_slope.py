@@ -19,8 +19,9 @@ PARAMS = Params.paper_simulation()
 SPEED = 0.2
 #: A quarter of the climbing limit under 0.5 N m (the offset table's slope).
 SLOPE = 0.25 * climbing_limit(PARAMS, 0.5)
-#: One operating point (straight, 0.2 m/s) and a short horizon keep the design and the run cheap.
-GAINS = nmpc.NmpcGains(v_min=SPEED, n_speeds=1, kappa_max=0.0, n_curvatures=1, horizon=10)
+#: One operating point (straight, 0.2 m/s) and a short horizon keep the design and the run cheap; the
+#: offset estimate off, so that the slope's feedforward and its estimate are what is tested.
+GAINS = nmpc.NmpcGains(v_min=SPEED, n_speeds=1, kappa_max=0.0, n_curvatures=1, horizon=10, disturbance_gain=0.0)
 ESTIMATING = dataclasses.replace(GAINS, slope_estimate_s=5.0)
 TARGET_M = 0.005
 
@@ -30,12 +31,12 @@ def _rolling(psi):
                          w_Y=SPEED / PARAMS.r, r=PARAMS.r)
 
 
-def _across_the_slope(controller):
-    """Second-half cross-track RMS [m] of 12 s heading +y on the slope rising towards +x (on the
+def _across_the_slope(controller, duration=12.0):
+    """Second-half cross-track RMS [m] of `duration` s heading +y on the slope rising towards +x (on the
     right), and the controller after the run."""
     x0 = _rolling(math.pi / 2)
     reference = line_path(x0[IDX_Q][:2], math.pi / 2, 0.0, 10.0, SPEED)
-    result = simulate_closed_loop(PARAMS.replace(slope=SLOPE), controller, reference, x0, 12.0, 0.005,
+    result = simulate_closed_loop(PARAMS.replace(slope=SLOPE), controller, reference, x0, duration, 0.005,
                                   method="rkmk4")
     e = reference.cross_track(result.trajectory[len(result.trajectory) // 2:, IDX_Q])
     return float(np.sqrt(np.mean(e ** 2)))
@@ -56,3 +57,13 @@ def test_the_online_estimate_holds_a_line_across_an_unknown_slope(cls):
 
 def test_without_the_estimate_the_flat_nmpc_leaves_the_line_across_the_slope():
     assert _across_the_slope(nmpc.NmpcC(PARAMS, rate=20.0, gains=GAINS)) > 2 * TARGET_M
+
+
+def test_the_offset_estimate_with_the_shells_acceleration_brings_a_line_across_an_unknown_slope_close():
+    # The slope's pull on the shell is not a torque of the motors: the estimate's shell acceleration
+    # carries it, and the flat prediction comes within 2 target widths in 30 s (without the estimate:
+    # above; with the torque offset alone: 0.19 m); the integral removes the rest more slowly.  The
+    # Python NMPC estimates the same offsets (test_offset_free.py).
+    controller = nmpc.NmpcC(PARAMS, rate=20.0, gains=dataclasses.replace(GAINS, disturbance_gain=0.05))
+    assert _across_the_slope(controller, 30.0) < 2 * TARGET_M
+    assert np.linalg.norm(controller.shell_accel) > 0
