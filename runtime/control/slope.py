@@ -179,10 +179,17 @@ class SlopeEstimator:
             residual = np.asarray(x)[IDX_NU] - flat
             self._normal = self._forget * self._normal + G.T @ G
             self._rhs = self._forget * self._rhs + G.T @ residual
+            scales = np.array([scale for _, _, scale in self._pendulum])
             if np.linalg.cond(self._normal) < 1e10:
                 theta = np.linalg.solve(self._normal, self._rhs)
-                self.slope, self.torque_offset = theta[:2], theta[2:4]
-                self.pendulum = theta[4:] * np.array([scale for _, _, scale in self._pendulum])
+                self.slope, self.torque_offset, self.pendulum = theta[:2], theta[2:4], theta[4:] * scales
+            elif np.linalg.cond(self._normal[:4, :4]) < 1e10:
+                # Until the samples tell the pendulum from the slope and d (rolling straight at the
+                # start), the slope and d alone, the pendulum held: the slope's estimate arrives as
+                # soon as it would without the pendulum.
+                held = self._rhs[:4] - self._normal[:4, 4:] @ (self.pendulum / scales)
+                theta = np.linalg.solve(self._normal[:4, :4], held)
+                self.slope, self.torque_offset = theta[:2], theta[2:]
         self._last = np.array(x, dtype=float)
         return self.slope
 

@@ -10,7 +10,7 @@ from runtime import so3
 from runtime.control import lqr
 from runtime.control.climbing import climbing_limit
 from runtime.control.closed_loop import simulate_closed_loop
-from runtime.control.reference import circle_path
+from runtime.control.reference import SpeedHeading, circle_path
 from runtime.control.slope import SlopeEstimator
 from runtime.params import Params
 from runtime.state import IDX_Q, initial_state
@@ -20,6 +20,8 @@ SPEED, RADIUS, RATE = 0.3, 2.0, 20.0
 #: A quarter of the climbing limit under 0.5 N m (the offset table's slope).
 SLOPE = 0.25 * climbing_limit(PARAMS, 0.5)
 GAINS = lqr.LqrGains(v_min=SPEED, n_speeds=1, kappa_max=0.5, n_curvatures=3)
+#: How soon [s] a slope is read rolling straight up it.
+READ_WITHIN_S = 0.5
 
 
 def _estimates_on_the_circle(plant, duration=20.0):
@@ -57,3 +59,17 @@ def test_a_slope_is_still_read_as_the_slope():
     slopes, pendulums = _estimates_on_the_circle(PARAMS.replace(slope=SLOPE))
     assert np.linalg.norm(slopes[-1] - (SLOPE, 0.0)) < 0.02 * SLOPE
     assert np.all(np.abs(pendulums[-1]) < 1e-3 * np.array([PARAMS.m_P, 1, 1, 1]))
+
+
+def test_rolling_straight_the_slope_is_read_before_the_pendulum_can_be():
+    # Up a slope at one heading the pendulum's columns are not yet told from the slope's and d's;
+    # the estimate then holds the pendulum and reads the slope as it would without it.
+    plant = PARAMS.replace(slope=SLOPE)
+    x0 = initial_state(R_S=so3.rot_z(-math.pi / 2), q=(0.0, 0.0, PARAMS.r), w_S=(-SPEED / PARAMS.r, 0.0, 0.0),
+                       w_Y=SPEED / PARAMS.r, r=PARAMS.r)
+    result = simulate_closed_loop(plant, lqr.Lqr(PARAMS, rate=RATE, gains=GAINS), SpeedHeading(SPEED, 0.0), x0,
+                                  READ_WITHIN_S, 0.005, method="rkmk4")
+    estimator, per = SlopeEstimator(PARAMS, 1 / RATE, 5.0), round(1 / (RATE * 0.005))
+    for k in range(0, len(result.time) - 1, per):
+        estimator.update(result.trajectory[k], result.torques[k - 1] if k else np.zeros(2))
+    assert np.linalg.norm(estimator.slope - (SLOPE, 0.0)) < 0.02 * SLOPE
