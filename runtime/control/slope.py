@@ -31,7 +31,10 @@ to the fall line and acts on the whole robot.  So the estimate carries the pendu
 centre of mass as well, their columns the model's one-period rates with each moved, less the flat
 ones (the identification's parameter sensitivities, here by differences); the slope fed forward is
 the part the pendulum does not explain.  The pendulum's part is not fed forward: the controllers'
-integrals and torque offset hold it as they do without an estimate.
+integrals and torque offset hold it as they do without an estimate.  Until the samples tell the
+pendulum from the slope and d (rolling straight from the start, its columns lie nearly in their
+span), the slope and d are fitted alone with the pendulum held, so the slope is read as early as
+without it.
 """
 import dataclasses
 import math
@@ -138,7 +141,7 @@ class SlopeEstimator:
     (3,) [m]) from the measured states and the torques held between them (see the module's
     docstring): least squares with exponential forgetting over `time_constant_s`.  What the torque
     offset or the pendulum explains is not read as a slope: they act on the rates along other
-    directions, fixed to the robot where the slope's turn with the heading."""
+    directions, fixed to the robot, where the slope's pull turns with the heading."""
 
     def __init__(self, params, period, time_constant_s):
         self.period, self.time_constant_s = float(period), float(time_constant_s)
