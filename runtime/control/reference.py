@@ -44,6 +44,35 @@ class SpeedHeading:
         return Target(self.speed, self.heading)
 
 
+#: A turn between samples below this [rad] is straight (round-off of collinear samples).
+STRAIGHT_RAD = 1e-9
+
+
+def _spread_curvature(s, turns):
+    """The curvature (n,) [1/m] at the samples of arc lengths s (n,) of a path turning by `turns`
+    (n − 2,) [rad] at its interior samples: each turn spread evenly over the arc length centred on
+    its sample and reaching halfway to the nearest turning sample (or end) on either side, as a fillet
+    would round it; then each sample's curvature the mean over its own cell (halfway to its
+    neighbours).  A path that turns at every sample (a sampled arc) keeps turn / cell; a polyline
+    sampled finer than its legs turns at few samples, and a point curvature there (turn / cell,
+    tens of times the legs' mean) would be all that a controller sampling the path ahead sees or
+    misses: its mean curvature is the turn spread over the legs."""
+    n = len(s)
+    kappa = np.zeros(n)
+    at = 1 + np.nonzero(np.abs(turns) > STRAIGHT_RAD)[0]
+    if len(at) == 0:
+        return kappa
+    bounds = np.concatenate([[0], at, [n - 1]])
+    half = 0.5 * np.minimum(s[at] - s[bounds[:-2]], s[bounds[2:]] - s[at])
+    # The cumulative turn Θ(s): a ramp of each turn over its window (windows touch at most).
+    knots = np.ravel(np.column_stack([s[at] - half, s[at] + half]))
+    theta = np.concatenate([[0.0], np.repeat(np.cumsum(turns[at - 1]), 2)[:-1]])
+    lo = np.concatenate([[s[0]], 0.5 * (s[:-1] + s[1:])])
+    hi = np.concatenate([0.5 * (s[:-1] + s[1:]), [s[-1]]])
+    kappa[1:-1] = ((np.interp(hi, knots, theta) - np.interp(lo, knots, theta)) / (hi - lo))[1:-1]
+    return kappa
+
+
 class Path:
     """A path sampled as points (n, 2), with tangent headings and curvatures per point, at `speed`."""
     is_path = True
@@ -57,10 +86,8 @@ class Path:
         self.s = np.concatenate([[0.0], np.cumsum(seg)])
         self.tangent = np.concatenate([np.arctan2(d[:, 1], d[:, 0]), [math.atan2(d[-1, 1], d[-1, 0])]])
         turn = wrap_angle(np.diff(self.tangent))
-        kappa = np.zeros(len(self.points))
         # A polyline's corners (turns > 0.1 rad between samples) are not curvature to feed forward.
-        kappa[1:-1] = np.where(np.abs(turn[:-1]) > 0.1, 0.0, turn[:-1] / (0.5 * (seg[:-1] + seg[1:])))
-        self.curvature = kappa
+        self.curvature = _spread_curvature(self.s, np.where(np.abs(turn[:-1]) > 0.1, 0.0, turn[:-1]))
         self.speed = float(speed)
         self._hint = 0
 

@@ -21,6 +21,20 @@ Estimate.  Between two samples the torques are held, so the rates one period lat
 model predicts plus what the slope adds, linear in s: ν⁺ − ν̂⁺(flat) ≈ G_x s_x + G_y s_y, G the
 model's step on a slope along x (for s_y: with the state turned by −π/2 about the normal) less the
 flat one, per radian.  `SlopeEstimator` solves these with exponential forgetting (time constant τ).
+
+A slope and a pendulum unlike the model's.  A pendulum heavier than the model's, or with its centre
+of mass moved, pulls on the rates too, and fitted with the slope and a torque offset alone it is read
+as a slope (in a transient, tens of times the slope the table's plants stand on) that the
+feedforward then acts on.  But it pulls as a change of the model's parameters does: through the
+pendulum's swing and lean, fixed to the robot, where a slope's pull turns with the heading relative
+to the fall line and acts on the whole robot.  So the estimate carries the pendulum's mass and
+centre of mass as well, their columns the model's one-period rates with each moved, less the flat
+ones (the identification's parameter sensitivities, here by differences); the slope fed forward is
+the part the pendulum does not explain.  The pendulum's part is not fed forward: the controllers'
+integrals and torque offset hold it as they do without an estimate.  Until the samples tell the
+pendulum from the slope and d (rolling straight from the start, its columns lie nearly in their
+span), the slope and d are fitted alone with the pendulum held, so the slope is read as early as
+without it.
 """
 import dataclasses
 import math
@@ -40,6 +54,10 @@ PROBE_SLOPE = 1e-3
 PREDICT_DT = 0.005
 #: The torque step [N m] of the estimator's derivatives with respect to the torques.
 TORQUE_PROBE = 1e-3
+#: The pendulum's parameters estimated with the slope: their steps (relative for the mass, metres
+#: for the centre of mass) and the sizes their columns are scaled to (a tenth of the mass, 1 cm).
+MASS_PROBE, CENTRE_PROBE_M = 1e-3, 1e-4
+MASS_SCALE, CENTRE_SCALE_M = 0.1, 0.01
 
 
 class _Turned:
@@ -118,25 +136,32 @@ def _design(params, schedule):
 
 
 class SlopeEstimator:
-    """The world's slope vector s [rad] and a torque offset d [N m] (the plant moving as the model
-    under u + d: a moved centre of mass, a motor's bias) from the measured states and the torques held
-    between them (see the module's docstring): least squares with exponential forgetting over
-    `time_constant_s`.  The torque offset is estimated with the slope so that what a torque explains
-    is not read as a slope; the two act on the rates along different directions."""
+    """The world's slope vector s [rad], a torque offset d [N m] (the plant moving as the model under
+    u + d: a motor's bias) and the pendulum's departure from the model (`pendulum`: Δm_P [kg], Δc_P
+    (3,) [m]) from the measured states and the torques held between them (see the module's
+    docstring): least squares with exponential forgetting over `time_constant_s`.  What the torque
+    offset or the pendulum explains is not read as a slope: they act on the rates along other
+    directions, fixed to the robot, where the slope's pull turns with the heading."""
 
     def __init__(self, params, period, time_constant_s):
         self.period, self.time_constant_s = float(period), float(time_constant_s)
         self._flat = Model(params.replace(slope=0.0))
         self._sloped = Model(params.replace(slope=PROBE_SLOPE))
+        c_P = np.asarray(params.c_P, dtype=float)
+        # (the model with one pendulum parameter moved, the step, the column's scale)
+        self._pendulum = [(Model(params.replace(slope=0.0, m_P=params.m_P * (1 + MASS_PROBE))),
+                           MASS_PROBE * params.m_P, MASS_SCALE * params.m_P)]
+        self._pendulum += [(Model(params.replace(slope=0.0, c_P=tuple(c_P + CENTRE_PROBE_M * e))), CENTRE_PROBE_M,
+                            CENTRE_SCALE_M) for e in np.eye(3)]
         self._steps = max(1, math.ceil(self.period / PREDICT_DT - 1e-9))
         self._forget = math.exp(-self.period / self.time_constant_s)
         self.reset()
 
     def reset(self):
         """Forgets the samples and the estimate."""
-        self._normal, self._rhs = np.zeros((4, 4)), np.zeros(4)
+        self._normal, self._rhs = np.zeros((8, 8)), np.zeros(8)
         self._last = None
-        self.slope, self.torque_offset = np.zeros(2), np.zeros(2)
+        self.slope, self.torque_offset, self.pendulum = np.zeros(2), np.zeros(2), np.zeros(4)
 
     def _rates(self, model, x, u):
         return model.simulate(x, self.period / self._steps, self._steps, np.tile(u, (self._steps, 1)),
@@ -152,12 +177,21 @@ class SlopeEstimator:
                        # a slope towards the world's +y is the model's (+x) with the world turned by −π/2
                        (self._rates(self._sloped, turned_state(x0, -math.pi / 2), u) - flat) / PROBE_SLOPE]
             columns += [(self._rates(self._flat, x0, u + TORQUE_PROBE * e) - flat) / TORQUE_PROBE for e in np.eye(2)]
+            columns += [(self._rates(model, x0, u) - flat) * (scale / step) for model, step, scale in self._pendulum]
             G = np.stack(columns, axis=1)
             residual = np.asarray(x)[IDX_NU] - flat
             self._normal = self._forget * self._normal + G.T @ G
             self._rhs = self._forget * self._rhs + G.T @ residual
+            scales = np.array([scale for _, _, scale in self._pendulum])
             if np.linalg.cond(self._normal) < 1e10:
                 theta = np.linalg.solve(self._normal, self._rhs)
+                self.slope, self.torque_offset, self.pendulum = theta[:2], theta[2:4], theta[4:] * scales
+            elif np.linalg.cond(self._normal[:4, :4]) < 1e10:
+                # Until the samples tell the pendulum from the slope and d (rolling straight at the
+                # start), the slope and d alone, the pendulum held: the slope's estimate arrives as
+                # soon as it would without the pendulum.
+                held = self._rhs[:4] - self._normal[:4, 4:] @ (self.pendulum / scales)
+                theta = np.linalg.solve(self._normal[:4, :4], held)
                 self.slope, self.torque_offset = theta[:2], theta[2:]
         self._last = np.array(x, dtype=float)
         return self.slope
