@@ -1,0 +1,56 @@
+"""The sensor fit's start states: each segment's start is fitted alone from its readings and the
+start guess (the EKF's estimate, weighed by the filter's standard deviations), so that an error in
+one segment's guess stays in that segment."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from runtime.estimation.sense import simulate_log
+from runtime.identification import fit as fitmod
+from runtime.identification.fit import free_parameters
+from runtime.scenario import TorqueWindow, load_scenario
+from runtime.sensor_set import SensorSet
+
+SCENARIO = load_scenario("battery-geared")
+NOMINAL = SCENARIO.params
+NAMES = free_parameters("k_Y")
+
+
+@pytest.fixture(scope="module")
+def guess():
+    program = (TorqueWindow(0.0, 0.5, 0.3, -0.1), TorqueWindow(0.5, 1.0, -0.2, 0.15))
+    run = dataclasses.replace(SCENARIO, torques=program, steps=int(round(1.0 / SCENARIO.dt)))
+    log = simulate_log(run, SensorSet.default(), seed=3)
+    x, b, sigma = fitmod._start_guess(log, NOMINAL, with_sigma=True)
+    return log, x, b, sigma
+
+
+def fitted_starts(guess, sigma, turn):
+    """The start states after `fit_starts`, the first segment's guess turned by `turn` rad about
+    the vertical (the heading, which one segment's readings do not determine)."""
+    log, x, b, _ = guess
+    prob = fitmod._Problem(log, NOMINAL, NAMES, 0.5, "rkmk4", x, b, x_sigma=sigma)
+    model = prob.model(prob.theta_start)
+    turned = np.zeros(12)
+    turned[2] = turn
+    prob.xref[0] = model.retract(prob.xref[0], turned)
+    guessed = prob.xref.copy()
+    prob.fit_starts(prob.z0())
+    return model, guessed, prob.xref
+
+
+def test_an_error_in_one_segments_guess_does_not_pass_to_the_next(guess):
+    model, guessed, fitted = fitted_starts(guess, guess[3], 0.3)
+    # the second segment keeps its own (right) heading; a chain from the first's end would carry 0.3 rad
+    assert abs(model.local(guessed[1], fitted[1])[2]) < 0.03
+    assert abs(model.local(guessed[0], fitted[0])[2]) < 0.03
+
+
+def test_the_guess_weighs_each_start_by_the_filters_standard_deviations(guess):
+    tight = np.full_like(guess[3], 1e-9)
+    model, guessed, fitted = fitted_starts(guess, tight, 0.0)
+    # a guess known to 1e-9 holds its start; the readings alone move it further
+    assert np.abs(model.local(guessed, fitted)).max() < 1e-6
+    _, _, free = fitted_starts(guess, None, 0.0)
+    assert np.abs(model.local(guessed, free)).max() > 1e-4
