@@ -59,6 +59,10 @@ Z95 = float(scipy.stats.norm.ppf(0.975))
 GAUGE_SIGMA = 10.0
 #: Smallest standard deviation of an end-state difference, for a sensor set without process noise.
 DEFECT_FLOOR = 1e-7
+#: Evaluations of the sensor fit's first stage, which fits the start states and biases with the
+#: parameters held (the segments, each fitted alone, disagree at their ends by the start guess's
+#: errors, which are linear in the start states).
+STATES_NFEV = 8
 
 
 class IdentifyError(ValueError):
@@ -241,6 +245,7 @@ class _Problem:
         self._cache = (None, None)
         self.nfev = 0
         self.progress = None
+        self.hold_parameters = False        # the parameters' columns zero: only the states and biases move
 
     # -- the unknowns ---------------------------------------------------------------------------
     def split(self, z):
@@ -285,7 +290,7 @@ class _Problem:
         out = []
         for s in range(self.S):
             nxt = starts[s + 1] if s + 1 < self.S else None
-            out.append(self.segment_block(model, s, starts[s], nxt, b))
+            out.append(self.segment_block(model, s, starts[s], nxt, b, sensitivities=not self.hold_parameters))
         return out
 
     def segment_block(self, model, s, start, nxt, b, sensitivities=True):
@@ -643,6 +648,14 @@ def _identify(log, params, free, segment, method, full_state, max_nfev, progress
         z0 = np.clip(prob.z0(), np.where(np.isfinite(lo), lo + 1e-12 * np.maximum(1, abs(lo)), lo),
                      np.where(np.isfinite(hi), hi - 1e-12 * np.maximum(1, abs(hi)), hi))
 
+    if not full_state:
+        # first the start states and biases alone: until the segments agree at their ends, the
+        # parameters would move to absorb the start guess's errors (seen: to their bounds)
+        prob.hold_parameters = True
+        z0 = levenberg_marquardt(lambda z: prob.assemble(z)[:2], z0, lo, hi, STATES_NFEV).x
+        prob.hold_parameters = False
+        prob.chol = None            # the covariance where the segments agree
+        prob._cache = (None, None)
     if full_state:
         opts = dict(jac=lambda z: prob.assemble(z)[1].toarray(), bounds=(lo, hi), method="trf", x_scale="jac",
                     max_nfev=max_nfev, xtol=1e-8, ftol=1e-8, gtol=1e-10)

@@ -54,3 +54,23 @@ def test_the_guess_weighs_each_start_by_the_filters_standard_deviations(guess):
     assert np.abs(model.local(guessed, fitted)).max() < 1e-6
     _, _, free = fitted_starts(guess, None, 0.0)
     assert np.abs(model.local(guessed, free)).max() > 1e-4
+
+
+def test_the_joint_fit_starts_once_the_start_states_agree_with_the_parameters_held(guess, monkeypatch):
+    log = guess[0]
+    calls = []
+    solve = fitmod.levenberg_marquardt
+
+    def recording(evaluate, z0, lo, hi, max_nfev, **options):
+        r, J = evaluate(z0)
+        sol = solve(evaluate, z0, lo, hi, max_nfev, **options)
+        calls.append((z0.copy(), 0.5 * float(r @ r), abs(J[:, :1]).max(), sol))
+        return sol
+
+    monkeypatch.setattr(fitmod, "levenberg_marquardt", recording)
+    fitmod.identify(log, NOMINAL, "k_Y", max_nfev=2)
+    (z0, cost0, theta_column, first), (z1, _, theta_column_joint, _) = calls[:2]
+    # the first stage moves the states and biases only, and lowers the cost; the joint fit starts there
+    assert theta_column == 0 and first.x[0] == z0[0] and first.cost < cost0
+    np.testing.assert_array_equal(z1[1:], first.x[1:])
+    assert theta_column_joint > 0
