@@ -15,12 +15,13 @@ from runtime.sensor_set import SensorSet
 SCENARIO = load_scenario("battery-geared")
 NOMINAL = SCENARIO.params
 NAMES = free_parameters("k_Y")
+SEGMENT = 0.25
 
 
 @pytest.fixture(scope="module")
 def guess():
-    program = (TorqueWindow(0.0, 0.5, 0.3, -0.1), TorqueWindow(0.5, 1.0, -0.2, 0.15))
-    run = dataclasses.replace(SCENARIO, torques=program, steps=int(round(1.0 / SCENARIO.dt)))
+    program = (TorqueWindow(0.0, 0.25, 0.3, -0.1), TorqueWindow(0.25, 0.5, -0.2, 0.15))
+    run = dataclasses.replace(SCENARIO, torques=program, steps=int(round(0.5 / SCENARIO.dt)))
     log = simulate_log(run, SensorSet.default(), seed=3)
     x, b, sigma = fitmod._start_guess(log, NOMINAL, with_sigma=True)
     return log, x, b, sigma
@@ -30,7 +31,7 @@ def fitted_starts(guess, sigma, turn):
     """The start states after `fit_starts`, the first segment's guess turned by `turn` rad about
     the vertical (the heading, which one segment's readings do not determine)."""
     log, x, b, _ = guess
-    prob = fitmod._Problem(log, NOMINAL, NAMES, 0.5, "rkmk4", x, b, x_sigma=sigma)
+    prob = fitmod._Problem(log, NOMINAL, NAMES, SEGMENT, "rkmk4", x, b, x_sigma=sigma)
     model = prob.model(prob.theta_start)
     turned = np.zeros(12)
     turned[2] = turn
@@ -68,7 +69,7 @@ def test_the_joint_fit_starts_once_the_start_states_agree_with_the_parameters_he
         return sol
 
     monkeypatch.setattr(fitmod, "levenberg_marquardt", recording)
-    fitmod.identify(log, NOMINAL, "k_Y", max_nfev=2)
+    fitmod.identify(log, NOMINAL, "k_Y", segment=SEGMENT, max_nfev=2)
     (z0, cost0, theta_column, first), (z1, _, theta_column_joint, _) = calls[:2]
     # the first stage moves the states and biases only, and lowers the cost; the joint fit starts there
     assert theta_column == 0 and first.x[0] == z0[0] and first.cost < cost0
