@@ -15,14 +15,70 @@ import os
 import time
 
 import numpy as np
+import scipy.stats
 
 from ..atomic import write_text
 from ..estimation.sense import simulate_log
-from ..param_derivatives import PARAMETER_NAMES
+from ..param_derivatives import PARAMETER_NAMES, PI_NAMES
 from ..params import Params
 from ..scenario import TorqueWindow, load_scenario
 from ..sensor_set import SensorSet
+from .first_guess import _pi_of
 from .fit import STARTS, free_parameters, identify
+
+#: The within-tolerance target of the combinations (relative; a vector's error relative to its norm).
+COMBINATION_TOLERANCE = 0.02
+
+
+def combinations_of(p):
+    """{name: values (k,)} of the combinations a sensor log of this robot determines although the
+    entries inside them may not be (both hinges sit at the shell centre), of a parameter vector p
+    (`PARAMETER_NAMES` order, need not be physical): the total mass, the pendulum's first moment
+    m_P c_P (3,), the pendulum's inertia about its hinge JO_P_yy, the inertia about the yoke's axis
+    with the reflected rotor JO_Y_xx + JO_P_zz + n_Y² j_mY, and the three dampings."""
+    pi = dict(zip(PI_NAMES, _pi_of(p)))
+    v = dict(zip(PARAMETER_NAMES, p))
+    return {"m_S + m_Y + m_P": np.array([v["m_S"] + v["m_Y"] + v["m_P"]]),
+            "m_P c_P": np.array([pi["mc_P_x"], pi["mc_P_y"], pi["mc_P_z"]]),
+            "JO_P_yy": np.array([pi["JO_P_yy"]]),
+            "JO_Y_xx + JO_P_zz + n_Y^2 j_mY": np.array([pi["JO_Y_xx"] + pi["JO_P_zz"] + v["n_Y"] ** 2 * v["j_mY"]]),
+            "k_S": np.array([v["k_S"]]), "k_Y": np.array([v["k_Y"]]), "k_P": np.array([v["k_P"]])}
+
+
+def combination_errors(fit, truth):
+    """Per combination (`combinations_of`) of a fit's robot against the true robot: {"truth",
+    "estimate", "relative_error" (|estimate − truth| / |truth|, the vector's norms), "within"
+    (COMBINATION_TOLERANCE), "inside" (the truth inside the estimate's 95 % region: the
+    Mahalanobis distance under the delta method's covariance, by the chi-square quantile of its
+    rank; None for a combination no free entry moves), "sigma" (per component)}."""
+    idx = [PARAMETER_NAMES.index(n) for n in fit.names]
+    p = fit.params.as_array()
+    est, true = combinations_of(p), combinations_of(truth.as_array())
+    sigma = np.where(np.isfinite(fit.sigma), fit.sigma, 0.0)
+    cov = np.nan_to_num(fit.correlation) * np.outer(sigma, sigma)
+    grads = {name: np.zeros((len(v), len(idx))) for name, v in est.items()}
+    for c, i in enumerate(idx):         # the combinations are polynomials in p: central differences
+        step = 1e-6 * max(abs(p[i]), 1e-9)
+        hi, lo = p.copy(), p.copy()
+        hi[i] += step
+        lo[i] -= step
+        up, down = combinations_of(hi), combinations_of(lo)
+        for name in grads:
+            grads[name][:, c] = (up[name] - down[name]) / (2 * step)
+    out = {}
+    for name, e in est.items():
+        t, G = true[name], grads[name]
+        C = G @ cov @ G.T
+        rank = int(np.linalg.matrix_rank(C, tol=1e-12 * max(float(np.abs(C).max()), 1e-300))) if np.any(C) else 0
+        d = e - t
+        Cp = np.linalg.pinv(C, rcond=1e-12)
+        # outside the region too: an error along a direction the covariance says is known exactly
+        inside = None if not rank else bool(d @ Cp @ d <= scipy.stats.chi2.ppf(0.95, rank)
+                                            and np.linalg.norm(d - C @ Cp @ d) <= 1e-6 * np.linalg.norm(d))
+        rel = float(np.linalg.norm(d) / np.linalg.norm(t)) if np.linalg.norm(t) > 0 else float(np.linalg.norm(d))
+        out[name] = {"truth": t.tolist(), "estimate": e.tolist(), "sigma": np.sqrt(np.clip(np.diag(C), 0, None)).tolist(),
+                     "relative_error": rel, "within": rel <= COMBINATION_TOLERANCE, "inside": inside}
+    return out
 
 
 def random_torques(duration, rng, period=0.25, yoke=0.3, pendulum=0.15):
@@ -70,7 +126,7 @@ def simulated_log(names, duration, seed, spread=0.3, excitation=None):
 def trial(names, duration, seed, spread=0.3, full_state=False, segment=0.5, max_nfev=20, excitation=None,
           start="regressor"):
     """One seeded fit: {"seed", "names", "truth", "start", "estimate", "sigma", "inside", "rms",
-    "passed" (the residual check), "wall_time_s", "cpu_time_s" (the fit's, without the log's
+    "passed" (the residual check), "combinations" (`combination_errors`), "wall_time_s", "cpu_time_s" (the fit's, without the log's
     simulation), "load_average" (the machine's, over the last minute, at the fit's end)}."""
     log, nominal, truth = simulated_log(names, duration, seed, spread, excitation)
     started, cpu = time.perf_counter(), time.process_time()
@@ -81,7 +137,7 @@ def trial(names, duration, seed, spread=0.3, full_state=False, segment=0.5, max_
             "estimate": fit.estimate.tolist(), "sigma": fit.sigma.tolist(),
             "inside": (np.abs(fit.estimate - true) <= 1.959964 * fit.sigma).tolist(),
             "rms": fit.residual_check["rms"], "passed": fit.residual_check["passed"],
-            "wall_time_s": wall, "cpu_time_s": cpu, "load_average": os.getloadavg()[0]}
+            "combinations": combination_errors(fit, truth), "wall_time_s": wall, "cpu_time_s": cpu, "load_average": os.getloadavg()[0]}
 
 
 def _trial(args):
@@ -111,11 +167,20 @@ def coverage(names, duration, fits, seed=0, jobs=1, done=None, **options):
 
 
 def summarise(trials):
-    """{"names", "coverage" (per entry), "passed", "trials" (in seed order)} of some trials."""
+    """{"names", "coverage" (per entry), "passed", "combinations" ({name: {"coverage", "within",
+    "fits"}}: of the fits whose free entries move the combination, the fractions whose 95 % region
+    holds its truth and whose estimate is within COMBINATION_TOLERANCE of it), "trials" (in seed
+    order)} of some trials."""
     trials = sorted(trials, key=lambda t: t["seed"])
     inside = np.array([t["inside"] for t in trials], dtype=float)
+    combos = {}
+    for name in trials[0].get("combinations", {}):      # those the free entries move
+        rows = [t["combinations"][name] for t in trials if t["combinations"][name]["inside"] is not None]
+        if rows:
+            combos[name] = {"coverage": float(np.mean([c["inside"] for c in rows])),
+                            "within": float(np.mean([c["within"] for c in rows])), "fits": len(rows)}
     return {"names": trials[0]["names"], "coverage": inside.mean(axis=0).tolist(),
-            "passed": float(np.mean([t["passed"] for t in trials])), "trials": trials}
+            "passed": float(np.mean([t["passed"] for t in trials])), "combinations": combos, "trials": trials}
 
 
 def calibration_figure(result, path, title=""):
@@ -195,6 +260,9 @@ def main(argv):
         return 2
     for name, c in zip(result["names"], result["coverage"]):
         print(f"{name}: truth inside the 95 % interval in {100 * c:.0f} % of {args.fits} fits")
+    for name, c in result["combinations"].items():
+        print(f"{name}: truth inside the 95 % region in {100 * c['coverage']:.0f} %, within "
+              f"{100 * COMBINATION_TOLERANCE:g} % in {100 * c['within']:.0f} % of {c['fits']} fits")
     print(f"residual check passed in {100 * result['passed']:.0f} % of {args.fits} fits")
     return 0
 

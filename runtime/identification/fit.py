@@ -59,6 +59,10 @@ Z95 = float(scipy.stats.norm.ppf(0.975))
 GAUGE_SIGMA = 10.0
 #: Smallest standard deviation of an end-state difference, for a sensor set without process noise.
 DEFECT_FLOOR = 1e-7
+#: Evaluations of the sensor fit's first stage, which fits the start states and biases with the
+#: parameters held (the segments, each fitted alone, disagree at their ends by the start guess's
+#: errors, which are linear in the start states).
+STATES_NFEV = 8
 
 
 class IdentifyError(ValueError):
@@ -211,7 +215,7 @@ class Fit:
 class _Problem:
     """The multiple-shooting problem of a sensor log."""
 
-    def __init__(self, log, params, free, segment, method, x_guess, bias_guess, jacobian="analytic"):
+    def __init__(self, log, params, free, segment, method, x_guess, bias_guess, jacobian="analytic", x_sigma=None):
         self.log, self.params, self.free, self.method, self.jacobian = log, params, free, method, jacobian
         self.idx = [PARAMETER_NAMES.index(n) for n in free]
         self.nf = len(free)
@@ -226,6 +230,8 @@ class _Problem:
         self.ends = np.append(self.starts[1:], n - 1)
         self.S = len(self.starts)
         self.xref = np.array(x_guess[self.starts])
+        # the start guess's standard deviations (its 12 error coordinates) at the segments' starts
+        self.xsig = None if x_sigma is None else np.asarray(x_sigma, dtype=float)[self.starts, :NE]
         self.b0 = np.asarray(bias_guess, dtype=float)
         self.mount = log.sensors.imu.mount
         sensors = log.sensors
@@ -239,6 +245,7 @@ class _Problem:
         self._cache = (None, None)
         self.nfev = 0
         self.progress = None
+        self.hold_parameters = False        # the parameters' columns zero: only the states and biases move
 
     # -- the unknowns ---------------------------------------------------------------------------
     def split(self, z):
@@ -283,7 +290,7 @@ class _Problem:
         out = []
         for s in range(self.S):
             nxt = starts[s + 1] if s + 1 < self.S else None
-            out.append(self.segment_block(model, s, starts[s], nxt, b))
+            out.append(self.segment_block(model, s, starts[s], nxt, b, sensitivities=not self.hold_parameters))
         return out
 
     def segment_block(self, model, s, start, nxt, b, sensitivities=True):
@@ -357,20 +364,19 @@ class _Problem:
         return block
 
     def fit_starts(self, z):
-        """The segments' start states one after the other (the parameters and biases held): each
-        from its own readings and, after the first, from the previous segment's end (weighed by the
-        process noise between them), a small Levenberg–Marquardt fit; the guesses then move there
-        (the fit's offsets start at zero)."""
+        """Each segment's start state alone (the parameters and biases held): from its own readings,
+        whitened as the joint fit whitens them, and the start guess as a prior with the guess's
+        standard deviations (`x_sigma`: the EKF's, which carry the fixes' information about the
+        position and the heading that a single segment cannot see); a small Levenberg–Marquardt
+        fit per segment.  The guesses then move there (the fit's offsets start at zero).  The
+        segments are not chained: a chain carries one segment's error in the heading or the
+        position through every later start, where only a few fixes per segment can pull it back."""
         theta, b, _ = self.split(z)
         model = self.model(theta)
-        prior = None
         for s in range(self.S):
             x_ref = self.xref[s]
-            if prior is not None:       # start from the previous segment's end
-                x_ref = prior[0]
-            cache = {}
-
-            white = {}
+            cache, white = {}, {}
+            prior = None if self.xsig is None else 1.0 / np.maximum(self.xsig[s], DEFECT_FLOOR)
 
             def evaluate(dv, x_ref=x_ref, prior=prior, s=s, white=white):
                 key = dv.tobytes()
@@ -382,18 +388,14 @@ class _Problem:
                         white["w"] = self.covariances([blk], first=s)[0]
                     r, J = self.whiten(white["w"], blk["r"]), self.whiten(white["w"], blk["x"])
                     if prior is not None:
-                        e = model.local(prior[0], start[0])
-                        _, Bd = self._dlocal(model, prior[0], start[0])
-                        r = np.concatenate([r, scipy.linalg.solve_triangular(prior[1], e, lower=True)])
-                        J = np.vstack([J, scipy.linalg.solve_triangular(prior[1], Bd @ start[1], lower=True)])
+                        r = np.concatenate([r, prior * dv])
+                        J = np.vstack([J, np.diag(prior)])
                     cache[key] = (r, J, blk)
                 return cache[key]
 
             sol = scipy.optimize.least_squares(lambda dv: evaluate(dv)[0], np.zeros(NE),
                                                jac=lambda dv: evaluate(dv)[1], method="lm", max_nfev=20)
             self.xref[s] = model.retract(x_ref, sol.x)
-            blk = evaluate(sol.x)[2]
-            prior = (blk["X"][-1], np.linalg.cholesky(self.end_covariance(s, blk)))
         self._cache = (None, None)
 
     def noise_map(self, s, blk):
@@ -584,8 +586,9 @@ class _FullState:
         return np.array(lo), np.array(hi)
 
 
-def _start_guess(log, params):
-    """The EKF's estimate at every IMU time and its final biases (the fit's starting point).  The
+def _start_guess(log, params, with_sigma=False):
+    """The EKF's estimate at every IMU time and its final biases (the fit's starting point), and
+    with `with_sigma` the filter's standard deviations of the 18 error coordinates there.  The
     filter runs on the nominal robot with its gate open: the readings of a robot that differs from
     the nominal one are what the gate would refuse (on a robot within ±30 % it refused half of them
     and lost the motion), and a log to identify is taken as free of outliers."""
@@ -593,7 +596,7 @@ def _start_guess(log, params):
     est = estimate_log(log, params, gate=1.0)
     k = np.searchsorted(est.t, log.imu.t)
     k = np.clip(k, 0, len(est.t) - 1)
-    return est.x[k], est.biases[-1]
+    return (est.x[k], est.biases[-1], est.sigma[k]) if with_sigma else (est.x[k], est.biases[-1])
 
 
 def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, max_nfev=20, progress=None,
@@ -629,11 +632,12 @@ def _identify(log, params, free, segment, method, full_state, max_nfev, progress
     if full_state:
         prob = _FullState(log, params, free, method, jacobian)
     else:
+        x_sigma = None
         if x_guess is None:
-            x_guess, guess_b = _start_guess(log, params)
+            x_guess, guess_b, x_sigma = _start_guess(log, params, with_sigma=True)
             bias_guess = guess_b if bias_guess is None else bias_guess
         prob = _Problem(log, params, free, segment, method, np.asarray(x_guess), np.zeros(6) if bias_guess is None
-                        else bias_guess, jacobian)
+                        else bias_guess, jacobian, x_sigma)
     prob.progress = progress
     if start == "regressor":
         prob.theta_start = first_guess(log, params, free, prob, full_state, x_guess).theta
@@ -644,6 +648,14 @@ def _identify(log, params, free, segment, method, full_state, max_nfev, progress
         z0 = np.clip(prob.z0(), np.where(np.isfinite(lo), lo + 1e-12 * np.maximum(1, abs(lo)), lo),
                      np.where(np.isfinite(hi), hi - 1e-12 * np.maximum(1, abs(hi)), hi))
 
+    if not full_state:
+        # first the start states and biases alone: until the segments agree at their ends, the
+        # parameters would move to absorb the start guess's errors (seen: to their bounds)
+        prob.hold_parameters = True
+        z0 = levenberg_marquardt(lambda z: prob.assemble(z)[:2], z0, lo, hi, STATES_NFEV).x
+        prob.hold_parameters = False
+        prob.chol = None            # the covariance where the segments agree
+        prob._cache = (None, None)
     if full_state:
         opts = dict(jac=lambda z: prob.assemble(z)[1].toarray(), bounds=(lo, hi), method="trf", x_scale="jac",
                     max_nfev=max_nfev, xtol=1e-8, ftol=1e-8, gtol=1e-10)

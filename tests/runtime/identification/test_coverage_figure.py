@@ -9,7 +9,11 @@ def test_the_coverage_command_draws_its_calibration_figure(tmp_path):
     assert coverage.main(["--params", "k_Y", "--fits", "2", "--duration", "1", "--full-state", "--out", str(out),
                           "--figure", str(figure)]) == 0
     assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert len(json.loads(out.read_text())["trials"]) == 2
+    result = json.loads(out.read_text())
+    assert len(result["trials"]) == 2
+    # the combinations the fitted entry moves are recorded per fit and summarised
+    assert set(result["trials"][0]["combinations"]["k_Y"]) >= {"truth", "estimate", "relative_error", "inside"}
+    assert result["combinations"]["k_Y"]["fits"] == 2
 
 
 
