@@ -9,11 +9,11 @@ import pytest
 from runtime.estimation.sense import simulate_log
 from runtime.identification import fit as fitmod
 from runtime.identification.fit import free_parameters
-from runtime.identification.segments import dlocal_batch, dretract_batch, segment_blocks
+from runtime.identification.segments import _simulate, dlocal_batch, dretract_batch, segment_blocks
 from runtime.model import Model
 from runtime.scenario import TorqueWindow, load_scenario
 from runtime.sensor_set import SensorSet
-from runtime.state import NE
+from runtime.state import IDX_E_NU, NE
 
 SCENARIO = load_scenario("battery-geared")
 NOMINAL = SCENARIO.params
@@ -72,6 +72,23 @@ def test_a_segment_is_the_models_simulation_and_its_transition_the_product_of_it
     np.testing.assert_array_equal(blk["nodes"], np.arange(k0, k1 + 1))
 
 
+def test_the_chained_sensitivity_is_the_sum_of_each_steps_carried_to_the_end(problem):
+    prob, model, x0, _, _ = problem
+    segs = np.arange(prob.S)
+    X, G = _simulate(prob, model, segs, x0, sensitivities=True)
+    for s in (0, prob.S - 1):                       # one of each length
+        k0, k1 = prob.starts[s], prob.ends[s]
+        u = prob.data.u[k0:k1]
+        F = model.step_jacobian(X[s][:-1], u, prob.data.h, "rkmk4")[0]
+        Jp = model.step_param_jacobian(X[s][:-1], u, prob.data.h, "rkmk4", columns=prob.idx)
+        Sens = np.zeros((NE, prob.nf))
+        for k in range(k1 - k0):
+            Sens = F[k] @ Sens + Jp[k]
+        np.testing.assert_allclose(G[s][-1][:, NE:], Sens, rtol=1e-10, atol=1e-14)
+    _, held = _simulate(prob, model, segs[:1], x0[:1], sensitivities=False)
+    assert held[0].shape == G[0].shape and not held[0][:, :, NE:].any()
+
+
 def test_the_batched_group_map_derivatives_are_those_of_each_row(problem):
     prob, model, x0, _, _ = problem
     n = prob.S - 1
@@ -90,3 +107,26 @@ def test_the_batched_group_map_derivatives_are_those_of_each_row(problem):
             db = model.local(x0[i], model.retract(x0[i + 1], step)) - model.local(x0[i], model.retract(x0[i + 1], -step))
             np.testing.assert_allclose(A[i][:, j], da / (2 * e), rtol=1e-12, atol=1e-12)
             np.testing.assert_allclose(B[i][:, j], db / (2 * e), rtol=1e-12, atol=1e-12)
+
+
+def test_the_process_noise_reaches_the_end_state_through_the_transition_from_its_entry(problem):
+    prob, model, x0, D, b = problem
+    s = 0
+    blk = segment_blocks(prob, model, np.array([s]), x0[:1], D[:1], b)[0]
+    A, _ = prob.noise_map(s, blk)
+    d, Phi = prob.data, blk["Phi"]
+    k0, k1 = prob.starts[s], prob.ends[s]
+    periods = np.unique(d.interval[k0:k1 + 1])
+    Minv = np.linalg.inv(model.inertia_batch(blk["X"]))
+    entered = 0
+    for c, j in enumerate(periods):
+        later = np.flatnonzero(d.interval[k0 + 1:k1 + 1] > j)
+        expected = np.zeros((NE, 5))
+        if later.size:                  # the velocity jump M⁻¹ w τ at the first node of a later period
+            kappa = later[0] + 1
+            jump = np.zeros((NE, 5))
+            jump[IDX_E_NU] = Minv[kappa - 1] * d.tau
+            expected = Phi[-1] @ np.linalg.solve(Phi[kappa], jump)
+            entered += 1
+        np.testing.assert_allclose(A[-NE:, 5 * c:5 * c + 5], expected, rtol=1e-10, atol=1e-12)
+    assert entered >= 2
