@@ -65,7 +65,6 @@ def _simulate(prob, model, segs, x0, sensitivities):
     d = prob.data
     k0, L = prob.starts[segs], prob.ends[segs] - prob.starts[segs]
     nf = prob.nf
-    width = NE + (nf if sensitivities else 0)
     X = [model.simulate(x0[i], d.h, L[i], u=d.u[k0[i]:k0[i] + L[i]], method=prob.method, energy_tol=None)
          for i in range(len(segs))]
     G = [None] * len(segs)
@@ -80,15 +79,13 @@ def _simulate(prob, model, segs, x0, sensitivities):
         else:
             F = step_state_jacobian(model, xs, us, d.h, prob.method, prob.jacobian)
         F = F.reshape(len(g), length, NE, NE)
-        Gg = np.empty((len(g), length + 1, NE, width))
+        Gg = np.empty((len(g), length + 1, NE, NE + nf))
         Gg[:, 0] = 0.0
         Gg[:, 0, :, :NE] = np.eye(NE)
         for k in range(length):
             np.matmul(F[:, k], Gg[:, k], out=Gg[:, k + 1])
             if sensitivities:
                 Gg[:, k + 1, :, NE:] += Jp[:, k]
-        if not sensitivities:          # the parameters' columns held at zero
-            Gg = np.concatenate([Gg, np.zeros(Gg.shape[:-1] + (nf,))], axis=-1)
         for i, c in enumerate(g):
             G[c] = Gg[i]
     return X, G
@@ -116,17 +113,17 @@ def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True):
     un = d.u[gnode]
     nudot = model.accel(Xn, un)
     Ja = accel_state_jacobian(model, Xn, un, prob.jacobian)
-    parts = []                  # (node, kind, r, Hx, Hn, sig, Hb, [Hx Φ | Hx S + Hn ∂ν̇/∂θ]) per kind
+    Jpa = np.zeros((len(Xn), NV, nf))          # ∂ν̇/∂θ where an IMU reads it
+    parts = []                  # (node, kind, r, Hx, Hn, sig, Hb) per kind
     li = np.flatnonzero(d.imu_row[gnode] >= 0)
     if li.size:
         y, H, Hn = imu_partials_batch(model, Xn[li], nudot[li], mount=prob.mount, bias=b)
         Hx = H[:, :, :NE] + Hn @ Ja[li]
-        HG = Hx @ Gn[li]
         if sensitivities:
-            HG[:, :, NE:] += Hn @ accel_sensitivity(model, Xn[li], un[li], prob.idx, prob.jacobian)
+            Jpa[li] = accel_sensitivity(model, Xn[li], un[li], prob.idx, prob.jacobian)
         r = prob.log.imu.data[d.imu_row[gnode[li]]] - y
         parts.append((np.repeat(li, 6), 0, r.ravel(), Hx.reshape(-1, NE), Hn.reshape(-1, NV),
-                      np.tile(prob.sig_imu, li.size), H[:, :, NE:].reshape(-1, 6), HG.reshape(-1, NE + nf)))
+                      np.tile(prob.sig_imu, li.size), H[:, :, NE:].reshape(-1, 6)))
     for kind, rows_of, batch, sig in ((1, d.enc_row, encoders_jacobian_batch, prob.sig_enc),
                                       (2, d.fix_row, position_jacobian_batch, prob.sig_fix)):
         lk = np.flatnonzero(rows_of[gnode] >= 0)
@@ -139,14 +136,17 @@ def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True):
             r = prob.fix_xy[rows_of[gnode[lk]]] - y
         Hx = H[:, :, :NE]
         parts.append((np.repeat(lk, 2), kind, r.ravel(), Hx.reshape(-1, NE), np.zeros((2 * lk.size, NV)),
-                      np.full(2 * lk.size, float(sig)), np.zeros((2 * lk.size, 6)), (Hx @ Gn[lk]).reshape(-1, NE + nf)))
+                      np.full(2 * lk.size, float(sig)), np.zeros((2 * lk.size, 6))))
     node = np.concatenate([p[0] for p in parts])
     kinds = np.concatenate([np.full(len(p[0]), p[1]) for p in parts])
     order = np.lexsort((kinds, node))           # stable: each reading's components stay in order
     node, kinds = node[order], kinds[order]
-    r, Hx, Hn, sig, Hb, HG = (np.concatenate([p[i] for p in parts])[order] for i in range(2, 8))
+    r, Hx, Hn, sig, Hb = (np.concatenate([p[i] for p in parts])[order] for i in range(2, 7))
     r = r / sig
-    HG = -HG / sig[:, None]
+    # per row, as a segment alone forms them (the same products in the same order, bit for bit)
+    Phi_n, Sens_n = Gn[:, :, :NE], Gn[:, :, NE:]
+    th = -(np.einsum("rj,rjk->rk", Hx, Sens_n[node]) + np.einsum("rj,rjk->rk", Hn, Jpa[node])) / sig[:, None]
+    xs = -np.einsum("rj,rjk->rk", Hx, Phi_n[node]) / sig[:, None]
     Hb = -Hb / sig[:, None]
     bounds = np.searchsorted(seg_of[node], np.arange(len(segs) + 1))
     if nxt is not None:
@@ -159,7 +159,7 @@ def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True):
     for i, s in enumerate(segs):
         sl = slice(bounds[i], bounds[i + 1])
         Phi, Sens = G[i][:, :, :NE], G[i][:, :, NE:]
-        blk = {"r": r[sl], "th": HG[sl, NE:], "b": Hb[sl], "x": HG[sl, :NE] @ D[i], "next": None,
+        blk = {"r": r[sl], "th": th[sl], "b": Hb[sl], "x": xs[sl] @ D[i], "next": None,
                "rows": {"node": local[node[sl]], "kind": kinds[sl], "Hx": Hx[sl], "Hn": Hn[sl], "sig": sig[sl]},
                "X": X[i], "Phi": Phi, "nodes": gnode[seg_of == i], "model": model, "n_out": sl.stop - sl.start}
         j = where.get(i) if nxt is not None else None
