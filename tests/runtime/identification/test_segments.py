@@ -103,8 +103,9 @@ def test_the_batched_group_map_derivatives_are_those_of_each_row(problem):
             plus = model.local(x[i], model.retract(prob.xref[i], d[i] + step))
             minus = model.local(x[i], model.retract(prob.xref[i], d[i] - step))
             np.testing.assert_allclose(D[i][:, j], (plus - minus) / (2 * e), rtol=1e-12, atol=1e-12)
-            da = model.local(model.retract(x0[i], step), x0[i + 1]) - model.local(model.retract(x0[i], -step), x0[i + 1])
-            db = model.local(x0[i], model.retract(x0[i + 1], step)) - model.local(x0[i], model.retract(x0[i + 1], -step))
+            a, b = x0[i], x0[i + 1]
+            da = model.local(model.retract(a, step), b) - model.local(model.retract(a, -step), b)
+            db = model.local(a, model.retract(b, step)) - model.local(a, model.retract(b, -step))
             np.testing.assert_allclose(A[i][:, j], da / (2 * e), rtol=1e-12, atol=1e-12)
             np.testing.assert_allclose(B[i][:, j], db / (2 * e), rtol=1e-12, atol=1e-12)
 
