@@ -36,11 +36,10 @@ import threadpoolctl
 from ..model import Model
 from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_parameters
 from ..params import SHAPES, Params, flat_names
-from ..sensors import encoders_jacobian_batch, imu_partials_batch, position_jacobian_batch
 from ..state import IDX_E_NU, IDX_NU, NE, NV
 from .first_guess import _pi_of, regressor_guess
-from .sensitivity import (JACOBIANS, accel_sensitivity, accel_state_jacobian, step_jacobians, step_sensitivity,
-                          step_state_jacobian)
+from .segments import dlocal_batch, dretract_batch, segment_blocks
+from .sensitivity import JACOBIANS, step_sensitivity
 
 #: Where the fit starts the parameters: the regressor's linear least-squares first guess, or the nominal robot.
 STARTS = ("regressor", "nominal")
@@ -115,10 +114,6 @@ def bounds_of(entry, params, free=()):
         a, b = J[others[0], others[0]], J[others[1], others[1]]
         return abs(a - b), a + b
     return -math.inf, math.inf
-
-
-def _wrap(a):
-    return np.remainder(a + np.pi, 2 * np.pi) - np.pi
 
 
 @dataclasses.dataclass
@@ -261,37 +256,28 @@ class _Problem:
                                 f"identifiable from this log, or the nominal robot is too far from the truth") from None
 
     def _dretract(self, model, x, d):
-        """∂ local(retract(x, d), retract(x, d + δ)) / ∂δ (12, 12) by central differences of the
-        group maps (exact maps, no dynamics); the start-state unknowns are offsets about a fixed guess."""
-        x0 = model.retract(x, d)
-        e = 1e-6
-        E = e * np.eye(NE)
-        moved = model.retract(np.broadcast_to(x, (2 * NE, len(x))), np.vstack([d + E, d - E]))
-        diff = model.local(np.broadcast_to(x0, moved.shape), moved)
-        return x0, (diff[:NE] - diff[NE:]).T / (2 * e)
+        """(x ⊕ d, ∂ local(x ⊕ d, x ⊕ (d + δ)) / ∂δ (12, 12)) by central differences of the group maps
+        (exact maps, no dynamics); the start-state unknowns are offsets about a fixed guess."""
+        x0, D = dretract_batch(model, x, d)
+        return x0[0], D[0]
 
     def _dlocal(self, model, a, b):
         """(∂ local(a ⊕ δ, b)/∂δ, ∂ local(a, b ⊕ δ)/∂δ) at δ = 0, central differences."""
-        e = 1e-6
-        steps = np.vstack([e * np.eye(NE), -e * np.eye(NE)])
-        a_moved = model.retract(np.broadcast_to(a, (2 * NE, len(a))), steps)
-        b_moved = model.retract(np.broadcast_to(b, (2 * NE, len(b))), steps)
-        da = model.local(a_moved, np.broadcast_to(b, a_moved.shape))
-        db = model.local(np.broadcast_to(a, b_moved.shape), b_moved)
-        return (da[:NE] - da[NE:]).T / (2 * e), (db[:NE] - db[NE:]).T / (2 * e)
+        A, B = dlocal_batch(model, a, b)
+        return A[0], B[0]
 
     # -- one evaluation -------------------------------------------------------------------------
     def segment_blocks(self, z):
         """Per segment: raw residuals r (noise-scaled readings, then the end-state difference), their
-        Jacobian blocks (theta, bias, own start, next start), and what the whitening needs."""
+        Jacobian blocks (theta, bias, own start, next start), and what the whitening needs; all
+        segments evaluated together (runtime.identification.segments)."""
         theta, b, Dz = self.split(z)
         model = self.model(theta)
-        starts = [self._dretract(model, self.xref[s], Dz[s]) for s in range(self.S)]
-        out = []
-        for s in range(self.S):
-            nxt = starts[s + 1] if s + 1 < self.S else None
-            out.append(self.segment_block(model, s, starts[s], nxt, b, sensitivities=not self.hold_parameters))
-        return out
+        x0, D = dretract_batch(model, self.xref, Dz)
+        has = np.arange(self.S) < self.S - 1
+        nxt = (np.roll(x0, -1, axis=0), np.roll(D, -1, axis=0), has)
+        return segment_blocks(self, model, np.arange(self.S), x0, D, b, nxt,
+                              sensitivities=not self.hold_parameters)
 
     def segment_block(self, model, s, start, nxt, b, sensitivities=True):
         """One segment's block: simulated from start = (x0, D) under the logged torques; the
@@ -299,69 +285,10 @@ class _Problem:
         readings are ordered by time, at one time IMU, encoders, fix; `rows` keeps, per reading row,
         its node, kind (0 IMU, 1 encoders, 2 fix), ∂y/∂x, ∂y/∂ν̇ and noise σ.  Without
         `sensitivities` the parameters' columns are left zero (the start-state fit holds them)."""
-        d = self.data
         x0, D = start
-        k0, k1 = self.starts[s], self.ends[s]
-        steps = k1 - k0
-        X = model.simulate(x0, d.h, steps, u=d.u[k0:k1], method=self.method, energy_tol=None)
-        if sensitivities:
-            F, Jp = step_jacobians(model, X[:-1], d.u[k0:k1], d.h, self.method, self.idx, self.jacobian)
-        else:
-            F = step_state_jacobian(model, X[:-1], d.u[k0:k1], d.h, self.method, self.jacobian)
-            Jp = np.zeros((steps, NE, self.nf))
-        last = s == self.S - 1
-        nodes = np.arange(k0, k1 + 1 if last else k1)
-        Xn = X[:len(nodes)]
-        nudot = model.accel(Xn, d.u[nodes])
-        Ja = accel_state_jacobian(model, Xn, d.u[nodes], self.jacobian)
-        Jpa = (accel_sensitivity(model, Xn, d.u[nodes], self.idx, self.jacobian) if sensitivities
-               else np.zeros((len(nodes), NV, self.nf)))
-        G = np.empty((steps + 1, NE, NE + self.nf))     # [Φ_k | S_k]: one product per step
-        G[0] = np.hstack([np.eye(NE), np.zeros((NE, self.nf))])
-        for k in range(steps):
-            G[k + 1] = F[k] @ G[k]
-            G[k + 1][:, NE:] += Jp[k]
-        Phi, Sens = G[:, :, :NE], G[:, :, NE:]
-        parts = []                  # (node, kind, r, Hx, Hn, sig, Hb) per kind, row-wise
-        li = np.flatnonzero(d.imu_row[nodes] >= 0)
-        if li.size:
-            y, H, Hn = imu_partials_batch(model, Xn[li], nudot[li], mount=self.mount, bias=b)
-            Hx = H[:, :, :NE] + Hn @ Ja[li]
-            r = self.log.imu.data[d.imu_row[nodes[li]]] - y
-            parts.append((np.repeat(li, 6), 0, r.ravel(), Hx.reshape(-1, NE), Hn.reshape(-1, NV),
-                          np.tile(self.sig_imu, li.size), H[:, :, NE:].reshape(-1, 6)))
-        for kind, rows_of, batch, sig in ((1, d.enc_row, encoders_jacobian_batch, self.sig_enc),
-                                          (2, d.fix_row, position_jacobian_batch, self.sig_fix)):
-            lk = np.flatnonzero(rows_of[nodes] >= 0)
-            if not lk.size:
-                continue
-            y, H = batch(model, Xn[lk])
-            if kind == 1:
-                r = _wrap(self.log.encoders.data[rows_of[nodes[lk]]] - y)
-            else:
-                r = self.fix_xy[rows_of[nodes[lk]]] - y
-            parts.append((np.repeat(lk, 2), kind, r.ravel(), H[:, :, :NE].reshape(-1, NE), np.zeros((2 * lk.size, NV)),
-                          np.full(2 * lk.size, float(sig)), np.zeros((2 * lk.size, 6))))
-        node = np.concatenate([p[0] for p in parts])
-        kinds = np.concatenate([np.full(len(p[0]), p[1]) for p in parts])
-        order = np.lexsort((kinds, node))           # stable: each reading's components stay in order
-        node, kinds = node[order], kinds[order]
-        r, Hx, Hn, sig, Hb = (np.concatenate([p[i] for p in parts])[order] for i in range(2, 7))
-        r = r / sig
-        th = -(np.einsum("rj,rjk->rk", Hx, Sens[node]) + np.einsum("rj,rjk->rk", Hn, Jpa[node])) / sig[:, None]
-        xs = -np.einsum("rj,rjk->rk", Hx, Phi[node]) / sig[:, None]
-        block = {"r": r, "th": th, "b": -Hb / sig[:, None], "x": xs @ D, "next": None,
-                 "rows": {"node": node, "kind": kinds, "Hx": Hx, "Hn": Hn, "sig": sig},
-                 "X": X, "Phi": Phi, "nodes": nodes, "model": model, "n_out": len(r)}
-        if nxt is not None:
-            A, B = self._dlocal(model, X[-1], nxt[0])
-            defect = model.local(X[-1], nxt[0])
-            block["r"] = np.concatenate([block["r"], defect])
-            block["th"] = np.vstack([block["th"], A @ Sens[-1]])
-            block["b"] = np.vstack([block["b"], np.zeros((NE, 6))])
-            block["x"] = np.vstack([block["x"], A @ Phi[-1] @ D])
-            block["next"] = np.vstack([np.zeros((len(block["r"]) - NE, NE)), B @ nxt[1]])
-        return block
+        after = None if nxt is None else (np.asarray(nxt[0])[None], np.asarray(nxt[1])[None], np.ones(1, bool))
+        return segment_blocks(self, model, np.array([s]), np.asarray(x0)[None], np.asarray(D)[None], b, after,
+                              sensitivities)[0]
 
     def fit_starts(self, z):
         """Each segment's start state alone (the parameters and biases held): from its own readings,
@@ -411,14 +338,15 @@ class _Problem:
         enters = np.full(len(js), np.iinfo(int).max)
         Minv = np.linalg.inv(model.inertia_batch(X))
         later = d.interval[k0 + 1:last_node + 1]
-        for c, j in enumerate(js):
-            after = np.flatnonzero(later > j)
-            if after.size:
-                kappa = after[0] + 1
-                Bk = np.zeros((NE, 5))
-                Bk[IDX_E_NU] = Minv[kappa - 1] * d.tau
-                P[:, 5 * c:5 * c + 5] = np.linalg.solve(Phi[kappa], Bk)
-                enters[c] = kappa
+        # w_j enters the state at the first node of a later period, κ_j (none for the last period)
+        first_after = np.searchsorted(later, js, side="right")
+        entering = np.flatnonzero(first_after < len(later))
+        if entering.size:               # one batched solve for every period's entry
+            kappa = first_after[entering] + 1
+            Bk = np.zeros((len(kappa), NE, 5))
+            Bk[:, IDX_E_NU] = Minv[kappa - 1] * d.tau
+            P.reshape(NE, -1, 5)[:, entering] = np.swapaxes(np.linalg.solve(Phi[kappa], Bk), 0, 1)
+            enters[entering] = kappa
         node, sig = rows["node"], rows["sig"][:, None]
         n = len(node)
         A = np.zeros((n + NE, 5 * len(js)))
