@@ -174,7 +174,7 @@ class NmpcGains(LqrGains):
     """Tuning of `Nmpc` (`[controller]` keys): the LQR's error sizes and design grid (the
     operating points are the horizon's reference), and the horizon."""
     torque_step_n_m: float = 0.1      # a change of torque from one node to the next worth the full cost
-    cross_track_integral_m_s: float = 2.0    # ∫e_y: faster than the LQR's (the horizon sees its overshoot)
+    cross_track_integral_m_s: float = 2.0    # ∫e_y dt (the horizon sees its overshoot)
     steady_rate_m_s: float = 0.005    # ∫e_y advances only while |ė_y| ≤ this [m/s] (the horizon sees the overshoot)
     disturbance_gain: float = 0.05    # the share of the offsets' one-sample update taken (0: no estimate)
     horizon: float = 30               # N nodes
