@@ -43,8 +43,9 @@ LQR_RANGES = {
 
 #: `NmpcGains`: the LQR's and the horizon's.
 NMPC_RANGES = {
-    **{name: rng for name, rng in LQR_RANGES.items() if name != "world_share"},
+    **LQR_RANGES,
     "tight_band_m": Range(0, 0, "m", "the NMPC has no tight gains (an LQR setting): 0 only"),
+    "world_share": Range(0, 0, "", "the NMPC holds no world-frame integral (an LQR setting): 0 only"),
     "torque_step_n_m": Range(1e-6, 1e6, "N m", "a torque change worth the full cost"),
     "disturbance_gain": Range(0, 1, "", "the share of the torque offset's update taken per sample (0: no estimate)"),
     "horizon": Range(1, 200, "", "nodes of the horizon: the QP has 2N unknowns and a dense (2N)^2 Hessian",
