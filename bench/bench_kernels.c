@@ -73,8 +73,9 @@ static sr_lqr LQR;
 static const sr_lqr_target LQR_TARGET = {SR_C(0.3), SR_C(0.5), SR_C(0.2), SR_C(0.05), 1};
 static int k_lqr_control(const sr_model *m, int i, int arg)
 {
-    sr_lqr_memory memory = {{0, 0}, 0, 0, 0};
+    sr_lqr_memory memory;
     (void)arg;
+    if (sr_lqr_reset(&memory) != SR_OK) return SR_ERR_NULL;
     return sr_lqr_control(&LQR, m, X[i], &LQR_TARGET, &memory, OUT[i], NULL);
 }
 static int k_step_jacobian_cf4(const sr_model *m, int i, int arg) { (void)arg; return sr_step_jacobian_cf4(m, X[i], U[i], 0.01, JOUT[i], JOUT[i] + SR_NE * SR_NE); }
@@ -194,31 +195,31 @@ int main(int argc, char **argv)
 #endif
     {
         bench_case cases[] = {
-            {k_accel, 0, SR_NV, 1, "accel", 0},
-            {k_gen_accel, 0, SR_NV, 1, "accel_unchecked", 0},
-            {k_inertia, 0, SR_NV * SR_NV, 1, "inertia", 0},
-            {k_step, SR_LIE_EULER, SR_NX, 1, "step_lie_euler", 0},
-            {k_step, SR_RKMK4, SR_NX, 1, "step_rkmk4", 0},
-            {k_step, SR_CF4, SR_NX, 1, "step_cf4", 0},
+            {k_accel, 0, SR_NV, 1, "accel", 0, 0},
+            {k_gen_accel, 0, SR_NV, 1, "accel_unchecked", 0, 0},
+            {k_inertia, 0, SR_NV * SR_NV, 1, "inertia", 0, 0},
+            {k_step, SR_LIE_EULER, SR_NX, 1, "step_lie_euler", 0, 0},
+            {k_step, SR_RKMK4, SR_NX, 1, "step_rkmk4", 0, 0},
+            {k_step, SR_CF4, SR_NX, 1, "step_cf4", 0, 0},
             {k_checked_accel_batch, 0, SR_NV, 1, "checked_accel_batch", 0, 1},
             {k_step_batch, SR_LIE_EULER, SR_NX, 1, "step_batch_lie_euler", 0, 2},
             {k_step_batch, SR_RKMK4, SR_NX, 1, "step_batch_rkmk4", 0, 2},
             {k_step_batch, SR_CF4, SR_NX, 1, "step_batch_cf4", 0, 2},
-            {k_accel_general, 0, SR_NV, 1, "accel_general_robot", 0},
-            {k_step_general, SR_RKMK4, SR_NX, 1, "step_rkmk4_general_robot", 0},
-            {k_accel_jacobian, 0, SR_NV * (SR_NE + SR_NU), 1, "accel_jacobian", 0},
-            {k_step_jacobian_lie_euler, 0, NOUT, 1, "step_jacobian_lie_euler", 0},
-            {k_step_jacobian_rkmk4, 0, NOUT, 4, "step_jacobian_rkmk4", 0},
-            {k_step_jacobian_cf4, 0, NOUT, 4, "step_jacobian_cf4", 0},
-            {k_lqr_control, 0, SR_NU, 1, "lqr_control", 0},
+            {k_accel_general, 0, SR_NV, 1, "accel_general_robot", 0, 0},
+            {k_step_general, SR_RKMK4, SR_NX, 1, "step_rkmk4_general_robot", 0, 0},
+            {k_accel_jacobian, 0, SR_NV * (SR_NE + SR_NU), 1, "accel_jacobian", 0, 0},
+            {k_step_jacobian_lie_euler, 0, NOUT, 1, "step_jacobian_lie_euler", 0, 0},
+            {k_step_jacobian_rkmk4, 0, NOUT, 4, "step_jacobian_rkmk4", 0, 0},
+            {k_step_jacobian_cf4, 0, NOUT, 4, "step_jacobian_cf4", 0, 0},
+            {k_lqr_control, 0, SR_NU, 1, "lqr_control", 0, 0},
 #ifdef WITH_CASADI
-            {k_casadi, 0, SR_NV, 10, "casadi_generated_reference_accel", 0},
+            {k_casadi, 0, SR_NV, 10, "casadi_generated_reference_accel", 0, 0},
 #endif
 #ifdef WITH_KANE
-            {k_kane_casadi, 0, SR_NV, 4, "kane_casadi_c_accel", 0},
-            {k_kane_sympy, 0, SR_NV, 4, "kane_sympy_c_accel", 0},
-            {k_kane_pydy, 0, SR_NV, 4, "kane_pydy_c_accel", 0},
-            {k_kane_casadi_jac, 0, SR_NV * (SR_NE + SR_NU), 4, "kane_casadi_c_accel_jacobian", 0},
+            {k_kane_casadi, 0, SR_NV, 4, "kane_casadi_c_accel", 0, 0},
+            {k_kane_sympy, 0, SR_NV, 4, "kane_sympy_c_accel", 0, 0},
+            {k_kane_pydy, 0, SR_NV, 4, "kane_pydy_c_accel", 0, 0},
+            {k_kane_casadi_jac, 0, SR_NV * (SR_NE + SR_NU), 4, "kane_casadi_c_accel_jacobian", 0, 0},
 #endif
         };
         const int ncases = (int)(sizeof cases / sizeof cases[0]);
