@@ -334,7 +334,8 @@ SR_LANES_CLONES int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int metho
      * Jacobian can make nonzero (its construction, sr_internal_step_jacobian_lie_euler): the
      * attitude's rows read the attitude and w_S, the joint angles' their own angle and rate, q's
      * the attitude, their own q and w_S, the rates' every column but q's (dq_identity; else those
-     * too).  473 products instead of 936, most of them in the columns of the sparse rows. */
+     * too).  473 products instead of the dense upper triangle's 936: the sparse rows of F_d meet
+     * most of the lower triangle's entries. */
 #define SR_DOT3(t, f, c) ((t[c] * f[c] + t[(c) + 1] * f[(c) + 1]) + t[(c) + 2] * f[(c) + 2])
     for (j = 0; j < SR_E_th_Y; ++j) {
         const sr_real *f = F + NE * j;
