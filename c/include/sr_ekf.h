@@ -14,7 +14,8 @@
  * whatever the method the mean steps with: one evaluation of the accelerations' Jacobian instead
  * of one per stage, and within O(dt^2) of the method's own step Jacobian, far below the process
  * noise at the sample rates of a filter (docs/estimation.md, "Transition matrix").  The biases
- * do not enter the step, so only the 12 x 12 block and the cross terms move.  Q_d is white generalized torque noise w on nu
+ * do not enter the step, so only the 12 x 12 block and the cross terms move, and F's structural
+ * zeros (the attitude's, joint angles' and q's rows read few columns) are skipped.  Q_d is white generalized torque noise w on nu
  * (M nu' = f + w; spectral densities: the shell's three axes, the yoke joint, the pendulum joint,
  * process->torque_psd [N m/sqrt(Hz)]), Q_d = dt M^-1 diag(psd^2) M^-1 in the nu block, M the
  * inertia at the prior x; Q_b = dt diag(rw^2) for the biases' random walks.

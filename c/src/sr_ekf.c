@@ -28,6 +28,8 @@
 /* The predict's pairs of rows need an even NE; its skip of the dq columns, that they are the two
  * before nu. */
 typedef char layout_fits[(NE % 2 == 0 && SR_E_nu == SR_E_q + 2) ? 1 : -1];
+/* The predict's sparse F_d P F_d^T: the attitude first, the two joint angles, q, then the five rates. */
+typedef char order_fits[(SR_E_xi_S == 0 && SR_E_th_Y == 3 && SR_E_th_P == 4 && SR_E_q == 5 && NE == SR_E_nu + 5) ? 1 : -1];
 
 static const sr_real pi_ = SR_C(3.14159265358979323846);
 
@@ -328,12 +330,44 @@ SR_LANES_CLONES int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int metho
             }
         }
     }
-    for (i = 0; i < NE; ++i)
-        for (j = i; j < NE; ++j) {
-            sr_real s = 0;
-            for (k = 0; k < NE; ++k) s += T[NBP * i + k] * F[NE * j + k];
+    /* Pn_dd[i][j] = T_dd[i] . F_d[j] on the lower triangle (i >= j), over the entries the Lie-Euler
+     * Jacobian can make nonzero (its construction, sr_internal_step_jacobian_lie_euler): the
+     * attitude's rows read the attitude and w_S, the joint angles' their own angle and rate, q's
+     * the attitude, their own q and w_S, the rates' every column but q's (dq_identity; else those
+     * too).  473 products instead of the dense upper triangle's 936: the sparse rows of F_d meet
+     * most of the lower triangle's entries. */
+#define SR_DOT3(t, f, c) ((t[c] * f[c] + t[(c) + 1] * f[(c) + 1]) + t[(c) + 2] * f[(c) + 2])
+    for (j = 0; j < SR_E_th_Y; ++j) {
+        const sr_real *f = F + NE * j;
+        for (i = j; i < NE; ++i) {
+            const sr_real *t = T + NBP * i;
+            Pn[NB * i + j] = Pn[NB * j + i] = SR_DOT3(t, f, 0) + SR_DOT3(t, f, SR_E_nu);
+        }
+    }
+    for (j = SR_E_th_Y; j < SR_E_q; ++j) {
+        const sr_real *f = F + NE * j;
+        const int rate = SR_E_nu + 3 + j - SR_E_th_Y;
+        for (i = j; i < NE; ++i)
+            Pn[NB * i + j] = Pn[NB * j + i] = T[NBP * i + j] * f[j] + T[NBP * i + rate] * f[rate];
+    }
+    for (j = SR_E_q; j < SR_E_nu; ++j) {
+        const sr_real *f = F + NE * j;
+        for (i = j; i < NE; ++i) {
+            const sr_real *t = T + NBP * i;
+            Pn[NB * i + j] = Pn[NB * j + i] = (SR_DOT3(t, f, 0) + t[j] * f[j]) + SR_DOT3(t, f, SR_E_nu);
+        }
+    }
+    for (j = SR_E_nu; j < NE; ++j) {
+        const sr_real *f = F + NE * j;
+        for (i = j; i < NE; ++i) {
+            const sr_real *t = T + NBP * i;
+            sr_real s = (SR_DOT3(t, f, 0) + (t[3] * f[3] + t[4] * f[4]))
+                      + (SR_DOT3(t, f, SR_E_nu) + (t[SR_E_nu + 3] * f[SR_E_nu + 3] + t[SR_E_nu + 4] * f[SR_E_nu + 4]));
+            if (!dq_identity) s += t[SR_E_q] * f[SR_E_q] + t[SR_E_q + 1] * f[SR_E_q + 1];
             Pn[NB * i + j] = Pn[NB * j + i] = s;
         }
+    }
+#undef SR_DOT3
     for (i = 0; i < SR_NV && white > 0; ++i)
         for (j = 0; j < SR_NV; ++j) Pn[NB * (SR_EB_nu + i) + SR_EB_nu + j] += white * Qnu[SR_NV * i + j];
     /* The cross terms F P_db (in T already); the bias block only gains its random walk. */
@@ -481,7 +515,7 @@ static SR_LANES_CLONES int apply(sr_ekf *ekf, int kind, int m, const sr_real *r,
     for (a = 0; a < NB; ++a) {
         sr_real *row = Pn + NBP * a;
         const int b0 = a - a % 4;
-        for (b = b0; b < NB; ++b) row[b] = ekf->P[NB * a + b];
+        for (b = 0; b < NB; ++b) row[b] = ekf->P[NB * a + b];   /* whole: the finiteness test reads it */
         for (b = NB; b < NBP; ++b) row[b] = 0;
         for (i = 0; i + 1 < m; i += 2) {   /* two entries of the sample a pass: half the row's loads and stores */
             const sr_real ka = KT[NBP * i + a], da = DT[NBP * i + a], *Ci = CT + NBP * i, *Ki = KT + NBP * i;
@@ -503,9 +537,12 @@ static SR_LANES_CLONES int apply(sr_ekf *ekf, int kind, int m, const sr_real *r,
             }
         }
     }
-    for (a = 0; a < NB; ++a)
-        for (b = a + 1; b < NB; ++b) Pn[NBP * b + a] = Pn[NBP * a + b];
+    /* Only the upper triangle is read from here on (the reset's three entries below the diagonal
+     * excepted, mirrored here); the filter's P gets both halves from it in one pass at the end. */
     for (a = 0; a < NB * NBP && recovering; ++a) Pn[a] *= inflate;
+    Pn[NBP * 1] = Pn[1];
+    Pn[NBP * 2] = Pn[2];
+    Pn[NBP * 2 + 1] = Pn[NBP + 2];
 
     /* Injection, then the reset of the shell's block by Jr(e_xi). */
     /* The state was checked by the call: the retraction without its checks. */
@@ -517,7 +554,7 @@ static SR_LANES_CLONES int apply(sr_ekf *ekf, int kind, int m, const sr_real *r,
             T[NB * i + b] = Jr[3 * i] * Pn[NBP * (SR_EB_xi_S) + b] + Jr[3 * i + 1] * Pn[NBP * (SR_EB_xi_S + 1) + b]
                           + Jr[3 * i + 2] * Pn[NBP * (SR_EB_xi_S + 2) + b];
     for (i = 0; i < 3; ++i) {
-        for (b = 3; b < NB; ++b) Pn[NBP * (SR_EB_xi_S + i) + b] = Pn[NBP * b + SR_EB_xi_S + i] = T[NB * i + b];
+        for (b = 3; b < NB; ++b) Pn[NBP * (SR_EB_xi_S + i) + b] = T[NB * i + b];
         for (j = i; j < 3; ++j) {
             const sr_real s = T[NB * i] * Jr[3 * j] + T[NB * i + 1] * Jr[3 * j + 1] + T[NB * i + 2] * Jr[3 * j + 2];
             Pn[NBP * i + j] = Pn[NBP * j + i] = s;
@@ -526,7 +563,10 @@ static SR_LANES_CLONES int apply(sr_ekf *ekf, int kind, int m, const sr_real *r,
     if (!all_finite(Pn, NB * NBP) || !all_finite(xn, SR_NX)) return SR_ERR_NONFINITE;
     memcpy(ekf->x, xn, sizeof xn);
     for (i = 0; i < SR_NBIAS; ++i) ekf->bias[i] += e[SR_EB_b_g + i];
-    for (a = 0; a < NB; ++a) memcpy(ekf->P + NB * a, Pn + NBP * a, NB * sizeof(sr_real));
+    for (a = 0; a < NB; ++a) {
+        for (b = 0; b < a; ++b) ekf->P[NB * a + b] = Pn[NBP * b + a];
+        for (b = a; b < NB; ++b) ekf->P[NB * a + b] = Pn[NBP * a + b];
+    }
     if (recovering)
         ekf->recovered[kind] += 1;
     else

@@ -407,12 +407,7 @@ int sr_internal_step_jacobian_lie_euler(const sr_model *model, const sr_real x[S
 int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
                                sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
 {
-    int status = arg_model(model, READS(JACOBIAN) | READS(STATE));
-    if (status != SR_OK) return status;
-    if (!x || !F || !G) return SR_ERR_NULL;
-    if (arg_dt(dt) != SR_OK) return SR_ERR_ARG;
-    status = sr_internal_check_state(model, x);
-    if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
+    const int status = sr_internal_check_step_arguments(model, x, u, dt, F, G);
     if (status != SR_OK) return status;
     return sr_internal_step_jacobian_lie_euler(model, x, u ? u : sr_zero_u, dt, F, G);   /* checked above */
 }

@@ -13,6 +13,7 @@
 #define sr_internal_accel_jacobian sr_internal_accel_jacobian_f
 #define sr_internal_accel_jacobian_along sr_internal_accel_jacobian_along_f
 #define sr_internal_step_jacobian_lie_euler sr_internal_step_jacobian_lie_euler_f
+#define sr_internal_check_step_arguments sr_internal_check_step_arguments_f
 #endif
 
 /* sr_accel_jacobian without the checks (x valid, u not NULL): Ja, Jb and the accelerations a
@@ -36,5 +37,10 @@ int sr_internal_accel_jacobian_along(const sr_model *model, const sr_real x[SR_N
  * if either is not finite.  The filter's transition matrix (sr_ekf.h). */
 int sr_internal_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                                         sr_real dt, sr_real F[SR_NE * SR_NE], sr_real *G);
+
+/* The step Jacobians' argument checks, in the order of sr_argcheck.h: the model, the pointers
+ * (x, F, G), dt, then the state and the torques (u may be NULL).  c/src/sr_step_jacobians.c. */
+int sr_internal_check_step_arguments(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                     sr_real dt, const sr_real *F, const sr_real *G);
 
 #endif /* SR_JACOBIANS_H */

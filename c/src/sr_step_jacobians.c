@@ -311,9 +311,8 @@ static int deliver_jacobians(const error dy, sr_real F[SR_NE * SR_NE], sr_real G
     return SR_OK;
 }
 
-/* In the order of sr_argcheck.h: the model, the pointers, dt, then the state and the torques. */
-static int check_step_arguments(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,
-                                sr_real *F, sr_real *G)
+int sr_internal_check_step_arguments(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                     sr_real dt, const sr_real *F, const sr_real *G)
 {
     int status = arg_model(model, READS(JACOBIAN) | READS(STATE));
     if (status != SR_OK) return status;
@@ -349,7 +348,7 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_rkmk4(const sr_model *model, const sr_re
                            sr_real F[SR_NE * SR_NE], sr_real G[SR_NE * SR_NU])
 {
     static const sr_real zero_u[SR_NU] = {0, 0};
-    const int status = check_step_arguments(model, x, u, dt, F, G);
+    const int status = sr_internal_check_step_arguments(model, x, u, dt, F, G);
     if (status != SR_OK) return status;
     return rkmk4_jacobian(model, x, u ? u : zero_u, dt, F, G, NULL);
 }
@@ -362,7 +361,7 @@ SR_JACOBIAN_CLONES int sr_step_jacobian_cf4(const sr_model *model, const sr_real
     sr_real dY2[NREAD][NC], dY4[NREAD][NC], dth4[NREAD][NC];
     tangent dF[4];
     error dY;
-    int i, c, status = check_step_arguments(model, x, u, dt, F, G);
+    int i, c, status = sr_internal_check_step_arguments(model, x, u, dt, F, G);
     if (status != SR_OK) return status;
     if (!u) u = zero_u;
     status = first_stage_jacobian(model, x, u, Fk[0], dF[0]);                            /* F1 = f(x) */
