@@ -6,7 +6,8 @@
 
 The filter (runtime.ekf, C in c/src/sr_ekf.c) assumes what the log's sensor set declares
 (`ekf_noise`); between two samples it predicts under the torques the log says were applied (a
-torque row holds until the next); samples of one time are applied IMU first, then encoders,
+torque row holds until the next), with the truth's stepping method when the log says which
+(`prediction_method`, else RKMK4); samples of one time are applied IMU first, then encoders,
 fixes and heading.  A fix that arrives after the instant it measures (`t_measured` < `t`) is marked
 at that instant and applied on arrival as a delayed fix (runtime.ekf, `mark_position`).  The
 accelerometer's noise is `ekf_noise`'s rule `accel_noise`: by default ("largest") its σ includes
@@ -20,7 +21,7 @@ import math
 
 import numpy as np
 
-from ..ekf import DELAYED_SLOTS, start_from_measurements
+from ..ekf import DELAYED_SLOTS, METHODS, start_from_measurements
 from ..model import Model
 from ..sensors import heading as heading_of
 from ..sensor_sim import ekf_noise
@@ -86,6 +87,16 @@ def torque_period(log):
     return float(np.median(np.diff(t))) if len(t) > 1 else None
 
 
+def prediction_method(log):
+    """The stepping method the filter predicts with: the truth's, when the log says which (log.json's
+    "method", written by `sense`), else RKMK4 (a robot's own log); the filter then predicts between
+    the log's rows, at the truth's step when the log has one row per step."""
+    method = log.meta.get("method", "rkmk4")
+    if method not in METHODS:
+        raise ValueError(f"log.json method: expected one of {sorted(METHODS)}, got {method!r}")
+    return method
+
+
 def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progress=None, covariance_every=None,
                  accel_noise="largest"):
     """Run the filter over `log` (runtime.estimation.logs.Log) for the robot `params` (None: the one
@@ -115,7 +126,8 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
         start["heading"] = float(log.heading["psi"][0])
     ekf = start_from_measurements(model, noise=noise, mount=sensors.imu.mount, gate=gate,
                                   heading_prior=start_heading(log) if heading is None else heading,
-                                  rate_sigma=MOVING_RATE_SIGMA if moving_at_start(log) else 0.01, **start)
+                                  rate_sigma=MOVING_RATE_SIGMA if moving_at_start(log) else 0.01,
+                                  method=prediction_method(log), **start)
     late = []                                   # (t_measured, index) of the fixes that arrive late
     if log.fixes is not None and len(log.fixes):
         measured = log.fixes["t_measured"]

@@ -105,3 +105,23 @@ def test_the_command_refuses_a_folder_that_is_not_a_log_in_one_line(tmp_path, ca
     err = capsys.readouterr().err
     assert err.startswith("error: ") and err.count("\n") == 1
     assert not (tmp_path / "est").exists()
+
+
+def test_the_filter_predicts_with_the_truths_method_when_the_log_says_which():
+    from types import SimpleNamespace
+    from runtime.estimation.estimate import prediction_method
+    assert prediction_method(SimpleNamespace(meta={"method": "lie-euler"})) == "lie-euler"
+    assert prediction_method(SimpleNamespace(meta={"method": "cf4"})) == "cf4"
+
+
+def test_a_log_without_a_method_is_predicted_with_rkmk4():
+    from types import SimpleNamespace
+    from runtime.estimation.estimate import prediction_method
+    assert prediction_method(SimpleNamespace(meta={})) == "rkmk4"
+
+
+def test_a_log_naming_an_unknown_method_is_refused_naming_the_field():
+    from types import SimpleNamespace
+    from runtime.estimation.estimate import prediction_method
+    with pytest.raises(ValueError, match="method"):
+        prediction_method(SimpleNamespace(meta={"method": "euler"}))
