@@ -92,15 +92,44 @@ class Ekf:
 START_POSITION_M, START_ATTITUDE_RAD, START_RATE_RAD_S = 0.01, 0.01, 0.05
 
 
+def mismatch_torque_psd(params, sensors, *, slope_rad=0.0, centre_of_mass_m=0.0, damping=0.0, speed=0.0):
+    """The process noise [N·m/√Hz] that stands for a declared model mismatch in a filter on the
+    nominal model (`params`): the largest constant generalized force the mismatch can put on the
+    robot rolling straight at `speed` [m/s], spread as a white torque over the fixes' period.
+
+    The constant forces are the slope's pull on the shell (m_R g r sin `slope_rad`), the pendulum's
+    weight about a centre of mass moved by `centre_of_mass_m` (m_P g δc) and a damping off by the
+    fraction `damping` at the rolling rate (`damping` k_S v / r on the shell); a mass off its value
+    adds only inertia, which at a steady roll is no force.  A constant force b acts as an impulse
+    b τ over τ; a white torque of density q gives one of spread q √τ over τ, so q = b √τ with τ the
+    fixes' period, over which the filter must absorb the force before a fix corrects the position
+    it moved.  Without fixes nothing corrects it and the mismatch adds nothing (0)."""
+    for name, value in (("slope_rad", slope_rad), ("centre_of_mass_m", centre_of_mass_m),
+                        ("damping", damping), ("speed", speed)):
+        if not (isinstance(value, (int, float)) and np.isfinite(value) and value >= 0):
+            raise ValueError(f"{name}: expected a finite number >= 0, got {value!r}")
+    if sensors.fixes is None:
+        return 0.0
+    force = (params.m_R * params.g * params.r * np.sin(min(slope_rad, np.pi / 2))
+             + params.m_P * params.g * centre_of_mass_m + damping * params.k_S * speed / params.r)
+    return float(force * np.sqrt(1.0 / sensors.fixes.rate))
+
+
 class SensorEkf:
     """The C EKF (runtime.ekf) on the samples of a sensor set, on the controller's model (`params`),
     started at x0 (the task's initial state) with the START_* standard deviations and the set's
     biases' spread.  `sample(kind, t, row, u)` applies one sample at time t (the filter predicted
-    there under the held torques u first); `at(t, u)` -> the estimate predicted to t."""
+    there under the held torques u first); `at(t, u)` -> the estimate predicted to t.
+    `mismatch_psd` [N·m/√Hz]: a white torque for the plant's difference from `params`
+    (`mismatch_torque_psd`), added in quadrature to the set's process noise; 0: the set's alone."""
     kind = "sensors"
 
-    def __init__(self, params, sensors, x0, method="rkmk4"):
+    def __init__(self, params, sensors, x0, method="rkmk4", mismatch_psd=0.0):
         noise = ekf_noise(sensors, params)
+        if not (isinstance(mismatch_psd, (int, float)) and np.isfinite(mismatch_psd) and mismatch_psd >= 0):
+            raise ValueError(f"mismatch_psd: expected a finite number >= 0 of N m/sqrt(Hz), got {mismatch_psd!r}")
+        if mismatch_psd > 0:
+            noise = dataclasses.replace(noise, torque_psd=float(np.hypot(noise.torque_psd, mismatch_psd)))
         sigma = np.empty(NEB)
         sigma[IDX_E_XI_S] = START_ATTITUDE_RAD
         sigma[IDX_E_TH_Y] = sigma[IDX_E_TH_P] = noise.encoder

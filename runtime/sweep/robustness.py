@@ -361,6 +361,18 @@ def engine(controller, reference):
     return "c-loop" if supports(controller, reference) else "c"
 
 
+def mismatch_psd(spec, task):
+    """The filter's white torque [N m/sqrt(Hz)] for the plants the sweep draws around the task's robot
+    (runtime.control.estimator.mismatch_torque_psd at the sweep's largest slope, centre-of-mass shift
+    and damping change, the reference's speed): the filter knows the ranges, never the plant."""
+    from ..control.climbing import climbing_limit
+    from ..control.estimator import mismatch_torque_psd
+    params = task.scenario.params
+    return mismatch_torque_psd(params, task.sensors, slope_rad=spec.slope_fraction * climbing_limit(params, task.u_max),
+                               centre_of_mass_m=spec.centre_of_mass_m, damping=spec.damping,
+                               speed=abs(task.reference_spec["speed"]))
+
+
 def run_one(spec, inputs):
     """The outcome {OUTCOMES: value} of one run with these inputs (a row of `draw`)."""
     from ..control.benchmark import estimate_errors
@@ -387,7 +399,7 @@ def run_one(spec, inputs):
     x0[IDX_Q.start:IDX_Q.start + 2] += [inputs["dx0_m"], inputs["dy0_m"]]
     x0[IDX_RS] = (rot_z(float(inputs["dpsi0_rad"])) @ x0[IDX_RS].reshape(3, 3)).ravel()
     s = task.scenario
-    estimator = SensorEkf(s.params, task.sensors, x0, s.method)
+    estimator = SensorEkf(s.params, task.sensors, x0, s.method, mismatch_psd=mismatch_psd(spec, task))
     controller = task.controller()
     try:
         result = simulate_on_sensors(plant, controller, reference, x0, task.duration, s.dt, estimator,
