@@ -160,3 +160,14 @@ def test_each_failed_run_is_counted_under_its_first_cause():
         {"stopped": 1, "estimate lost": 2, "stall": 1, "offset": 0}
     cols["progress"][4] = 1.0
     assert failure_causes(cols, rows, SimpleNamespace(coverage=0.9))["offset"] == 1
+
+
+def test_a_lines_slope_pull_is_read_along_the_line_as_turned_by_the_slopes_direction():
+    from runtime.sweep.robustness import _task, steady_torque, turned
+    task = _task("line", "lqr", "default")
+    plant = task.scenario.params.replace(slope=0.001)
+    flat = steady_torque(task, task.scenario.params)
+    pull = plant.m_R * plant.g * plant.r * math.sin(0.001)
+    # The task turned by ψ runs at ψ to the slope (along x): across it at π/2, up it at π.
+    assert steady_torque(turned(task, math.pi / 2), plant) == pytest.approx(flat, abs=1e-9)
+    assert steady_torque(turned(task, math.pi), plant) == pytest.approx(flat + pull, rel=1e-9)
