@@ -290,8 +290,10 @@ def plant_of(task, inputs):
     return plant.replace(slope=float(inputs["slope_fraction"]) * climbing_limit(plant, task.u_max))
 
 
-def steady_torque(task, plant, slope_direction):
-    """The largest steady torque [N m] the plant needs on the task's path at its speed (see the module)."""
+def steady_torque(task, plant):
+    """The largest steady torque [N m] the plant needs on the task's path at its speed (see the module);
+    `task` is the run's, already `turned` by the slope's direction, so a line's heading is its
+    heading against the slope."""
     from ..control.lqr_design import operating_point
     from ..model import Model
     spec = task.reference_spec
@@ -299,8 +301,8 @@ def steady_torque(task, plant, slope_direction):
                   "figure8": (1 / spec.get("size", 1.0), -1 / spec.get("size", 1.0))}.get(spec["kind"], (0.0,))
     flat = Model(plant.replace(slope=0.0))
     pull = plant.m_R * plant.g * plant.r * abs(math.sin(plant.slope))
-    if spec["kind"] == "line":       # the line's heading against the plane's x axis (up the slope)
-        pull *= abs(math.cos(spec.get("heading", 0.0) + slope_direction))
+    if spec["kind"] == "line":       # the turned line's heading against the plane's x axis (up the slope)
+        pull *= abs(math.cos(spec.get("heading", 0.0)))
     worst = 0.0
     for kappa in curvatures:
         try:        # from the model's own operating point: one Newton solve instead of a continuation in κ
@@ -390,7 +392,7 @@ def run_one(spec, inputs):
         return out
     out["slope_rad"] = plant.slope
     try:
-        out["steady_torque_nm"] = steady_torque(task, plant, float(inputs["slope_direction_rad"]))
+        out["steady_torque_nm"] = steady_torque(task, plant)
         out["counted_apart"] = APART_TORQUE if out["steady_torque_nm"] > task.u_max else 0
     except ValueError:      # Newton found no operating point: the torque is unknown (NaN), the run is made
         out["counted_apart"] = APART_NO_OPERATING_POINT

@@ -160,3 +160,36 @@ def test_each_failed_run_is_counted_under_its_first_cause():
         {"stopped": 1, "estimate lost": 2, "stall": 1, "offset": 0}
     cols["progress"][4] = 1.0
     assert failure_causes(cols, rows, SimpleNamespace(coverage=0.9))["offset"] == 1
+
+
+def test_a_lines_slope_pull_is_read_along_the_line_as_turned_by_the_slopes_direction():
+    from runtime.sweep.robustness import _task, steady_torque, turned
+    task = _task("line", "lqr", "default")
+    plant = task.scenario.params.replace(slope=0.001)
+    flat = steady_torque(task, task.scenario.params)
+    pull = plant.m_R * plant.g * plant.r * math.sin(0.001)
+    # The task turned by ψ runs at ψ to the slope (along x): across it at π/2, up it at π.
+    assert steady_torque(turned(task, math.pi / 2), plant) == pytest.approx(flat, abs=1e-9)
+    assert steady_torque(turned(task, math.pi), plant) == pytest.approx(flat + pull, rel=1e-9)
+
+
+CIRCLE_PLANTS = """
+description = "the shipped study's plants on the circle with the LQR"
+samples = 20
+seed = 20261126
+samples_per_task = 1
+
+[control]
+tasks = ["circle"]
+controllers = ["lqr"]
+sensors = "default"
+"""
+
+
+def test_the_circle_lqr_holds_a_plant_on_which_tighter_attitude_gains_chatter_at_the_torque_limits_and_stall(tmp_path):
+    # Plant 16 of the shipped study (masses and dampings up to 24 % off, c_P 7 mm low): with the
+    # yoke's attitude sized 0.1 rad the torques clip on about 90 % of the samples and it stalls.
+    spec = load_sweep(str(_sweep(tmp_path, CIRCLE_PLANTS)))
+    row = spec.run_chunk(16, 17)
+    assert row["counted_apart"][0] == 0 and row["steady_torque_nm"][0] < 0.3
+    assert row["success"][0] == 1 and row["saturated_fraction"][0] < 0.3
