@@ -207,6 +207,12 @@ class Fit:
     start: np.ndarray = None
 
 
+def _inverse_cholesky(S):
+    """L⁻¹ (lower triangular) of S = L Lᵀ."""
+    L = np.linalg.cholesky(S)
+    return scipy.linalg.solve_triangular(L, np.eye(len(S)), lower=True, check_finite=False)
+
+
 class _Problem:
     """The multiple-shooting problem of a sensor log."""
 
@@ -325,13 +331,12 @@ class _Problem:
             self.xref[s] = model.retract(x_ref, sol.x)
         self._cache = (None, None)
 
-    def noise_map(self, s, blk):
-        """(A, Q): the effect on the segment's noise-scaled readings and on its end state (the last
-        12 rows) of the process noise's forces w_j, one per torque period and held over it (the
-        accelerometer reads M⁻¹ w_j, the velocities jump by M⁻¹ w_j τ at its end), w_j of
-        covariance diag(Q)."""
+    def _noise_parts(self, s, blk):
+        """What the process noise's forces w_j of a segment's torque periods js do (`noise_map`):
+        (js, P (12, 5 len(js)) their effect on Φ⁻¹ δx once they entered, enters (len(js),) the node
+        where each enters the state (a large number for none), Minv (L + 1, 5, 5))."""
         d = self.data
-        model, X, Phi, rows = blk["model"], blk["X"], blk["Phi"], blk["rows"]
+        model, X, Phi = blk["model"], blk["X"], blk["Phi"]
         k0, last_node = self.starts[s], self.ends[s]
         js = np.unique(d.interval[k0:last_node + 1])
         P = np.zeros((NE, 5 * len(js)))
@@ -347,6 +352,17 @@ class _Problem:
             Bk[:, IDX_E_NU] = Minv[kappa - 1] * d.tau
             P.reshape(NE, -1, 5)[:, entering] = np.swapaxes(np.linalg.solve(Phi[kappa], Bk), 0, 1)
             enters[entering] = kappa
+        return js, P, enters, Minv
+
+    def noise_map(self, s, blk):
+        """(A, Q): the effect on the segment's noise-scaled readings and on its end state (the last
+        12 rows) of the process noise's forces w_j, one per torque period and held over it (the
+        accelerometer reads M⁻¹ w_j, the velocities jump by M⁻¹ w_j τ at its end), w_j of
+        covariance diag(Q)."""
+        d = self.data
+        Phi, rows = blk["Phi"], blk["rows"]
+        k0 = self.starts[s]
+        js, P, enters, Minv = self._noise_parts(s, blk)
         node, sig = rows["node"], rows["sig"][:, None]
         n = len(node)
         A = np.zeros((n + NE, 5 * len(js)))
@@ -366,27 +382,77 @@ class _Problem:
     def covariances(self, blocks, first=0):
         """Each segment's whitening W (Wᵀ W = C⁻¹) of its residual covariance, in units of the
         sensor noise: C = D + A Q Aᵀ (`noise_map`), D the unit noise of the readings and the floor
-        of their end-state difference.  A has a few columns per torque period, so W is kept as
-        the symmetric root (I + U diag(f) Uᵀ) D^-1/2 from the thin SVD D^-1/2 A Q^1/2 = U S Vᵀ,
-        f = (1 + S²)^-1/2 − 1, never as a matrix of the segment's size.  `blocks` are those of the
-        segments first, first + 1, ..."""
+        of their end-state difference.  C is the covariance of a linear model along the segment
+        (the state's deviation η = Φ⁻¹ δx jumps by P_j w_j where w_j enters; a reading sees Φ η
+        and, at the IMU, its own period's w_j), so W is its innovations form: a Kalman filter on
+        η, one torque period's readings at a time (their own w_j appended to the state), then the
+        end-state difference, each innovation whitened by the Cholesky factor of its covariance.
+        W is the inverse Cholesky factor of C: a few products per torque period, never a matrix
+        of the segment's size.  Per segment a list of (rows, H (k, 12), L⁻¹ (k, k), K (12, k)): the
+        slice of its rows, their sensitivity to η, the inverse Cholesky factor of their innovations'
+        covariance and the gain of η's mean.  `blocks` are those of the segments first, first + 1, ..."""
         out = []
         for s, blk in enumerate(blocks, start=first):
-            A, Q = self.noise_map(s, blk)
-            nrow, row = len(blk["r"]), blk["n_out"]
-            dinv = np.ones(nrow)
-            dinv[row:] = 1.0 / DEFECT_FLOOR
-            B = dinv[:, None] * A[:nrow] * np.sqrt(Q)
-            U, S, _ = scipy.linalg.svd(B, full_matrices=False, check_finite=False)
-            out.append((dinv, U, 1.0 / np.sqrt(1.0 + S ** 2) - 1.0))
+            out.append(self._innovations(s, blk))
         return out
+
+    def _innovations(self, s, blk):
+        d = self.data
+        Phi, rows = blk["Phi"], blk["rows"]
+        k0 = self.starts[s]
+        js, P, enters, Minv = self._noise_parts(s, blk)
+        root_q = np.sqrt(self.q2 / d.tau)
+        Pw = (P.reshape(NE, -1, 5) * root_q).swapaxes(0, 1)        # (periods, 12, 5), w_j in unit noise
+        node, sig, kind = rows["node"], rows["sig"], rows["kind"]
+        n = blk["n_out"]
+        H = np.einsum("rj,rjk->rk", rows["Hx"], Phi[node]) / sig[:, None]
+        G = np.zeros((n, 5))            # the IMU's direct reading of its own period's w_j
+        imu = np.flatnonzero(kind == 0)
+        G[imu] = np.einsum("rj,rjk->rk", rows["Hn"][imu], Minv[node[imu]]) / sig[imu, None] * root_q
+        period = np.searchsorted(js, d.interval[k0 + node])
+        bounds = np.searchsorted(period, np.arange(len(js) + 1))
+        Sigma = np.zeros((NE, NE))
+        steps = []
+        Sa = np.zeros((NE + 5, NE + 5))
+        T = np.zeros((NE, NE + 5))
+        T[:, :NE] = np.eye(NE)
+        last = len(Phi) - 1
+        for j in range(len(js)):
+            lo, hi = bounds[j], bounds[j + 1]
+            T[:, NE:] = Pw[j] if enters[j] <= last else 0.0
+            Sa[:NE, :NE] = Sigma
+            Sa[:NE, NE:] = 0.0
+            Sa[NE:, :NE] = 0.0
+            Sa[NE:, NE:] = np.eye(5)
+            if hi > lo:
+                Ha = np.concatenate([H[lo:hi], G[lo:hi]], axis=1)
+                HS = Ha @ Sa
+                Linv = _inverse_cholesky(HS @ Ha.T + np.eye(hi - lo))
+                V = Linv @ HS                   # L⁻¹ H Σ
+                steps.append((slice(lo, hi), H[lo:hi], Linv, T @ (V.T @ Linv)))    # T Σ Hᵀ S⁻¹
+                Sa -= V.T @ V
+            Sigma = T @ Sa @ T.T
+            Sigma = 0.5 * (Sigma + Sigma.T)
+        if len(blk["r"]) > n:           # the end-state difference, in units of its floor
+            Hd = Phi[-1] / DEFECT_FLOOR
+            steps.append((slice(n, n + NE), Hd, _inverse_cholesky(Hd @ Sigma @ Hd.T + np.eye(NE)), None))
+        return steps
 
     @staticmethod
     def whiten(white, M):
-        """W M for a segment's whitening `white` (`covariances`)."""
-        dinv, U, f = white
-        M = dinv.reshape((-1,) + (1,) * (M.ndim - 1)) * M
-        return M + U @ (f.reshape((-1,) + (1,) * (M.ndim - 1)) * (U.T @ M))
+        """W M for a segment's whitening `white` (`covariances`): the innovations of M's rows,
+        each whitened; M (rows,) or (rows, m)."""
+        vec = M.ndim == 1
+        M = M[:, None] if vec else M
+        out = np.empty(M.shape)
+        mean = np.zeros((NE, M.shape[1]))
+        for rows, H, Linv, K in white:
+            Y = M[rows] / DEFECT_FLOOR if K is None else M[rows]
+            innovation = Y - H @ mean
+            out[rows] = Linv @ innovation
+            if K is not None:
+                mean += K @ innovation
+        return out[:, 0] if vec else out
 
     def assemble(self, z):
         """(residuals, sparse Jacobian, segment blocks) at z.  Each segment's whitened residuals r_s
