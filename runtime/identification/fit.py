@@ -209,8 +209,10 @@ class Fit:
 
 def _inverse_cholesky(S):
     """L⁻¹ (lower triangular) of S = L Lᵀ."""
-    L = np.linalg.cholesky(S)
-    return scipy.linalg.solve_triangular(L, np.eye(len(S)), lower=True, check_finite=False)
+    Linv, info = scipy.linalg.lapack.dtrtri(np.linalg.cholesky(S), lower=1)
+    if info:
+        raise np.linalg.LinAlgError(f"dtrtri: {info}")
+    return Linv
 
 
 class _Problem:
@@ -243,6 +245,7 @@ class _Problem:
         self.q2 = sensors.process.generalized() ** 2
         self.ncols = self.nf + 6 + NE * self.S
         self.chol = None
+        self._stacked = (None, None)       # (the whitenings, `stack_whitenings` of them)
         self._cache = (None, None)
         self.nfev = 0
         self.progress = None
@@ -454,6 +457,53 @@ class _Problem:
                 mean += K @ innovation
         return out[:, 0] if vec else out
 
+    @staticmethod
+    def stack_whitenings(whites):
+        """The segments' whitenings (`covariances`) padded to one array each, for `whiten_all`:
+        (rows (S, K, R) the row of each step's place or -1, unit (S, K, R) what a row is divided
+        by first (the end-state difference's floor, else 1), H (S, K, R, 12), L⁻¹ (S, K, R, R),
+        gains (S, K, 12, R)), K the most steps of a segment, R the most rows of a step; padding
+        is zero, so it neither reads nor moves anything."""
+        S, K = len(whites), max(len(w) for w in whites)
+        R = max(st[0].stop - st[0].start for w in whites for st in w)
+        rows, unit = np.full((S, K, R), -1), np.ones((S, K, R))
+        H, Linv, gains = np.zeros((S, K, R, NE)), np.zeros((S, K, R, R)), np.zeros((S, K, NE, R))
+        for s, w in enumerate(whites):
+            for k, (sl, h, li, gain) in enumerate(w):
+                m = sl.stop - sl.start
+                rows[s, k, :m] = np.arange(sl.start, sl.stop)
+                H[s, k, :m], Linv[s, k, :m, :m] = h, li
+                if gain is None:        # the end-state difference, in units of its floor
+                    unit[s, k, :m] = DEFECT_FLOOR
+                else:
+                    gains[s, k, :, :m] = gain
+        return rows, unit, H, Linv, gains
+
+    @staticmethod
+    def whiten_all(stacked, Ms):
+        """[W_s M_s] for every segment s at once (`stack_whitenings`): `whiten`'s recursion, one
+        step of all segments together."""
+        rows, unit, H, Linv, gains = stacked
+        S, K, R = rows.shape
+        m = max(M.shape[1] for M in Ms)
+        Y = np.zeros((S, K, R, m))
+        for s, M in enumerate(Ms):
+            Y[s, :, :, :M.shape[1]] = np.vstack([M, np.zeros((1, M.shape[1]))])[rows[s]]   # -1: the zero row
+        Y /= unit[..., None]
+        out = np.empty_like(Y)
+        mean = np.zeros((S, NE, m))
+        for k in range(K):
+            innovation = Y[:, k] - H[:, k] @ mean
+            out[:, k] = Linv[:, k] @ innovation
+            mean += gains[:, k] @ innovation
+        result = []
+        for s, M in enumerate(Ms):
+            valid = rows[s] >= 0
+            W = np.empty(M.shape)
+            W[rows[s][valid]] = out[s][valid][:, :M.shape[1]]
+            result.append(W)
+        return result
+
     def assemble(self, z):
         """(residuals, sparse Jacobian, segment blocks) at z.  Each segment's whitened residuals r_s
         and Jacobian J_s (columns θ, b, its start and the next) enter compressed: with the QR
@@ -465,16 +515,21 @@ class _Problem:
         blocks = self.segment_blocks(z)
         if self.chol is None:
             self.chol = self.covariances(blocks)
+        if self._stacked[0] is not self.chol:
+            self._stacked = (self.chol, self.stack_whitenings(self.chol))
         rs, data, ri, ci = [], [], [], []
         row0 = 0
         cols_g = np.arange(self.nf + 6)
+        Ms, colsets = [], []
         for s, blk in enumerate(blocks):
             parts = [np.hstack([blk["th"], blk["b"]]), blk["x"]]
             cols = [cols_g, self.nf + 6 + NE * s + np.arange(NE)]
             if blk["next"] is not None:
                 parts.append(blk["next"])
                 cols.append(self.nf + 6 + NE * (s + 1) + np.arange(NE))
-            M = self.whiten(self.chol[s], np.hstack(parts + [blk["r"][:, None]]))
+            Ms.append(np.hstack(parts + [blk["r"][:, None]]))
+            colsets.append(cols)
+        for M, cols in zip(self.whiten_all(self._stacked[1], Ms), colsets):
             R = scipy.linalg.qr(M, mode="r", overwrite_a=True, check_finite=False)[0]
             m = R.shape[1] - 1
             R = np.vstack([R, np.zeros((max(0, m + 1 - R.shape[0]), m + 1))])[:m + 1]
