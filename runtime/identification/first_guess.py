@@ -19,7 +19,7 @@ import scipy.optimize
 import scipy.signal
 
 from ..model import Model
-from ..param_derivatives import NPI, PARAMETER_NAMES, base_parameters, inertial_parameters
+from ..param_derivatives import NPI, PARAMETER_NAMES, PI_NAMES, base_parameters
 from ..params import Params
 from ..state import IDX_NU, NV
 
@@ -142,19 +142,36 @@ def _physical(params, idx, theta, theta0, lo, hi):
     return theta0.copy()
 
 
-def _pi_of(p):
-    """π of a parameter vector that need not pass the physical checks (a difference step may not)."""
-    values = dict(zip(PARAMETER_NAMES, p))
-    fields = {}
+def _pi_index():
+    """Where `_pi_of` reads each body's m, c, J (3, 3) and k in the parameter vector and writes its
+    m, k, m·c and JO in π, and the entries π copies."""
+    at, pi_at = PARAMETER_NAMES.index, PI_NAMES.index
+    pairs = (("xx", 0, 0), ("yy", 1, 1), ("zz", 2, 2), ("xy", 0, 1), ("xz", 0, 2), ("yz", 1, 2))
+    bodies = []
     for body in ("Y", "P"):
-        c = np.array([values[f"c_{body}_{a}"] for a in "xyz"])
-        J = np.array([[values[f"J_{body}_{''.join(sorted(a + b, key='xyz'.index))}"] for b in "xyz"] for a in "xyz"])
-        fields[body] = (values[f"m_{body}"], c, J)
-    proxy = type("P", (), {})()
-    for k in ("m_S", "j_S", "k_S", "k_Y", "k_P", "j_mY", "j_mP"):
-        setattr(proxy, k, values[k])
-    for body, (m, c, J) in fields.items():
-        setattr(proxy, f"m_{body}", m)
-        setattr(proxy, f"c_{body}", c)
-        setattr(proxy, f"J_{body}", J)
-    return inertial_parameters(proxy)
+        J = [[at(f"J_{body}_{''.join(sorted(a + b, key='xyz'.index))}") for b in "xyz"] for a in "xyz"]
+        bodies.append((at(f"m_{body}"), [at(f"c_{body}_{a}") for a in "xyz"], np.array(J), at(f"k_{body}"),
+                       pi_at(f"m_{body}"), pi_at(f"k_{body}"), [pi_at(f"mc_{body}_{a}") for a in "xyz"],
+                       [pi_at(f"JO_{body}_{k}") for k, _, _ in pairs], [i for _, i, _ in pairs],
+                       [j for _, _, j in pairs]))
+    copied = ("m_S", "j_S", "k_S", "j_mY", "j_mP")
+    return [pi_at(n) for n in copied], [at(n) for n in copied], bodies
+
+
+_PI_INDEX = _pi_index()
+
+
+def _pi_of(p):
+    """π of a parameter vector that need not pass the physical checks (a difference step may not):
+    `inertial_parameters`' arithmetic on the vector's entries."""
+    p = np.asarray(p, dtype=float)
+    to, frm, bodies = _PI_INDEX
+    out = np.empty(NPI)
+    out[to] = p[frm]
+    for m_at, c_at, J_at, k_at, m_to, k_to, mc_to, jo_to, rows, cols in bodies:
+        m, c, J = p[m_at], p[c_at], p[J_at]
+        JO = J + m * (c @ c * np.eye(3) - np.outer(c, c))
+        out[m_to], out[k_to] = m, p[k_at]
+        out[mc_to] = m * c
+        out[jo_to] = JO[rows, cols]
+    return out

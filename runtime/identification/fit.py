@@ -207,6 +207,14 @@ class Fit:
     start: np.ndarray = None
 
 
+def _inverse_cholesky(S):
+    """L⁻¹ (lower triangular) of S = L Lᵀ."""
+    Linv, info = scipy.linalg.lapack.dtrtri(np.linalg.cholesky(S), lower=1)
+    if info:
+        raise np.linalg.LinAlgError(f"dtrtri: {info}")
+    return Linv
+
+
 class _Problem:
     """The multiple-shooting problem of a sensor log."""
 
@@ -237,6 +245,7 @@ class _Problem:
         self.q2 = sensors.process.generalized() ** 2
         self.ncols = self.nf + 6 + NE * self.S
         self.chol = None
+        self._stacked = (None, None)       # (the whitenings, `stack_whitenings` of them)
         self._cache = (None, None)
         self.nfev = 0
         self.progress = None
@@ -325,13 +334,12 @@ class _Problem:
             self.xref[s] = model.retract(x_ref, sol.x)
         self._cache = (None, None)
 
-    def noise_map(self, s, blk):
-        """(A, Q): the effect on the segment's noise-scaled readings and on its end state (the last
-        12 rows) of the process noise's forces w_j, one per torque period and held over it (the
-        accelerometer reads M⁻¹ w_j, the velocities jump by M⁻¹ w_j τ at its end), w_j of
-        covariance diag(Q)."""
+    def _noise_parts(self, s, blk):
+        """What the process noise's forces w_j of a segment's torque periods js do (`noise_map`):
+        (js, P (12, 5 len(js)) their effect on Φ⁻¹ δx once they entered, enters (len(js),) the node
+        where each enters the state (a large number for none), Minv (L + 1, 5, 5))."""
         d = self.data
-        model, X, Phi, rows = blk["model"], blk["X"], blk["Phi"], blk["rows"]
+        model, X, Phi = blk["model"], blk["X"], blk["Phi"]
         k0, last_node = self.starts[s], self.ends[s]
         js = np.unique(d.interval[k0:last_node + 1])
         P = np.zeros((NE, 5 * len(js)))
@@ -347,6 +355,17 @@ class _Problem:
             Bk[:, IDX_E_NU] = Minv[kappa - 1] * d.tau
             P.reshape(NE, -1, 5)[:, entering] = np.swapaxes(np.linalg.solve(Phi[kappa], Bk), 0, 1)
             enters[entering] = kappa
+        return js, P, enters, Minv
+
+    def noise_map(self, s, blk):
+        """(A, Q): the effect on the segment's noise-scaled readings and on its end state (the last
+        12 rows) of the process noise's forces w_j, one per torque period and held over it (the
+        accelerometer reads M⁻¹ w_j, the velocities jump by M⁻¹ w_j τ at its end), w_j of
+        covariance diag(Q)."""
+        d = self.data
+        Phi, rows = blk["Phi"], blk["rows"]
+        k0 = self.starts[s]
+        js, P, enters, Minv = self._noise_parts(s, blk)
         node, sig = rows["node"], rows["sig"][:, None]
         n = len(node)
         A = np.zeros((n + NE, 5 * len(js)))
@@ -366,27 +385,124 @@ class _Problem:
     def covariances(self, blocks, first=0):
         """Each segment's whitening W (Wᵀ W = C⁻¹) of its residual covariance, in units of the
         sensor noise: C = D + A Q Aᵀ (`noise_map`), D the unit noise of the readings and the floor
-        of their end-state difference.  A has a few columns per torque period, so W is kept as
-        the symmetric root (I + U diag(f) Uᵀ) D^-1/2 from the thin SVD D^-1/2 A Q^1/2 = U S Vᵀ,
-        f = (1 + S²)^-1/2 − 1, never as a matrix of the segment's size.  `blocks` are those of the
-        segments first, first + 1, ..."""
+        of their end-state difference.  C is the covariance of a linear model along the segment
+        (the state's deviation η = Φ⁻¹ δx jumps by P_j w_j where w_j enters; a reading sees Φ η
+        and, at the IMU, its own period's w_j), so W is its innovations form: a Kalman filter on
+        η, one torque period's readings at a time (their own w_j appended to the state), then the
+        end-state difference, each innovation whitened by the Cholesky factor of its covariance.
+        W is the inverse Cholesky factor of C: a few products per torque period, never a matrix
+        of the segment's size.  Per segment a list of (rows, H (k, 12), L⁻¹ (k, k), K (12, k)): the
+        slice of its rows, their sensitivity to η, the inverse Cholesky factor of their innovations'
+        covariance and the gain of η's mean.  `blocks` are those of the segments first, first + 1, ..."""
         out = []
         for s, blk in enumerate(blocks, start=first):
-            A, Q = self.noise_map(s, blk)
-            nrow, row = len(blk["r"]), blk["n_out"]
-            dinv = np.ones(nrow)
-            dinv[row:] = 1.0 / DEFECT_FLOOR
-            B = dinv[:, None] * A[:nrow] * np.sqrt(Q)
-            U, S, _ = scipy.linalg.svd(B, full_matrices=False, check_finite=False)
-            out.append((dinv, U, 1.0 / np.sqrt(1.0 + S ** 2) - 1.0))
+            out.append(self._innovations(s, blk))
         return out
+
+    def _innovations(self, s, blk):
+        d = self.data
+        Phi, rows = blk["Phi"], blk["rows"]
+        k0 = self.starts[s]
+        js, P, enters, Minv = self._noise_parts(s, blk)
+        root_q = np.sqrt(self.q2 / d.tau)
+        Pw = (P.reshape(NE, -1, 5) * root_q).swapaxes(0, 1)        # (periods, 12, 5), w_j in unit noise
+        node, sig, kind = rows["node"], rows["sig"], rows["kind"]
+        n = blk["n_out"]
+        H = np.einsum("rj,rjk->rk", rows["Hx"], Phi[node]) / sig[:, None]
+        G = np.zeros((n, 5))            # the IMU's direct reading of its own period's w_j
+        imu = np.flatnonzero(kind == 0)
+        G[imu] = np.einsum("rj,rjk->rk", rows["Hn"][imu], Minv[node[imu]]) / sig[imu, None] * root_q
+        period = np.searchsorted(js, d.interval[k0 + node])
+        bounds = np.searchsorted(period, np.arange(len(js) + 1))
+        Sigma = np.zeros((NE, NE))
+        steps = []
+        Sa = np.zeros((NE + 5, NE + 5))
+        T = np.zeros((NE, NE + 5))
+        T[:, :NE] = np.eye(NE)
+        last = len(Phi) - 1
+        for j in range(len(js)):
+            lo, hi = bounds[j], bounds[j + 1]
+            T[:, NE:] = Pw[j] if enters[j] <= last else 0.0
+            Sa[:NE, :NE] = Sigma
+            Sa[:NE, NE:] = 0.0
+            Sa[NE:, :NE] = 0.0
+            Sa[NE:, NE:] = np.eye(5)
+            if hi > lo:
+                Ha = np.concatenate([H[lo:hi], G[lo:hi]], axis=1)
+                HS = Ha @ Sa
+                Linv = _inverse_cholesky(HS @ Ha.T + np.eye(hi - lo))
+                V = Linv @ HS                   # L⁻¹ H Σ
+                steps.append((slice(lo, hi), H[lo:hi], Linv, T @ (V.T @ Linv)))    # T Σ Hᵀ S⁻¹
+                Sa -= V.T @ V
+            Sigma = T @ Sa @ T.T
+            Sigma = 0.5 * (Sigma + Sigma.T)
+        if len(blk["r"]) > n:           # the end-state difference, in units of its floor
+            Hd = Phi[-1] / DEFECT_FLOOR
+            steps.append((slice(n, n + NE), Hd, _inverse_cholesky(Hd @ Sigma @ Hd.T + np.eye(NE)), None))
+        return steps
 
     @staticmethod
     def whiten(white, M):
-        """W M for a segment's whitening `white` (`covariances`)."""
-        dinv, U, f = white
-        M = dinv.reshape((-1,) + (1,) * (M.ndim - 1)) * M
-        return M + U @ (f.reshape((-1,) + (1,) * (M.ndim - 1)) * (U.T @ M))
+        """W M for a segment's whitening `white` (`covariances`): the innovations of M's rows,
+        each whitened; M (rows,) or (rows, m)."""
+        vec = M.ndim == 1
+        M = M[:, None] if vec else M
+        out = np.empty(M.shape)
+        mean = np.zeros((NE, M.shape[1]))
+        for rows, H, Linv, K in white:
+            Y = M[rows] / DEFECT_FLOOR if K is None else M[rows]
+            innovation = Y - H @ mean
+            out[rows] = Linv @ innovation
+            if K is not None:
+                mean += K @ innovation
+        return out[:, 0] if vec else out
+
+    @staticmethod
+    def stack_whitenings(whites):
+        """The segments' whitenings (`covariances`) padded to one array each, for `whiten_all`:
+        (rows (S, K, R) the row of each step's place or -1, unit (S, K, R) what a row is divided
+        by first (the end-state difference's floor, else 1), H (S, K, R, 12), L⁻¹ (S, K, R, R),
+        gains (S, K, 12, R)), K the most steps of a segment, R the most rows of a step; padding
+        is zero, so it neither reads nor moves anything."""
+        S, K = len(whites), max(len(w) for w in whites)
+        R = max(st[0].stop - st[0].start for w in whites for st in w)
+        rows, unit = np.full((S, K, R), -1), np.ones((S, K, R))
+        H, Linv, gains = np.zeros((S, K, R, NE)), np.zeros((S, K, R, R)), np.zeros((S, K, NE, R))
+        for s, w in enumerate(whites):
+            for k, (sl, h, li, gain) in enumerate(w):
+                m = sl.stop - sl.start
+                rows[s, k, :m] = np.arange(sl.start, sl.stop)
+                H[s, k, :m], Linv[s, k, :m, :m] = h, li
+                if gain is None:        # the end-state difference, in units of its floor
+                    unit[s, k, :m] = DEFECT_FLOOR
+                else:
+                    gains[s, k, :, :m] = gain
+        return rows, unit, H, Linv, gains
+
+    @staticmethod
+    def whiten_all(stacked, Ms):
+        """[W_s M_s] for every segment s at once (`stack_whitenings`): `whiten`'s recursion, one
+        step of all segments together."""
+        rows, unit, H, Linv, gains = stacked
+        S, K, R = rows.shape
+        m = max(M.shape[1] for M in Ms)
+        Y = np.zeros((S, K, R, m))
+        for s, M in enumerate(Ms):
+            Y[s, :, :, :M.shape[1]] = np.vstack([M, np.zeros((1, M.shape[1]))])[rows[s]]   # -1: the zero row
+        Y /= unit[..., None]
+        out = np.empty_like(Y)
+        mean = np.zeros((S, NE, m))
+        for k in range(K):
+            innovation = Y[:, k] - H[:, k] @ mean
+            out[:, k] = Linv[:, k] @ innovation
+            mean += gains[:, k] @ innovation
+        result = []
+        for s, M in enumerate(Ms):
+            valid = rows[s] >= 0
+            W = np.empty(M.shape)
+            W[rows[s][valid]] = out[s][valid][:, :M.shape[1]]
+            result.append(W)
+        return result
 
     def assemble(self, z):
         """(residuals, sparse Jacobian, segment blocks) at z.  Each segment's whitened residuals r_s
@@ -399,16 +515,21 @@ class _Problem:
         blocks = self.segment_blocks(z)
         if self.chol is None:
             self.chol = self.covariances(blocks)
+        if self._stacked[0] is not self.chol:
+            self._stacked = (self.chol, self.stack_whitenings(self.chol))
         rs, data, ri, ci = [], [], [], []
         row0 = 0
         cols_g = np.arange(self.nf + 6)
+        Ms, colsets = [], []
         for s, blk in enumerate(blocks):
             parts = [np.hstack([blk["th"], blk["b"]]), blk["x"]]
             cols = [cols_g, self.nf + 6 + NE * s + np.arange(NE)]
             if blk["next"] is not None:
                 parts.append(blk["next"])
                 cols.append(self.nf + 6 + NE * (s + 1) + np.arange(NE))
-            M = self.whiten(self.chol[s], np.hstack(parts + [blk["r"][:, None]]))
+            Ms.append(np.hstack(parts + [blk["r"][:, None]]))
+            colsets.append(cols)
+        for M, cols in zip(self.whiten_all(self._stacked[1], Ms), colsets):
             R = scipy.linalg.qr(M, mode="r", overwrite_a=True, check_finite=False)[0]
             m = R.shape[1] - 1
             R = np.vstack([R, np.zeros((max(0, m + 1 - R.shape[0]), m + 1))])[:m + 1]

@@ -90,3 +90,17 @@ def test_the_smoothing_keeps_a_linear_velocity_and_differentiates_it_exactly():
     x[:, IDX_NU] = np.outer(t, [1.0, -2.0, 0.5, 3.0, -1.0])
     xs, nudot, _ = smoothed_motion(t, x)
     assert np.allclose(xs[:, IDX_NU], x[:, IDX_NU]) and np.allclose(nudot, [1.0, -2.0, 0.5, 3.0, -1.0])
+
+
+def test_the_inertial_parameters_of_a_parameter_vector_are_those_of_its_robot():
+    from runtime.identification.first_guess import _pi_of
+    from runtime.param_derivatives import inertial_parameters
+    from runtime.params import Params
+
+    nominal = load_scenario("battery-geared").params
+    for seed in range(5):
+        # masses, centres of mass, dampings and rotor inertias moved; the tensors kept physical
+        moved = np.array([n[:2] in ("m_", "c_", "k_", "j_") for n in PARAMETER_NAMES])
+        p = nominal.as_array() * np.where(moved, np.random.default_rng(seed).uniform(0.7, 1.3, len(moved)), 1.0)
+        robot = Params.from_array(p)
+        np.testing.assert_array_equal(_pi_of(p), inertial_parameters(robot))
