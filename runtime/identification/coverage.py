@@ -167,7 +167,8 @@ def coverage(names, duration, fits, seed=0, jobs=1, done=None, **options):
 
 
 def summarise(trials):
-    """{"names", "coverage" (per entry), "passed", "combinations" ({name: {"coverage", "within",
+    """{"names", "coverage" (per entry), "coverage_passed" (the same over the fits that pass their
+    residual check), "spread" (`error_spread`), "passed", "combinations" ({name: {"coverage", "within",
     "fits"}}: of the fits whose free entries move the combination, the fractions whose 95 % region
     holds its truth and whose estimate is within COMBINATION_TOLERANCE of it), "trials" (in seed
     order)} of some trials."""
@@ -179,8 +180,20 @@ def summarise(trials):
         if rows:
             combos[name] = {"coverage": float(np.mean([c["inside"] for c in rows])),
                             "within": float(np.mean([c["within"] for c in rows])), "fits": len(rows)}
+    passed = np.array([t["passed"] for t in trials], dtype=bool)
     return {"names": trials[0]["names"], "coverage": inside.mean(axis=0).tolist(),
-            "passed": float(np.mean([t["passed"] for t in trials])), "combinations": combos, "trials": trials}
+            "coverage_passed": inside[passed].mean(axis=0).tolist() if passed.any() else None,
+            "spread": error_spread(trials),
+            "passed": float(np.mean(passed)), "combinations": combos, "trials": trials}
+
+
+def error_spread(trials):
+    """{"std", "robust_std"}: per entry, the standard deviation over the trials of the error in
+    units of the reported σ, (estimate − truth)/σ, and the same from the median absolute value
+    (/0.6745), which a few far misses do not move.  Honest intervals give 1 for both; a std well
+    above a robust std near 1 says a few fits went wrong, not that every interval is too narrow."""
+    z = np.array([(np.asarray(t["estimate"]) - np.asarray(t["truth"])) / np.asarray(t["sigma"]) for t in trials])
+    return {"std": np.std(z, axis=0).tolist(), "robust_std": (np.median(np.abs(z), axis=0) / 0.6745).tolist()}
 
 
 def calibration_figure(result, path, title=""):

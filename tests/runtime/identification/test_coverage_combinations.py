@@ -43,7 +43,8 @@ def test_a_combination_is_scored_by_its_relative_error_and_its_95_percent_region
 
 
 def test_the_summary_counts_each_combination_over_the_fits_that_move_it():
-    trial = {"seed": 0, "names": ["k_Y"], "inside": [True], "passed": True,
+    trial = {"seed": 0, "names": ["k_Y"], "truth": [1.0], "estimate": [1.0], "sigma": [0.1], "inside": [True],
+             "passed": True,
              "combinations": {"k_Y": {"inside": False, "within": True}, "k_S": {"inside": None, "within": True}}}
     result = coverage.summarise([trial, dict(trial, seed=1, combinations={
         "k_Y": {"inside": True, "within": False}, "k_S": {"inside": None, "within": True}})])
