@@ -134,14 +134,14 @@ class SensorSimulation:
 ACCEL_AXES = ("held", "largest", "each")
 
 
-def ekf_noise(sensors, params, x0=None, accel_axes="largest", hold=None):
-    """The EkfNoise a sensor set declares.  `accel_axes` "held": the filter models the process
-    noise as `SensorSimulation` draws it, a torque held over each step of `hold` seconds (None: the
-    IMU's period) whose acceleration the accelerometer reads (`torque_hold`; `accel` the white
+def ekf_noise(sensors, params, x0=None, accel_axes="held", hold=None):
+    """The EkfNoise a sensor set declares.  `accel_axes` "held", the default: the filter models the
+    process noise as `SensorSimulation` draws it, a torque held over each step of `hold` seconds (None:
+    the IMU's period) whose acceleration the accelerometer reads (`torque_hold`; `accel` the white
     noise alone; the filter carries the correlation, runtime.ekf).  Otherwise the accelerometer's standard deviation adds
     to its white noise what the process noise puts into its reading at the IMU's rate (at x0: the
     robot at rest by default), the filter's measurement model seeing the applied torques only:
-    "each", axis by axis; "largest", the largest axis's on all three, the default (each axis's own
+    "each", axis by axis; "largest", the largest axis's on all three (each axis's own
     makes the filter overconfident in the tilt: that share of the reading is correlated with the
     process noise; docs/estimation.md, "Consistency").  The biases' random walks are the IMU's."""
     if accel_axes not in ACCEL_AXES:

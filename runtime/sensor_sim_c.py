@@ -69,6 +69,7 @@ class SensorRunC:
         c.bias, c.bias_stride = buf(bias), stride
         c.filter_method = METHODS[f.method]
         c.filter_process = f._process[0]
+        c.filter_hold = f.noise.torque_hold     # > 0: the IMU through sr_ekf_update_imu_held, as runtime.ekf
         c.filter_time = estimator.t
         self.readings = {}
         total = 0

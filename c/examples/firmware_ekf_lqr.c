@@ -178,8 +178,13 @@ int main(void)
             break;
         case 1:
             COUNT_FROM();
-            status = sr_ekf_update_imu_axes(&ekf, &model, v, u, EKF_TASK_BODY, EKF_TASK_MOUNT, EKF_TASK_IMU_SIGMA,
-                                            EKF_TASK_GATE_IMU);
+            /* The torque disturbance held over EKF_TASK_TORQUE_HOLD (> 0) read by the accelerometer, as the
+             * closed loop's filter reads it; 0: its share in the accelerometer's sigma. */
+            status = EKF_TASK_TORQUE_HOLD > 0
+                ? sr_ekf_update_imu_held(&ekf, &model, v, u, EKF_TASK_BODY, EKF_TASK_MOUNT, EKF_TASK_IMU_SIGMA,
+                                         &process, EKF_TASK_TORQUE_HOLD, EKF_TASK_GATE_IMU)
+                : sr_ekf_update_imu_axes(&ekf, &model, v, u, EKF_TASK_BODY, EKF_TASK_MOUNT, EKF_TASK_IMU_SIGMA,
+                                         EKF_TASK_GATE_IMU);
             COUNT_PART(2);
             break;
         case 2:

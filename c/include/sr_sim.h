@@ -20,8 +20,10 @@
  *   heading  sr_heading_measure + noise * draw, wrapped into [-pi, pi] by remainder()
  * After the step every sample that has arrived before t_k + dt reaches the filter, in the order of
  * its arrival time, then its kind (IMU, encoders, fixes, heading), then its index: the filter is
- * predicted to the arrival time under the held torques, then updated.  Tolerances of the sample
- * times: 1e-9 dt, as in the Python simulation.
+ * predicted to the arrival time under the held torques, then updated: an IMU sample through
+ * sr_ekf_update_imu_held with the hold filter_hold > 0 (dt: the disturbance as this simulation
+ * holds it, the Python closed loop's default), else through sr_ekf_update_imu_axes.  Tolerances of
+ * the sample times: 1e-9 dt, as in the Python simulation.
  *
  * Self-contained C99: no dynamic allocation, no globals; the caller owns every buffer.
  * @file
@@ -86,6 +88,9 @@ typedef struct sr_sim {
     long bias_stride;            /**< 0: constant biases; SR_NBIAS: a row per IMU sample */
     int filter_method;           /**< the filter's prediction method */
     sr_ekf_process filter_process; /**< the filter's process noise */
+    sr_real filter_hold;         /**< > 0: the filter reads the IMU through sr_ekf_update_imu_held, the torque
+                                      disturbance held that long [s] (dt: as this simulation holds it);
+                                      0: through sr_ekf_update_imu_axes (the disturbance's share in sigma) */
     sr_real filter_time;         /**< the time [s] the filter is predicted to (the caller's predictions included) */
     long *order;                 /**< NULL, or 2 x (all samples): (kind, index) of every sample in the order applied */
     long applied;                /**< samples applied so far (entries of order written) */
@@ -93,8 +98,8 @@ typedef struct sr_sim {
 
 /** Checks a run's description: SR_ERR_NULL (sim, or a buffer of a stream with n > 0, or process
  * or bias), SR_ERR_ARG (dt not > 0 or not finite, steps < 0, a negative n or cursor, a stride
- * that is neither 0 nor SR_NBIAS, an unknown method, a negative or non-finite noise, range or
- * sigma, a negative or NaN gate), or a mount's sr_check_mount status. */
+ * that is neither 0 nor SR_NBIAS, an unknown method, a negative or non-finite noise, range,
+ * sigma or filter_hold, a negative or NaN gate), or a mount's sr_check_mount status. */
 int sr_sim_check(const sr_sim *sim);
 
 /** Advances the run by steps step..step+count-1 from the plant's state x (SR_NX, overwritten with

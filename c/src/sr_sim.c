@@ -55,6 +55,7 @@ int sr_sim_check(const sr_sim *sim)
         return SR_ERR_ARG;
     if (sim->bias_stride != 0 && sim->bias_stride != SR_NBIAS) return SR_ERR_ARG;
     if (!(sim->filter_time - sim->filter_time == 0) || sim->applied < 0) return SR_ERR_ARG;
+    if (!finite_nonnegative(sim->filter_hold)) return SR_ERR_ARG;
     if (sim->steps > 0 && !sim->process) return SR_ERR_NULL;
     if (sim->stream[SR_SIM_IMU].n > 0 && !sim->bias) return SR_ERR_NULL;
     for (k = 0; k < SR_NV; ++k) {
@@ -138,7 +139,10 @@ static int apply_sample(sr_sim *sim, sr_ekf *ekf, const sr_model *model, int kin
     }
     switch (kind) {
     case SR_SIM_IMU:
-        status = sr_ekf_update_imu_axes(ekf, model, y, u, s->filter_body, s->filter_mount, s->sigma, s->gate);
+        status = sim->filter_hold > 0
+            ? sr_ekf_update_imu_held(ekf, model, y, u, s->filter_body, s->filter_mount, s->sigma, &sim->filter_process,
+                                     sim->filter_hold, s->gate)
+            : sr_ekf_update_imu_axes(ekf, model, y, u, s->filter_body, s->filter_mount, s->sigma, s->gate);
         break;
     case SR_SIM_ENCODERS:
         status = sr_ekf_update_encoders(ekf, model, y, s->sigma[0], s->gate);

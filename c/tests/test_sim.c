@@ -69,6 +69,22 @@ static void test_at_rest_every_sample_is_read_once_and_reaches_the_filter_in_ord
     CHECK_NEAR(r.sim.filter_time, (STEPS - 1) * 0.005, 1e-6);   /* the float build too */
 }
 
+/* filter_hold > 0: every IMU sample goes through sr_ekf_update_imu_held (the last one's disturbance
+ * still held when the run ends); 0: through sr_ekf_update_imu_axes (nothing held). */
+static void test_a_hold_sends_the_imu_through_the_held_update(void)
+{
+    static rig r;
+    int hold;
+    for (hold = 0; hold < 2; ++hold) {
+        make_rig(&r);
+        r.sim.filter_process.torque_psd[0] = r.sim.filter_process.torque_psd[1] = r.sim.filter_process.torque_psd[2]
+            = SR_C(0.01);
+        r.sim.filter_hold = hold ? r.sim.dt : 0;
+        CHECK_STATUS(sr_sim_advance(&r.sim, &r.m, &r.ekf, &r.m, 0, STEPS, r.x, (sr_real[SR_NU]){0, 0}, NULL), SR_OK);
+        CHECK(r.ekf.accepted[SR_EKF_IMU] == STEPS && r.ekf.held.pending == hold);
+    }
+}
+
 static void test_a_bad_description_or_step_range_is_a_status_and_nothing_moves(void)
 {
     static rig r;
@@ -83,6 +99,11 @@ static void test_a_bad_description_or_step_range_is_a_status_and_nothing_moves(v
     r.sim.bias = NULL;
     CHECK_STATUS(sr_sim_advance(&r.sim, &r.m, &r.ekf, &r.m, 0, 1, r.x, u, NULL), SR_ERR_NULL);
     r.sim.bias = r.bias;
+    r.sim.filter_hold = SR_C(-0.005);
+    CHECK_STATUS(sr_sim_advance(&r.sim, &r.m, &r.ekf, &r.m, 0, 1, r.x, u, NULL), SR_ERR_ARG);
+    r.sim.filter_hold = (sr_real)NAN;
+    CHECK_STATUS(sr_sim_advance(&r.sim, &r.m, &r.ekf, &r.m, 0, 1, r.x, u, NULL), SR_ERR_ARG);
+    r.sim.filter_hold = 0;
     r.sim.dt = 0;
     CHECK_STATUS(sr_sim_advance(&r.sim, &r.m, &r.ekf, &r.m, 0, 1, r.x, u, NULL), SR_ERR_ARG);
     CHECK(memcmp(before, r.x, sizeof before) == 0 && r.sim.stream[0].read == 0 && r.sim.applied == 0);
@@ -91,5 +112,6 @@ static void test_a_bad_description_or_step_range_is_a_status_and_nothing_moves(v
 void suite_sim(void)
 {
     RUN_TEST(test_at_rest_every_sample_is_read_once_and_reaches_the_filter_in_order);
+    RUN_TEST(test_a_hold_sends_the_imu_through_the_held_update);
     RUN_TEST(test_a_bad_description_or_step_range_is_a_status_and_nothing_moves);
 }

@@ -121,11 +121,13 @@ class SensorEkf:
     biases' spread.  `sample(kind, t, row, u)` applies one sample at time t (the filter predicted
     there under the held torques u first); `at(t, u)` -> the estimate predicted to t.
     `mismatch_psd` [N·m/√Hz]: a white torque for the plant's difference from `params`
-    (`mismatch_torque_psd`), added in quadrature to the set's process noise; 0: the set's alone."""
+    (`mismatch_torque_psd`), added in quadrature to the set's process noise; 0: the set's alone.
+    `accel_noise`: `ekf_noise`'s accelerometer rule, by default "held": the process noise a torque
+    held over `hold` s (the plant's step; None: the IMU's period) that the accelerometer reads."""
     kind = "sensors"
 
-    def __init__(self, params, sensors, x0, method="rkmk4", mismatch_psd=0.0):
-        noise = ekf_noise(sensors, params)
+    def __init__(self, params, sensors, x0, method="rkmk4", mismatch_psd=0.0, accel_noise="held", hold=None):
+        noise = ekf_noise(sensors, params, accel_axes=accel_noise, hold=hold)
         if not (isinstance(mismatch_psd, (int, float)) and np.isfinite(mismatch_psd) and mismatch_psd >= 0):
             raise ValueError(f"mismatch_psd: expected a finite number >= 0 of N m/sqrt(Hz), got {mismatch_psd!r}")
         if mismatch_psd > 0:

@@ -159,7 +159,8 @@ def ekf_header(task, estimator):
         f"#define EKF_TASK_METHOD {METHODS[f.method]}",
         f"#define EKF_TASK_BODY {BODIES[f.mount.body]}",
         *(f"#define EKF_TASK_{name.upper()} {_real(getattr(n, name))}"
-          for name in ("encoder", "position", "heading", "torque_psd", "gyro_bias_rw", "accel_bias_rw")),
+          for name in ("encoder", "position", "heading", "torque_psd", "gyro_bias_rw", "accel_bias_rw",
+                       "torque_hold")),
         *(f"#define EKF_TASK_GATE_{kind.upper()} {_real(f.gate[kind])}" for kind in ("imu", "encoders", "position",
                                                                                    "heading")),
         "",

@@ -132,7 +132,8 @@ class Task:
         """The filter on the controller's model (never the plant's): on the `[sensors]` a
         `SensorEkf`, else the `[estimator]`'s `Ekf`, else None."""
         if self.sensors is not None:
-            return SensorEkf(self.scenario.params, self.sensors, self.scenario.x0, self.scenario.method)
+            return SensorEkf(self.scenario.params, self.sensors, self.scenario.x0, self.scenario.method,
+                             hold=self.scenario.dt)
         return None if self.estimator is None else Ekf(self.scenario.params, self.estimator)
 
     def with_sensors(self, sensors):

@@ -70,7 +70,7 @@ def nees_band(dims, runs, probability=BAND):
     return (float(chi2.ppf(tail, runs * dims)) / runs, float(chi2.ppf(1 - tail, runs * dims)) / runs)
 
 
-def run_once(run, sensors, seed, duration=None, plant_mismatch=False, every=EVERY, accel_noise="largest"):
+def run_once(run, sensors, seed, duration=None, plant_mismatch=False, every=EVERY, accel_noise="held"):
     """One Monte Carlo run: the sensors `sensors` (a SensorSet, a shipped set's name or a file)
     simulated along `run` (a shipped scenario or task name, a file, or the object) with `seed`,
     the filter over the log (accelerometer rule `accel_noise`, `estimate_log`), started from the truth's
@@ -226,7 +226,7 @@ def summary(report, accuracy_table, meta):
 
 
 def run_many(run, sensors, seeds, duration=None, plant_mismatch=False, scheduler=None, workers=None,
-             progress=True, accel_noise="largest"):
+             progress=True, accel_noise="held"):
     """`run_once` for every seed: on an embedded LocalCluster of `workers` processes (scheduler
     None), a Dask scheduler's address, or in this process ("serial"); with a tqdm bar.  The
     results in the seeds' order."""
@@ -287,9 +287,10 @@ def build_parser():
     parser.add_argument("--duration", type=duration, help="simulate only this long [s]")
     parser.add_argument("--plant-mismatch", action="store_true",
                         help="the truth's robot 10 %% heavier with 20 %% less damping")
-    parser.add_argument("--accel-noise", choices=ACCEL_AXES, default="largest",
-                        help="the filter's accelerometer noise rule (runtime.sensor_sim.ekf_noise; 'held': the "
-                             "torque disturbance the accelerometer reads modelled; default 'largest')")
+    parser.add_argument("--accel-noise", choices=ACCEL_AXES, default="held",
+                        help="the filter's accelerometer noise rule (runtime.sensor_sim.ekf_noise; 'held', the "
+                             "default: the torque disturbance the accelerometer reads modelled; 'largest', "
+                             "'each': its share of the reading in the accelerometer's sigma)")
     parser.add_argument("--scheduler", help="a Dask scheduler's address, or 'serial' (default: an embedded "
                                             "LocalCluster)")
     parser.add_argument("--workers", type=whole(1), help="worker processes of the embedded cluster (default: cores)")

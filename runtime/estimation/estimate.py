@@ -10,11 +10,11 @@ torque row holds until the next), with the truth's stepping method when the log 
 (`prediction_method`, else RKMK4); samples of one time are applied IMU first, then encoders,
 fixes and heading.  A fix that arrives after the instant it measures (`t_measured` < `t`) is marked
 at that instant and applied on arrival as a delayed fix (runtime.ekf, `mark_position`).  The
-accelerometer's noise is `ekf_noise`'s rule `accel_noise`: by default ("largest") its σ includes
-what the process noise adds to the reading; "held" models the process noise as a torque held over
-each torque row's period (the simulation's step), which the accelerometer reads and the predicts
-of that period step with (the samples' noise and the process noise correlated, c/include/sr_ekf.h,
-"Held disturbance").
+accelerometer's noise is `ekf_noise`'s rule `accel_noise`: by default ("held") the process noise
+is a torque held over each torque row's period (the simulation's step), which the accelerometer
+reads and the predicts of that period step with (the samples' noise and the process noise
+correlated, c/include/sr_ekf.h, "Held disturbance"); "largest" and "each" put what the process
+noise adds to the reading into its σ instead.
 """
 import dataclasses
 import math
@@ -24,7 +24,7 @@ import numpy as np
 from ..ekf import DELAYED_SLOTS, METHODS, start_from_measurements
 from ..model import Model
 from ..sensors import heading as heading_of
-from ..sensor_sim import ekf_noise
+from ..sensor_sim import ACCEL_AXES, ekf_noise
 from ..params import Params
 from ..state import (COLUMN_INDEX, IDX_Q, IDX_RP, IDX_RS, IDX_RY, IDX_WS, NX, STATE_COLUMNS,
                      pendulum_angle, yoke_angle)
@@ -98,7 +98,7 @@ def prediction_method(log):
 
 
 def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progress=None, covariance_every=None,
-                 accel_noise="largest"):
+                 accel_noise="held"):
     """Run the filter over `log` (runtime.estimation.logs.Log) for the robot `params` (None: the one
     the log claims, else the paper's simulation robot), started by the start rule (the first
     START_SAMPLES accelerometer samples, the first encoder sample, the first fix and heading if the
@@ -106,7 +106,7 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
     already moving at the start (`moving_at_start`) starts with speeds of σ MOVING_RATE_SIGMA
     instead of at rest.  `progress(done, total)` is called every 1000 times.  `covariance_every` = k
     (a whole number >= 1) keeps the whole covariance at every k-th row (`Estimate.P`).  `accel_noise`:
-    `ekf_noise`'s accelerometer rule ("largest", "each", "held") when `noise` is None."""
+    `ekf_noise`'s accelerometer rule ("held", the default, "largest", "each") when `noise` is None."""
     if covariance_every is not None and (isinstance(covariance_every, bool) or not isinstance(
             covariance_every, (int, np.integer)) or covariance_every < 1):
         raise ValueError(f"covariance_every: expected a whole number >= 1, got {covariance_every!r}")
@@ -296,6 +296,10 @@ def build_parser():
     parser.add_argument("--sensors", metavar="FILE", help="a sensors file or shipped set (default: the log's)")
     parser.add_argument("--heading", type=degrees, metavar="DEG",
                         help="the IMU's heading at the start, known to 10 deg (default: the log's, else 0)")
+    parser.add_argument("--accel-noise", choices=ACCEL_AXES, default="held",
+                        help="the filter's accelerometer noise rule (runtime.sensor_sim.ekf_noise; 'held', the "
+                             "default: the torque disturbance the accelerometer reads modelled; 'largest', "
+                             "'each': its share of the reading in the accelerometer's sigma)")
     parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
     return parser
 
@@ -316,7 +320,8 @@ def main(argv):
         sensors = load_sensor_set(args.sensors) if args.sensors else None
         log = read_log(args.log, sensors=sensors)
         try:
-            result = estimate_log(log, heading=None if args.heading is None else math.radians(args.heading))
+            result = estimate_log(log, heading=None if args.heading is None else math.radians(args.heading),
+                                  accel_noise=args.accel_noise)
         except KernelError as exc:
             raise ValueError(f"{args.log}: the filter failed: {exc}") from None
         metrics = errors(log, result)
@@ -326,7 +331,8 @@ def main(argv):
             np.savetxt(path, rows, delimiter=",", header=",".join(header), comments="", fmt="%.17g")
         with atomic_path(args.out / "estimate.png") as path:
             figure(log, result, path)
-        summary = {"log": str(args.log), "samples": int(len(result.t)), "counters": result.counters,
+        summary = {"log": str(args.log), "accel_noise": args.accel_noise, "samples": int(len(result.t)),
+                   "counters": result.counters,
                    "skipped": log.skipped, "gaps": len(log.gaps), "errors": metrics}
         write_text(args.out / "summary.json", json.dumps(summary, indent=2) + "\n")
     except ValueError as exc:

@@ -401,7 +401,7 @@ def run_one(spec, inputs):
     x0[IDX_Q.start:IDX_Q.start + 2] += [inputs["dx0_m"], inputs["dy0_m"]]
     x0[IDX_RS] = (rot_z(float(inputs["dpsi0_rad"])) @ x0[IDX_RS].reshape(3, 3)).ravel()
     s = task.scenario
-    estimator = SensorEkf(s.params, task.sensors, x0, s.method, mismatch_psd=mismatch_psd(spec, task))
+    estimator = SensorEkf(s.params, task.sensors, x0, s.method, mismatch_psd=mismatch_psd(spec, task), hold=s.dt)
     controller = task.controller()
     try:
         result = simulate_on_sensors(plant, controller, reference, x0, task.duration, s.dt, estimator,

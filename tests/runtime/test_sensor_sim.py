@@ -26,10 +26,18 @@ def test_each_accelerometer_axis_may_carry_its_own_share_of_the_process_noise(pa
     assert sx > 1.2 * white and sy > 2 * sx
 
 
-def test_by_default_every_accelerometer_axis_carries_the_largest_share(params):
+def test_largest_gives_every_accelerometer_axis_the_largest_share(params):
     sensors = SensorSet.default()
     largest = max(ekf_noise(sensors, params, accel_axes="each").accel)
-    assert ekf_noise(sensors, params).accel == (largest,) * 3
+    assert ekf_noise(sensors, params, accel_axes="largest").accel == (largest,) * 3
+    assert ekf_noise(sensors, params, accel_axes="largest").torque_hold == 0
+
+
+def test_by_default_the_filter_models_the_held_disturbance_with_the_white_noise_alone(params):
+    sensors = SensorSet.default()
+    noise = ekf_noise(sensors, params)
+    assert noise.torque_hold == 1 / sensors.imu.rate
+    assert noise.accel == (sensors.imu.accel_noise,) * 3
 
 
 def test_an_unknown_accel_axes_rule_is_a_value_error_naming_it(params):

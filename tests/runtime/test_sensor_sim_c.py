@@ -25,13 +25,17 @@ def _sensors():
                                heading=HeadingSpec(rate=50.0, noise=0.05))
 
 
-def _run(engine, duration=0.3, seed=3):
+def _run(engine, duration=0.3, seed=3, held=True):
+    """`held` False: the filter's IMU updates leave the held disturbance out (sr_ekf_update_imu_axes,
+    the same sigma), on this engine only."""
     task = _task("circle", "lqr", "default").with_sensors(_sensors())
     s = task.scenario
     plant = s.params.with_changes(m_P=s.params.paper_params.m_P * 1.1)
     x0 = s.x0.copy()
     x0[-5:] += [0.02, -0.01, 0.03, 0.0, 0.01]        # moving at the start: the rates enter the readings
-    estimator = SensorEkf(s.params, task.sensors, x0, s.method)
+    estimator = SensorEkf(s.params, task.sensors, x0, s.method, hold=s.dt)   # two IMU samples a hold
+    if not held:
+        estimator.filter.noise = dataclasses.replace(estimator.filter.noise, torque_hold=0.0)
     return simulate_on_sensors(plant, task.controller(), task.reference(), x0, duration, s.dt, estimator,
                                task.sensors, s.method, seed, engine=engine)
 
@@ -57,6 +61,26 @@ def test_the_c_loop_reads_every_sensor_as_the_python_simulation_does(runs):
     kinds = {kind for _, kind, _ in python.samples}
     assert kinds == {"tick", "imu", "encoders", "fixes", "heading"}
     assert_same_run(python, c)
+
+
+def test_the_loops_filter_reads_the_imu_through_the_held_disturbance(runs):
+    python, _ = runs
+    task = _task("circle", "lqr", "default").with_sensors(_sensors())
+    estimator = SensorEkf(task.scenario.params, task.sensors, task.scenario.x0, task.scenario.method,
+                          hold=task.scenario.dt)
+    assert estimator.filter.noise.torque_hold == task.scenario.dt
+    assert estimator.filter.noise.accel == (task.sensors.imu.accel_noise,) * 3    # the white noise alone
+
+
+@pytest.mark.parametrize("engine", ["python", "c"])
+def test_either_engine_leaving_the_held_disturbance_out_is_told_apart(runs, engine):
+    python, c = runs
+    held = c if engine == "python" else python
+    other = _run(engine, held=False)
+    with pytest.raises(AssertionError):
+        assert_same_run(held, other)
+    # The first controller period's readings are the same: the filter's update alone moves the estimate.
+    assert not np.allclose(other.estimates[1], held.estimates[1], rtol=RTOL, atol=RTOL * 1e-3)
 
 
 def test_one_reading_off_by_a_part_in_a_billion_is_told_apart(runs):

@@ -12,6 +12,7 @@
 #define EKF_TASK_TORQUE_PSD SR_C(0.01)
 #define EKF_TASK_GYRO_BIAS_RW SR_C(1e-05)
 #define EKF_TASK_ACCEL_BIAS_RW SR_C(0.0001)
+#define EKF_TASK_TORQUE_HOLD SR_C(0.005)
 #define EKF_TASK_GATE_IMU SR_C(22.457744484825323)
 #define EKF_TASK_GATE_ENCODERS SR_C(13.815510557964274)
 #define EKF_TASK_GATE_POSITION SR_C(13.815510557964274)
@@ -24,7 +25,7 @@ static const sr_real EKF_TASK_MOUNT[SR_NMOUNT] = {
 
 /* The IMU's standard deviation per reading (gyroscope x, y, z, accelerometer x, y, z). */
 static const sr_real EKF_TASK_IMU_SIGMA[SR_NIMU] = {
-        SR_C(0.003), SR_C(0.003), SR_C(0.003), SR_C(0.08126173015912774), SR_C(0.08126173015912774), SR_C(0.08126173015912774)};
+        SR_C(0.003), SR_C(0.003), SR_C(0.003), SR_C(0.02), SR_C(0.02), SR_C(0.02)};
 
 /* The recovery policy per sensor kind (sr_ekf_set_recovery; 0: off). */
 static const long EKF_TASK_RECOVER_AFTER[SR_EKF_NKINDS] = {10, 10, 4, 4};

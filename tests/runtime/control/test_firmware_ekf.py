@@ -57,6 +57,19 @@ def test_the_bit_for_bit_check_fails_for_one_imu_reading_changed_in_its_last_dig
     assert not same_run(run_firmware(exe, "".join(lines)), result, per)
 
 
+def test_the_firmware_reads_the_imu_through_the_held_disturbance_as_the_closed_loop(runs, tmp_path):
+    exe, events, result, per = runs
+    header = (exe.parent.parent / "ekf_task.h").read_text()
+    hold = next(line for line in header.splitlines() if line.startswith("#define EKF_TASK_TORQUE_HOLD "))
+    assert float(hold.split("SR_C(")[1].rstrip(")")) == 0.005      # the task's plant step
+    shutil.copy(exe.parent.parent / "lqr_task.h", tmp_path)
+    (tmp_path / "ekf_task.h").write_text(header.replace(hold, "#define EKF_TASK_TORQUE_HOLD SR_C(0.0)"))
+    other = tmp_path / "build" / "firmware_ekf_lqr"
+    subprocess.run([MAKE, "-s", "-C", str(C_DIR), f"BUILD={tmp_path / 'build'}", f"CPPFLAGS=-I{tmp_path}",
+                    str(other)], check=True, capture_output=True, text=True)
+    assert not same_run(run_firmware(other, events), result, per)      # sr_ekf_update_imu_axes instead
+
+
 def test_the_firmware_refuses_a_line_that_is_not_an_event(runs):
     exe = runs[0]
     done = subprocess.run([str(exe)], input="0 0.0\n7 0.1\n", capture_output=True, text=True)

@@ -40,7 +40,7 @@ def _run(engine, duration=0.3, seed=3, controller=None):
     x0[IDX_Q.start] += 0.04                          # off the path: a cross-track error to integrate
     x0[-5:] += [0.02, -0.01, 0.03, 0.0, 0.01]
     controller = controller or Lqr(s.params, task.rate, U_MAX, task.controllers[0].gains)
-    estimator = SensorEkf(s.params, task.sensors, x0, s.method)
+    estimator = SensorEkf(s.params, task.sensors, x0, s.method, hold=s.dt)
     return simulate_on_sensors(plant, controller, _winding_path(s.x0, 0.3), x0, duration, s.dt, estimator,
                                task.sensors, s.method, seed, engine=engine), controller
 
@@ -143,6 +143,6 @@ def test_the_c_nmpcs_loop_with_the_targets_read_in_c_equals_the_python_loop():
 
     def run(engine):
         return simulate_on_sensors(s.params, task.controller(), task.reference(), x0, 0.3, s.dt,
-                                   SensorEkf(s.params, task.sensors, x0, s.method), task.sensors, s.method, 5,
+                                   SensorEkf(s.params, task.sensors, x0, s.method, hold=s.dt), task.sensors, s.method, 5,
                                    engine=engine)
     assert_same_run(run("python"), run("c"))
