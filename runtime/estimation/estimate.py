@@ -98,7 +98,7 @@ def prediction_method(log):
 
 
 def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progress=None, covariance_every=None,
-                 accel_noise="largest"):
+                 accel_noise="largest", constrained=False):
     """Run the filter over `log` (runtime.estimation.logs.Log) for the robot `params` (None: the one
     the log claims, else the paper's simulation robot), started by the start rule (the first
     START_SAMPLES accelerometer samples, the first encoder sample, the first fix and heading if the
@@ -106,7 +106,8 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
     already moving at the start (`moving_at_start`) starts with speeds of σ MOVING_RATE_SIGMA
     instead of at rest.  `progress(done, total)` is called every 1000 times.  `covariance_every` = k
     (a whole number >= 1) keeps the whole covariance at every k-th row (`Estimate.P`).  `accel_noise`:
-    `ekf_noise`'s accelerometer rule ("largest", "each", "held") when `noise` is None."""
+    `ekf_noise`'s accelerometer rule ("largest", "each", "held") when `noise` is None.  `constrained`:
+    the filter's observability constraint (`Ekf`'s; docs/estimation.md, "Observability constraint")."""
     if covariance_every is not None and (isinstance(covariance_every, bool) or not isinstance(
             covariance_every, (int, np.integer)) or covariance_every < 1):
         raise ValueError(f"covariance_every: expected a whole number >= 1, got {covariance_every!r}")
@@ -127,7 +128,7 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
     ekf = start_from_measurements(model, noise=noise, mount=sensors.imu.mount, gate=gate,
                                   heading_prior=start_heading(log) if heading is None else heading,
                                   rate_sigma=MOVING_RATE_SIGMA if moving_at_start(log) else 0.01,
-                                  method=prediction_method(log), **start)
+                                  method=prediction_method(log), constrained=constrained, **start)
     late = []                                   # (t_measured, index) of the fixes that arrive late
     if log.fixes is not None and len(log.fixes):
         measured = log.fixes["t_measured"]
