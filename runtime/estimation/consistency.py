@@ -35,6 +35,8 @@ UNOBSERVABLE = ("heading", "q_x", "q_y")
 START_HEADING_SIGMA = math.radians(10.0)
 #: Compared every this many filter rows (20 rows of 5 ms: every 0.1 s).
 EVERY = 20
+#: `--constrained`: the filter's observability constraint (None: on without fixes and heading).
+CONSTRAINED = {"auto": None, "on": True, "off": False}
 #: The targets: the share of samples whose average NEES lies in its band, of errors within ±3σ.
 NEES_TARGET, WITHIN_TARGET, BAND = 0.90, 0.99, 0.95
 
@@ -71,11 +73,11 @@ def nees_band(dims, runs, probability=BAND):
 
 
 def run_once(run, sensors, seed, duration=None, plant_mismatch=False, every=EVERY, accel_noise="largest",
-             constrained=False):
+             constrained=None):
     """One Monte Carlo run: the sensors `sensors` (a SensorSet, a shipped set's name or a file)
     simulated along `run` (a shipped scenario or task name, a file, or the object) with `seed`,
-    the filter over the log (accelerometer rule `accel_noise`, observability constraint `constrained`,
-    `estimate_log`), started from the truth's
+    the filter over the log (accelerometer rule `accel_noise`, observability constraint `constrained`
+    (None: `estimate_log`'s rule), `estimate_log`), started from the truth's
     heading off by a seeded N(0, 10°) draw.  Returns {"seed", "t" (m,), "e" (m, 18), "P" (m, 18, 18) (COMPONENTS,
     from SETTLE_S on), "metrics" (`errors`), "counters", "fixes" (whether the set has fixes or a
     heading)}."""
@@ -229,7 +231,7 @@ def summary(report, accuracy_table, meta):
 
 
 def run_many(run, sensors, seeds, duration=None, plant_mismatch=False, scheduler=None, workers=None,
-             progress=True, accel_noise="largest", constrained=False):
+             progress=True, accel_noise="largest", constrained=None):
     """`run_once` for every seed: on an embedded LocalCluster of `workers` processes (scheduler
     None), a Dask scheduler's address, or in this process ("serial"); with a tqdm bar.  The
     results in the seeds' order."""
@@ -294,9 +296,10 @@ def build_parser():
     parser.add_argument("--accel-noise", choices=ACCEL_AXES, default="largest",
                         help="the filter's accelerometer noise rule (runtime.sensor_sim.ekf_noise; 'held': the "
                              "torque disturbance the accelerometer reads modelled; default 'largest')")
-    parser.add_argument("--constrained", action="store_true",
+    parser.add_argument("--constrained", choices=CONSTRAINED, default="auto",
                         help="the filter's observability constraint (OC-EKF: heading and position kept "
-                             "unobservable by the IMU and the encoders; docs/estimation.md)")
+                             "unobservable by the IMU and the encoders; docs/estimation.md); default 'auto': on "
+                             "when the sensor set has neither fixes nor a heading")
     parser.add_argument("--scheduler", help="a Dask scheduler's address, or 'serial' (default: an embedded "
                                             "LocalCluster)")
     parser.add_argument("--workers", type=whole(1), help="worker processes of the embedded cluster (default: cores)")
@@ -333,7 +336,7 @@ def main(argv):
         try:
             runs = run_many(args.run, sensors, seeds, args.duration, args.plant_mismatch, args.scheduler,
                             args.workers, progress=not args.quiet, accel_noise=args.accel_noise,
-                            constrained=args.constrained)
+                            constrained=CONSTRAINED[args.constrained])
         except KernelError as exc:
             raise ValueError(f"{args.run}: a run failed: {exc}") from None
         report = consistency(runs)

@@ -98,7 +98,7 @@ def prediction_method(log):
 
 
 def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progress=None, covariance_every=None,
-                 accel_noise="largest", constrained=False):
+                 accel_noise="largest", constrained=None):
     """Run the filter over `log` (runtime.estimation.logs.Log) for the robot `params` (None: the one
     the log claims, else the paper's simulation robot), started by the start rule (the first
     START_SAMPLES accelerometer samples, the first encoder sample, the first fix and heading if the
@@ -107,7 +107,11 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
     instead of at rest.  `progress(done, total)` is called every 1000 times.  `covariance_every` = k
     (a whole number >= 1) keeps the whole covariance at every k-th row (`Estimate.P`).  `accel_noise`:
     `ekf_noise`'s accelerometer rule ("largest", "each", "held") when `noise` is None.  `constrained`:
-    the filter's observability constraint (`Ekf`'s; docs/estimation.md, "Observability constraint")."""
+    the filter's observability constraint (`Ekf`'s; docs/estimation.md, "Observability constraint"),
+    None: on when the log has neither fixes nor a heading (nothing that sees the heading and the
+    position), off otherwise."""
+    if constrained is not None and not isinstance(constrained, bool):
+        raise ValueError(f"constrained: expected True, False or None (on without fixes and heading), got {constrained!r}")
     if covariance_every is not None and (isinstance(covariance_every, bool) or not isinstance(
             covariance_every, (int, np.integer)) or covariance_every < 1):
         raise ValueError(f"covariance_every: expected a whole number >= 1, got {covariance_every!r}")
@@ -119,6 +123,8 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
         noise = ekf_noise(sensors, params, accel_axes=accel_noise, hold=hold)
     events = [(log.imu, "imu"), (log.encoders, "encoders"), (log.fixes, "fixes"), (log.heading, "heading")]
     events = [(table, kind) for table, kind in events if table is not None and len(table)]
+    if constrained is None:
+        constrained = not any(kind in ("fixes", "heading") for _, kind in events)
     start = {"accel": log.imu.select("accel_x", "accel_y", "accel_z")[:START_SAMPLES],
              "encoders": log.encoders.data[0]}
     if log.fixes is not None and len(log.fixes):
