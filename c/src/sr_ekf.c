@@ -288,14 +288,14 @@ static int unobservable(const sr_model *model, const sr_real x[SR_NX], sr_real N
     return c + 2;
 }
 
-/* D = -(A N - B) (N^T N)^-1 N^T (rows x NE, stride NE) for the first NE columns of `rows` rows of A
- * (stride `stride`), B rows x 3 (NULL: zero): A + D is the nearest matrix with (A + D) N = B.
+/* d = (A N - B) (N^T N)^-1 (rows x 3, stride 3) for the first NE columns of `rows` rows of A (stride
+ * `stride`), B rows x 3 (NULL: zero): A - d N^T is the nearest matrix to A with (A - d N^T) N = B.
  * N^T N is positive definite: its translations are unit vectors, its turn has a unit attitude part
  * (moved by resets, near unit). */
-static void constraint_correction(int rows, int stride, const sr_real *A, const sr_real *N, int cols,
-                                  const sr_real *B, sr_real *D)
+static void constraint_weights(int rows, int stride, const sr_real *A, const sr_real *N, int cols, const sr_real *B,
+                               sr_real *d)
 {
-    sr_real G[9], L[9], d[3];
+    sr_real G[9], L[9];
     int a, b, i, k;
     for (a = 0; a < cols; ++a)
         for (b = 0; b < cols; ++b) {
@@ -306,65 +306,76 @@ static void constraint_correction(int rows, int stride, const sr_real *A, const 
     (void)cholesky(cols, G, L);
     for (i = 0; i < rows; ++i) {
         const sr_real *row = A + stride * i;
+        sr_real *di = d + 3 * i;
         for (a = 0; a < cols; ++a) {
             sr_real s = B ? -B[3 * i + a] : 0;
             for (k = 0; k < NE; ++k) s += row[k] * N[3 * k + a];
-            d[a] = s;
+            di[a] = s;
         }
-        solve_both(cols, L, d);
-        for (k = 0; k < NE; ++k) {
-            sr_real s = 0;
-            for (a = 0; a < cols; ++a) s += d[a] * N[3 * k + a];
-            D[NE * i + k] = -s;
-        }
+        solve_both(cols, L, di);
     }
 }
 
 /* H <- H* = H - H N_k (N_k^T N_k)^-1 N_k^T for an IMU or encoder sample of m rows (stride NB). */
 static void constrain_sample(const sr_ekf *ekf, int m, sr_real *H)
 {
-    sr_real D[MAXM * NE];
-    int i, k;
-    constraint_correction(m, NB, H, ekf->null_space, ekf->null_cols, NULL, D);
+    sr_real d[MAXM * 3];
+    int a, i, k;
+    constraint_weights(m, NB, H, ekf->null_space, ekf->null_cols, NULL, d);
     for (i = 0; i < m; ++i)
-        for (k = 0; k < NE; ++k) H[NB * i + k] += D[NE * i + k];
+        for (k = 0; k < NE; ++k)
+            for (a = 0; a < ekf->null_cols; ++a) H[NB * i + k] -= d[3 * i + a] * ekf->null_space[3 * k + a];
 }
 
 /* The predict's transition with the constraint: Nn = N(xn), F <- F* = F + dF with F* N_k = Nn, and
  * Pn += Phi* P Phi*^T - Phi P Phi^T = dPhi P Phi*^T + Phi P dPhi^T (Phi = diag(F, I), dPhi = diag(dF, 0),
- * P the prior), added to the sparse product's Pn: U = dF P (NE x NB), V = F P_dd. */
+ * P the prior), added to the sparse product's Pn.  dF = -d N^T has rank <= 3, so with W = N^T P
+ * (3 x NB): dF P = -d W, dF P_dd F*^T = -d X (X = W_dd F*^T), F P_dd dF^T = -Y d^T (Y = F W_dd^T),
+ * about 2700 products. */
 static void constrain_predict(const sr_model *model, const sr_ekf *ekf, const sr_real xn[SR_NX], sr_real F[NE * NE],
                               sr_real Pn[NB * NB], sr_real Nn[NE * 3])
 {
-    sr_real dF[NE * NE], U[NE * NB], V[NE * NE];
-    int i, j, k;
+    sr_real d[NE * 3] = {0}, W[3 * NB], X[3 * NE], Y[NE * 3];
+    const sr_real *N = ekf->null_space;
+    int a, i, j, k;
     (void)unobservable(model, xn, Nn);
-    constraint_correction(NE, NE, F, ekf->null_space, ekf->null_cols, Nn, dF);
-    for (i = 0; i < NE; ++i) {
+    /* three columns throughout (a third left zero on a slope, in N and in d): loops of a fixed length */
+    constraint_weights(NE, NE, F, N, ekf->null_cols, Nn, d);
+    for (a = 0; a < 3; ++a)
         for (j = 0; j < NB; ++j) {
             sr_real s = 0;
-            for (k = 0; k < NE; ++k) s += dF[NE * i + k] * ekf->P[NB * k + j];
-            U[NB * i + j] = s;
+            for (k = 0; k < NE; ++k) s += N[3 * k + a] * ekf->P[NB * k + j];
+            W[NB * a + j] = s;
         }
+    for (i = 0; i < NE; ++i)   /* Y = F W_dd^T with the F of the sparse product */
+        for (a = 0; a < 3; ++a) {
+            sr_real s = 0;
+            for (k = 0; k < NE; ++k) s += F[NE * i + k] * W[NB * a + k];
+            Y[3 * i + a] = s;
+        }
+    for (i = 0; i < NE; ++i)   /* F <- F* */
+        for (k = 0; k < NE; ++k)
+            for (a = 0; a < 3; ++a) F[NE * i + k] -= d[3 * i + a] * N[3 * k + a];
+    for (a = 0; a < 3; ++a)
         for (j = 0; j < NE; ++j) {
             sr_real s = 0;
-            for (k = 0; k < NE; ++k) s += F[NE * i + k] * ekf->P[NB * k + j];
-            V[NE * i + j] = s;
+            for (k = 0; k < NE; ++k) s += W[NB * a + k] * F[NE * j + k];
+            X[NE * a + j] = s;
         }
-    }
     for (i = 0; i < NE; ++i) {
         for (j = 0; j <= i; ++j) {
             sr_real s = 0;
-            for (k = 0; k < NE; ++k) s += U[NB * i + k] * (F[NE * j + k] + dF[NE * j + k]) + V[NE * i + k] * dF[NE * j + k];
-            Pn[NB * i + j] += s;
+            for (a = 0; a < 3; ++a) s += d[3 * i + a] * X[NE * a + j] + Y[3 * i + a] * d[3 * j + a];
+            Pn[NB * i + j] -= s;
             if (j < i) Pn[NB * j + i] = Pn[NB * i + j];
         }
         for (j = NE; j < NB; ++j) {
-            Pn[NB * i + j] += U[NB * i + j];
+            sr_real s = 0;
+            for (a = 0; a < 3; ++a) s += d[3 * i + a] * W[NB * a + j];
+            Pn[NB * i + j] -= s;
             Pn[NB * j + i] = Pn[NB * i + j];
         }
     }
-    for (i = 0; i < NE * NE; ++i) F[i] += dF[i];
 }
 
 /* N <- G N after an applied sample's reset (G = Jr on the attitude's rows). */
