@@ -122,10 +122,12 @@ class Ekf:
     of the chi-square gate of every update (1: no gate); `recover_after`: the recovery policy, per
     kind ({"position": 4, ...}) the number of samples refused in a row after which the next refused
     one is admitted with the prior and its noise inflated (docs/estimation.md, "Recovery"); None:
-    RECOVER_AFTER, {}: off."""
+    RECOVER_AFTER, {}: off.  `constrained`: the observability constraint (OC-EKF: the predict's F
+    and the IMU's and encoders' H projected so that the heading and the position the sensors cannot
+    see stay unseen; c/include/sr_ekf.h, docs/estimation.md "Observability constraint")."""
 
     def __init__(self, model, x0, *, P0=None, sigma=None, biases=None, noise=None, mount=None, heading_mount=None,
-                 method="rkmk4", gate=0.999, recover_after=None):
+                 method="rkmk4", gate=0.999, recover_after=None, constrained=False):
         if not isinstance(model, Model):
             raise ValueError(f"model: expected a runtime.Model, got {type(model).__name__}")
         self.model = model
@@ -162,6 +164,10 @@ class Ekf:
         self.recover_after = _recovery(RECOVER_AFTER if recover_after is None else recover_after)
         for kind, after in self.recover_after.items():
             _check(lib.sr_ekf_set_recovery(self._ekf, KINDS.index(kind), after), "recover_after")
+        if not isinstance(constrained, bool):
+            raise ValueError(f"constrained: expected True or False, got {constrained!r}")
+        self.constrained = constrained
+        _check(lib.sr_ekf_set_observability_constraint(self._ekf, model._model, int(constrained)), "x0")
         n = self.noise
         self._process = ffi.new("sr_ekf_process *")
         self._process.torque_psd = [n.torque_psd] * 3

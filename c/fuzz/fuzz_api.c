@@ -661,6 +661,12 @@ static void fuzz_ekf(reader *r, const sr_model *model, const sr_real x[SR_NX], c
     check_ekf("sr_ekf_init", status, &ekf, &before);
     EXPECT_STATUS("sr_ekf_init(NULL)", sr_ekf_init(NULL, model, x, bias, P0), SR_ERR_NULL);
     if (status != SR_OK) return;
+    /* the observability constraint on half the time, an invalid switch (2) now and then */
+    k = (int)(read_u8(r) % 4);
+    memcpy(&before, &ekf, sizeof ekf);
+    status = sr_ekf_set_observability_constraint(&ekf, model, k == 3 ? 2 : k % 2);
+    EXPECT_STATUS("sr_ekf_set_observability_constraint", status, SR_OK, SR_ERR_ARG);
+    check_ekf("sr_ekf_set_observability_constraint", status, &ekf, &before);
 
     for (k = 0; k < 3; ++k) {
         const unsigned what = read_u8(r);

@@ -79,6 +79,27 @@
  * period ends.  A gated sample leaves everything as it was.  In a linear filter this is the exact
  * filter of the augmented state (e, a), with a revised by the IMU samples only.
  *
+ * Observability constraint (off unless sr_ekf_set_observability_constraint turns it on; the OC-EKF
+ * of Huang, Mourikis and Roumeliotis).  Without position fixes or a heading sensor, the IMU and the
+ * encoders cannot tell where the robot stands nor, on a level floor, which way it faces: every
+ * reading and the step are the same after the whole robot is turned about the floor's normal or
+ * moved along the floor.  In the error coordinates at x those motions are the columns of
+ *   N(x) = [n_yaw, n_x, n_y],  n_yaw = (R_S^T e_z, 0, 0, -q_y, q_x, 0...),  n_x = e_{q_x},  n_y = e_{q_y}
+ * (R_S Exp(a R_S^T e_z) = Rz(a) R_S; the joint angles, the body rates and the biases do not move;
+ * on a slope, gravity fixes the heading and N is (n_x, n_y)).  At any x, H(x) N(x) = 0 for the IMU
+ * and the encoders and F(x) N(x) = N(step(x)), but the filter takes F at the updated estimate and
+ * H at the predicted one, so the directions it cannot see change between the two and the updates
+ * feed it heading information the sensors do not hold (its sigma shrinks while its error does
+ * not).  With the constraint, the filter carries N_k, the directions at the last predicted state
+ * moved by every reset since (N <- G N), and
+ *   F* = F - (F N_k - N_k+1) (N_k^T N_k)^-1 N_k^T,  N_k+1 = N(the predicted state),
+ *   H* = H - H N_k (N_k^T N_k)^-1 N_k^T  for the IMU's and the encoders' samples,
+ * the nearest matrices (Frobenius) with F* N_k = N_k+1 and H* N_k = 0: the information along N
+ * (N^T P^-1 N) is then left as it is by those updates and only lowered by the process noise.
+ * Position fixes and the heading sensor keep their H.  The predict adds F* P F*^T - F P F^T to the
+ * sparse product (F* - F has rank 3: about 2700 products more), and the held disturbance and the
+ * waiting fixes step with F*.  Turned off, none of it runs: the filter's arithmetic is unchanged.
+ *
  * Checks, in the library's order (docs/robustness.md): the model (SR_ERR_NULL, SR_ERR_MODEL), the
  * other pointers (SR_ERR_NULL), the arguments (SR_ERR_ARG: method, dt, a standard deviation or a
  * noise density not finite and > 0 (>= 0 for the process noise), gate not > 0 or NaN, body; the
@@ -110,6 +131,7 @@ extern "C" {
 #define sr_ekf_update_position_delayed sr_ekf_update_position_delayed_f
 #define sr_ekf_set_recovery sr_ekf_set_recovery_f
 #define sr_ekf_update_imu_held sr_ekf_update_imu_held_f
+#define sr_ekf_set_observability_constraint sr_ekf_set_observability_constraint_f
 #endif
 
 #ifndef SR_EKF_NDELAYED
@@ -159,6 +181,9 @@ typedef struct sr_ekf {
     long recover_after[SR_EKF_NKINDS]; /**< the recovery policy per kind: 0 off (the start), else n of sr_ekf_set_recovery */
     sr_ekf_delayed delayed[SR_EKF_NDELAYED]; /**< the delayed fixes waiting, by slot */
     sr_ekf_held held;                 /**< the disturbance read by sr_ekf_update_imu_held, until its period ends */
+    int constrained;                  /**< 1: observability-constrained (sr_ekf_set_observability_constraint), 0: off (the start) */
+    int null_cols;                    /**< the columns of null_space: 3 on a level floor, 2 on a slope */
+    sr_real null_space[SR_NE * 3];    /**< N, the unobservable directions in the current error coordinates (SR_NE x 3 row-major) */
 } sr_ekf;
 
 /** The process noise of sr_ekf_predict (all >= 0 and finite). */
@@ -244,6 +269,12 @@ int sr_ekf_update_heading(sr_ekf *ekf, const sr_model *model, sr_real y, int bod
  * prior and its noise inflated (see the file's description); n = 0 turns it off (the default after
  * sr_ekf_init), n < 0 is SR_ERR_ARG.  The counters stay as they are. */
 int sr_ekf_set_recovery(sr_ekf *ekf, int kind, long n);
+
+/** The observability constraint (see the file's description): on = 1 turns it on, with N = N(x) at
+ * the filter's estimate (its third column only on a level floor, model's slope 0), on = 0 turns
+ * it off (the default after sr_ekf_init); any other on is SR_ERR_ARG.  Checks the model, the
+ * pointers and the filter's data as the updates do; the counters stay as they are. */
+int sr_ekf_set_observability_constraint(sr_ekf *ekf, const sr_model *model, int on);
 
 #ifdef __cplusplus
 }

@@ -269,10 +269,146 @@ static int step_and_transition(const sr_model *model, int method, const sr_real 
     return status;
 }
 
+/* ---- The observability constraint (sr_ekf.h, "Observability constraint"): off, none of it runs. */
+
+/* N(x) (NE x 3 row-major; the columns beyond the count returned are zero): the turn about the
+ * floor's normal (on a level floor only), then the moves along the floor's x and y. */
+static int unobservable(const sr_model *model, const sr_real x[SR_NX], sr_real N[NE * 3])
+{
+    int i, c = 0;
+    memset(N, 0, NE * 3 * sizeof(sr_real));
+    if (model->p[SR_P_slope] == 0) {
+        for (i = 0; i < 3; ++i) N[3 * (SR_E_xi_S + i)] = x[SR_X_R_S + 6 + i];   /* R_S^T e_z: R_S's third row */
+        N[3 * SR_E_q] = -x[SR_X_q + 1];
+        N[3 * (SR_E_q + 1)] = x[SR_X_q];
+        c = 1;
+    }
+    N[3 * SR_E_q + c] = 1;
+    N[3 * (SR_E_q + 1) + c + 1] = 1;
+    return c + 2;
+}
+
+/* d = (A N - B) (N^T N)^-1 (rows x 3, stride 3) for the first NE columns of `rows` rows of A (stride
+ * `stride`), B rows x 3 (NULL: zero): A - d N^T is the nearest matrix to A with (A - d N^T) N = B.
+ * N^T N is positive definite: its translations are unit vectors, its turn has a unit attitude part
+ * (moved by resets, near unit). */
+static void constraint_weights(int rows, int stride, const sr_real *A, const sr_real *N, int cols, const sr_real *B,
+                               sr_real *d)
+{
+    sr_real G[9], L[9];
+    int a, b, i, k;
+    for (a = 0; a < cols; ++a)
+        for (b = 0; b < cols; ++b) {
+            sr_real s = 0;
+            for (k = 0; k < NE; ++k) s += N[3 * k + a] * N[3 * k + b];
+            G[cols * a + b] = s;
+        }
+    (void)cholesky(cols, G, L);
+    for (i = 0; i < rows; ++i) {
+        const sr_real *row = A + stride * i;
+        sr_real *di = d + 3 * i;
+        for (a = 0; a < cols; ++a) {
+            sr_real s = B ? -B[3 * i + a] : 0;
+            for (k = 0; k < NE; ++k) s += row[k] * N[3 * k + a];
+            di[a] = s;
+        }
+        solve_both(cols, L, di);
+    }
+}
+
+/* H <- H* = H - H N_k (N_k^T N_k)^-1 N_k^T for an IMU or encoder sample of m rows (stride NB). */
+static void constrain_sample(const sr_ekf *ekf, int m, sr_real *H)
+{
+    sr_real d[MAXM * 3];
+    int a, i, k;
+    constraint_weights(m, NB, H, ekf->null_space, ekf->null_cols, NULL, d);
+    for (i = 0; i < m; ++i)
+        for (k = 0; k < NE; ++k)
+            for (a = 0; a < ekf->null_cols; ++a) H[NB * i + k] -= d[3 * i + a] * ekf->null_space[3 * k + a];
+}
+
+/* The predict's transition with the constraint: Nn = N(xn), F <- F* = F + dF with F* N_k = Nn, and
+ * Pn += Phi* P Phi*^T - Phi P Phi^T = dPhi P Phi*^T + Phi P dPhi^T (Phi = diag(F, I), dPhi = diag(dF, 0),
+ * P the prior), added to the sparse product's Pn.  dF = -d N^T has rank <= 3, so with W = N^T P
+ * (3 x NB): dF P = -d W, dF P_dd F*^T = -d X (X = W_dd F*^T), F P_dd dF^T = -Y d^T (Y = F W_dd^T),
+ * about 2700 products. */
+static void constrain_predict(const sr_model *model, const sr_ekf *ekf, const sr_real xn[SR_NX], sr_real F[NE * NE],
+                              sr_real Pn[NB * NB], sr_real Nn[NE * 3])
+{
+    sr_real d[NE * 3] = {0}, W[3 * NB], X[3 * NE], Y[NE * 3];
+    const sr_real *N = ekf->null_space;
+    int a, i, j, k;
+    (void)unobservable(model, xn, Nn);
+    /* three columns throughout (a third left zero on a slope, in N and in d): loops of a fixed length */
+    constraint_weights(NE, NE, F, N, ekf->null_cols, Nn, d);
+    for (a = 0; a < 3; ++a)
+        for (j = 0; j < NB; ++j) {
+            sr_real s = 0;
+            for (k = 0; k < NE; ++k) s += N[3 * k + a] * ekf->P[NB * k + j];
+            W[NB * a + j] = s;
+        }
+    for (i = 0; i < NE; ++i)   /* Y = F W_dd^T with the F of the sparse product */
+        for (a = 0; a < 3; ++a) {
+            sr_real s = 0;
+            for (k = 0; k < NE; ++k) s += F[NE * i + k] * W[NB * a + k];
+            Y[3 * i + a] = s;
+        }
+    for (i = 0; i < NE; ++i)   /* F <- F* */
+        for (k = 0; k < NE; ++k)
+            for (a = 0; a < 3; ++a) F[NE * i + k] -= d[3 * i + a] * N[3 * k + a];
+    for (a = 0; a < 3; ++a)
+        for (j = 0; j < NE; ++j) {
+            sr_real s = 0;
+            for (k = 0; k < NE; ++k) s += W[NB * a + k] * F[NE * j + k];
+            X[NE * a + j] = s;
+        }
+    for (i = 0; i < NE; ++i) {
+        for (j = 0; j <= i; ++j) {
+            sr_real s = 0;
+            for (a = 0; a < 3; ++a) s += d[3 * i + a] * X[NE * a + j] + Y[3 * i + a] * d[3 * j + a];
+            Pn[NB * i + j] -= s;
+            if (j < i) Pn[NB * j + i] = Pn[NB * i + j];
+        }
+        for (j = NE; j < NB; ++j) {
+            sr_real s = 0;
+            for (a = 0; a < 3; ++a) s += d[3 * i + a] * W[NB * a + j];
+            Pn[NB * i + j] -= s;
+            Pn[NB * j + i] = Pn[NB * i + j];
+        }
+    }
+}
+
+/* N <- G N after an applied sample's reset (G = Jr on the attitude's rows). */
+static void carry_null_space(sr_ekf *ekf, const sr_real Jr[9])
+{
+    sr_real t[9];
+    int i, c;
+    for (i = 0; i < 3; ++i)
+        for (c = 0; c < 3; ++c)
+            t[3 * i + c] = Jr[3 * i] * ekf->null_space[3 * SR_E_xi_S + c] + Jr[3 * i + 1] * ekf->null_space[3 * (SR_E_xi_S + 1) + c]
+                         + Jr[3 * i + 2] * ekf->null_space[3 * (SR_E_xi_S + 2) + c];
+    memcpy(ekf->null_space + 3 * SR_E_xi_S, t, sizeof t);
+}
+
+int sr_ekf_set_observability_constraint(sr_ekf *ekf, const sr_model *model, int on)
+{
+    int status = arg_model(model, READS(WHOLE));
+    if (status != SR_OK) return status;
+    if (!ekf) return SR_ERR_NULL;
+    if (on != 0 && on != 1) return SR_ERR_ARG;
+    status = check_filter(model, ekf);
+    if (status != SR_OK) return status;
+    memset(ekf->null_space, 0, sizeof ekf->null_space);
+    ekf->null_cols = on ? unobservable(model, ekf->x, ekf->null_space) : 0;
+    ekf->constrained = on;
+    return SR_OK;
+}
+
 SR_LANES_CLONES int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real u[SR_NU], sr_real dt,
                    const sr_ekf_process *process)
 {
     sr_real xn[SR_NX], F[NE * NE], Qnu[SR_NV * SR_NV], T[NE * NBP], Pp[NE * NBP], Pn[NB * NB], g, white;
+    sr_real Nn[NE * 3];   /* the constraint's N at the predicted state */
     sr_ekf_held next;
     int status = arg_model(model, READS(WHOLE)), i, j, k, dq_identity = 1, cols[NE], ncols = 0;
     if (status != SR_OK) return status;
@@ -379,10 +515,12 @@ SR_LANES_CLONES int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int metho
         Pn[NB * (SR_EB_b_g + i) + SR_EB_b_g + i] += dt * process->gyro_bias_rw * process->gyro_bias_rw;
         Pn[NB * (SR_EB_b_a + i) + SR_EB_b_a + i] += dt * process->accel_bias_rw * process->accel_bias_rw;
     }
+    if (ekf->constrained) constrain_predict(model, ekf, xn, F, Pn, Nn);   /* F <- F* from here on */
     step_held(&ekf->held, F, g, dt, xn, Pn, &next);
     if (!all_finite(Pn, NB * NB)) return SR_ERR_NONFINITE;
     memcpy(ekf->x, xn, sizeof xn);
     memcpy(ekf->P, Pn, sizeof Pn);
+    if (ekf->constrained) memcpy(ekf->null_space, Nn, sizeof Nn);
     /* The waiting fixes' cross-covariances: C <- diag(F, I) C (the process noise is independent). */
     for (k = 0; k < SR_EKF_NDELAYED; ++k) {
         sr_real *Ck = ekf->delayed[k].C, t[NE * 2];
@@ -563,6 +701,7 @@ static SR_LANES_CLONES int apply(sr_ekf *ekf, int kind, int m, const sr_real *r,
     if (!all_finite(Pn, NB * NBP) || !all_finite(xn, SR_NX)) return SR_ERR_NONFINITE;
     memcpy(ekf->x, xn, sizeof xn);
     for (i = 0; i < SR_NBIAS; ++i) ekf->bias[i] += e[SR_EB_b_g + i];
+    if (ekf->constrained) carry_null_space(ekf, Jr);
     for (a = 0; a < NB; ++a) {
         for (b = 0; b < a; ++b) ekf->P[NB * a + b] = Pn[NBP * b + a];
         for (b = a; b < NB; ++b) ekf->P[NB * a + b] = Pn[NBP * a + b];
@@ -662,6 +801,7 @@ int sr_ekf_update_imu_axes(sr_ekf *ekf, const sr_model *model, const sr_real y[S
     /* The state, biases, mount and u are checked: the Jacobian without its checks. */
     if (status == SR_OK) status = sr_internal_imu_jacobian(model, ekf->x, u, body, mount, ekf->bias, yh, H);
     if (status != SR_OK) return status;
+    if (ekf->constrained) constrain_sample(ekf, SR_NIMU, H);
     for (i = 0; i < SR_NIMU; ++i) {
         r[i] = y[i] - yh[i];
         Rd[i] = sigma[i] * sigma[i];
@@ -696,6 +836,7 @@ int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[S
     /* The reading is linear in nu': Hn is the same at any nu', zero included. */
     if (status == SR_OK) status = sr_imu_partials(model, ekf->x, zero, body, mount, ekf->bias, yd, Hd, Hn);
     if (status != SR_OK) return status;
+    if (ekf->constrained) constrain_sample(ekf, SR_NIMU, H);
 
     h = &ekf->held;
     if (!h->pending) {   /* a's prior: mean 0, Q_a = M^-1 D^2 M^-1 / hold, independent of e */
@@ -817,6 +958,7 @@ int sr_ekf_update_encoders(sr_ekf *ekf, const sr_model *model, const sr_real y[2
     const int status = check_simple(ekf, model, y, 2, sigma, gate);
     if (status != SR_OK) return status;
     sr_internal_encoders_jacobian(ekf->x, yh, H);
+    if (ekf->constrained) constrain_sample(ekf, 2, H);
     r[0] = angle_difference(y[0], yh[0]);
     r[1] = angle_difference(y[1], yh[1]);
     Rd[0] = Rd[1] = sigma * sigma;

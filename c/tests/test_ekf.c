@@ -1,7 +1,8 @@
 /*
  * test_ekf.c -- the error-state EKF (c/src/sr_ekf.c): updates whose answer is known by hand (a
  * position fix on a diagonal covariance is a scalar Kalman filter per axis), the block structure
- * of the prediction, gating and the recovery from a run of refusals, the bias states, and status codes with nothing written on error.
+ * of the prediction, gating and the recovery from a run of refusals, the bias states, the observability
+ * constraint, and status codes with nothing written on error.
  */
 #include "sr_test.h"
 #include "sr_ekf.h"
@@ -314,6 +315,104 @@ static void test_a_held_disturbance_is_read_by_the_imu_sample_and_spent_by_the_n
     for (i = 0; i < SR_NV; ++i) CHECK_NEAR(ekf.x[SR_X_w_S + i] - plain.x[SR_X_w_S + i], dt * a_hat[i], 8 * TEST_EPS);
 }
 
+#ifndef SR_USE_FLOAT
+/* n^T P^-1 n for the turn n (the first column of the constraint's N, or N at the estimate): P n' = n
+ * by Gaussian elimination on a copy. */
+static double information_along(const sr_ekf *ekf, const sr_real N[SR_NE * 3])
+{
+    double A[SR_NEB][SR_NEB + 1], s = 0;
+    int i, j, k;
+    for (i = 0; i < SR_NEB; ++i) {
+        for (j = 0; j < SR_NEB; ++j) A[i][j] = ekf->P[SR_NEB * i + j];
+        A[i][SR_NEB] = i < SR_NE ? N[3 * i] : 0;
+    }
+    for (k = 0; k < SR_NEB; ++k)
+        for (i = k + 1; i < SR_NEB; ++i) {
+            const double f = A[i][k] / A[k][k];
+            for (j = k; j <= SR_NEB; ++j) A[i][j] -= f * A[k][j];
+        }
+    for (i = SR_NEB - 1; i >= 0; --i) {
+        for (j = i + 1; j < SR_NEB; ++j) A[i][SR_NEB] -= A[i][j] * A[j][SR_NEB];
+        A[i][SR_NEB] /= A[i][i];
+        s += (i < SR_NE ? N[3 * i] : 0) * A[i][SR_NEB];
+    }
+    return s;
+}
+
+/* Without process noise: a predict, two IMU samples (the second away from where N was taken) and
+ * an encoder sample, n^T P^-1 n before and after; N the filter's (constrained) or the turn at the
+ * estimate (not). */
+static void information_before_after(int constrained, double *before, double *after)
+{
+    sr_ekf ekf;
+    sr_model m;
+    sr_real N[SR_NE * 3] = {0};
+    const sr_ekf_process quiet = {{0, 0, 0}, 0, 0};
+    const sr_real u[2] = {SR_C(0.2), SR_C(0.05)}, enc[2] = {SR_C(0.001), SR_C(-0.002)};
+    const sr_real y[SR_NIMU] = {SR_C(0.01), SR_C(-0.02), SR_C(0.03), SR_C(0.1), SR_C(-0.05), SR_C(9.7)};
+    const sr_real mount[SR_NMOUNT] = {0, 0, SR_C(-0.05), 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    int i, k;
+    start(&ekf, &m, 0.05);
+    ekf.x[SR_X_q] = SR_C(0.7);
+    ekf.x[SR_X_q + 1] = SR_C(-0.4);
+    CHECK_STATUS(sr_ekf_set_observability_constraint(&ekf, &m, constrained), SR_OK);
+    for (k = 0; k < 2; ++k) {
+        CHECK_STATUS(sr_ekf_predict(&ekf, &m, SR_RKMK4, u, SR_C(0.005), &quiet), SR_OK);
+        if (k == 1) break;
+        CHECK_STATUS(sr_ekf_update_imu(&ekf, &m, y, u, SR_BODY_yoke, mount, SR_C(0.003), SR_C(0.02), (sr_real)INFINITY), SR_OK);
+    }
+    for (i = 0; i < 3; ++i) N[3 * i] = ekf.x[SR_X_R_S + 6 + i];
+    N[3 * SR_E_q] = -ekf.x[SR_X_q + 1];
+    N[3 * (SR_E_q + 1)] = ekf.x[SR_X_q];
+    if (constrained) {   /* right after a predict, the filter's N is the turn at its estimate */
+        for (i = 0; i < SR_NE; ++i) CHECK(fabs(ekf.null_space[3 * i] - N[3 * i]) <= 1e-15);
+    }
+    *before = information_along(&ekf, N);
+    for (k = 0; k < 2; ++k)
+        CHECK_STATUS(sr_ekf_update_imu(&ekf, &m, y, u, SR_BODY_yoke, mount, SR_C(0.003), SR_C(0.02), (sr_real)INFINITY), SR_OK);
+    CHECK_STATUS(sr_ekf_update_encoders(&ekf, &m, enc, SR_C(0.0005), (sr_real)INFINITY), SR_OK);
+    CHECK_STATUS(sr_ekf_predict(&ekf, &m, SR_RKMK4, u, SR_C(0.005), &quiet), SR_OK);
+    if (constrained) memcpy(N, ekf.null_space, sizeof N);
+    else {
+        for (i = 0; i < 3; ++i) N[3 * i] = ekf.x[SR_X_R_S + 6 + i];
+        N[3 * SR_E_q] = -ekf.x[SR_X_q + 1];
+        N[3 * (SR_E_q + 1)] = ekf.x[SR_X_q];
+    }
+    *after = information_along(&ekf, N);
+}
+#endif
+
+static void test_with_the_observability_constraint_the_imu_and_encoders_tell_nothing_of_the_heading(void)
+{
+#ifndef SR_USE_FLOAT
+    double before, after;
+    information_before_after(1, &before, &after);
+    CHECK(fabs(after - before) <= 1e-9 * before);
+    information_before_after(0, &before, &after);   /* the same without the constraint: it learns */
+    CHECK(fabs(after - before) > 1e-6 * before);
+#endif
+}
+
+static void test_the_observability_constraint_turned_off_is_the_filter_as_it_was(void)
+{
+    sr_ekf plain, toggled;
+    sr_model m;
+    const sr_ekf_process q = {{SR_C(0.01), SR_C(0.01), SR_C(0.01)}, 0, 0};
+    const sr_real u[2] = {SR_C(0.1), 0}, y[SR_NIMU] = {0, 0, 0, 0, 0, SR_C(9.81)};
+    const sr_real mount[SR_NMOUNT] = {0, 0, SR_C(-0.05), 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    start(&plain, &m, 0.01);
+    toggled = plain;
+    CHECK_STATUS(sr_ekf_set_observability_constraint(&toggled, &m, 1), SR_OK);
+    CHECK(toggled.constrained == 1 && toggled.null_cols == 3);
+    CHECK_STATUS(sr_ekf_set_observability_constraint(&toggled, &m, 0), SR_OK);
+    CHECK(memcmp(&toggled, &plain, sizeof plain) == 0);
+    CHECK_STATUS(sr_ekf_predict(&plain, &m, SR_RKMK4, u, SR_C(0.005), &q), SR_OK);
+    CHECK_STATUS(sr_ekf_update_imu(&plain, &m, y, u, SR_BODY_yoke, mount, SR_C(0.003), SR_C(0.02), (sr_real)INFINITY), SR_OK);
+    CHECK_STATUS(sr_ekf_predict(&toggled, &m, SR_RKMK4, u, SR_C(0.005), &q), SR_OK);
+    CHECK_STATUS(sr_ekf_update_imu(&toggled, &m, y, u, SR_BODY_yoke, mount, SR_C(0.003), SR_C(0.02), (sr_real)INFINITY), SR_OK);
+    CHECK(memcmp(&toggled, &plain, sizeof plain) == 0);
+}
+
 static void test_bad_input_gives_a_status_and_writes_nothing(void)
 {
     sr_ekf ekf, before;
@@ -357,6 +456,9 @@ static void test_bad_input_gives_a_status_and_writes_nothing(void)
     CHECK_STATUS(sr_ekf_set_recovery(&ekf, -1, 1), SR_ERR_ARG);
     CHECK_STATUS(sr_ekf_set_recovery(&ekf, SR_EKF_IMU, -1), SR_ERR_ARG);
     CHECK_STATUS(sr_ekf_set_recovery(NULL, SR_EKF_IMU, 1), SR_ERR_NULL);
+    CHECK_STATUS(sr_ekf_set_observability_constraint(&ekf, &m, 2), SR_ERR_ARG);
+    CHECK_STATUS(sr_ekf_set_observability_constraint(NULL, &m, 1), SR_ERR_NULL);
+    CHECK_STATUS(sr_ekf_set_observability_constraint(&ekf, &broken, 1), SR_ERR_MODEL);
     CHECK(memcmp(&ekf, &before, sizeof ekf) == 0);
     /* a covariance that is not symmetric, or not positive definite */
     memcpy(P0, ekf.P, sizeof P0);
@@ -382,5 +484,7 @@ void suite_ekf(void)
     RUN_TEST(test_a_fix_marked_and_applied_at_once_is_the_plain_fix);
     RUN_TEST(test_a_late_fix_corrects_the_estimate_by_what_it_said_when_it_measured);
     RUN_TEST(test_a_held_disturbance_is_read_by_the_imu_sample_and_spent_by_the_next_predict);
+    RUN_TEST(test_with_the_observability_constraint_the_imu_and_encoders_tell_nothing_of_the_heading);
+    RUN_TEST(test_the_observability_constraint_turned_off_is_the_filter_as_it_was);
     RUN_TEST(test_bad_input_gives_a_status_and_writes_nothing);
 }

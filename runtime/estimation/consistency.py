@@ -35,6 +35,8 @@ UNOBSERVABLE = ("heading", "q_x", "q_y")
 START_HEADING_SIGMA = math.radians(10.0)
 #: Compared every this many filter rows (20 rows of 5 ms: every 0.1 s).
 EVERY = 20
+#: `--constrained`: the filter's observability constraint (None: on without fixes and heading).
+CONSTRAINED = {"auto": None, "on": True, "off": False}
 #: The targets: the share of samples whose average NEES lies in its band, of errors within ±3σ.
 NEES_TARGET, WITHIN_TARGET, BAND = 0.90, 0.99, 0.95
 
@@ -70,10 +72,12 @@ def nees_band(dims, runs, probability=BAND):
     return (float(chi2.ppf(tail, runs * dims)) / runs, float(chi2.ppf(1 - tail, runs * dims)) / runs)
 
 
-def run_once(run, sensors, seed, duration=None, plant_mismatch=False, every=EVERY, accel_noise="held"):
+def run_once(run, sensors, seed, duration=None, plant_mismatch=False, every=EVERY, accel_noise="held",
+             constrained=None):
     """One Monte Carlo run: the sensors `sensors` (a SensorSet, a shipped set's name or a file)
     simulated along `run` (a shipped scenario or task name, a file, or the object) with `seed`,
-    the filter over the log (accelerometer rule `accel_noise`, `estimate_log`), started from the truth's
+    the filter over the log (accelerometer rule `accel_noise`, observability constraint `constrained`
+    (None: `estimate_log`'s rule), `estimate_log`), started from the truth's
     heading off by a seeded N(0, 10°) draw.  Returns {"seed", "t" (m,), "e" (m, 18), "P" (m, 18, 18) (COMPONENTS,
     from SETTLE_S on), "metrics" (`errors`), "counters", "fixes" (whether the set has fixes or a
     heading)}."""
@@ -90,7 +94,8 @@ def run_once(run, sensors, seed, duration=None, plant_mismatch=False, every=EVER
     # The operator's heading at the start is the truth's off by a draw of the σ the start rule
     # assumes: started at the truth's, the filter would look conservative in heading by design.
     heading = start_heading(log) + np.random.default_rng([seed, 1]).normal(0.0, START_HEADING_SIGMA)
-    result = estimate_log(log, heading=heading, covariance_every=every, accel_noise=accel_noise)
+    result = estimate_log(log, heading=heading, covariance_every=every, accel_noise=accel_noise,
+                          constrained=constrained)
     model = Model(claimed_params(log))
     rows = result.P_rows
     start = min(SETTLE_S, result.t[-1] / 2)
@@ -226,7 +231,7 @@ def summary(report, accuracy_table, meta):
 
 
 def run_many(run, sensors, seeds, duration=None, plant_mismatch=False, scheduler=None, workers=None,
-             progress=True, accel_noise="held"):
+             progress=True, accel_noise="held", constrained=None):
     """`run_once` for every seed: on an embedded LocalCluster of `workers` processes (scheduler
     None), a Dask scheduler's address, or in this process ("serial"); with a tqdm bar.  The
     results in the seeds' order."""
@@ -237,13 +242,14 @@ def run_many(run, sensors, seeds, duration=None, plant_mismatch=False, scheduler
     with tqdm(total=len(seeds), unit="run", desc="consistency", disable=not progress or None) as bar:
         if scheduler == SERIAL:
             for seed in seeds:
-                out[seed] = run_once(run, sensors, seed, duration, plant_mismatch, accel_noise=accel_noise)
+                out[seed] = run_once(run, sensors, seed, duration, plant_mismatch, accel_noise=accel_noise,
+                                     constrained=constrained)
                 bar.update(1)
         else:
             from distributed import as_completed
             with dask_client(scheduler, workers) as client:
                 futures = {client.submit(run_once, run, sensors, seed, duration, plant_mismatch, EVERY, accel_noise,
-                                         pure=False): seed
+                                         constrained, pure=False): seed
                            for seed in seeds}
                 for future in as_completed(futures):
                     out[futures[future]] = future.result()
@@ -291,6 +297,10 @@ def build_parser():
                         help="the filter's accelerometer noise rule (runtime.sensor_sim.ekf_noise; 'held', the "
                              "default: the torque disturbance the accelerometer reads modelled; 'largest', "
                              "'each': its share of the reading in the accelerometer's sigma)")
+    parser.add_argument("--constrained", choices=CONSTRAINED, default="auto",
+                        help="the filter's observability constraint (OC-EKF: heading and position kept "
+                             "unobservable by the IMU and the encoders; docs/estimation.md); default 'auto': on "
+                             "when the sensor set has neither fixes nor a heading")
     parser.add_argument("--scheduler", help="a Dask scheduler's address, or 'serial' (default: an embedded "
                                             "LocalCluster)")
     parser.add_argument("--workers", type=whole(1), help="worker processes of the embedded cluster (default: cores)")
@@ -326,7 +336,8 @@ def main(argv):
         seeds = list(range(args.first_seed, args.first_seed + args.runs))
         try:
             runs = run_many(args.run, sensors, seeds, args.duration, args.plant_mismatch, args.scheduler,
-                            args.workers, progress=not args.quiet, accel_noise=args.accel_noise)
+                            args.workers, progress=not args.quiet, accel_noise=args.accel_noise,
+                            constrained=CONSTRAINED[args.constrained])
         except KernelError as exc:
             raise ValueError(f"{args.run}: a run failed: {exc}") from None
         report = consistency(runs)
@@ -350,7 +361,8 @@ def main(argv):
                  f"{report['inside']:.0%} of samples in the band")
         with atomic_path(args.out / "consistency.png") as path:
             figure(report, path, title)
-        meta = {"run": args.run, "sensors": args.sensors, "accel_noise": args.accel_noise, "seeds": [seeds[0], seeds[-1]],
+        meta = {"run": args.run, "sensors": args.sensors, "accel_noise": args.accel_noise,
+                "constrained": args.constrained, "seeds": [seeds[0], seeds[-1]],
                 "duration_s": args.duration, "plant_mismatch": args.plant_mismatch}
         result = summary(report, table, meta)
         write_text(args.out / "summary.json", json.dumps(result, indent=2) + "\n")

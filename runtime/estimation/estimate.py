@@ -98,7 +98,7 @@ def prediction_method(log):
 
 
 def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progress=None, covariance_every=None,
-                 accel_noise="held"):
+                 accel_noise="held", constrained=None):
     """Run the filter over `log` (runtime.estimation.logs.Log) for the robot `params` (None: the one
     the log claims, else the paper's simulation robot), started by the start rule (the first
     START_SAMPLES accelerometer samples, the first encoder sample, the first fix and heading if the
@@ -106,7 +106,12 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
     already moving at the start (`moving_at_start`) starts with speeds of σ MOVING_RATE_SIGMA
     instead of at rest.  `progress(done, total)` is called every 1000 times.  `covariance_every` = k
     (a whole number >= 1) keeps the whole covariance at every k-th row (`Estimate.P`).  `accel_noise`:
-    `ekf_noise`'s accelerometer rule ("held", the default, "largest", "each") when `noise` is None."""
+    `ekf_noise`'s accelerometer rule ("held", the default, "largest", "each") when `noise` is None.  `constrained`:
+    the filter's observability constraint (`Ekf`'s; docs/estimation.md, "Observability constraint"),
+    None: on when the log has neither fixes nor a heading (nothing that sees the heading and the
+    position), off otherwise."""
+    if constrained is not None and not isinstance(constrained, bool):
+        raise ValueError(f"constrained: expected True, False or None (on without fixes and heading), got {constrained!r}")
     if covariance_every is not None and (isinstance(covariance_every, bool) or not isinstance(
             covariance_every, (int, np.integer)) or covariance_every < 1):
         raise ValueError(f"covariance_every: expected a whole number >= 1, got {covariance_every!r}")
@@ -118,6 +123,8 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
         noise = ekf_noise(sensors, params, accel_axes=accel_noise, hold=hold)
     events = [(log.imu, "imu"), (log.encoders, "encoders"), (log.fixes, "fixes"), (log.heading, "heading")]
     events = [(table, kind) for table, kind in events if table is not None and len(table)]
+    if constrained is None:
+        constrained = not any(kind in ("fixes", "heading") for _, kind in events)
     start = {"accel": log.imu.select("accel_x", "accel_y", "accel_z")[:START_SAMPLES],
              "encoders": log.encoders.data[0]}
     if log.fixes is not None and len(log.fixes):
@@ -127,7 +134,7 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
     ekf = start_from_measurements(model, noise=noise, mount=sensors.imu.mount, gate=gate,
                                   heading_prior=start_heading(log) if heading is None else heading,
                                   rate_sigma=MOVING_RATE_SIGMA if moving_at_start(log) else 0.01,
-                                  method=prediction_method(log), **start)
+                                  method=prediction_method(log), constrained=constrained, **start)
     late = []                                   # (t_measured, index) of the fixes that arrive late
     if log.fixes is not None and len(log.fixes):
         measured = log.fixes["t_measured"]

@@ -24,11 +24,17 @@ sample reads it through ∂y/∂ν̇; its gain revises the current error and a (
 samples move the current error alone; each predict within its period is the linear map e ← Φ e + g a
 on ν's rows (g: the part of dt in the period), a ← a, with the torque noise over dt − g only; a is
 dropped when its period ends.
+
+Observability constraint (`constrained`): N (12, k), the directions the IMU and the encoders cannot
+see in the error coordinates (`unobservable`), is taken at the start and after every predict at the
+predicted state, and moved by every reset (N ← G N); the predict's F is replaced by
+F − (F N − N') (Nᵀ N)⁻¹ Nᵀ with N' at the new state, the IMU's and the encoders' H by
+H − H N (Nᵀ N)⁻¹ Nᵀ, both written out as such.
 """
 import numpy as np
 
 from .. import sensors
-from ..state import IDX_E_NU, IDX_E_XI_S, IDX_NU, NE, NV
+from ..state import IDX_E_NU, IDX_E_Q, IDX_E_XI_S, IDX_NU, IDX_Q, IDX_RS, NE, NV
 
 NB = NE + 6
 KINDS = ("imu", "encoders", "position", "heading")
@@ -45,6 +51,28 @@ def right_jacobian(phi):
     return J
 
 
+def unobservable(model, x):
+    """N(x) (12, k): the whole robot turned about the floor's normal (R_S → Rz(α) R_S = R_S Exp(α R_Sᵀ e_z),
+    q → Rz(α) q; on a level floor only), then moved along the floor's x and y."""
+    cols = []
+    if model.params.slope == 0:
+        n = np.zeros(NE)
+        n[IDX_E_XI_S] = x[IDX_RS].reshape(3, 3).T @ np.array([0.0, 0.0, 1.0])
+        q = x[IDX_Q]
+        n[IDX_E_Q] = (-q[1], q[0])
+        cols.append(n)
+    for k in range(2):
+        n = np.zeros(NE)
+        n[IDX_E_Q.start + k] = 1.0
+        cols.append(n)
+    return np.column_stack(cols)
+
+
+def nearest_with(A, N, B):
+    """The matrix nearest A (Frobenius) with A N = B: A − (A N − B) (Nᵀ N)⁻¹ Nᵀ."""
+    return A - (A @ N - B) @ np.linalg.solve(N.T @ N, N.T)
+
+
 def wrapped(angle):
     """An angle difference brought into (−π, π] through the unit circle."""
     return float(np.angle(np.exp(1j * angle)))
@@ -55,7 +83,7 @@ class EkfReference:
     `P` is the current error's block of the augmented covariance `P_aug`; `clones` the marked
     fixes' states by slot, in the order of their blocks."""
 
-    def __init__(self, model, x0, bias, P0, method="rkmk4", recover_after=None):
+    def __init__(self, model, x0, bias, P0, method="rkmk4", recover_after=None, constrained=False):
         self.model, self.method = model, method
         self.recover_after = dict(recover_after or {})
         self.streak = dict.fromkeys(KINDS, 0)
@@ -69,6 +97,7 @@ class EkfReference:
         self.accepted = dict.fromkeys(KINDS, 0)
         self.gated = dict.fromkeys(KINDS, 0)
         self.nis = dict.fromkeys(KINDS, 0.0)
+        self.N = unobservable(model, self.x) if constrained else None
 
     @property
     def P(self):
@@ -134,6 +163,7 @@ class EkfReference:
             Q = self.process_noise(dt, torque_psd, gyro_bias_rw, accel_bias_rw)
             Q[IDX_E_NU, IDX_E_NU] *= (dt - g) / dt
             self.x = self.model.step(self.x, u, dt, self.method)
+            F = self.constrain_transition(F)
             self.x[IDX_NU] += g * self.held
             n = len(self.P_aug)
             T = np.eye(n)
@@ -148,11 +178,29 @@ class EkfReference:
             return
         Q = self.process_noise(dt, torque_psd, gyro_bias_rw, accel_bias_rw)
         self.x = self.model.step(self.x, u, dt, self.method)
+        F = self.constrain_transition(F)
         P = self.propagate(F, Q)
         Phi = np.eye(NB)
         Phi[:NE, :NE] = F
         self.transform(Phi)
         self.P = P
+
+    def constrain_transition(self, F):
+        """With the constraint, F's nearest with F N = N(x) at the stepped x, which becomes N."""
+        if self.N is None:
+            return F
+        N = unobservable(self.model, self.x)
+        F = nearest_with(F, self.N, N)
+        self.N = N
+        return F
+
+    def constrain_sample(self, H):
+        """With the constraint, the IMU's or the encoders' H nearest with H N = 0."""
+        if self.N is None:
+            return H
+        H = H.copy()
+        H[:, :NE] = nearest_with(H[:, :NE], self.N, np.zeros((len(H), self.N.shape[1])))
+        return H
 
     @staticmethod
     def accepts(nis, gate):
@@ -201,6 +249,8 @@ class EkfReference:
         P = G @ self.P @ G.T
         self.transform(G)
         self.P = P
+        if self.N is not None:
+            self.N = G[:NE, :NE] @ self.N
 
     def _update(self, kind, r, H, R, gate):
         S = H @ self.P @ H.T + R
@@ -226,6 +276,7 @@ class EkfReference:
     def update_imu(self, y, u, mount, sigma_gyro, sigma_accel, gate):
         """One IMU sample (6,) under the torques u; `sigma_accel` one number or one per axis (3,)."""
         yh, H = sensors.imu_jacobian(self.model, self.x, u, mount=mount, bias=self.b)
+        H = self.constrain_sample(H)
         R = np.diag(np.concatenate([np.full(3, sigma_gyro), np.broadcast_to(sigma_accel, (3,))]) ** 2)
         return self._update("imu", np.asarray(y) - yh, H, R, gate)
 
@@ -234,6 +285,7 @@ class EkfReference:
         `hold` seconds (appended unless one is held already); `sigma` (6,) the readings' own noise."""
         yh, H = sensors.imu_jacobian(self.model, self.x, u, mount=mount, bias=self.b)
         _, _, Hn = sensors.imu_partials(self.model, self.x, np.zeros(NV), mount=mount, bias=self.b)
+        H = self.constrain_sample(H)
         new = self.held is None
         if new:
             Minv = np.linalg.inv(self.model.inertia(self.x))
@@ -276,6 +328,7 @@ class EkfReference:
     def update_encoders(self, y, sigma, gate):
         """One encoder sample (θ_Y, θ_P)."""
         yh, H = sensors.encoders_jacobian(self.model, self.x)
+        H = self.constrain_sample(H)
         r = np.array([wrapped(y[0] - yh[0]), wrapped(y[1] - yh[1])])
         return self._update("encoders", r, H, sigma ** 2 * np.eye(2), gate)
 

@@ -1,6 +1,7 @@
 """The EKF over a log (runtime/estimation/estimate.py, `python -m runtime estimate`): on a simulated
 circle with the default sensor set it meets the accuracy targets of docs/estimation.md, without
-fixes its tilt and speeds still hold; the metrics see a planted error; the command writes the
+fixes its tilt and speeds still hold, and (nothing seeing the heading) the filter is
+observability-constrained, with fixes it is not; the metrics see a planted error; the command writes the
 estimate in trajectory.csv's columns and refuses a bad log in one line.  Short runs only."""
 import dataclasses
 import json
@@ -125,3 +126,21 @@ def test_a_log_naming_an_unknown_method_is_refused_naming_the_field():
     from runtime.estimation.estimate import prediction_method
     with pytest.raises(ValueError, match="method"):
         prediction_method(SimpleNamespace(meta={"method": "euler"}))
+
+
+def test_without_fixes_and_heading_the_filter_is_observability_constrained(without_fixes):
+    log, result = without_fixes
+    heading = ERROR_NAMES.index("xi_S_z")
+    on, off = (estimate_log(log, constrained=c).sigma[-1, heading] for c in (True, False))
+    assert result.sigma[-1, heading] == on and on > 1.15 * off
+
+
+def test_with_fixes_the_filter_is_not_observability_constrained(with_fixes):
+    log, result = with_fixes
+    assert (result.sigma == estimate_log(log, constrained=False).sigma).all()
+    assert not (result.sigma == estimate_log(log, constrained=True).sigma).all()
+
+
+def test_a_constrained_that_is_not_a_bool_or_none_is_a_value_error_naming_it(with_fixes):
+    with pytest.raises(ValueError, match="constrained"):
+        estimate_log(with_fixes[0], constrained="auto")
