@@ -15,6 +15,7 @@ until it is.
 import dataclasses
 
 import numpy as np
+import scipy.linalg
 import scipy.optimize
 import scipy.signal
 
@@ -95,9 +96,11 @@ def regressor_guess(t, x, u, params, free, bounds, weights=None, window=WINDOW_S
         """β̂ of the rows weighed by w (5,), and θ nearest it with the pull `prior` (per entry, on
         the relative change)."""
         Yw = (Y * w[None, :, None]).reshape(-1, NPI)
-        # Y π = Y_kept β with β = π_kept + C π_dep: β̂ is a full-rank linear least-squares problem
-        beta, *_ = np.linalg.lstsq(Yw[:, kept], (b * w).ravel(), rcond=None)
-        R = np.linalg.qr(Yw[:, kept], mode="r")
+        # Y π = Y_kept β with β = π_kept + C π_dep: β̂ is a full-rank linear least-squares
+        # problem, solved from one QR factorisation of [Y_kept | b]: R and Qᵀb at once
+        Ra = np.linalg.qr(np.column_stack([Yw[:, kept], (b * w).ravel()]), mode="r")
+        R = Ra[:-1, :-1]
+        beta = scipy.linalg.solve_triangular(R, Ra[:-1, -1])
 
         RB = R @ B
 
