@@ -38,7 +38,7 @@ from ..model import Model
 from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_parameters
 from ..params import SHAPES, Params, flat_names
 from ..state import IDX_E_NU, IDX_NU, NE, NV
-from .first_guess import _pi_of, regressor_guess
+from .first_guess import _dpi_of, regressor_guess
 from .segments import dlocal_batch, dretract_batch, segment_blocks
 from .sensitivity import JACOBIANS, step_sensitivity
 
@@ -895,19 +895,6 @@ def _report(prob, sol, free, params, full_state):
                mode="full-state" if full_state else "sensors", start=prob.theta_start.copy())
 
 
-def _dpi(params, idx):
-    """∂π/∂θ (27, n) by central differences of the exact polynomial π(p)."""
-    p = params.as_array()
-    out = np.empty((len(inertial_parameters(params)), len(idx)))
-    for c, i in enumerate(idx):
-        e = 1e-6 * max(abs(p[i]), 1e-3)
-        hi, lo = p.copy(), p.copy()
-        hi[i] += e
-        lo[i] -= e
-        out[:, c] = (_pi_of(hi) - _pi_of(lo)) / (2 * e)
-    return out
-
-
 def _combinations(nominal, estimated, idx, cov, null, scale):
     """The base parameters (runtime.param_derivatives.base_parameters of the robot) that the free
     entries enter, with their value at the estimate, a sigma by the delta method and whether the
@@ -917,7 +904,7 @@ def _combinations(nominal, estimated, idx, cov, null, scale):
     for k, i in enumerate(base.independent):
         G[k, i] = 1.0
         G[k, list(base.dependent)] = base.combination[k]
-    dpi = _dpi(estimated, idx)
+    dpi = _dpi_of(estimated.as_array(), idx)
     values = base.values(inertial_parameters(estimated))
     nominal_values = base.values(inertial_parameters(nominal))
     out = []
