@@ -276,11 +276,29 @@ def stacked_regressor(model, n_states=60, seed=0, max_speed=5.0):
     return model.regressor(X, A).reshape(-1, NPI)
 
 
+#: The entries of p that the regressor Y itself reads (the others enter through π alone): robots
+#: that agree in these have the same stacked regressor and so the same base parameters.
+REGRESSOR_ENTRIES = ("r", "n_Y", "n_P", "g", "slope")
+_BASE_CACHE = {}
+
+
 def base_parameters(model, n_states=60, seed=0, rtol=1e-9):
     """The base parameters of `model`'s robot: the columns of the stacked regressor kept in
     `PI_NAMES` order when they add to the rank of those kept before them (singular values of the
     column-scaled block above rtol times the largest), each other column expressed in the kept
-    ones by least squares.  Known r, n_Y, n_P, g, slope enter through Y."""
+    ones by least squares.  Known r, n_Y, n_P, g, slope enter through Y.  Kept per
+    `REGRESSOR_ENTRIES` and arguments (its arrays read-only): a fit asks for them of its start
+    robot and of its estimate, which share those entries."""
+    p = model.params.as_array()
+    key = (tuple(float(p[PARAMETER_NAMES.index(n)]) for n in REGRESSOR_ENTRIES), n_states, seed, rtol)
+    if key not in _BASE_CACHE:
+        if len(_BASE_CACHE) >= 64:
+            _BASE_CACHE.clear()
+        _BASE_CACHE[key] = _base_parameters(model, n_states, seed, rtol)
+    return _BASE_CACHE[key]
+
+
+def _base_parameters(model, n_states, seed, rtol):
     Y = stacked_regressor(model, n_states, seed)
     scale = np.linalg.norm(Y, axis=0)
     scale[scale == 0] = 1.0
@@ -298,4 +316,6 @@ def base_parameters(model, n_states=60, seed=0, rtol=1e-9):
     _, _, Vt = np.linalg.svd(Ys)
     null = Vt[len(kept):].T / scale[:, None]     # Y v = 0  <=>  Ys (scale v) = 0
     null /= np.maximum(np.linalg.norm(null, axis=0), 1e-300)
+    for a in (combination, s_all, null):
+        a.flags.writeable = False
     return BaseParameters(len(kept), tuple(kept), tuple(dependent), combination, s_all, null)

@@ -15,6 +15,7 @@ until it is.
 import dataclasses
 
 import numpy as np
+import scipy.linalg
 import scipy.optimize
 import scipy.signal
 
@@ -79,6 +80,7 @@ def regressor_guess(t, x, u, params, free, bounds, weights=None, window=WINDOW_S
     b[:, 3:] = us[keep]
     base = base_parameters(model)
     kept = list(base.independent)
+    B = base.values(np.eye(NPI))            # β = B π: the base parameters are linear in π
     idx = [PARAMETER_NAMES.index(n) for n in free]
     p0 = params.as_array()
     theta0 = p0[idx]
@@ -94,24 +96,31 @@ def regressor_guess(t, x, u, params, free, bounds, weights=None, window=WINDOW_S
         """β̂ of the rows weighed by w (5,), and θ nearest it with the pull `prior` (per entry, on
         the relative change)."""
         Yw = (Y * w[None, :, None]).reshape(-1, NPI)
-        # Y π = Y_kept β with β = π_kept + C π_dep: β̂ is a full-rank linear least-squares problem
-        beta, *_ = np.linalg.lstsq(Yw[:, kept], (b * w).ravel(), rcond=None)
-        R = np.linalg.qr(Yw[:, kept], mode="r")
+        # Y π = Y_kept β with β = π_kept + C π_dep: β̂ is a full-rank linear least-squares
+        # problem, solved from one QR factorisation of [Y_kept | b]: R and Qᵀb at once
+        Ra = np.linalg.qr(np.column_stack([Yw[:, kept], (b * w).ravel()]), mode="r")
+        R = Ra[:-1, :-1]
+        beta = scipy.linalg.solve_triangular(R, Ra[:-1, -1])
+
+        RB = R @ B
 
         def residual(theta):
-            return np.concatenate([R @ (base.values(pi_of(theta)) - beta), prior * (theta - theta0) / scale])
+            return np.concatenate([RB @ pi_of(theta) - R @ beta, prior * (theta - theta0) / scale])
 
-        sol = scipy.optimize.least_squares(residual, np.clip(theta0, lo, hi), bounds=(lo, hi), x_scale=scale,
-                                           method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12)
+        def jacobian(theta):
+            p = p0.copy()
+            p[idx] = theta
+            return np.vstack([RB @ _dpi_of(p, idx), np.diag(prior / scale)])
+
+        sol = scipy.optimize.least_squares(residual, np.clip(theta0, lo, hi), jac=jacobian, bounds=(lo, hi),
+                                           x_scale=scale, method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12)
         return sol.x, beta, R
 
     w = np.ones(NV) if weights is None else np.asarray(weights, dtype=float)
     # first the rows alone (a pull of PRIOR_WEIGHT of what the rows say about each entry alone, which
     # only settles what they leave undetermined) ...
     _, _, R = solve(w, 0.0)
-    step = 1e-6 * scale
-    alone = np.array([np.linalg.norm(R @ (base.values(pi_of(theta0 + step[i] * np.eye(len(idx))[i]))
-                                          - base.values(pi_of(theta0)))) / step[i] for i in range(len(idx))]) * scale
+    alone = np.linalg.norm(R @ B @ _dpi_of(p0, idx), axis=0) * scale
     theta, beta, _ = solve(w, PRIOR_WEIGHT * np.where(alone > 0, alone, alone.max(initial=0.0) or 1.0))
     # ... then weighed by what they leave: each equation by its residuals' RMS, the rows counted
     # once per smoothing window (the filter correlates its neighbours), against the nominal values
@@ -159,6 +168,27 @@ def _pi_index():
 
 
 _PI_INDEX = _pi_index()
+
+
+def _dpi_of(p, idx):
+    """∂π/∂p (NPI, len(idx)) of `_pi_of` at the parameter vector p, on the entries idx: exact (π is
+    polynomial in p: m·c bilinear, J_O = J + m (|c|² I − c cᵀ) cubic)."""
+    p = np.asarray(p, dtype=float)
+    to, frm, bodies = _PI_INDEX
+    full = np.zeros((NPI, len(p)))
+    full[to, frm] = 1.0
+    eye = np.eye(3)
+    for m_at, c_at, J_at, k_at, m_to, k_to, mc_to, jo_to, rows, cols in bodies:
+        m, c = p[m_at], p[c_at]
+        full[m_to, m_at] = full[k_to, k_at] = 1.0
+        full[mc_to, m_at] = c
+        full[np.ix_(mc_to, c_at)] = m * eye
+        full[jo_to, J_at[rows, cols]] = 1.0
+        full[jo_to, m_at] = (c @ c * eye - np.outer(c, c))[rows, cols]
+        for a in range(3):          # ∂/∂c_a of m (|c|² δ_rs − c_r c_s)
+            d = 2 * c[a] * eye - np.outer(eye[a], c) - np.outer(c, eye[a])
+            full[jo_to, c_at[a]] = m * d[rows, cols]
+    return full[:, idx]
 
 
 def _pi_of(p):

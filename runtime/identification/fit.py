@@ -24,6 +24,7 @@ eigenvalues the rank and conditioning; the base parameters (runtime.param_deriva
 combinations a rank-deficient fit still determines.
 """
 import dataclasses
+import functools
 import math
 
 import numpy as np
@@ -37,7 +38,7 @@ from ..model import Model
 from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_parameters
 from ..params import SHAPES, Params, flat_names
 from ..state import IDX_E_NU, IDX_NU, NE, NV
-from .first_guess import _pi_of, regressor_guess
+from .first_guess import _dpi_of, regressor_guess
 from .segments import dlocal_batch, dretract_batch, segment_blocks
 from .sensitivity import JACOBIANS, step_sensitivity
 
@@ -612,20 +613,24 @@ class _FullState:
 
     model = _Problem.model
 
-    def assemble(self, z):
-        if self._cache[0] is not None and np.array_equal(self._cache[0], z):
-            return self._cache[1]
-        model = self.model(z)
-        pred = model.step(self.X[:-1], self.u, self.h, self.method)
-        e = self.X[1:, IDX_NU] - pred[:, IDX_NU]
-        Jp = step_sensitivity(model, self.X[:-1], self.u, self.h, self.method, self.idx, self.jacobian)[:, IDX_E_NU]
-        r = np.matmul(self.white, e[..., None])[..., 0]
-        J = -np.matmul(self.white, Jp)
-        self._cache = (z.copy(), (r.ravel(), scipy.sparse.csr_matrix(J.reshape(-1, self.nf)), None))
-        self.nfev += 1
-        if self.progress is not None:
-            self.progress()
-        return self._cache[1]
+    def assemble(self, z, sparse=True):
+        """(r, J, None) at z, J a CSR matrix as `_Problem.assemble` gives it, or with `sparse` False
+        the dense (n, nf) array the optimizer takes (a CSR copy of a dense block costs more than
+        the evaluation's products)."""
+        if self._cache[0] is None or not np.array_equal(self._cache[0], z):
+            model = self.model(z)
+            pred = model.step(self.X[:-1], self.u, self.h, self.method)
+            e = self.X[1:, IDX_NU] - pred[:, IDX_NU]
+            Jp = step_sensitivity(model, self.X[:-1], self.u, self.h, self.method, self.idx,
+                                  self.jacobian)[:, IDX_E_NU]
+            r = np.matmul(self.white, e[..., None])[..., 0]
+            J = -np.matmul(self.white, Jp)
+            self._cache = (z.copy(), (r.ravel(), J.reshape(-1, self.nf), None))
+            self.nfev += 1
+            if self.progress is not None:
+                self.progress()
+        r, J, _ = self._cache[1]
+        return r, scipy.sparse.csr_matrix(J) if sparse else J, None
 
     def z0(self):
         return self.theta_start
@@ -671,9 +676,16 @@ def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, 
         raise IdentifyError(f"segment: expected a length > 0 in s, got {segment!r}")
     # The fit's products are small: one BLAS thread each (threads spinning for a busy core cost
     # far more than they gain on a shared 2-core machine).
-    with threadpoolctl.threadpool_limits(1, user_api="blas"):
+    with _blas_threads().limit(limits=1, user_api="blas"):
         return _identify(log, params, free, segment, method, full_state, max_nfev, progress, x_guess, bias_guess,
                          jacobian, start)
+
+
+@functools.cache
+def _blas_threads():
+    """The process's thread pools (threadpoolctl), found once: finding them walks every loaded
+    library, 30 ms of CPU, a tenth of a full-state fit's."""
+    return threadpoolctl.ThreadpoolController()
 
 
 def _identify(log, params, free, segment, method, full_state, max_nfev, progress, x_guess, bias_guess, jacobian,
@@ -706,9 +718,9 @@ def _identify(log, params, free, segment, method, full_state, max_nfev, progress
         prob.chol = None            # the covariance where the segments agree
         prob._cache = (None, None)
     if full_state:
-        opts = dict(jac=lambda z: prob.assemble(z)[1].toarray(), bounds=(lo, hi), method="trf", x_scale="jac",
+        opts = dict(jac=lambda z: prob.assemble(z, sparse=False)[1], bounds=(lo, hi), method="trf", x_scale="jac",
                     max_nfev=max_nfev, xtol=1e-8, ftol=1e-8, gtol=1e-10)
-        sol = scipy.optimize.least_squares(lambda z: prob.assemble(z)[0], z0, **opts)
+        sol = scipy.optimize.least_squares(lambda z: prob.assemble(z, sparse=False)[0], z0, **opts)
     else:
         def evaluate(z):
             r, J, _ = prob.assemble(z)
@@ -883,19 +895,6 @@ def _report(prob, sol, free, params, full_state):
                mode="full-state" if full_state else "sensors", start=prob.theta_start.copy())
 
 
-def _dpi(params, idx):
-    """∂π/∂θ (27, n) by central differences of the exact polynomial π(p)."""
-    p = params.as_array()
-    out = np.empty((len(inertial_parameters(params)), len(idx)))
-    for c, i in enumerate(idx):
-        e = 1e-6 * max(abs(p[i]), 1e-3)
-        hi, lo = p.copy(), p.copy()
-        hi[i] += e
-        lo[i] -= e
-        out[:, c] = (_pi_of(hi) - _pi_of(lo)) / (2 * e)
-    return out
-
-
 def _combinations(nominal, estimated, idx, cov, null, scale):
     """The base parameters (runtime.param_derivatives.base_parameters of the robot) that the free
     entries enter, with their value at the estimate, a sigma by the delta method and whether the
@@ -905,7 +904,7 @@ def _combinations(nominal, estimated, idx, cov, null, scale):
     for k, i in enumerate(base.independent):
         G[k, i] = 1.0
         G[k, list(base.dependent)] = base.combination[k]
-    dpi = _dpi(estimated, idx)
+    dpi = _dpi_of(estimated.as_array(), idx)
     values = base.values(inertial_parameters(estimated))
     nominal_values = base.values(inertial_parameters(nominal))
     out = []

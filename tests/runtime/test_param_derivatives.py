@@ -189,3 +189,38 @@ def test_base_parameter_values_are_a_linear_image_of_pi(geared):
     values = geared.values(pi)
     assert values.shape == (geared.rank,) and len(geared.names()) == geared.rank
     assert geared.rank < NPI
+
+
+def _same_base(a, b):
+    return (a.independent == b.independent and a.dependent == b.dependent
+            and np.array_equal(a.combination, b.combination) and np.array_equal(a.null_space, b.null_space))
+
+
+def test_robots_that_agree_in_the_regressors_entries_have_the_same_base_parameters():
+    """What lets `base_parameters` keep its result per REGRESSOR_ENTRIES: computed afresh for a robot
+    with every other entry moved, the base parameters are the same to the bit."""
+    from runtime.param_derivatives import REGRESSOR_ENTRIES, _base_parameters
+
+    geared = Model(GENERAL.replace(n_Y=60.0))
+    p = geared.params.as_array()
+    moved = np.array([n not in REGRESSOR_ENTRIES and n[:2] in ("m_", "c_", "k_", "j_") for n in PARAMETER_NAMES])
+    other = Model(Params.from_array(p * np.where(moved, 1.2, 1.0)))
+    assert _same_base(_base_parameters(geared, 60, 0, 1e-9), _base_parameters(other, 60, 0, 1e-9))
+
+
+def test_the_same_base_check_tells_robots_apart_that_differ_in_a_regressor_entry():
+    from runtime.param_derivatives import _base_parameters
+
+    geared = Model(GENERAL.replace(n_Y=60.0))
+    other = Model(geared.params.replace(r=geared.params.r * 1.01))
+    assert not _same_base(_base_parameters(geared, 60, 0, 1e-9), _base_parameters(other, 60, 0, 1e-9))
+
+
+def test_the_kept_base_parameters_are_those_of_the_robot_asked_for():
+    from runtime.param_derivatives import _base_parameters
+
+    geared = Model(GENERAL.replace(n_Y=60.0))
+    other = Model(geared.params.replace(n_Y=geared.params.n_Y * 2))
+    base_parameters(geared)
+    assert _same_base(base_parameters(other), _base_parameters(other, 60, 0, 1e-9))
+    assert base_parameters(geared).combination.flags.writeable is False

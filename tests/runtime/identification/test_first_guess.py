@@ -104,3 +104,47 @@ def test_the_inertial_parameters_of_a_parameter_vector_are_those_of_its_robot():
         p = nominal.as_array() * np.where(moved, np.random.default_rng(seed).uniform(0.7, 1.3, len(moved)), 1.0)
         robot = Params.from_array(p)
         np.testing.assert_array_equal(_pi_of(p), inertial_parameters(robot))
+
+
+def _dpi_error(dpi_of, p, idx):
+    """The largest difference of dpi_of(p, idx) from the central differences of `_pi_of`, relative
+    to the derivative's largest entry (π is a cubic polynomial in p: the differences are exact to
+    rounding but for h² times its third derivative)."""
+    from runtime.identification.first_guess import _pi_of
+
+    d = dpi_of(p, idx)
+    fd = np.empty_like(d)
+    for c, i in enumerate(idx):
+        h = 1e-5 * max(abs(p[i]), 1e-2)
+        hi, lo = p.copy(), p.copy()
+        hi[i] += h
+        lo[i] -= h
+        fd[:, c] = (_pi_of(hi) - _pi_of(lo)) / (2 * h)
+    return np.max(np.abs(d - fd)) / np.max(np.abs(fd))
+
+
+def _moved_robot(seed):
+    """The battery-geared robot's vector with every entry moved by up to ±30 % (not checked: π needs none)."""
+    p = NOMINAL.as_array()
+    return p * np.random.default_rng(seed).uniform(0.7, 1.3, len(p)) + 1e-3 * (p == 0)
+
+
+def test_the_first_guess_derivative_of_the_inertial_parameters_equals_their_differences():
+    from runtime.identification.first_guess import _dpi_of
+
+    idx = list(range(len(PARAMETER_NAMES)))
+    for seed in range(5):
+        assert _dpi_error(_dpi_of, _moved_robot(seed), idx) < 1e-8
+
+
+def test_the_derivative_check_fails_for_a_slightly_wrong_derivative():
+    from runtime.identification.first_guess import _dpi_of
+
+    idx = [PARAMETER_NAMES.index(n) for n in ("m_P", "c_P_x", "c_P_z", "J_P_yy")]
+
+    def perturbed(p, cols):          # ∂J_O/∂c off by a part in 10⁶
+        d = _dpi_of(p, cols).copy()
+        d[:, 1:3] *= 1 + 1e-6
+        return d
+
+    assert _dpi_error(perturbed, _moved_robot(0), idx) > 1e-8
