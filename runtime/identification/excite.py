@@ -21,8 +21,15 @@ quantisation, the fixes); the start at rest is known, the biases are not modelle
 are taken every `sample` seconds with each weighted by the sensor samples it stands for.  SciPy's
 L-BFGS-B maximises it from a random-phase multisine; then the whole program's amplitude is
 reduced, if need be, until the pendulum's inclination stays inside the flip-over envelope
-(`max_lean`, below the horizontal where it flips over, runtime.control.envelope).  The output is a
-scenario file (`[[torque]]` windows of `hold` seconds) that `python -m runtime run` runs.
+(`max_lean`, below the horizontal where it flips over, runtime.control.envelope).
+
+That information ignores the process noise, which is what limits the fit: `process_information`
+is the bound it leaves (a damping's information is ∫ (k ω)² dt / q²), and its σ predicts the
+sensor fit's.  So the last `push` of the program is a damping phase (`damping_phase`): the yoke's
+torque held at the limit, the pendulum's a sine at the frequency that maximises
+`weighted_criterion` (log det plus the dampings' own information, weighted), scaled into the
+envelope.  The output is a scenario file (`[[torque]]` windows of `hold` seconds) that
+`python -m runtime run` runs.
 """
 import argparse
 import dataclasses
