@@ -348,7 +348,8 @@ class Result:
     (fraction of u_max after the envelope), its information's log det and condition number, its
     peak lean, the number of evaluations of the information, its worst relative standard deviation
     (`worst_sigma`), and the same numbers of the naive programs (name -> (log det, condition, lean,
-    amplitude, worst sigma))."""
+    amplitude, worst sigma)); `sigmas`: program name -> (weighted criterion, σ per parameter) of
+    the process-noise bound (`process_information`), the damping phase's first when it was kept."""
     design: Design
     torques: np.ndarray
     amplitude: float

@@ -118,7 +118,8 @@ def test_the_command_writes_a_scenario_and_reports(tmp_path, capsys):
     out = tmp_path / "p.toml"
     assert cli.main(["excite", "--params", "k_S", "--duration", "2", "--harmonics", "2", "--iterations", "1",
                      "--f-high", "1.5", "--out", str(out)]) == 0
-    assert "log det" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "log det" in printed and "predicted sigma" in printed
     assert load_scenario(out).steps == 200
 
 
