@@ -21,8 +21,15 @@ quantisation, the fixes); the start at rest is known, the biases are not modelle
 are taken every `sample` seconds with each weighted by the sensor samples it stands for.  SciPy's
 L-BFGS-B maximises it from a random-phase multisine; then the whole program's amplitude is
 reduced, if need be, until the pendulum's inclination stays inside the flip-over envelope
-(`max_lean`, below the horizontal where it flips over, runtime.control.envelope).  The output is a
-scenario file (`[[torque]]` windows of `hold` seconds) that `python -m runtime run` runs.
+(`max_lean`, below the horizontal where it flips over, runtime.control.envelope).
+
+That information ignores the process noise, which is what limits the fit: `process_information`
+is the bound it leaves (a damping's information is ∫ (k ω)² dt / q²), and its σ predicts the
+sensor fit's.  So the last `push` of the program is a damping phase (`damping_phase`): the yoke's
+torque held at the limit, the pendulum's a sine at the frequency that maximises
+`weighted_criterion` (log det plus the dampings' own information, weighted), scaled into the
+envelope.  The output is a scenario file (`[[torque]]` windows of `hold` seconds) that
+`python -m runtime run` runs.
 """
 import argparse
 import dataclasses
@@ -53,8 +60,10 @@ U_MAX, MAX_LEAN = 0.5, math.pi / 3
 class Design:
     """What shapes a program: the parameters it is for (`names`, entries of PARAMETER_NAMES), its
     duration [s], the torque limit u_max [N m], the flip-over envelope max_lean [rad], the band
-    [f_low, f_high] [Hz] with `harmonics` frequencies per motor, the torque hold [s] and the
-    information's sampling [s]."""
+    [f_low, f_high] [Hz] with `harmonics` frequencies per motor, the torque hold [s], the
+    information's sampling [s], the fraction of the duration at the end given to the damping phase
+    (`push`, 0 for none: the yoke's torque held, the pendulum driven at one frequency) and the
+    weight of the dampings in the criterion (`weighted_criterion`)."""
     names: tuple
     duration: float
     u_max: float = U_MAX
@@ -64,12 +73,14 @@ class Design:
     harmonics: int = 4
     hold: float = 0.05
     sample: float = 0.02
+    push: float = 0.5
+    damping_weight: float = 2.0
 
     def __post_init__(self):
         object.__setattr__(self, "names", parameter_names(self.names))
         for name, low, high in (("duration", DT, 600.0), ("u_max", 0.0, 100.0), ("max_lean", 0.0, math.pi / 2),
                                 ("f_low", 0.0, 50.0), ("f_high", 0.0, 50.0), ("hold", DT, 10.0),
-                                ("sample", DT, 10.0)):
+                                ("sample", DT, 10.0), ("push", -1e-12, 0.9), ("damping_weight", -1e-12, 100.0)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
                 raise ValueError(f"{name}: expected a finite number, got {value!r}")
@@ -78,6 +89,8 @@ class Design:
             object.__setattr__(self, name, float(value))
         if isinstance(self.harmonics, bool) or not isinstance(self.harmonics, int) or not 1 <= self.harmonics <= 50:
             raise ValueError(f"harmonics: expected a whole number in 1..50, got {self.harmonics!r}")
+        if self.push > 0 and round(self.push * self.duration / self.hold) < 1:
+            raise ValueError(f"push: {self.push:g} of {self.duration:g} s is shorter than one hold of {self.hold:g} s")
         if self.f_low >= self.f_high:
             raise ValueError(f"f_low, f_high: need f_low < f_high, got {self.f_low:g}, {self.f_high:g}")
         for name in ("hold", "sample"):
@@ -217,6 +230,31 @@ def information(model, design, u, sensors=None):
     return info, lean
 
 
+def process_information(model, design, u, sensors=None):
+    """(I, peak lean): the information (n, n) in the design's relative parameters that the sensor
+    set's process noise leaves, the bound on what any log of the program can hold.  The fit whitens
+    every reading by the torque disturbances (white, density q per generalized force,
+    `SensorSet.process`); with the velocities and accelerations read exactly, a parameter is seen
+    only through the generalized force it moves, g = M ν̇ − f, against that disturbance averaged over
+    each sample: I = Σ_samples sample · (M ∂ν̇/∂p)ᵀ diag(q)⁻² (M ∂ν̇/∂p).  A damping's column is its
+    torque −k ω, so its information is ∫ (k ω)² dt / q²: the speeds the program reaches.  Its
+    Cramér–Rao σ (`sigmas`) is what the sensor fit's σ comes to (docs/identification.md,
+    "Excitation"); the sensors' own information (`information`) is far larger."""
+    sensors = SensorSet.default() if sensors is None else sensors
+    q = sensors.process.generalized()
+    if not np.all(q > 0):
+        raise ValueError(f"sensors: the process noise's densities must be > 0 for its information, got {q.tolist()}")
+    columns = [PARAMETER_NAMES.index(n) for n in design.names]
+    p = model.params.as_array()
+    scale = np.where(np.abs(p[columns]) > 0, np.abs(p[columns]), 1.0)
+    X = model.simulate(initial_state(r=model.params.r), DT, design.steps, u=u, method=METHOD, energy_tol=None)
+    lean = float(np.max(absolute_inclinations(X)[1]))
+    rows = np.arange(0, design.steps, round(design.sample / DT))
+    G = np.einsum("bij,bjk->bik", model.inertia_batch(X[rows]),
+                  model.param_jacobian(X[rows], u[rows], columns=columns) * scale) / q[None, :, None]
+    return design.sample * np.einsum("bik,bil->kl", G, G), lean
+
+
 def _imu_rows(model, mount):
     """(x, ν̇) -> (H (6, 18), Hn (6, 5)) of the IMU at `mount`: sr_imu_partials on buffers made once
     (the per-sample cost of runtime.sensors.imu_partials is its argument checks, done once by the
@@ -243,6 +281,32 @@ def criterion(info):
     sign, logdet = np.linalg.slogdet(info)
     s = np.linalg.svd(info, compute_uv=False)
     return (float(logdet) if sign > 0 else -math.inf), (float(s[0] / s[-1]) if s[-1] > 0 else math.inf)
+
+
+#: The dampings: their torques −k ω are what the damping weight of the criterion is for.
+DAMPINGS = ("k_S", "k_Y", "k_P")
+
+
+def weighted_criterion(info, names, damping_weight):
+    """log det I + w Σ_dampings −log (I⁻¹)_dd: D-optimality with each named damping's own
+    Cramér–Rao variance weighted in by w (−inf when I is singular).  D-optimality alone trades a
+    damping's σ for the volume of the whole confidence ellipsoid; the weight makes the dampings'
+    marginal information count on top of it."""
+    sign, logdet = np.linalg.slogdet(info)
+    if sign <= 0:
+        return -math.inf
+    inverse = np.linalg.inv(info)
+    dampings = [i for i, n in enumerate(names) if n in DAMPINGS]
+    return float(logdet - damping_weight * sum(math.log(inverse[i, i]) for i in dampings))
+
+
+def sigmas(info):
+    """The Cramér–Rao standard deviations of the relative parameters, sqrt(diag I⁻¹) (inf when I is
+    singular)."""
+    try:
+        return np.sqrt(np.diag(np.linalg.inv(info)))
+    except np.linalg.LinAlgError:
+        return np.full(len(info), math.inf)
 
 
 def worst_sigma(info):
@@ -284,7 +348,8 @@ class Result:
     (fraction of u_max after the envelope), its information's log det and condition number, its
     peak lean, the number of evaluations of the information, its worst relative standard deviation
     (`worst_sigma`), and the same numbers of the naive programs (name -> (log det, condition, lean,
-    amplitude, worst sigma))."""
+    amplitude, worst sigma)); `sigmas`: program name -> (weighted criterion, σ per parameter) of
+    the process-noise bound (`process_information`), the damping phase's first when it was kept."""
     design: Design
     torques: np.ndarray
     amplitude: float
@@ -294,6 +359,54 @@ class Result:
     naive: dict
     evaluations: int
     sigma: float = math.nan
+    sigmas: dict = dataclasses.field(default_factory=dict)
+
+
+def _process_numbers(model, design, u):
+    """(weighted criterion, σ per parameter, lean) of a program from `process_information`."""
+    info, lean = process_information(model, design, u)
+    return weighted_criterion(info, design.names, design.damping_weight), sigmas(info), lean
+
+
+def damping_phase(model, design, u):
+    """The program u (steps, 2) with its last `push` of the duration replaced by the damping phase,
+    and the whole scaled into the envelope: (torques, amplitude, weighted criterion, σ, lean).  A
+    damping's information is ∫ (k ω)² dt / q² (`process_information`), so the phase holds the
+    yoke's torque at the limit (the shell rolls on at the speed its dampings allow) and drives the
+    pendulum's torque as a sine at the frequency, on a 0.1 Hz grid over [f_low, f_high], and the
+    yoke's sign that maximise the weighted criterion; each candidate at the largest amplitude
+    (bisection to 1 %) that keeps the pendulum inside max_lean.  Returns u itself (amplitude 1)
+    when no candidate beats it or push is 0."""
+    base = _process_numbers(model, design, u)
+    best = (u, 1.0, *base)
+    n = round(round(design.push * design.duration / design.hold) * design.hold / DT)
+    if n == 0:
+        return best
+    per_hold = round(design.hold / DT)
+    t = (np.arange(n) // per_hold) * per_hold * DT
+    frequencies = np.arange(math.ceil(design.f_low / 0.1 - 1e-9), math.floor(design.f_high / 0.1 + 1e-9) + 1) * 0.1
+    for f in frequencies[frequencies > 0]:
+        for sign in (1.0, -1.0):
+            program = u.copy()
+            program[-n:] = design.u_max * np.stack([np.full(n, sign), np.sin(2 * np.pi * f * t)], axis=1)
+            lo, hi, found = 0.0, 1.0, None
+            for attempt in range(10):
+                amplitude = 1.0 if attempt == 0 else 0.5 * (lo + hi)
+                try:
+                    numbers = _process_numbers(model, design, amplitude * program)
+                except ValueError:
+                    numbers = None
+                if numbers is not None and numbers[2] <= design.max_lean:
+                    lo, found = amplitude, (amplitude * program, amplitude, *numbers)
+                    if amplitude == 1.0:
+                        break
+                else:
+                    hi = amplitude
+                if hi - lo < 0.01:
+                    break
+            if found is not None and found[2] > best[2]:
+                best = found
+    return best
 
 
 def design_program(params, design, seed=0, max_iterations=10):
@@ -342,7 +455,19 @@ def design_program(params, design, seed=0, max_iterations=10):
     if logdet < naive["random multisine"][0]:     # the search may only improve on where it started
         amplitude, u, info, lean = _within_envelope(model, design, start)
         logdet, condition = criterion(info)
-    return Result(design, u, amplitude, logdet, condition, lean, naive, count[0], worst_sigma(info))
+    predicted = {"D-optimal multisine": _process_numbers(model, design, u)[:2]}
+    for name, program in (("random multisine", torques(design, start, naive["random multisine"][3])),
+                          ("chirp", naive["chirp"][3] * chirp_u if "chirp" in naive else None)):
+        if program is not None:
+            predicted[name] = _process_numbers(model, design, program)[:2]
+    if design.push > 0:
+        pushed, scale, weighted, sigma, lean_p = damping_phase(model, design, u)
+        if scale != 1.0 or pushed is not u:
+            u, amplitude, lean = pushed, amplitude * scale, lean_p
+            info, _ = information(model, design, u)
+            logdet, condition = criterion(info)
+            predicted = {"with the damping phase": (weighted, sigma), **predicted}
+    return Result(design, u, amplitude, logdet, condition, lean, naive, count[0], worst_sigma(info), predicted)
 
 
 # -- the scenario file ------------------------------------------------------------------------------
@@ -352,8 +477,8 @@ def scenario_text(result, robot=None, out=None):
     [[torque]] window per hold."""
     d = result.design
     per_hold = round(d.hold / DT)
-    lines = [f"# An excitation for identifying {', '.join(d.names)}: a D-optimal multisine within |u| <= "
-             f"{d.u_max:g} N m",
+    lines = [f"# An excitation for identifying {', '.join(d.names)}: a D-optimal multisine"
+             + (f", its last {d.push:g} a damping phase," if d.push > 0 else "") + f" within |u| <= {d.u_max:g} N m",
              f"# and a pendulum lean of at most {d.max_lean:.4g} rad (python -m runtime excite; docs/identification.md).",
              f"# log det of the information {result.logdet:.4g}, condition number {result.condition:.3g}, "
              f"peak lean {result.lean:.3g} rad.",
@@ -382,7 +507,7 @@ def _toml_string(text):
 
 def report(result):
     """The comparison as text: the designed program's log det and condition against the naive ones."""
-    rows = [("D-optimal multisine", result.logdet, result.condition, result.lean, result.amplitude, result.sigma)]
+    rows = [("designed program", result.logdet, result.condition, result.lean, result.amplitude, result.sigma)]
     rows += [(name, *values) for name, values in result.naive.items()]
     lines = [f"parameters: {', '.join(result.design.names)} (relative to their nominal values); "
              f"{result.design.duration:g} s, |u| <= {result.design.u_max:g} N m, lean <= {result.design.max_lean:.4g} rad",
@@ -390,6 +515,13 @@ def report(result):
     lines += [f"{name:<22} {logdet:>10.3f} {cond:>10.3g} {lean:>10.3f} {amp:>10.3g} {sig:>12.3g}"
               for name, logdet, cond, lean, amp, sig in rows]
     lines.append(f"({result.evaluations} evaluations of the information)")
+    if result.sigmas:
+        names = result.design.names
+        lines.append(f"predicted sigma (relative, the process noise's bound), criterion = log det + "
+                     f"{result.design.damping_weight:g} x the dampings' log information:")
+        lines.append(f"{'program':<24} {'criterion':>10} " + " ".join(f"{n:>8}" for n in names))
+        lines += [f"{name:<24} {weighted:>10.3f} " + " ".join(f"{100 * v:>7.3g}%" for v in sigma)
+                  for name, (weighted, sigma) in result.sigmas.items()]
     return "\n".join(lines)
 
 
@@ -406,13 +538,18 @@ def main(argv):
                         help="the flip-over envelope: largest pendulum inclination [rad] (default pi/3)")
     parser.add_argument("--harmonics", type=int, default=4, help="frequencies per motor (default 4)")
     parser.add_argument("--f-high", type=float, default=2.0, help="the band's top [Hz] (default 2)")
+    parser.add_argument("--push", type=float, default=0.5,
+                        help="the fraction of the duration at the end given to the damping phase (default 0.5; 0: none)")
+    parser.add_argument("--damping-weight", type=float, default=2.0,
+                        help="the dampings' weight in the criterion (default 2; 0: D-optimality alone)")
     parser.add_argument("--iterations", type=int, default=10, help="L-BFGS-B iterations at most (default 10)")
     parser.add_argument("--seed", type=int, default=0, help="the random-phase start (default 0)")
     args = parser.parse_args(argv)
     try:
         params = load_robot(args.robot) if args.robot else Params.paper_simulation()
         design = Design(args.params, args.duration, u_max=args.u_max, max_lean=args.max_lean,
-                        harmonics=args.harmonics, f_high=args.f_high)
+                        harmonics=args.harmonics, f_high=args.f_high, push=args.push,
+                        damping_weight=args.damping_weight)
         if args.iterations < 1:
             raise ValueError(f"iterations: expected a whole number >= 1, got {args.iterations}")
         if args.seed < 0:
@@ -428,5 +565,6 @@ def main(argv):
     return 0
 
 
-__all__ = ["Design", "Result", "design_program", "information", "criterion", "worst_sigma", "torques", "chirp",
+__all__ = ["Design", "Result", "design_program", "information", "process_information", "weighted_criterion",
+           "damping_phase", "sigmas", "DAMPINGS", "criterion", "worst_sigma", "torques", "chirp",
            "random_coefficients", "parameter_names", "scenario_text", "report", "main"]

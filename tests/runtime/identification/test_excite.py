@@ -12,13 +12,14 @@ from runtime.identification import excite
 from runtime.model import Model
 from runtime.params import Params
 from runtime.scenario import load_scenario, run_scenario
+from runtime.sensor_set import SensorSet
 from runtime.state import absolute_inclinations, initial_state
 
 NAMES = "k_S,k_Y,k_P"
 
 
 def design(**changes):
-    return excite.Design(NAMES, 2.0, **{"harmonics": 2, "f_high": 1.5, "sample": 0.05, **changes})
+    return excite.Design(NAMES, 2.0, **{"harmonics": 2, "f_high": 1.5, "sample": 0.05, "push": 0.0, **changes})
 
 
 @pytest.fixture(scope="module")
@@ -67,6 +68,43 @@ def test_the_information_is_the_sensitivities_gram_matrix(result):
     assert math.isclose(excite.criterion(info)[0], result.logdet, rel_tol=1e-9)
 
 
+def test_the_damping_weight_ranks_a_dampings_information_above_the_volume():
+    names = ("m_P", "k_S", "k_Y")
+    volume = np.diag([4.0, 1.0, 1.0])          # log det log 4, the dampings' variances 1
+    dampings = np.diag([1.0, 1.5, 1.5])        # log det log 2.25: a smaller ellipsoid's volume loses
+    assert np.linalg.slogdet(volume)[1] > np.linalg.slogdet(dampings)[1]
+    # log 4 against log 2.25 + 2 (2 log 1.5): the weight of 2 on each damping's −log variance decides
+    assert excite.weighted_criterion(dampings, names, 2.0) > excite.weighted_criterion(volume, names, 2.0)
+    assert math.isclose(excite.weighted_criterion(volume, names, 0.0), math.log(4.0))
+
+
+def test_the_process_information_of_a_damping_is_its_torque_squared_over_the_noise():
+    # g = M ν̇ − f moves by −ω_P per unit k_P: I[k_P, k_P] = Σ sample (k_P ω_P)² / q_P², from the motion alone
+    params = Params.paper_simulation()
+    d = excite.Design("k_P,m_P", 2.0, sample=0.05)
+    u = 0.3 * np.stack([np.sin(np.arange(d.steps) * 0.02), np.cos(np.arange(d.steps) * 0.05)], axis=1)
+    info, lean = excite.process_information(Model(params), d, u)
+    X = Model(params).simulate(initial_state(r=params.r), excite.DT, d.steps, u=u, method=excite.METHOD,
+                               energy_tol=None)
+    w_P = X[np.arange(0, d.steps, 5), -1]
+    q = SensorSet.default().process.pendulum
+    assert math.isclose(info[0, 0], d.sample * np.sum((params.k_P * w_P) ** 2) / q ** 2, rel_tol=1e-9)
+    assert math.isclose(lean, lean_of(u), rel_tol=1e-12)
+
+
+def test_the_damping_phase_holds_the_yoke_and_drives_the_pendulum_within_the_envelope():
+    d = excite.Design(NAMES, 4.0, harmonics=2, f_high=1.5, sample=0.05, push=0.5, max_lean=0.6)
+    model = Model(Params.paper_simulation())
+    u0 = excite.torques(d, excite.random_coefficients(d), 0.05)
+    u, amplitude, weighted, sigma, lean = excite.damping_phase(model, d, u0)
+    half = d.steps // 2
+    assert np.allclose(u[:half], amplitude * u0[:half])
+    assert np.ptp(u[half:, 0]) == 0 and abs(u[-1, 0]) == pytest.approx(amplitude * d.u_max)
+    assert np.abs(u[half:, 1]).max() == pytest.approx(amplitude * d.u_max, rel=0.05)
+    assert lean_of(u) <= d.max_lean and np.abs(u).max() <= d.u_max * (1 + 1e-12)
+    assert sigma[0] < excite.sigmas(excite.process_information(model, d, u0)[0])[0]     # k_S better seen
+
+
 def test_the_scenario_file_runs_the_designed_torques(result, tmp_path):
     path = tmp_path / "excite.toml"
     path.write_text(excite.scenario_text(result))
@@ -80,7 +118,8 @@ def test_the_command_writes_a_scenario_and_reports(tmp_path, capsys):
     out = tmp_path / "p.toml"
     assert cli.main(["excite", "--params", "k_S", "--duration", "2", "--harmonics", "2", "--iterations", "1",
                      "--f-high", "1.5", "--out", str(out)]) == 0
-    assert "log det" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "log det" in printed and "predicted sigma" in printed
     assert load_scenario(out).steps == 200
 
 
@@ -117,6 +156,9 @@ def test_a_whole_field_stands_for_its_entries():
     ({"f_low": 1.0, "f_high": 0.5}, "f_low, f_high: need f_low < f_high"),
     ({"harmonics": 0}, "harmonics: expected a whole number"),
     ({"hold": 0.015}, "hold: 0.015 s is not a whole number of steps"),
+    ({"push": 0.95}, "push: 0.95 is outside"),
+    ({"push": 0.01}, "push: 0.01 of 2 s is shorter than one hold"),
+    ({"damping_weight": -1.0}, "damping_weight: -1 is outside"),
 ])
 def test_bad_design_settings_are_named(changes, message):
     with pytest.raises(ValueError, match=message):
