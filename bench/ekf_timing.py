@@ -1,8 +1,8 @@
 """Builds and runs bench/bench_ekf.c (one 200 Hz sample of the error-state EKF: an RKMK4 predict, an
 IMU and an encoder update; each part alone too) in the portable -O2 build of the bench
 (runtime.bench.harness.ekf_sample), and prints its JSON.  With --baseline REV the same program is
-also built with the filter's sources (EKF_SOURCES: the filter, the step Jacobians and the
-accelerations' Jacobians) as they were at the git revision REV, and the two run in turns (the same
+also built with the filter's sources (EKF_SOURCES: the filter, the step Jacobians, the
+accelerations' Jacobians and the sensors' Jacobians) as they were at the git revision REV, and the two run in turns (the same
 samples, the same load): before and after, C against C in one run.  With --callgrind each build's
 instructions per sample and per part are counted too (valgrind's callgrind, the setup subtracted):
 the numbers a loaded machine does not move.
@@ -35,7 +35,7 @@ FLAGS = [f for f in LIBRARY_FLAGS if f != "-O3"] + ["-O2", "-ffp-contract=off"]
 #: bench_ekf's PARTS: what each counted run does.
 PARTS = {"predict_imu_encoders": 7, "predict": 1, "update_imu": 2, "update_encoders": 4}
 #: The sources of c/src that --baseline takes from the other revision: those a sample's own work runs in.
-EKF_SOURCES = ("sr_ekf.c", "sr_step_jacobians.c", "sr_jacobians.c")
+EKF_SOURCES = ("sr_ekf.c", "sr_step_jacobians.c", "sr_jacobians.c", "sr_sensors.c")
 
 
 def instructions(exe, samples, parts):

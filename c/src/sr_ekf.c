@@ -116,7 +116,7 @@ static void solve_both(int n, const sr_real *L, sr_real *b)
 }
 
 /* The filter's own data: x a valid state, biases and P finite. */
-static int check_filter(const sr_model *model, const sr_ekf *ekf)
+static SR_LANES_CLONES int check_filter(const sr_model *model, const sr_ekf *ekf)
 {
     const int status = sr_internal_check_state(model, ekf->x);
     if (status != SR_OK) return status;
@@ -176,28 +176,34 @@ static int valid_process(const sr_ekf_process *q)
     return q->gyro_bias_rw >= 0 && isfinite(q->gyro_bias_rw) && q->accel_bias_rw >= 0 && isfinite(q->accel_bias_rw);
 }
 
-/* Q_nu = dt M^-1 D^2 M^-1 (D = diag of the torque densities): Z = M^-1 D by the library's Cholesky
- * solve on all five columns at once, Q = dt Z Z^T. */
-static int torque_noise(const sr_model *model, const sr_real x[SR_NX], const sr_ekf_process *q, sr_real dt,
-                        sr_real Q[SR_NV * SR_NV])
+/* Q_nu = dt M^-1 D^2 M^-1 (D = diag of the torque densities) from M^-1 (the factorisation of the
+ * accelerations' Jacobian, sr_internal_accel_jacobian_minv): Z = M^-1 D, Q = dt Z Z^T, exactly
+ * symmetric. */
+static void torque_noise_of(const sr_real Minv[SR_NV * SR_NV], const sr_ekf_process *q, sr_real dt,
+                            sr_real Q[SR_NV * SR_NV])
 {
-    sr_real M[SR_NV * SR_NV], Mu[15], L[SR_NV * SR_NV], inv[SR_NV], Z[SR_NV * SR_NV] = {0};
+    sr_real Z[SR_NV * SR_NV];
     const sr_real d[SR_NV] = {q->torque_psd[0], q->torque_psd[0], q->torque_psd[0], q->torque_psd[1],
                               q->torque_psd[2]};
-    int status = sr_internal_inertia(model, x, M), i, j, k;
-    if (status != SR_OK) return status;
+    int i, j, k;
     for (i = 0; i < SR_NV; ++i)
-        for (j = i; j < SR_NV; ++j) Mu[SR_UPPER[i][j]] = M[SR_NV * i + j];
-    status = sr_internal_cholesky(Mu, L, inv);
-    if (status != SR_OK) return status;
-    for (i = 0; i < SR_NV; ++i) Z[SR_NV * i + i] = d[i];
-    sr_internal_cholesky_solve(L, inv, SR_NV, SR_NV, Z);
+        for (k = 0; k < SR_NV; ++k) Z[SR_NV * i + k] = Minv[SR_NV * i + k] * d[k];
     for (i = 0; i < SR_NV; ++i)
         for (j = i; j < SR_NV; ++j) {
             sr_real s = 0;
             for (k = 0; k < SR_NV; ++k) s += Z[SR_NV * i + k] * Z[SR_NV * j + k];
             Q[SR_NV * i + j] = Q[SR_NV * j + i] = dt * s;
         }
+}
+
+/* The same at x, M^-1 by its own evaluation (x valid): for a held disturbance's prior. */
+static int torque_noise(const sr_model *model, const sr_real x[SR_NX], const sr_ekf_process *q, sr_real dt,
+                        sr_real Q[SR_NV * SR_NV])
+{
+    sr_real a[SR_NV], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], Minv[SR_NV * SR_NV];
+    const int status = sr_internal_accel_jacobian_minv(model, x, sr_zero_u, a, Ja, Jb, Minv);
+    if (status != SR_OK) return status;
+    torque_noise_of(Minv, q, dt, Q);
     return SR_OK;
 }
 
@@ -259,13 +265,14 @@ static void release_held(sr_ekf *ekf, sr_real g, const sr_ekf_held *next)
 
 /* x_next = the step of `method` (sr_step's bits) and F the transition matrix: the Lie-Euler step's
  * Jacobian at x, whatever the method (sr_ekf.h, "Transition matrix"), one evaluation of the
- * accelerations' Jacobian instead of one per stage.  x valid, u finite, method and dt valid. */
+ * accelerations' Jacobian instead of one per stage; Minv = M^-1 at x from its factorisation, for
+ * the process noise.  x valid, u finite, method and dt valid. */
 static int step_and_transition(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                               sr_real dt, sr_real x_next[SR_NX], sr_real F[NE * NE])
+                               sr_real dt, sr_real x_next[SR_NX], sr_real F[NE * NE], sr_real Minv[SR_NV * SR_NV])
 {
     int status = sr_internal_advance(model, method, x, u, dt, NULL, x_next);
     if (status == SR_OK && !all_finite(x_next, SR_NX)) status = SR_ERR_NONFINITE;
-    if (status == SR_OK) status = sr_internal_step_jacobian_lie_euler(model, x, u, dt, F, NULL);
+    if (status == SR_OK) status = sr_internal_step_jacobian_lie_euler_minv(model, x, u, dt, F, NULL, Minv);
     return status;
 }
 
@@ -407,7 +414,7 @@ int sr_ekf_set_observability_constraint(sr_ekf *ekf, const sr_model *model, int 
 SR_LANES_CLONES int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int method, const sr_real u[SR_NU], sr_real dt,
                    const sr_ekf_process *process)
 {
-    sr_real xn[SR_NX], F[NE * NE], Qnu[SR_NV * SR_NV], T[NE * NBP], Pp[NE * NBP], Pn[NB * NB], g, white;
+    sr_real xn[SR_NX], F[NE * NE], Minv[SR_NV * SR_NV], Qnu[SR_NV * SR_NV], T[NE * NBP], Pp[NE * NBP], Pn[NB * NB], g, white;
     sr_real Nn[NE * 3];   /* the constraint's N at the predicted state */
     sr_ekf_held next;
     int status = arg_model(model, READS(WHOLE)), i, j, k, dq_identity = 1, cols[NE], ncols = 0;
@@ -417,12 +424,12 @@ SR_LANES_CLONES int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int metho
     if (u && !all_finite(u, SR_NU)) return SR_ERR_NONFINITE;
     status = check_filter(model, ekf);
     /* The state and u are checked: the step of `method`, and F (sr_ekf.h, "Transition matrix"). */
-    if (status == SR_OK) status = step_and_transition(model, method, ekf->x, u ? u : sr_zero_u, dt, xn, F);
+    if (status == SR_OK) status = step_and_transition(model, method, ekf->x, u ? u : sr_zero_u, dt, xn, F, Minv);
     /* A held disturbance drives g of dt; the torque noise the rest (white, a share of Q_nu). */
     g = held_for(&ekf->held, dt);
     white = (dt - g) / dt;
-    if (status == SR_OK && white > 0) status = torque_noise(model, ekf->x, process, dt, Qnu);
     if (status != SR_OK) return status;
+    if (white > 0) torque_noise_of(Minv, process, dt, Qnu);
 
     /* F P F^T with F = [[F_d, 0], [0, I]] blockwise: T = F_d [P_dd P_db] (the cross terms F_d P_db come
      * with it), then F_d P_dd F_d^T = T_dd F_d^T on the upper triangle.  The steps' F_d has the
@@ -702,10 +709,20 @@ static SR_LANES_CLONES int apply(sr_ekf *ekf, int kind, int m, const sr_real *r,
     memcpy(ekf->x, xn, sizeof xn);
     for (i = 0; i < SR_NBIAS; ++i) ekf->bias[i] += e[SR_EB_b_g + i];
     if (ekf->constrained) carry_null_space(ekf, Jr);
-    for (a = 0; a < NB; ++a) {
-        for (b = 0; b < a; ++b) ekf->P[NB * a + b] = Pn[NBP * b + a];
-        for (b = a; b < NB; ++b) ekf->P[NB * a + b] = Pn[NBP * a + b];
+    /* Pn's rows whole (a copy of fixed length, in vectors), then the lower triangle from the upper,
+     * two rows of Pn a pass (one entry of each a step: half the overhead of a column at a time). */
+    for (a = 0; a < NB; ++a)
+        for (b = 0; b < NB; ++b) ekf->P[NB * a + b] = Pn[NBP * a + b];
+    for (b = 0; b + 1 < NB; b += 2) {
+        const sr_real *u0 = Pn + NBP * b, *u1 = u0 + NBP;
+        ekf->P[NB * (b + 1) + b] = u0[b + 1];
+        for (a = b + 2; a < NB; ++a) {
+            ekf->P[NB * a + b] = u0[a];
+            ekf->P[NB * a + b + 1] = u1[a];
+        }
     }
+    for (; b < NB; ++b)
+        for (a = b + 1; a < NB; ++a) ekf->P[NB * a + b] = Pn[NBP * b + a];
     if (recovering)
         ekf->recovered[kind] += 1;
     else

@@ -96,7 +96,8 @@ static inline void subtract_dM_g(const sr_real dM[4 * 15], const sr_real g[SR_NV
 /* The general robot, in the shell frame: M, f, df/dd, df/du, dM/dd from the generated kernel,
  * M = L L^T; ja, jb its 5 x 12 and 5 x 2 Jacobians. */
 static int general_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                                  sr_real acc[SR_NV], sr_real ja[SR_NV * SR_NE], sr_real jb[SR_NV * SR_NU])
+                                  sr_real acc[SR_NV], sr_real ja[SR_NV * SR_NE], sr_real jb[SR_NV * SR_NU],
+                                  sr_real *minv)
 {
     sr_real Mu[15], f[SR_NV], df[SR_NV * SR_NE], dfdu[SR_NV * SR_NU], dM[5 * 15], L[SR_NV * SR_NV], inv[SR_NV];
     sr_real a[SR_NV][NCOL], B[SR_NV][NCOL];
@@ -119,6 +120,13 @@ static int general_accel_jacobian(const sr_model *model, const sr_real x[SR_NX],
         for (k = 0; k < SR_NE; ++k) ja[SR_NE * i + k] = B[i][k];
         for (k = 0; k < SR_NU; ++k) jb[SR_NU * i + k] = B[i][SR_NE + k];
     }
+    if (minv) {   /* M^-1 = M^-1 I */
+        for (i = 0; i < SR_NV; ++i)
+            for (k = 0; k < SR_NV; ++k) a[i][k] = i == k ? 1 : 0;
+        sr_internal_cholesky_solve(L, inv, NCOL, SR_NV, &a[0][0]);
+        for (i = 0; i < SR_NV; ++i)
+            for (k = 0; k < SR_NV; ++k) minv[SR_NV * i + k] = a[i][k];
+    }
     return SR_OK;
 }
 
@@ -137,9 +145,13 @@ static int general_accel_jacobian(const sr_model *model, const sr_real x[SR_NX],
  * column loops of joint_first_solve need no scalar remainder (which GCC's -O2 does not vectorise). */
 enum { Y_XI = 0, Y_TH_P = 3, Y_W = 4, Y_U = 9, Y_NCOL = 11, Y_SOLVED = 12 };
 typedef char solved_fit[(Y_SOLVED <= NCOL && Y_SOLVED % 4 == 0) ? 1 : -1];
+/* SR_LANES_CLONES: with -DSR_CLONES also compiled for AVX2 (the same bits: no FMA, no contraction),
+ * so that joint_first_solve's column loops run four numbers a vector (the filter's predict and IMU
+ * update call it). */
 
-static int paper_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                                sr_real acc[SR_NV], sr_real ja[SR_NV * SR_NE], sr_real jb[SR_NV * SR_NU])
+static SR_LANES_CLONES int paper_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                sr_real acc[SR_NV], sr_real ja[SR_NV * SR_NE], sr_real jb[SR_NV * SR_NU],
+                                sr_real *minv)
 {
     const sr_real c = x[SR_X_R_Y + 4], s = x[SR_X_R_Y + 7];
     const sr_real *w = x + SR_X_w_S;
@@ -197,13 +209,39 @@ static int paper_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], c
         for (k = 0; k < SR_NE; ++k) ja[SR_NE * i + k] = Y[i][k];
         for (k = 0; k < SR_NU; ++k) jb[SR_NU * i + k] = Y[i][SR_NE + k];
     }
+    if (minv) {   /* M^-1 = T^T M'^-1 T: M'^-1 on eight columns (the identity's five, zeros), then
+                   * R_Y on rows 1 and 2 (T^T) and on columns 1 and 2 (T) */
+        for (i = 0; i < SR_NV; ++i)
+            for (k = 0; k < 8; ++k) g[i][k] = i == k ? 1 : 0;
+        joint_first_solve(&jf, g, 8);
+        for (i = 0; i < SR_NV; ++i) {
+            const sr_real y1 = g[i][1], y2 = g[i][2];
+            g[i][1] = c * y1 - s * y2;
+            g[i][2] = s * y1 + c * y2;
+        }
+        for (k = 0; k < SR_NV; ++k) {
+            minv[k] = g[0][k];
+            minv[SR_NV + k] = c * g[1][k] - s * g[2][k];
+            minv[2 * SR_NV + k] = s * g[1][k] + c * g[2][k];
+            minv[3 * SR_NV + k] = g[3][k];
+            minv[4 * SR_NV + k] = g[4][k];
+        }
+    }
     return SR_OK;
+}
+
+int sr_internal_accel_jacobian_minv(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                    sr_real a[SR_NV], sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU],
+                                    sr_real *Minv)
+{
+    return model->general ? general_accel_jacobian(model, x, u, a, Ja, Jb, Minv)
+                          : paper_accel_jacobian(model, x, u, a, Ja, Jb, Minv);
 }
 
 int sr_internal_accel_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
                                sr_real a[SR_NV], sr_real Ja[SR_NV * SR_NE], sr_real Jb[SR_NV * SR_NU])
 {
-    return model->general ? general_accel_jacobian(model, x, u, a, Ja, Jb) : paper_accel_jacobian(model, x, u, a, Ja, Jb);
+    return sr_internal_accel_jacobian_minv(model, x, u, a, Ja, Jb, NULL);
 }
 
 /* out = Ja V on the read rows (see sr_jacobians.h), the paper's robot: the chain rule of
@@ -291,7 +329,7 @@ static int general_accel_jacobian_along(const sr_model *model, const sr_real x[S
                                                    SR_E_th_P, SR_E_nu + 0, SR_E_nu + 1, SR_E_nu + 2,
                                                    SR_E_nu + 3, SR_E_nu + 4};
     sr_real ja[SR_NV * SR_NE];
-    int i, k, l, status = general_accel_jacobian(model, x, u, acc, ja, jb);
+    int i, k, l, status = general_accel_jacobian(model, x, u, acc, ja, jb, NULL);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NV; ++i) {
         sr_real o[SR_J_NC];
@@ -350,13 +388,13 @@ int sr_accel_jacobian_batch(const sr_model *model, long n, const sr_real *x, con
     return SR_OK;
 }
 
-int sr_internal_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                                        sr_real dt, sr_real F[SR_NE * SR_NE], sr_real *G)
+int sr_internal_step_jacobian_lie_euler_minv(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                             sr_real dt, sr_real F[SR_NE * SR_NE], sr_real *G, sr_real *Minv)
 {
     const sr_real *w, *R;
     sr_real a[SR_NV], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], phi[3], D[9], Jr[9], f[SR_NE * SR_NE], g[SR_NE * SR_NU];
     sr_real v[2][3], r;
-    int status = sr_internal_accel_jacobian(model, x, u, a, Ja, Jb), i, j;
+    int status = sr_internal_accel_jacobian_minv(model, x, u, a, Ja, Jb, Minv), i, j;
     if (status != SR_OK) return status;
     w = x + SR_X_w_S;
     R = x + SR_X_R_S;
@@ -402,6 +440,12 @@ int sr_internal_step_jacobian_lie_euler(const sr_model *model, const sr_real x[S
     memcpy(F, f, sizeof f);
     if (G) memcpy(G, g, sizeof g);
     return SR_OK;
+}
+
+int sr_internal_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                        sr_real dt, sr_real F[SR_NE * SR_NE], sr_real *G)
+{
+    return sr_internal_step_jacobian_lie_euler_minv(model, x, u, dt, F, G, NULL);
 }
 
 int sr_step_jacobian_lie_euler(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], sr_real dt,

@@ -136,7 +136,9 @@ int sr_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real
     return sr_internal_imu_jacobian(model, x, u, body, mount, bias, y, H);
 }
 
-int sr_internal_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int body,
+/* SR_LANES_CLONES: with -DSR_CLONES also compiled for AVX2 (the same bits: no FMA, no
+ * contraction), the accelerometer's chain rule four columns a vector (the filter's IMU update). */
+SR_LANES_CLONES int sr_internal_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int body,
                              const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU],
                              sr_real H[SR_NIMU * SR_NEB])
 {
