@@ -126,6 +126,7 @@ class _Data:
     enc_row: np.ndarray
     fix_row: np.ndarray
     interval: np.ndarray     # (n,) index of the process-noise interval (torque period) of each node
+    into: np.ndarray         # (n,) time since the start of the node's torque period
     tau: float               # the torque period
     skipped: int             # samples off the node grid
 
@@ -152,8 +153,10 @@ def _grid(log):
     dts = np.diff(log.torques.t)
     tau = float(np.median(dts)) if len(dts) else h
     interval = np.floor((t - float(log.torques.t[0])) / tau + 1e-6).astype(int)
+    into = np.clip(t - float(log.torques.t[0]) - interval * tau, 0.0, tau)
+    into[into <= 1e-6 * tau] = 0.0
     return _Data(t=t, h=h, u=log.torque_at(t), imu_row=rows(imu.t), enc_row=rows(log.encoders.t),
-                 fix_row=rows(fix_times), interval=interval, tau=tau, skipped=skipped)
+                 fix_row=rows(fix_times), interval=interval, into=into, tau=tau, skipped=skipped)
 
 
 def check_log(log, full_state=False):
@@ -357,11 +360,26 @@ class _Problem:
             enters[entering] = kappa
         return js, P, enters, Minv
 
+    def _own_period(self, s, blk, Minv):
+        """(n, 5): what each noise-scaled reading of a segment sees directly of its own torque
+        period's force w (per unit force): the accelerometer's M⁻¹ w, and the velocities' jump so
+        far, M⁻¹ w t' at a time t' into the period (the truth's held force moves the velocities
+        from the period's start, `runtime.sensor_sim`; the states of the fit's later nodes see
+        the whole jump M⁻¹ w τ once the period has ended).  With a period longer than the IMU's,
+        the readings inside it would otherwise miss that share: the gyroscope about the yoke's
+        axis read 1.7 times its declared variance there."""
+        rows = blk["rows"]
+        node, sig = rows["node"], rows["sig"][:, None]
+        into = self.data.into[self.starts[s] + node]
+        M = Minv[node]
+        return (np.einsum("rj,rjk->rk", rows["Hn"], M)
+                + np.einsum("rj,rjk->rk", rows["Hx"][:, IDX_E_NU], M) * into[:, None]) / sig
+
     def noise_map(self, s, blk):
         """(A, Q): the effect on the segment's noise-scaled readings and on its end state (the last
         12 rows) of the process noise's forces w_j, one per torque period and held over it (the
-        accelerometer reads M⁻¹ w_j, the velocities jump by M⁻¹ w_j τ at its end), w_j of
-        covariance diag(Q)."""
+        accelerometer reads M⁻¹ w_j, the velocities jump by M⁻¹ w_j τ at its end; a reading inside
+        the period sees their jump so far, `_own_period`), w_j of covariance diag(Q)."""
         d = self.data
         Phi, rows = blk["Phi"], blk["rows"]
         k0 = self.starts[s]
@@ -370,9 +388,8 @@ class _Problem:
         n = len(node)
         A = np.zeros((n + NE, 5 * len(js)))
         A[:n] = np.einsum("rj,rjk->rk", rows["Hx"], Phi[node]) @ P / sig * np.repeat(enters[None, :] <= node[:, None], 5, 1)
-        imu = np.flatnonzero(rows["kind"] == 0)
-        c = np.searchsorted(js, d.interval[k0 + node[imu]])
-        A[imu[:, None], 5 * c[:, None] + np.arange(5)] += np.einsum("rj,rjk->rk", rows["Hn"][imu], Minv[node[imu]]) / sig[imu]
+        c = np.searchsorted(js, d.interval[k0 + node])
+        A[np.arange(n)[:, None], 5 * c[:, None] + np.arange(5)] += self._own_period(s, blk, Minv)
         A[n:] = (Phi[-1] @ P) * np.repeat(enters <= len(Phi) - 1, 5)
         return A, np.tile(self.q2 / d.tau, len(js))
 
@@ -406,12 +423,10 @@ class _Problem:
         js, P, enters, Minv = self._noise_parts(s, blk)
         root_q = np.sqrt(self.q2 / d.tau)
         Pw = (P.reshape(NE, -1, 5) * root_q).swapaxes(0, 1)        # (periods, 12, 5), w_j in unit noise
-        node, sig, kind = rows["node"], rows["sig"], rows["kind"]
+        node, sig = rows["node"], rows["sig"]
         n = blk["n_out"]
         H = np.einsum("rj,rjk->rk", rows["Hx"], Phi[node]) / sig[:, None]
-        G = np.zeros((n, 5))            # the IMU's direct reading of its own period's w_j
-        imu = np.flatnonzero(kind == 0)
-        G[imu] = np.einsum("rj,rjk->rk", rows["Hn"][imu], Minv[node[imu]]) / sig[imu, None] * root_q
+        G = self._own_period(s, blk, Minv) * root_q     # the direct reading of its own period's w_j
         period = np.searchsorted(js, d.interval[k0 + node])
         bounds = np.searchsorted(period, np.arange(len(js) + 1))
         Sigma = np.zeros((NE, NE))
