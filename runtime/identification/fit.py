@@ -62,6 +62,12 @@ DEFECT_FLOOR = 1e-7
 #: parameters held (the segments, each fitted alone, disagree at their ends by the start guess's
 #: errors, which are linear in the start states).
 STATES_NFEV = 8
+#: A sensor fit has converged when an undamped Gauss–Newton step would lower its cost ½‖r‖² by less
+#: than this: the optimum is then within √(2 · 0.01) = 0.14 σ of the estimate in the information's
+#: metric (every unknown together).  The first joint stage stops at RELINEARISE_DECREMENT instead:
+#: the covariance is linearised again where it stops, which moves the optimum by more than that.
+CONVERGED_DECREMENT = 0.01
+RELINEARISE_DECREMENT = 1.0
 
 
 class IdentifyError(ValueError):
@@ -183,7 +189,9 @@ class Fit:
     combinations the log cannot separate; `biases` (6,) and their sigma; `residual_check`: {"rms",
     "chi2", "dof", "p_value", "passed"}; `residuals` {kind: (t, whitened residuals)} for plots;
     `params` the estimated robot; `nfev`, `status`, `message` of the solver; `start` the free
-    entries where the fit started them (`STARTS`)."""
+    entries where the fit started them (`STARTS`); `converged`: the solver stopped at the optimum
+    (a sensor fit: its Gauss–Newton `decrement` below CONVERGED_DECREMENT), not at its budget;
+    an unconverged fit's estimates and intervals are not the optimum's, and its message says so."""
     names: tuple
     nominal: np.ndarray
     estimate: np.ndarray
@@ -208,6 +216,8 @@ class Fit:
     message: str
     mode: str
     start: np.ndarray = None
+    converged: bool = True
+    decrement: float = math.nan
 
 
 def _inverse_cholesky(S):
@@ -663,13 +673,15 @@ def _start_guess(log, params, with_sigma=False):
     return (est.x[k], est.biases[-1], est.sigma[k]) if with_sigma else (est.x[k], est.biases[-1])
 
 
-def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, max_nfev=20, progress=None,
+def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, max_nfev=60, progress=None,
              x_guess=None, bias_guess=None, jacobian="analytic", start="regressor"):
     """Fit the parameters `names` (see `free_parameters`) of the robot `params` (the others held) to
     `log` (runtime.estimation.logs.Log), with the IMU's biases and each segment's start state; or,
     `full_state`, to the log's truth by the one-step prediction error.  `segment` [s]: the
     multiple-shooting segments' length; `x_guess` (n_imu, 35) and `bias_guess` (6,) replace the
-    EKF's start guess.  `progress()` is called once per evaluation.  `jacobian`: the parameter
+    EKF's start guess.  `max_nfev`: the evaluations of each of a sensor fit's two joint stages
+    (before and after the covariance is linearised again; each stops early once converged,
+    `CONVERGED_DECREMENT`), of a full-state fit's solver.  `progress()` is called once per evaluation.  `jacobian`: the parameter
     sensitivities' source (`JACOBIANS`: "analytic", or "fd"/"fd-all", differences in C).  `start`
     (`STARTS`): the parameters' start, "regressor" the linear least-squares first guess
     (runtime.identification.first_guess) from the start guess's states (the log's truth for a
@@ -729,26 +741,29 @@ def _identify(log, params, free, segment, method, full_state, max_nfev, progress
             r, J, _ = prob.assemble(z)
             return r, J
 
-        sol = levenberg_marquardt(evaluate, z0, lo, hi, max_nfev)
-        prob.chol = None            # the covariance at the optimum, then a short refinement
+        sol = levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, dtol=RELINEARISE_DECREMENT)
+        prob.chol = None            # the covariance at the optimum, then the refinement
         prob._cache = (None, None)
-        sol = levenberg_marquardt(evaluate, sol.x, lo, hi, max(3, max_nfev // 2))
+        sol = levenberg_marquardt(evaluate, sol.x, lo, hi, max_nfev, dtol=CONVERGED_DECREMENT)
     return _report(prob, sol, free, params, full_state)
 
 
 @dataclasses.dataclass
 class Solution:
     """What `levenberg_marquardt` returns: the point `x`, its `cost` ½‖r‖², the evaluations `nfev`,
-    `status` (0 the evaluations ran out, 2 the cost stopped falling, 3 the step became negligible,
-    4 no step lowers the cost) and a `message`."""
+    `status` (0 the evaluations ran out, 1 converged: a Gauss–Newton step would lower the cost by
+    less than `dtol`, 2 the cost stopped falling, 3 the step became negligible, 4 no step lowers
+    the cost), a `message` and `decrement`, what an undamped Gauss–Newton step from x would lower
+    the cost by (½ gᵀ (JᵀJ)⁻¹ g over the entries not held on a bound)."""
     x: np.ndarray
     cost: float
     nfev: int
     status: int
     message: str
+    decrement: float = math.inf
 
 
-def levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, ftol=1e-8, xtol=1e-8, damping=1e-2):
+def levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, ftol=1e-8, xtol=1e-8, damping=1e-2, dtol=0.0):
     """Minimise ½‖r(z)‖² for lo <= z <= hi by Levenberg–Marquardt steps on the normal equations
     (JᵀJ + λ diag(d²)) δ = −Jᵀr, d the largest column norms of J seen so far (the scaling
     SciPy's x_scale="jac" uses), λ adapted by the gain ratio (Nielsen's rule), a step leaving the
@@ -767,14 +782,25 @@ def levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, ftol=1e-8, xtol=1e-8, da
     lam, nu = damping, 2.0
     status, message = 0, "the maximum number of evaluations is reached"
     fresh = True
-    while nfev < max_nfev:
-        if fresh:
-            A = (J.T @ J).toarray()
-            g = J.T @ r
-            d = np.maximum(d, np.sqrt(np.diag(A)))
-            d[d == 0] = 1.0
-            fresh = False
+
+    def normal_equations(z, r, J, d):
+        A = (J.T @ J).toarray()
+        g = J.T @ r
+        d = np.maximum(d, np.sqrt(np.diag(A)))
+        d[d == 0] = 1.0
         # entries on a bound that the gradient pushes outwards are held (the active set)
+        free = ~(((z <= lo) & (g > 0)) | ((z >= hi) & (g < 0)))
+        return A, g, d, free, _decrement(A[np.ix_(free, free)], g[free], d[free])
+
+    while True:
+        if fresh:
+            A, g, d, free, decrement = normal_equations(z, r, J, d)
+            fresh = False
+            if decrement <= dtol:
+                status, message = 1, f"converged: a Gauss–Newton step would lower the cost by {decrement:.2g}"
+                break
+        if nfev >= max_nfev:
+            break
         free = ~(((z <= lo) & (g > 0)) | ((z >= hi) & (g < 0)))
         try:
             c = scipy.linalg.cho_factor(A[np.ix_(free, free)] + lam * np.diag(d[free] ** 2), check_finite=False)
@@ -812,7 +838,20 @@ def levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, ftol=1e-8, xtol=1e-8, da
             if lam > 1e16:
                 status, message = 4, "no step lowers the cost"
                 break
-    return Solution(x=z, cost=cost, nfev=nfev, status=status, message=message)
+    if fresh:                   # stopped at a new point: what is left from there
+        decrement = normal_equations(z, r, J, d)[4]
+    return Solution(x=z, cost=cost, nfev=nfev, status=status, message=message, decrement=decrement)
+
+
+def _decrement(A, g, d):
+    """½ gᵀ A⁻¹ g: what an undamped Gauss–Newton step would lower the cost by (A regularised by
+    1e-12 of its scale, d², against a direction the log does not determine); inf if A is not
+    positive definite."""
+    try:
+        c = scipy.linalg.cho_factor(A + 1e-12 * np.diag(d ** 2), check_finite=False)
+    except np.linalg.LinAlgError:
+        return math.inf
+    return 0.5 * float(g @ scipy.linalg.cho_solve(c, g, check_finite=False))
 
 
 def first_guess(log, params, free, prob, full_state, x_guess):
@@ -880,6 +919,15 @@ def _report(prob, sol, free, params, full_state):
     rms = math.sqrt(chi2 / dof)
     check = {"rms": rms, "chi2": chi2, "dof": dof, "p_value": float(scipy.stats.chi2.sf(chi2, dof)),
              "tolerance": RESIDUAL_TOLERANCE, "passed": bool(abs(rms - 1) <= RESIDUAL_TOLERANCE)}
+    message = str(sol.message)
+    if full_state:
+        converged, decrement = bool(sol.status > 0), math.nan
+    else:
+        converged, decrement = bool(sol.decrement <= CONVERGED_DECREMENT), float(sol.decrement)
+        if not converged:
+            message += (f"; NOT converged: a Gauss–Newton step would still lower the cost by {decrement:.3g} "
+                        f"(converged below {CONVERGED_DECREMENT:g}), the estimates and intervals are not the "
+                        f"optimum's")
     if full_state:
         biases, bsig = np.full(6, np.nan), np.full(6, np.nan)
         series = {"velocities": (prob.t[1:], r.reshape(-1, NV))}
@@ -894,8 +942,9 @@ def _report(prob, sol, free, params, full_state):
                high=theta + Z95 * sigma, information=info, correlation=corr, rank=rank, condition=condition,
                identified=identified, on_bound=on_bound, combinations=combos, null_directions=nulls,
                biases=biases, bias_sigma=bsig, residual_check=check, residuals=series, params=estimated,
-               nfev=int(prob.nfev), status=int(sol.status), message=str(sol.message),
-               mode="full-state" if full_state else "sensors", start=prob.theta_start.copy())
+               nfev=int(prob.nfev), status=int(sol.status), message=message,
+               mode="full-state" if full_state else "sensors", start=prob.theta_start.copy(), converged=converged,
+               decrement=decrement)
 
 
 def _dpi(params, idx):
