@@ -62,12 +62,11 @@ DEFECT_FLOOR = 1e-7
 #: parameters held (the segments, each fitted alone, disagree at their ends by the start guess's
 #: errors, which are linear in the start states).
 STATES_NFEV = 8
-#: A sensor fit has converged when an undamped Gauss–Newton step would lower its cost ½‖r‖² by less
-#: than this: the optimum is then within √(2 · 0.01) = 0.14 σ of the estimate in the information's
-#: metric (every unknown together).  The first joint stage stops at RELINEARISE_DECREMENT instead:
-#: the covariance is linearised again where it stops, which moves the optimum by more than that.
-CONVERGED_DECREMENT = 0.01
-RELINEARISE_DECREMENT = 1.0
+#: A sensor fit has converged when an undamped Gauss–Newton step would move no free parameter by
+#: more than this fraction of its σ.  The first joint stage stops at RELINEARISE_SHIFT instead: the
+#: covariance is linearised again where it stops, which moves the optimum by more than that.
+CONVERGED_SHIFT = 0.05
+RELINEARISE_SHIFT = 0.5
 
 
 class IdentifyError(ValueError):
@@ -190,7 +189,8 @@ class Fit:
     "chi2", "dof", "p_value", "passed"}; `residuals` {kind: (t, whitened residuals)} for plots;
     `params` the estimated robot; `nfev`, `status`, `message` of the solver; `start` the free
     entries where the fit started them (`STARTS`); `converged`: the solver stopped at the optimum
-    (a sensor fit: its Gauss–Newton `decrement` below CONVERGED_DECREMENT), not at its budget;
+    (a sensor fit: its Gauss–Newton step `shift` of the parameters, in σ, below CONVERGED_SHIFT),
+    not at its budget;
     an unconverged fit's estimates and intervals are not the optimum's, and its message says so."""
     names: tuple
     nominal: np.ndarray
@@ -217,7 +217,7 @@ class Fit:
     mode: str
     start: np.ndarray = None
     converged: bool = True
-    decrement: float = math.nan
+    shift: float = math.nan
 
 
 def _inverse_cholesky(S):
@@ -681,7 +681,7 @@ def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, 
     multiple-shooting segments' length; `x_guess` (n_imu, 35) and `bias_guess` (6,) replace the
     EKF's start guess.  `max_nfev`: the evaluations of each of a sensor fit's two joint stages
     (before and after the covariance is linearised again; each stops early once converged,
-    `CONVERGED_DECREMENT`), of a full-state fit's solver.  `progress()` is called once per evaluation.  `jacobian`: the parameter
+    `CONVERGED_SHIFT`), of a full-state fit's solver.  `progress()` is called once per evaluation.  `jacobian`: the parameter
     sensitivities' source (`JACOBIANS`: "analytic", or "fd"/"fd-all", differences in C).  `start`
     (`STARTS`): the parameters' start, "regressor" the linear least-squares first guess
     (runtime.identification.first_guess) from the start guess's states (the log's truth for a
@@ -741,35 +741,37 @@ def _identify(log, params, free, segment, method, full_state, max_nfev, progress
             r, J, _ = prob.assemble(z)
             return r, J
 
-        sol = levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, dtol=RELINEARISE_DECREMENT)
+        sol = levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, stol=RELINEARISE_SHIFT, watch=prob.nf)
         prob.chol = None            # the covariance at the optimum, then the refinement
         prob._cache = (None, None)
-        sol = levenberg_marquardt(evaluate, sol.x, lo, hi, max_nfev, dtol=CONVERGED_DECREMENT)
+        sol = levenberg_marquardt(evaluate, sol.x, lo, hi, max_nfev, stol=CONVERGED_SHIFT, watch=prob.nf)
     return _report(prob, sol, free, params, full_state)
 
 
 @dataclasses.dataclass
 class Solution:
     """What `levenberg_marquardt` returns: the point `x`, its `cost` ½‖r‖², the evaluations `nfev`,
-    `status` (0 the evaluations ran out, 1 converged: a Gauss–Newton step would lower the cost by
-    less than `dtol`, 2 the cost stopped falling, 3 the step became negligible, 4 no step lowers
-    the cost), a `message` and `decrement`, what an undamped Gauss–Newton step from x would lower
-    the cost by (½ gᵀ (JᵀJ)⁻¹ g over the entries not held on a bound)."""
+    `status` (0 the evaluations ran out, 1 converged: a Gauss–Newton step would move no watched
+    entry by more than `stol` σ, 2 the cost stopped falling, 3 the step became negligible, 4 no step lowers
+    the cost), a `message` and `shift`, the largest step of a watched entry that an undamped
+    Gauss–Newton step from x would take, in units of its standard deviation (`_shift`)."""
     x: np.ndarray
     cost: float
     nfev: int
     status: int
     message: str
-    decrement: float = math.inf
+    shift: float = math.inf
 
 
-def levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, ftol=1e-8, xtol=1e-8, damping=1e-2, dtol=0.0):
+def levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, ftol=1e-8, xtol=1e-8, damping=1e-2, stol=0.0, watch=None):
     """Minimise ½‖r(z)‖² for lo <= z <= hi by Levenberg–Marquardt steps on the normal equations
     (JᵀJ + λ diag(d²)) δ = −Jᵀr, d the largest column norms of J seen so far (the scaling
     SciPy's x_scale="jac" uses), λ adapted by the gain ratio (Nielsen's rule), a step leaving the
     bounds projected onto them and the entries on a bound that the gradient pushes outwards held.
     `evaluate(z)` -> (r, J sparse); an `IdentifyError` (a candidate robot the model refuses)
-    counts as a rejected step.  The multiple-shooting Jacobian has a
+    counts as a rejected step.  Converged (status 1) when the undamped Gauss–Newton step would
+    move none of the first `watch` entries (None: all) by more than `stol` of its standard
+    deviation (`_shift`).  The multiple-shooting Jacobian has a
     dozen global columns and a band of start-state columns, so JᵀJ is small and nearly block
     tridiagonal and one Cholesky factorisation of it costs milliseconds; SciPy's dense
     trust-region solver instead takes an SVD of the whole Jacobian at every iteration, most of the
@@ -790,14 +792,14 @@ def levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, ftol=1e-8, xtol=1e-8, da
         d[d == 0] = 1.0
         # entries on a bound that the gradient pushes outwards are held (the active set)
         free = ~(((z <= lo) & (g > 0)) | ((z >= hi) & (g < 0)))
-        return A, g, d, free, _decrement(A[np.ix_(free, free)], g[free], d[free])
+        return A, g, d, free, _shift(A, g, d, free, len(z) if watch is None else watch)
 
     while True:
         if fresh:
-            A, g, d, free, decrement = normal_equations(z, r, J, d)
+            A, g, d, free, shift = normal_equations(z, r, J, d)
             fresh = False
-            if decrement <= dtol:
-                status, message = 1, f"converged: a Gauss–Newton step would lower the cost by {decrement:.2g}"
+            if shift <= stol:
+                status, message = 1, f"converged: a Gauss–Newton step would move the estimates by {shift:.2g} σ"
                 break
         if nfev >= max_nfev:
             break
@@ -839,19 +841,32 @@ def levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, ftol=1e-8, xtol=1e-8, da
                 status, message = 4, "no step lowers the cost"
                 break
     if fresh:                   # stopped at a new point: what is left from there
-        decrement = normal_equations(z, r, J, d)[4]
-    return Solution(x=z, cost=cost, nfev=nfev, status=status, message=message, decrement=decrement)
+        shift = normal_equations(z, r, J, d)[4]
+    return Solution(x=z, cost=cost, nfev=nfev, status=status, message=message, shift=shift)
 
 
-def _decrement(A, g, d):
-    """½ gᵀ A⁻¹ g: what an undamped Gauss–Newton step would lower the cost by (A regularised by
-    1e-12 of its scale, d², against a direction the log does not determine); inf if A is not
-    positive definite."""
+def _shift(A, g, d, free, watch):
+    """max |δ_i| / σ_i over the first `watch` entries that are free: the undamped Gauss–Newton step
+    δ = −A⁻¹ g of the free entries (the others held), each in units of its standard deviation
+    σ_i = √(A⁻¹)_ii (A regularised by 1e-12 of its scale, d², against a direction nothing
+    determines); 0 with no such entry, inf if A is not positive definite.  A step measured in
+    σ is what matters for an interval; the cost's decrease ½ gᵀ A⁻¹ g is not: it stays large
+    along a direction of the start states that the log barely determines, where the quadratic
+    model does not hold and the steps creep (a 1 s log's fit did, its parameters settled)."""
+    idx = np.flatnonzero(free)
+    watched = np.flatnonzero(idx < watch)
+    if not watched.size:
+        return 0.0
+    Af = A[np.ix_(idx, idx)]
     try:
-        c = scipy.linalg.cho_factor(A + 1e-12 * np.diag(d ** 2), check_finite=False)
+        c = scipy.linalg.cho_factor(Af + 1e-12 * np.diag(d[idx] ** 2), check_finite=False)
     except np.linalg.LinAlgError:
         return math.inf
-    return 0.5 * float(g @ scipy.linalg.cho_solve(c, g, check_finite=False))
+    step = scipy.linalg.cho_solve(c, g[idx], check_finite=False)[watched]
+    unit = np.zeros((len(idx), watched.size))
+    unit[watched, np.arange(watched.size)] = 1.0
+    var = np.einsum("ij,ij->j", unit, scipy.linalg.cho_solve(c, unit, check_finite=False))
+    return float(np.max(np.abs(step) / np.sqrt(var)))
 
 
 def first_guess(log, params, free, prob, full_state, x_guess):
@@ -921,12 +936,12 @@ def _report(prob, sol, free, params, full_state):
              "tolerance": RESIDUAL_TOLERANCE, "passed": bool(abs(rms - 1) <= RESIDUAL_TOLERANCE)}
     message = str(sol.message)
     if full_state:
-        converged, decrement = bool(sol.status > 0), math.nan
+        converged, shift = bool(sol.status > 0), math.nan
     else:
-        converged, decrement = bool(sol.decrement <= CONVERGED_DECREMENT), float(sol.decrement)
+        converged, shift = bool(sol.shift <= CONVERGED_SHIFT), float(sol.shift)
         if not converged:
-            message += (f"; NOT converged: a Gauss–Newton step would still lower the cost by {decrement:.3g} "
-                        f"(converged below {CONVERGED_DECREMENT:g}), the estimates and intervals are not the "
+            message += (f"; NOT converged: a Gauss–Newton step would still move the estimates by {shift:.3g} σ "
+                        f"(converged below {CONVERGED_SHIFT:g} σ), the estimates and intervals are not the "
                         f"optimum's")
     if full_state:
         biases, bsig = np.full(6, np.nan), np.full(6, np.nan)
@@ -944,7 +959,7 @@ def _report(prob, sol, free, params, full_state):
                biases=biases, bias_sigma=bsig, residual_check=check, residuals=series, params=estimated,
                nfev=int(prob.nfev), status=int(sol.status), message=message,
                mode="full-state" if full_state else "sensors", start=prob.theta_start.copy(), converged=converged,
-               decrement=decrement)
+               shift=shift)
 
 
 def _dpi(params, idx):
