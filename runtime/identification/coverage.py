@@ -123,10 +123,10 @@ def simulated_log(names, duration, seed, spread=0.3, excitation=None):
     return simulate_log(run, SensorSet.default(), seed=seed), nominal, truth
 
 
-def trial(names, duration, seed, spread=0.3, full_state=False, segment=0.5, max_nfev=20, excitation=None,
+def trial(names, duration, seed, spread=0.3, full_state=False, segment=0.5, max_nfev=60, excitation=None,
           start="regressor"):
     """One seeded fit: {"seed", "names", "truth", "start", "estimate", "sigma", "inside", "rms",
-    "passed" (the residual check), "combinations" (`combination_errors`), "wall_time_s", "cpu_time_s" (the fit's, without the log's
+    "passed" (the residual check), "converged", "evaluations", "combinations" (`combination_errors`), "wall_time_s", "cpu_time_s" (the fit's, without the log's
     simulation), "load_average" (the machine's, over the last minute, at the fit's end)}."""
     log, nominal, truth = simulated_log(names, duration, seed, spread, excitation)
     started, cpu = time.perf_counter(), time.process_time()
@@ -137,6 +137,7 @@ def trial(names, duration, seed, spread=0.3, full_state=False, segment=0.5, max_
             "estimate": fit.estimate.tolist(), "sigma": fit.sigma.tolist(),
             "inside": (np.abs(fit.estimate - true) <= 1.959964 * fit.sigma).tolist(),
             "rms": fit.residual_check["rms"], "passed": fit.residual_check["passed"],
+            "converged": fit.converged, "evaluations": fit.nfev,
             "combinations": combination_errors(fit, truth), "wall_time_s": wall, "cpu_time_s": cpu, "load_average": os.getloadavg()[0]}
 
 
@@ -253,8 +254,8 @@ def main(argv):
                                                              "random piecewise-constant torques")
     parser.add_argument("--start", choices=STARTS, default="regressor",
                         help="the fits' start: the regressor's first guess (default) or the nominal robot")
-    parser.add_argument("--max-evaluations", type=whole_number(1), default=20,
-                        help="each fit's evaluation budget (20)")
+    parser.add_argument("--max-evaluations", type=whole_number(1), default=60,
+                        help="each fit's evaluation budget, of each of a sensor fit's two joint stages (60)")
     parser.add_argument("--jobs", type=whole_number(1), default=1, help="fits run at once, one process each (1)")
     parser.add_argument("--out", required=True, type=pathlib.Path, help="the JSON file of the results")
     parser.add_argument("--figure", type=pathlib.Path, help="also draw the calibration figure (PNG)")
@@ -277,6 +278,7 @@ def main(argv):
         print(f"{name}: truth inside the 95 % region in {100 * c['coverage']:.0f} %, within "
               f"{100 * COMBINATION_TOLERANCE:g} % in {100 * c['within']:.0f} % of {c['fits']} fits")
     print(f"residual check passed in {100 * result['passed']:.0f} % of {args.fits} fits")
+    print(f"converged: {sum(t.get('converged', True) for t in result['trials'])} of {args.fits} fits")
     return 0
 
 

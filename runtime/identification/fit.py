@@ -63,6 +63,11 @@ DEFECT_FLOOR = 1e-7
 #: parameters held (the segments, each fitted alone, disagree at their ends by the start guess's
 #: errors, which are linear in the start states).
 STATES_NFEV = 8
+#: A sensor fit has converged when an undamped Gauss–Newton step would move no free parameter by
+#: more than this fraction of its σ.  The first joint stage stops at RELINEARISE_SHIFT instead: the
+#: covariance is linearised again where it stops, which moves the optimum by more than that.
+CONVERGED_SHIFT = 0.05
+RELINEARISE_SHIFT = 0.5
 
 
 class IdentifyError(ValueError):
@@ -127,6 +132,7 @@ class _Data:
     enc_row: np.ndarray
     fix_row: np.ndarray
     interval: np.ndarray     # (n,) index of the process-noise interval (torque period) of each node
+    into: np.ndarray         # (n,) time since the start of the node's torque period
     tau: float               # the torque period
     skipped: int             # samples off the node grid
 
@@ -153,8 +159,10 @@ def _grid(log):
     dts = np.diff(log.torques.t)
     tau = float(np.median(dts)) if len(dts) else h
     interval = np.floor((t - float(log.torques.t[0])) / tau + 1e-6).astype(int)
+    into = np.clip(t - float(log.torques.t[0]) - interval * tau, 0.0, tau)
+    into[into <= 1e-6 * tau] = 0.0
     return _Data(t=t, h=h, u=log.torque_at(t), imu_row=rows(imu.t), enc_row=rows(log.encoders.t),
-                 fix_row=rows(fix_times), interval=interval, tau=tau, skipped=skipped)
+                 fix_row=rows(fix_times), interval=interval, into=into, tau=tau, skipped=skipped)
 
 
 def check_log(log, full_state=False):
@@ -181,7 +189,10 @@ class Fit:
     combinations the log cannot separate; `biases` (6,) and their sigma; `residual_check`: {"rms",
     "chi2", "dof", "p_value", "passed"}; `residuals` {kind: (t, whitened residuals)} for plots;
     `params` the estimated robot; `nfev`, `status`, `message` of the solver; `start` the free
-    entries where the fit started them (`STARTS`)."""
+    entries where the fit started them (`STARTS`); `converged`: the solver stopped at the optimum
+    (a sensor fit: its Gauss–Newton step `shift` of the parameters, in σ, below CONVERGED_SHIFT),
+    not at its budget;
+    an unconverged fit's estimates and intervals are not the optimum's, and its message says so."""
     names: tuple
     nominal: np.ndarray
     estimate: np.ndarray
@@ -206,6 +217,8 @@ class Fit:
     message: str
     mode: str
     start: np.ndarray = None
+    converged: bool = True
+    shift: float = math.nan
 
 
 def _inverse_cholesky(S):
@@ -358,11 +371,26 @@ class _Problem:
             enters[entering] = kappa
         return js, P, enters, Minv
 
+    def _own_period(self, s, blk, Minv):
+        """(n, 5): what each noise-scaled reading of a segment sees directly of its own torque
+        period's force w (per unit force): the accelerometer's M⁻¹ w, and the velocities' jump so
+        far, M⁻¹ w t' at a time t' into the period (the truth's held force moves the velocities
+        from the period's start, `runtime.sensor_sim`; the states of the fit's later nodes see
+        the whole jump M⁻¹ w τ once the period has ended).  With a period longer than the IMU's,
+        the readings inside it would otherwise miss that share: the gyroscope about the yoke's
+        axis read 1.7 times its declared variance there."""
+        rows = blk["rows"]
+        node, sig = rows["node"], rows["sig"][:, None]
+        into = self.data.into[self.starts[s] + node]
+        M = Minv[node]
+        return (np.einsum("rj,rjk->rk", rows["Hn"], M)
+                + np.einsum("rj,rjk->rk", rows["Hx"][:, IDX_E_NU], M) * into[:, None]) / sig
+
     def noise_map(self, s, blk):
         """(A, Q): the effect on the segment's noise-scaled readings and on its end state (the last
         12 rows) of the process noise's forces w_j, one per torque period and held over it (the
-        accelerometer reads M⁻¹ w_j, the velocities jump by M⁻¹ w_j τ at its end), w_j of
-        covariance diag(Q)."""
+        accelerometer reads M⁻¹ w_j, the velocities jump by M⁻¹ w_j τ at its end; a reading inside
+        the period sees their jump so far, `_own_period`), w_j of covariance diag(Q)."""
         d = self.data
         Phi, rows = blk["Phi"], blk["rows"]
         k0 = self.starts[s]
@@ -371,9 +399,8 @@ class _Problem:
         n = len(node)
         A = np.zeros((n + NE, 5 * len(js)))
         A[:n] = np.einsum("rj,rjk->rk", rows["Hx"], Phi[node]) @ P / sig * np.repeat(enters[None, :] <= node[:, None], 5, 1)
-        imu = np.flatnonzero(rows["kind"] == 0)
-        c = np.searchsorted(js, d.interval[k0 + node[imu]])
-        A[imu[:, None], 5 * c[:, None] + np.arange(5)] += np.einsum("rj,rjk->rk", rows["Hn"][imu], Minv[node[imu]]) / sig[imu]
+        c = np.searchsorted(js, d.interval[k0 + node])
+        A[np.arange(n)[:, None], 5 * c[:, None] + np.arange(5)] += self._own_period(s, blk, Minv)
         A[n:] = (Phi[-1] @ P) * np.repeat(enters <= len(Phi) - 1, 5)
         return A, np.tile(self.q2 / d.tau, len(js))
 
@@ -407,12 +434,10 @@ class _Problem:
         js, P, enters, Minv = self._noise_parts(s, blk)
         root_q = np.sqrt(self.q2 / d.tau)
         Pw = (P.reshape(NE, -1, 5) * root_q).swapaxes(0, 1)        # (periods, 12, 5), w_j in unit noise
-        node, sig, kind = rows["node"], rows["sig"], rows["kind"]
+        node, sig = rows["node"], rows["sig"]
         n = blk["n_out"]
         H = np.einsum("rj,rjk->rk", rows["Hx"], Phi[node]) / sig[:, None]
-        G = np.zeros((n, 5))            # the IMU's direct reading of its own period's w_j
-        imu = np.flatnonzero(kind == 0)
-        G[imu] = np.einsum("rj,rjk->rk", rows["Hn"][imu], Minv[node[imu]]) / sig[imu, None] * root_q
+        G = self._own_period(s, blk, Minv) * root_q     # the direct reading of its own period's w_j
         period = np.searchsorted(js, d.interval[k0 + node])
         bounds = np.searchsorted(period, np.arange(len(js) + 1))
         Sigma = np.zeros((NE, NE))
@@ -656,13 +681,15 @@ def _start_guess(log, params, with_sigma=False):
     return (est.x[k], est.biases[-1], est.sigma[k]) if with_sigma else (est.x[k], est.biases[-1])
 
 
-def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, max_nfev=20, progress=None,
+def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, max_nfev=60, progress=None,
              x_guess=None, bias_guess=None, jacobian="analytic", start="regressor"):
     """Fit the parameters `names` (see `free_parameters`) of the robot `params` (the others held) to
     `log` (runtime.estimation.logs.Log), with the IMU's biases and each segment's start state; or,
     `full_state`, to the log's truth by the one-step prediction error.  `segment` [s]: the
     multiple-shooting segments' length; `x_guess` (n_imu, 35) and `bias_guess` (6,) replace the
-    EKF's start guess.  `progress()` is called once per evaluation.  `jacobian`: the parameter
+    EKF's start guess.  `max_nfev`: the evaluations of each of a sensor fit's two joint stages
+    (before and after the covariance is linearised again; each stops early once converged,
+    `CONVERGED_SHIFT`), of a full-state fit's solver.  `progress()` is called once per evaluation.  `jacobian`: the parameter
     sensitivities' source (`JACOBIANS`: "analytic", or "fd"/"fd-all", differences in C).  `start`
     (`STARTS`): the parameters' start, "regressor" the linear least-squares first guess
     (runtime.identification.first_guess) from the start guess's states (the log's truth for a
@@ -729,32 +756,37 @@ def _identify(log, params, free, segment, method, full_state, max_nfev, progress
             r, J, _ = prob.assemble(z)
             return r, J
 
-        sol = levenberg_marquardt(evaluate, z0, lo, hi, max_nfev)
-        prob.chol = None            # the covariance at the optimum, then a short refinement
+        sol = levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, stol=RELINEARISE_SHIFT, watch=prob.nf)
+        prob.chol = None            # the covariance at the optimum, then the refinement
         prob._cache = (None, None)
-        sol = levenberg_marquardt(evaluate, sol.x, lo, hi, max(3, max_nfev // 2))
+        sol = levenberg_marquardt(evaluate, sol.x, lo, hi, max_nfev, stol=CONVERGED_SHIFT, watch=prob.nf)
     return _report(prob, sol, free, params, full_state)
 
 
 @dataclasses.dataclass
 class Solution:
     """What `levenberg_marquardt` returns: the point `x`, its `cost` ½‖r‖², the evaluations `nfev`,
-    `status` (0 the evaluations ran out, 2 the cost stopped falling, 3 the step became negligible,
-    4 no step lowers the cost) and a `message`."""
+    `status` (0 the evaluations ran out, 1 converged: a Gauss–Newton step would move no watched
+    entry by more than `stol` σ, 2 the cost stopped falling, 3 the step became negligible, 4 no step lowers
+    the cost), a `message` and `shift`, the largest step of a watched entry that an undamped
+    Gauss–Newton step from x would take, in units of its standard deviation (`_shift`)."""
     x: np.ndarray
     cost: float
     nfev: int
     status: int
     message: str
+    shift: float = math.inf
 
 
-def levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, ftol=1e-8, xtol=1e-8, damping=1e-2):
+def levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, ftol=1e-8, xtol=1e-8, damping=1e-2, stol=0.0, watch=None):
     """Minimise ½‖r(z)‖² for lo <= z <= hi by Levenberg–Marquardt steps on the normal equations
     (JᵀJ + λ diag(d²)) δ = −Jᵀr, d the largest column norms of J seen so far (the scaling
     SciPy's x_scale="jac" uses), λ adapted by the gain ratio (Nielsen's rule), a step leaving the
     bounds projected onto them and the entries on a bound that the gradient pushes outwards held.
     `evaluate(z)` -> (r, J sparse); an `IdentifyError` (a candidate robot the model refuses)
-    counts as a rejected step.  The multiple-shooting Jacobian has a
+    counts as a rejected step.  Converged (status 1) when the undamped Gauss–Newton step would
+    move none of the first `watch` entries (None: all) by more than `stol` of its standard
+    deviation (`_shift`).  The multiple-shooting Jacobian has a
     dozen global columns and a band of start-state columns, so JᵀJ is small and nearly block
     tridiagonal and one Cholesky factorisation of it costs milliseconds; SciPy's dense
     trust-region solver instead takes an SVD of the whole Jacobian at every iteration, most of the
@@ -767,14 +799,25 @@ def levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, ftol=1e-8, xtol=1e-8, da
     lam, nu = damping, 2.0
     status, message = 0, "the maximum number of evaluations is reached"
     fresh = True
-    while nfev < max_nfev:
-        if fresh:
-            A = (J.T @ J).toarray()
-            g = J.T @ r
-            d = np.maximum(d, np.sqrt(np.diag(A)))
-            d[d == 0] = 1.0
-            fresh = False
+
+    def normal_equations(z, r, J, d):
+        A = (J.T @ J).toarray()
+        g = J.T @ r
+        d = np.maximum(d, np.sqrt(np.diag(A)))
+        d[d == 0] = 1.0
         # entries on a bound that the gradient pushes outwards are held (the active set)
+        free = ~(((z <= lo) & (g > 0)) | ((z >= hi) & (g < 0)))
+        return A, g, d, free, _shift(A, g, d, free, len(z) if watch is None else watch)
+
+    while True:
+        if fresh:
+            A, g, d, free, shift = normal_equations(z, r, J, d)
+            fresh = False
+            if shift <= stol:
+                status, message = 1, f"converged: a Gauss–Newton step would move the estimates by {shift:.2g} σ"
+                break
+        if nfev >= max_nfev:
+            break
         free = ~(((z <= lo) & (g > 0)) | ((z >= hi) & (g < 0)))
         try:
             c = scipy.linalg.cho_factor(A[np.ix_(free, free)] + lam * np.diag(d[free] ** 2), check_finite=False)
@@ -812,7 +855,33 @@ def levenberg_marquardt(evaluate, z0, lo, hi, max_nfev, ftol=1e-8, xtol=1e-8, da
             if lam > 1e16:
                 status, message = 4, "no step lowers the cost"
                 break
-    return Solution(x=z, cost=cost, nfev=nfev, status=status, message=message)
+    if fresh:                   # stopped at a new point: what is left from there
+        shift = normal_equations(z, r, J, d)[4]
+    return Solution(x=z, cost=cost, nfev=nfev, status=status, message=message, shift=shift)
+
+
+def _shift(A, g, d, free, watch):
+    """max |δ_i| / σ_i over the first `watch` entries that are free: the undamped Gauss–Newton step
+    δ = −A⁻¹ g of the free entries (the others held), each in units of its standard deviation
+    σ_i = √(A⁻¹)_ii (A regularised by 1e-12 of its scale, d², against a direction nothing
+    determines); 0 with no such entry, inf if A is not positive definite.  A step measured in
+    σ is what matters for an interval; the cost's decrease ½ gᵀ A⁻¹ g is not: it stays large
+    along a direction of the start states that the log barely determines, where the quadratic
+    model does not hold and the steps creep (a 1 s log's fit did, its parameters settled)."""
+    idx = np.flatnonzero(free)
+    watched = np.flatnonzero(idx < watch)
+    if not watched.size:
+        return 0.0
+    Af = A[np.ix_(idx, idx)]
+    try:
+        c = scipy.linalg.cho_factor(Af + 1e-12 * np.diag(d[idx] ** 2), check_finite=False)
+    except np.linalg.LinAlgError:
+        return math.inf
+    step = scipy.linalg.cho_solve(c, g[idx], check_finite=False)[watched]
+    unit = np.zeros((len(idx), watched.size))
+    unit[watched, np.arange(watched.size)] = 1.0
+    var = np.einsum("ij,ij->j", unit, scipy.linalg.cho_solve(c, unit, check_finite=False))
+    return float(np.max(np.abs(step) / np.sqrt(var)))
 
 
 def first_guess(log, params, free, prob, full_state, x_guess):
@@ -880,6 +949,15 @@ def _report(prob, sol, free, params, full_state):
     rms = math.sqrt(chi2 / dof)
     check = {"rms": rms, "chi2": chi2, "dof": dof, "p_value": float(scipy.stats.chi2.sf(chi2, dof)),
              "tolerance": RESIDUAL_TOLERANCE, "passed": bool(abs(rms - 1) <= RESIDUAL_TOLERANCE)}
+    message = str(sol.message)
+    if full_state:
+        converged, shift = bool(sol.status > 0), math.nan
+    else:
+        converged, shift = bool(sol.shift <= CONVERGED_SHIFT), float(sol.shift)
+        if not converged:
+            message += (f"; NOT converged: a Gauss–Newton step would still move the estimates by {shift:.3g} σ "
+                        f"(converged below {CONVERGED_SHIFT:g} σ), the estimates and intervals are not the "
+                        f"optimum's")
     if full_state:
         biases, bsig = np.full(6, np.nan), np.full(6, np.nan)
         series = {"velocities": (prob.t[1:], r.reshape(-1, NV))}
@@ -894,8 +972,9 @@ def _report(prob, sol, free, params, full_state):
                high=theta + Z95 * sigma, information=info, correlation=corr, rank=rank, condition=condition,
                identified=identified, on_bound=on_bound, combinations=combos, null_directions=nulls,
                biases=biases, bias_sigma=bsig, residual_check=check, residuals=series, params=estimated,
-               nfev=int(prob.nfev), status=int(sol.status), message=str(sol.message),
-               mode="full-state" if full_state else "sensors", start=prob.theta_start.copy())
+               nfev=int(prob.nfev), status=int(sol.status), message=message,
+               mode="full-state" if full_state else "sensors", start=prob.theta_start.copy(), converged=converged,
+               shift=shift)
 
 
 def _combinations(nominal, estimated, idx, cov, null, scale):

@@ -66,6 +66,10 @@ def report_md(fit, log_path):
            f"Residual check {verdict}: whitened residual RMS {check['rms']:.3f} (passes within "
            f"{check['tolerance']:g} of 1), chi-square {check['chi2']:.1f} on {check['dof']} degrees of freedom "
            f"(p = {check['p_value']:.3g}).", ""]
+    if not fit.converged:
+        out += ["**The fit did not converge**: the solver stopped at its evaluation budget short of the optimum, "
+                "so the estimates and intervals below are not the optimum's (run it again with a larger "
+                "`--max-evaluations`).", ""]
     if not check["passed"]:
         out += ["The residuals are not what the sensors' noise explains: the log does not look like the claimed "
                 "robot with only these parameters free (another robot, a parameter held at a wrong value, a "
@@ -125,6 +129,7 @@ def summary(fit, wall, log_path, robot_source):
         return None if not np.isfinite(v) else float(v)
     return {"log": str(log_path), "robot": robot_source, "mode": fit.mode, "wall_time_s": wall,
             "evaluations": fit.nfev, "solver_status": fit.status, "solver_message": fit.message,
+            "converged": fit.converged,
             "start": dict(zip(fit.names, map(float, fit.start))),
             "rank": fit.rank, "condition": num(fit.condition),
             "parameters": [{"name": n, "nominal": float(fit.nominal[i]), "estimate": float(fit.estimate[i]),
@@ -161,7 +166,8 @@ def build_parser():
     parser.add_argument("--out", required=True, type=pathlib.Path, help="the output folder (created if missing)")
     parser.add_argument("--full-state", action="store_true", help="fit to the log's truth table (a full-state log)")
     parser.add_argument("--segment", type=positive, default=0.5, help="multiple-shooting segment length [s] (0.5)")
-    parser.add_argument("--max-evaluations", type=count, default=20, help="the solver's evaluation budget (20)")
+    parser.add_argument("--max-evaluations", type=count, default=60,
+                        help="the solver's evaluation budget, of each of a sensor fit's two joint stages (60)")
     parser.add_argument("--start", choices=STARTS, default="regressor",
                         help="where the parameters start: the regressor's linear least-squares first guess "
                              "(default) or the nominal robot")
@@ -214,6 +220,8 @@ def main(argv):
     if not args.quiet:
         print(f"{args.log}: {len(fit.names)} parameters in {wall:.1f} s, rank {fit.rank}; residual RMS "
               f"{check['rms']:.3f}; wrote {args.out}/")
+    if not fit.converged:
+        print(f"the fit did not converge in its evaluations: {fit.message}", file=sys.stderr)
     if not check["passed"]:
         print(f"residual check failed: whitened residual RMS {check['rms']:.3f} is not within "
               f"{RESIDUAL_TOLERANCE:g} of 1 (p = {check['p_value']:.3g}): the log does not look like this robot "

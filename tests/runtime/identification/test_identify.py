@@ -60,12 +60,21 @@ def test_a_full_state_fit_recovers_the_planted_parameters_within_its_intervals(s
 
 
 def test_a_sensor_log_fit_recovers_the_planted_parameters_within_its_intervals(short_log):
-    fit = identify(short_log, NOMINAL, ["m_P", "k_Y"], segment=0.25, max_nfev=30)
+    fit = identify(short_log, NOMINAL, ["m_P", "k_Y"], segment=0.25)
     truth = truth_of(fit.names)
     assert np.all(np.abs(fit.estimate - truth) <= 3 * fit.sigma), (fit.estimate, truth, fit.sigma)
     assert abs(fit.nominal[0] - truth[0]) > 3 * fit.sigma[0]      # m_P: the nominal value would fail the check
     assert fit.residual_check["passed"], fit.residual_check
     assert np.all(np.abs(fit.biases[:3] - short_log.meta["truth_bias"]["gyro"]) <= 3 * fit.bias_sigma[:3])
+    assert fit.converged and fit.shift <= fitmod.CONVERGED_SHIFT, fit.message
+
+
+def test_a_sensor_fit_stopped_by_its_budget_says_it_did_not_converge(short_log):
+    fit = identify(short_log, NOMINAL, ["m_P", "k_Y"], segment=0.25, max_nfev=2)
+    assert not fit.converged and fit.shift > fitmod.CONVERGED_SHIFT
+    assert "NOT converged" in fit.message
+    assert "did not converge" in cli.report_md(fit, "log")
+    assert cli.summary(fit, 0.0, "log", "robot")["converged"] is False
 
 
 def test_a_fit_of_another_robots_log_fails_its_residual_check(state_log):

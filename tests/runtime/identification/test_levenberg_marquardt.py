@@ -73,3 +73,33 @@ def test_it_converges_from_far_starts(start):
     sol = levenberg_marquardt(evaluate, np.array(start), lo, hi, 200)
     ref = scipy.optimize.least_squares(residuals, [1.0, 0.3, 0.0], jac=jacobian, xtol=1e-12, ftol=1e-12)
     np.testing.assert_allclose(sol.x, ref.x, rtol=1e-5)
+
+
+
+def test_its_shift_is_the_step_to_the_exact_optimum_in_sigmas_on_a_linear_problem():
+    # for a linear least-squares problem the Gauss-Newton step is exact: the shift at a point is
+    # the largest |optimum - point| / sigma of the watched entries, numpy's lstsq and inverse
+    # giving both independently
+    rng = np.random.default_rng(1)
+    A, y = rng.standard_normal((30, 4)), rng.standard_normal(30)
+    z0 = np.array([3.0, -2.0, 1.0, 0.5])
+    best = np.linalg.lstsq(A, y, rcond=None)[0]
+    sigma = np.sqrt(np.diag(np.linalg.inv(A.T @ A)))
+    for watch in (None, 2):
+        sol = levenberg_marquardt(lambda z: (A @ z - y, scipy.sparse.csr_matrix(A)), z0, np.full(4, -np.inf),
+                                  np.full(4, np.inf), 1, watch=watch)
+        assert sol.nfev == 1 and sol.status == 0
+        n = 4 if watch is None else watch
+        np.testing.assert_allclose(sol.shift, np.max(np.abs(best - z0)[:n] / sigma[:n]), rtol=1e-9)
+
+
+def test_it_stops_once_the_shift_is_below_its_tolerance():
+    lo, hi = np.full(3, -np.inf), np.full(3, np.inf)
+    start = np.array([1.0, 0.3, 0.0])
+    full = levenberg_marquardt(evaluate, start, lo, hi, 200)
+    early = levenberg_marquardt(evaluate, start, lo, hi, 200, stol=0.05)
+    assert early.status == 1 and early.message.startswith("converged")
+    assert early.shift <= 0.05 < levenberg_marquardt(evaluate, start, lo, hi, early.nfev - 1).shift
+    assert early.nfev < full.nfev
+    sigma = np.sqrt(np.diag(np.linalg.inv(jacobian(full.x).T @ jacobian(full.x))))
+    assert np.all(np.abs(early.x - full.x) <= 0.06 * sigma)

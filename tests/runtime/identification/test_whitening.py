@@ -64,3 +64,45 @@ def test_the_segments_whitened_together_are_each_whitened_as_alone(problem):
     together = prob.whiten_all(prob.stack_whitenings(whites), Ms)
     for white, M, W in zip(whites, Ms, together):
         np.testing.assert_allclose(W, prob.whiten(white, M), rtol=1e-9, atol=1e-9 * np.abs(W).max())
+
+
+@pytest.fixture(scope="module")
+def at_the_truth():
+    """A 10 s log of the nominal robot whose truth steps (and holds its torque disturbance) every
+    10 ms while the IMU reads every 5 ms, and the fit's problem at the truth: the true robot, the
+    true biases and the true states at the segments' starts, so that its residuals are the noise
+    alone."""
+    rng = np.random.default_rng(8)
+    program = tuple(TorqueWindow(i * 0.25, (i + 1) * 0.25, float(rng.uniform(-0.3, 0.3)),
+                                 float(rng.uniform(-0.15, 0.15))) for i in range(40))
+    run = dataclasses.replace(SCENARIO, torques=program, steps=1000)
+    assert run.dt == 2 / SensorSet.default().imu.rate
+    log = simulate_log(run, SensorSet.default(), seed=5)
+    truth = log.truth_states()
+    x = truth[np.round(log.imu.t / run.dt).astype(int)]       # only the segments' starts are used
+    return fitmod._Problem(log, NOMINAL, free_parameters("k_S"), 0.5, "rkmk4", x, log.truth_biases()[0])
+
+
+def _yoke_gyro_variance(prob):
+    """The whitened yoke-axis gyroscope readings' mean square (the IMU's x axis) at the IMU's
+    samples between two of the truth's steps."""
+    blocks = prob.segment_blocks(prob.z0())
+    squares = []
+    for s, (blk, white) in enumerate(zip(blocks, prob.covariances(blocks))):
+        w, rows = prob.whiten(white, blk["r"]), blk["rows"]
+        gyro_x = np.flatnonzero(rows["kind"] == 0)[::6]
+        steps = prob.data.t[prob.starts[s] + rows["node"][gyro_x]] / SCENARIO.dt      # the truth's steps
+        inside = gyro_x[np.abs(steps - np.round(steps)) > 0.25]
+        squares.append(w[inside] ** 2)
+    squares = np.concatenate(squares)
+    assert len(squares) > 900
+    return float(squares.mean())
+
+
+def test_a_reading_inside_a_torque_period_is_whitened_to_unit_variance(at_the_truth):
+    assert 0.88 < _yoke_gyro_variance(at_the_truth) < 1.12
+
+
+def test_without_the_velocities_jump_inside_the_period_the_yoke_gyro_reads_too_much(at_the_truth, monkeypatch):
+    monkeypatch.setattr(at_the_truth.data, "into", np.zeros_like(at_the_truth.data.into))
+    assert _yoke_gyro_variance(at_the_truth) > 1.3
