@@ -13,7 +13,10 @@ one constant mismatch or on an unmodelled slope, out/control/offsets.md and .csv
 cases whose "task plant controller" contains TEXT; `--known-slope` runs only the slope cases, the
 slope in the controller's model too (its slope feedforward).  A task with the NMPC (kind nmpc) also runs the
 C NMPC (kind nmpc-c) on the same settings, in the row after it, unless it lists nmpc-c itself or its
-horizon exceeds the C NMPC's capacity.
+horizon exceeds the C NMPC's capacity.  Below the table, the runs that read an estimate (on sensors,
+or a task's `[estimator]`): the estimate's position and heading errors and, for a task on sensors, its
+target ("Closed on the estimator": cross-track RMS ≤ 3 cm; the heading step within its nominal
+task's settle time + 2 s) and whether it is met.
 """
 import argparse
 import csv
@@ -42,6 +45,14 @@ from .task import load_task, shipped_tasks
 
 COLUMNS = ("cross_track_rms_m", "cross_track_max_m", "heading_settle_s", "speed_settle_s", "overshoot",
            "motor_energy_j", "saturated_fraction", "solve_ms_p50", "solve_ms_p99")
+#: The estimator table's columns (the runs whose controller read an estimate).
+ESTIMATOR_COLUMNS = ("position_rms_m", "position_max_m", "heading_rms_deg", "heading_max_deg")
+#: The targets on the robot's own sensors (docs/control.md, "Closed on the estimator"): the path tasks'
+#: second-half cross-track RMS [m]; the heading step within its nominal settle time plus this [s].
+SENSORS_CROSS_TRACK_M = 0.03
+SENSORS_SETTLE_MARGIN_S = 2.0
+#: The suffix of a task on sensors; the same name without it is its nominal task.
+SENSORS_SUFFIX = "-sensors"
 
 
 def cpu_name():
@@ -103,6 +114,43 @@ def estimate_errors(result):
 
 def _fmt(value):
     return "—" if value is None else f"{value:.4g}"
+
+
+def sensors_target(row, rows):
+    """(target, met) of a run on sensors against "Closed on the estimator": a path task's cross-track RMS
+    ≤ 3 cm; a heading task's settle time ≤ its nominal task's (the same controller, the task's name
+    without "-sensors", among `rows`) + 2 s.  ("—", None) where no target applies or the nominal
+    task was not run."""
+    if not row["task"].endswith(SENSORS_SUFFIX):
+        return "—", None
+    if row["cross_track_rms_m"] is not None:
+        return f"RMS ≤ {SENSORS_CROSS_TRACK_M:g} m", row["cross_track_rms_m"] <= SENSORS_CROSS_TRACK_M
+    nominal = row["task"][:-len(SENSORS_SUFFIX)]
+    settle = [r["heading_settle_s"] for r in rows if r["task"] == nominal and r["controller"] == row["controller"]]
+    if not settle or settle[0] is None:
+        return "—", None
+    limit = settle[0] + SENSORS_SETTLE_MARGIN_S
+    return f"settle ≤ {limit:.4g} s", row["heading_settle_s"] is not None and row["heading_settle_s"] <= limit
+
+
+def estimator_table(rows):
+    """The Markdown table of the runs that read an estimate (rows with an `estimate`): the estimate's
+    errors against the plant and, on sensors, the target and whether it is met; "" if there are none."""
+    runs = [r for r in rows if r.get("estimate") is not None]
+    if not runs:
+        return ""
+    header = ["task", "controller", "estimate position RMS / max [mm]", "estimate heading RMS / max [deg]",
+              "target on sensors", "met"]
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for r in runs:
+        e = r["estimate"]
+        target, met = sensors_target(r, rows)
+        lines.append("| " + " | ".join([
+            r["task"], r["controller"], f"{1e3 * e['position_rms_m']:.1f} / {1e3 * e['position_max_m']:.1f}",
+            f"{e['heading_rms_deg']:.2f} / {e['heading_max_deg']:.2f}", target,
+            "—" if met is None else ("yes" if met else "**no**")]) + " |")
+    return "On the estimator (the estimate the controller read against the plant's state, at its samples):\n\n" + \
+        "\n".join(lines) + "\n"
 
 
 def main(argv=()):
@@ -175,21 +223,23 @@ def main(argv=()):
         summary = {"task": name, "controller": task.controller_kind, "rate_hz": task.rate, "u_max": task.u_max,
                    "duration_s": task.duration, "cpu": cpu_name(), "tracking": metrics,
                    "contact": run_contact(task, result)}
-        if task.sensors is not None:
-            summary["estimate"] = estimate_errors(result)
+        estimate = None if result.estimates is None else estimate_errors(result)
+        if estimate is not None:
+            summary["estimate"] = estimate
         write_text(folder / "summary.json", json.dumps(summary, indent=2) + "\n")
         plot_run(result, reference, task, folder / "tracking.png")
         if task.sensors is not None:
             plot_estimate(result, reference, task, folder / "estimate.png")
-        rows.append({"task": name, "controller": task.controller_kind, **metrics})
+        rows.append({"task": name, "controller": task.controller_kind, **metrics, "estimate": estimate})
     header = ["task", "controller", *COLUMNS]
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join([r["task"], r["controller"]] + [_fmt(r[c]) for c in COLUMNS]) + " |" for r in rows]
     cut = "" if args.duration is None else f" Every task cut to at most {args.duration:g} s (smoke run)."
-    table = "\n".join(lines) + f"\n\nCPU: {cpu_name()}.{cut}\n"
+    estimates = estimator_table(rows)
+    table = "\n".join(lines) + "\n\n" + (estimates + "\n" if estimates else "") + f"CPU: {cpu_name()}.{cut}\n"
     write_text(out / "table.md", table)
     with atomic_path(out / "table.csv") as tmp, open(tmp, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=header)
+        writer = csv.DictWriter(f, fieldnames=header, extrasaction="ignore")
         writer.writeheader()
         writer.writerows(rows)
     print(table)

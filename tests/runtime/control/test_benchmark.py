@@ -7,7 +7,7 @@ import pytest
 
 from bindings._sr import lib
 from runtime.__main__ import main
-from runtime.control.benchmark import COLUMNS, controller_runs
+from runtime.control.benchmark import COLUMNS, controller_runs, estimator_table, sensors_target
 from runtime.control.offsets import offset_cases
 from runtime.control.task import load_task
 
@@ -26,6 +26,44 @@ def test_the_benchmark_writes_one_table_row_and_one_summary_per_task_and_control
         assert set(summary["tracking"]) == set(COLUMNS)
         assert summary["contact"]["least_normal_force_N"] > 0 and summary["contact"]["largest_friction_ratio"] > 0
         assert (tmp_path / run / "tracking.png").stat().st_size > 0
+
+
+def test_a_task_on_sensors_adds_its_estimate_errors_and_target_below_the_table(tmp_path):
+    assert main(["control", "--out", str(tmp_path), "--tasks", "circle-sensors", "--duration", "0.5"]) == 0
+    table = (tmp_path / "table.md").read_text()
+    assert "On the estimator" in table
+    for kind in ("lqr", "nmpc-c"):
+        e = json.loads((tmp_path / f"circle-sensors-{kind}" / "summary.json").read_text())["estimate"]
+        assert f"| circle-sensors | {kind} | {1e3 * e['position_rms_m']:.1f} / {1e3 * e['position_max_m']:.1f} | " \
+            f"{e['heading_rms_deg']:.2f} / {e['heading_max_deg']:.2f} | RMS ≤ 0.03 m |" in table
+
+
+def _row(task, controller, settle=None, rms=None, estimate=None):
+    return {"task": task, "controller": controller, "heading_settle_s": settle, "cross_track_rms_m": rms,
+            "estimate": estimate}
+
+
+def test_the_heading_step_on_sensors_is_held_to_its_own_controllers_nominal_settle_time_plus_two_seconds():
+    nominal = [_row("heading-step", "lqr", settle=7.6), _row("heading-step", "nmpc-c", settle=5.0)]
+    assert sensors_target(_row("heading-step-sensors", "lqr", settle=9.6), nominal) == ("settle ≤ 9.6 s", True)
+    assert sensors_target(_row("heading-step-sensors", "lqr", settle=9.61), nominal)[1] is False
+    assert sensors_target(_row("heading-step-sensors", "lqr", settle=None), nominal)[1] is False
+    assert sensors_target(_row("heading-step-sensors", "nmpc-c", settle=7.1), nominal)[1] is False
+
+
+def test_a_path_task_on_sensors_is_held_to_three_centimetres_and_other_tasks_to_no_target():
+    assert sensors_target(_row("line-sensors", "lqr", rms=0.03), [])[1] is True
+    assert sensors_target(_row("line-sensors", "lqr", rms=0.0301), [])[1] is False
+    assert sensors_target(_row("circle-mismatch-ekf", "lqr", rms=0.0301), []) == ("—", None)
+    assert sensors_target(_row("heading-step-sensors", "lqr", settle=9.0), []) == ("—", None)
+
+
+def test_the_estimator_table_lists_only_the_runs_that_read_an_estimate():
+    e = {"position_rms_m": 0.004, "position_max_m": 0.012, "heading_rms_deg": 0.2, "heading_max_deg": 0.8}
+    table = estimator_table([_row("circle", "lqr", rms=0.001), _row("circle-sensors", "lqr", rms=0.02, estimate=e)])
+    assert "| circle-sensors | lqr | 4.0 / 12.0 | 0.20 / 0.80 | RMS ≤ 0.03 m | yes |" in table
+    assert "| circle | lqr |" not in table
+    assert estimator_table([_row("circle", "lqr", rms=0.001)]) == ""
 
 
 def test_the_offset_table_writes_one_row_per_chosen_case_with_its_target(tmp_path):
