@@ -283,8 +283,8 @@ def criterion(info):
     return (float(logdet) if sign > 0 else -math.inf), (float(s[0] / s[-1]) if s[-1] > 0 else math.inf)
 
 
-#: The dampings: their torques −k ω are what the damping weight of the criterion is for.
 DAMPINGS = ("k_S", "k_Y", "k_P")
+"""The dampings: their torques −k ω are what the damping weight of the criterion is for."""
 
 
 def weighted_criterion(info, names, damping_weight):
