@@ -193,3 +193,16 @@ def test_the_circle_lqr_holds_a_plant_on_which_tighter_attitude_gains_chatter_at
     row = spec.run_chunk(16, 17)
     assert row["counted_apart"][0] == 0 and row["steady_torque_nm"][0] < 0.3
     assert row["success"][0] == 1 and row["saturated_fraction"][0] < 0.3
+
+
+LINE_PLANTS = CIRCLE_PLANTS.replace("on the circle", "on the line").replace('tasks = ["circle"]', 'tasks = ["line"]')
+
+
+def test_the_line_lqr_holds_a_plant_whose_wander_the_3_cm_tight_gains_leave_above_the_rule(tmp_path):
+    # Plant 31 of the shipped study (its sensors' seed, the filter's mismatch allowance): with the
+    # tight path gains designed at 3 cm the second-half wander is 32 mm, over the 3 cm rule; the
+    # line task's 2 cm gains hold it to about 27 mm (docs/control.md, "Robustness over many robots").
+    spec = load_sweep(str(_sweep(tmp_path, LINE_PLANTS.replace("samples = 20", "samples = 40"))))
+    row = spec.run_chunk(31, 32)
+    assert row["plant"][0] == 31 and row["progress"][0] > 0.9
+    assert row["success"][0] == 1 and row["cross_track_rms_m"][0] < 0.029
