@@ -125,6 +125,27 @@ class ParamDerivativeMethods:
         self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
         return out
 
+    def step_and_param_jacobian(self, x, u=None, dt=0.01, method="lie-euler", columns=None):
+        """(x_next, Jp): the step of `method` from x (35,) or (B, 35) and the columns `columns` of
+        `step_param_jacobian` (default all) from one pass of the stages (C:
+        sr_step_and_param_jacobian_cols_batch); x_next equals `step`'s to rounding (the stages solve
+        for ν̇ by the parameter path's factorisation).  What a fit needs at each evaluation, the
+        prediction and its sensitivity, for the cost of the sensitivity alone."""
+        choice(method, "method", STEP_METHODS, "integrator with a parameter Jacobian")
+        x, u = self._state_and_input(x, u)
+        dt = self._dt(dt)
+        cols = _column_list(np.arange(NPARAM) if columns is None else columns)
+        xb = np.ascontiguousarray(x.reshape(-1, x.shape[-1]))
+        ub = np.ascontiguousarray(u.reshape(-1, u.shape[-1]))
+        nxt = np.empty(xb.shape)
+        Jp = np.empty((xb.shape[0], NE, len(cols)))
+        failed = ffi.new("long *")
+        status = lib.sr_step_and_param_jacobian_cols_batch(
+            self._model, getattr(lib, STEP_METHODS[method]), xb.shape[0], _ptr(xb), _ptr(ub), dt, len(cols),
+            ffi.new("int[]", [int(c) for c in cols]), _ptr(nxt), _ptr(Jp), failed)
+        self._check(f"x[{failed[0]}]" if failed[0] >= 0 and x.ndim > 1 else "x", status)
+        return (nxt, Jp) if x.ndim > 1 else (nxt[0], Jp[0])
+
     def step_jacobians(self, x, u=None, dt=0.01, method="lie-euler", columns=None):
         """(F, Jp) at once: F of `step_jacobian` (12, 12) and the columns `columns` of
         `step_param_jacobian` (12, len(columns); default all), at the same states; batches
