@@ -90,6 +90,7 @@ CDEF = header_cdef()
 PY_ENTRIES_CDEF = """
 int sr_py_accel(const sr_model *model, const void *x, const void *u, void *a);
 int sr_py_step(const sr_model *model, int method, const void *x, const void *u, double dt, void *x_next);
+int sr_py_inertia_batch(const sr_model *model, long n, const double *x, double *M, long *failed_row);
 """
 PY_ENTRIES_SOURCE = """
 static int sr_py_accel(const sr_model *model, const void *x, const void *u, void *a)
@@ -102,6 +103,22 @@ static int sr_py_step(const sr_model *model, int method, const void *x, const vo
 {
     /* sr_step checks x in full itself (sr_check_state): no second check here. */
     return sr_step(model, method, (const sr_real *)x, (const sr_real *)u, dt, (sr_real *)x_next);
+}
+
+/* sr_inertia on n states (x n x SR_NX, M n x 25), stopping at the first failing row (its index in
+ * *failed_row, else -1): Model.inertia_batch's loop in C instead of one cffi call a state. */
+static int sr_py_inertia_batch(const sr_model *model, long n, const double *x, double *M, long *failed_row)
+{
+    long i;
+    *failed_row = -1;
+    for (i = 0; i < n; ++i) {
+        const int status = sr_inertia(model, x + i * SR_NX, M + i * SR_NV * SR_NV);
+        if (status != SR_OK) {
+            *failed_row = i;
+            return status;
+        }
+    }
+    return SR_OK;
 }
 """
 

@@ -206,9 +206,10 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativ
         """M (B, 5, 5) of the states x (B, 35)."""
         x = np.ascontiguousarray(self._valid_states(x))
         out = np.empty((x.shape[0], NV, NV))
-        xp, op = _ptr(x), _ptr(out)
-        for i in range(x.shape[0]):     # C has no batch of M; the states are checked once, above
-            self._check(f"x[{i}]", lib.sr_inertia(self._model, xp + NX * i, op + NV * NV * i))
+        failed = ffi.new("long *")
+        # the binding's loop over sr_inertia (bindings/build_sr.py); the states are checked in full above
+        status = lib.sr_py_inertia_batch(self._model, x.shape[0], _ptr(x), _ptr(out), failed)
+        self._check(f"x[{failed[0]}]", status)
         return out
 
     def rhs(self, x, u=None):

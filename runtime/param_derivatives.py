@@ -20,7 +20,7 @@ from bindings._sr import ffi, lib
 
 from .params import FLAT_FIELDS, SHAPES, flat_names, parameter_order
 from .so3 import random_rotation
-from .state import NE, NV, initial_state
+from .state import NE, NV, NX, initial_state
 from .validation import choice, check_finite, real_array
 
 
@@ -125,6 +125,14 @@ class ParamDerivativeMethods:
         self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
         return out
 
+    def step_and_param_jacobian(self, x, u=None, dt=0.01, method="lie-euler", columns=None):
+        """(x_next, Jp): the step of `method` from x (35,) or (B, 35) and the columns `columns` of
+        `step_param_jacobian` (default all) from one pass of the stages (C:
+        sr_step_and_param_jacobian_cols_batch); x_next equals `step`'s to rounding (the stages solve
+        for ν̇ by the parameter path's factorisation).  What a fit needs at each evaluation, the
+        prediction and its sensitivity, for the cost of the sensitivity alone."""
+        return self._with_columns(lib.sr_step_and_param_jacobian_cols_batch, (NX,), x, u, dt, method, columns)
+
     def step_jacobians(self, x, u=None, dt=0.01, method="lie-euler", columns=None):
         """(F, Jp) at once: F of `step_jacobian` (12, 12) and the columns `columns` of
         `step_param_jacobian` (12, len(columns); default all), at the same states; batches
@@ -132,21 +140,24 @@ class ParamDerivativeMethods:
         parameter stages carries F's columns too, so each stage's derivative kernel and
         factorisation serve both (C: sr_step_jacobian_param_cols_batch); F equals `step_jacobian`'s
         to rounding."""
+        return self._with_columns(lib.sr_step_jacobian_param_cols_batch, (NE, NE), x, u, dt, method, columns)
+
+    def _with_columns(self, batch, first_shape, x, u, dt, method, columns):
+        """(first, Jp) of a step's C batch `batch` that writes an array of `first_shape` per state,
+        then the parameter columns `columns` (default all), for one state or a batch."""
         choice(method, "method", STEP_METHODS, "integrator with a parameter Jacobian")
         x, u = self._state_and_input(x, u)
         dt = self._dt(dt)
         cols = _column_list(np.arange(NPARAM) if columns is None else columns)
         xb = np.ascontiguousarray(x.reshape(-1, x.shape[-1]))
         ub = np.ascontiguousarray(u.reshape(-1, u.shape[-1]))
-        F = np.empty((xb.shape[0], NE, NE))
+        first = np.empty((xb.shape[0], *first_shape))
         Jp = np.empty((xb.shape[0], NE, len(cols)))
         failed = ffi.new("long *")
-        status = lib.sr_step_jacobian_param_cols_batch(self._model, getattr(lib, STEP_METHODS[method]), xb.shape[0],
-                                                       _ptr(xb), _ptr(ub), dt, len(cols),
-                                                       ffi.new("int[]", [int(c) for c in cols]), _ptr(F), _ptr(Jp),
-                                                       failed)
+        status = batch(self._model, getattr(lib, STEP_METHODS[method]), xb.shape[0], _ptr(xb), _ptr(ub), dt, len(cols),
+                       ffi.new("int[]", [int(c) for c in cols]), _ptr(first), _ptr(Jp), failed)
         self._check(f"x[{failed[0]}]" if failed[0] >= 0 and x.ndim > 1 else "x", status)
-        return (F, Jp) if x.ndim > 1 else (F[0], Jp[0])
+        return (first, Jp) if x.ndim > 1 else (first[0], Jp[0])
 
     def _columns(self, batch, x, u, rows, columns, step=()):
         """The columns `columns` of a parameter Jacobian with `rows` rows by the C batch `batch`, for

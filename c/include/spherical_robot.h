@@ -514,6 +514,7 @@ int sr_local_batch(const sr_model *model, long n, const sr_real *x, const sr_rea
 #define sr_step_param_jacobian_batch sr_step_param_jacobian_batch_f
 #define sr_step_param_jacobian_fd_batch sr_step_param_jacobian_fd_batch_f
 #define sr_step_param_jacobian_cols_batch sr_step_param_jacobian_cols_batch_f
+#define sr_step_and_param_jacobian_cols_batch sr_step_and_param_jacobian_cols_batch_f
 #define sr_accel_param_jacobian_cols_batch sr_accel_param_jacobian_cols_batch_f
 #define sr_step_jacobian_param_cols_batch sr_step_jacobian_param_cols_batch_f
 #define sr_regressor sr_regressor_f
@@ -621,6 +622,16 @@ int sr_step_param_jacobian_batch(const sr_model *model, int method, long n, cons
  * all succeed); the rows before it are written. */
 int sr_step_param_jacobian_cols_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u,
                                       sr_real dt, int ncols, const int *cols, sr_real *Jp, long *failed_row);
+
+/** sr_step_param_jacobian_cols_batch that also writes each row's step, x_next n x SR_NX: the end
+ * state of the same stages (x . exp(Theta), Theta summed from the stages' K as the stepper sums
+ * them), so a fit that needs the step and its sensitivity pays for the stages once.  x_next equals
+ * sr_step's to rounding (the stages solve M nu' = f by the parameter path's Cholesky factor, not by
+ * sr_accel's solve).  Checks and status codes as sr_step_param_jacobian_cols_batch (x_next too not
+ * NULL; SR_ERR_NONFINITE also for a non-finite end state); the rows before a failing one are written. */
+int sr_step_and_param_jacobian_cols_batch(const sr_model *model, int method, long n, const sr_real *x,
+                                          const sr_real *u, sr_real dt, int ncols, const int *cols, sr_real *x_next,
+                                          sr_real *Jp, long *failed_row);
 
 /** The step's state Jacobian F (sr_step_jacobian's, n x SR_NE x SR_NE row-major) and its parameter
  * sensitivity on the columns cols[0..ncols) (sr_step_param_jacobian_cols_batch's Jp, n x SR_NE x

@@ -389,7 +389,7 @@ static int field_rows(const sr_model *model, const sr_real *constants, const col
  * and the combination sum_k b_k dK_k is summed as the stages go (in the combine's order): a
  * quarter of the stack, which keeps the working set in L1. */
 static int rkmk4_param(const sr_model *model, const colset *cs, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                       sr_real h, error_p dy)
+                       sr_real h, error_p dy, sr_real *x_end)
 {
     static const sr_real a_diag[3] = {SR_C(0.5), SR_C(0.5), SR_C(1.0)};
     const sr_real b[4] = {h / 6, h / 3, h / 3, h / 6};
@@ -434,14 +434,15 @@ static int rkmk4_param(const sr_model *model, const colset *cs, const sr_real x[
         th[i] = 0;
         for (s = 0; s < 4; ++s) th[i] += b[s] * K[s][i];
     }
-    if (cs->ns) so3_exp_minus_identity(th + SR_T_S, D);
+    if (cs->ns || x_end) so3_exp_minus_identity(th + SR_T_S, D);
+    if (x_end) act_increment(x, D, th, NULL, x_end);   /* the step itself, as the stepper's advance */
     action_rows(cs->ns, nc, th, D, (const sr_real(*)[NW])dsum, dy);
     return SR_OK;
 }
 
 /* Lie-Euler: x_new = x . exp(h f(x)). */
 static int lie_euler_param(const sr_model *model, const colset *cs, const sr_real x[SR_NX], const sr_real u[SR_NU],
-                           sr_real h, error_p dy)
+                           sr_real h, error_p dy, sr_real *x_end)
 {
     sr_real f[SR_NT], th[SR_NT], D[9], cg[SR_GEN_GENERAL_NCONST];
     tangent_p df;
@@ -453,21 +454,23 @@ static int lie_euler_param(const sr_model *model, const colset *cs, const sr_rea
         th[i] = h * f[i];
         for (c = 0; c < cs->n; ++c) df[i][c] *= h;
     }
-    if (cs->ns) so3_exp_minus_identity(th + SR_T_S, D);
+    if (cs->ns || x_end) so3_exp_minus_identity(th + SR_T_S, D);
+    if (x_end) act_increment(x, D, th, NULL, x_end);
     action_rows(cs->ns, cs->n, th, D, (const sr_real(*)[NW])df, dy);
     return SR_OK;
 }
 
 /* The step's sensitivity on the columns cs at a state not yet checked (u may be NULL); dy's first
- * cs->n columns written. */
+ * cs->n columns written, and x_end (unless NULL) the step's end state, from the same stages. */
 static int step_param(const sr_model *model, const colset *cs, int method, const sr_real x[SR_NX],
-                      const sr_real u[SR_NU], sr_real dt, error_p dy)
+                      const sr_real u[SR_NU], sr_real dt, error_p dy, sr_real *x_end)
 {
     int status = sr_internal_check_state(model, x);
     if (status == SR_OK && u && !all_finite(u, SR_NU)) status = SR_ERR_NONFINITE;
     if (status != SR_OK) return status;
     if (!u) u = sr_zero_u;
-    return method == SR_LIE_EULER ? lie_euler_param(model, cs, x, u, dt, dy) : rkmk4_param(model, cs, x, u, dt, dy);
+    return method == SR_LIE_EULER ? lie_euler_param(model, cs, x, u, dt, dy, x_end)
+                                  : rkmk4_param(model, cs, x, u, dt, dy, x_end);
 }
 
 int sr_step_param_jacobian(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
@@ -478,7 +481,7 @@ int sr_step_param_jacobian(const sr_model *model, int method, const sr_real x[SR
     if (status != SR_OK) return status;
     if (!x || !Jp) return SR_ERR_NULL;
     if ((method != SR_LIE_EULER && method != SR_RKMK4) || arg_dt(dt) != SR_OK) return SR_ERR_ARG;
-    status = step_param(model, &ALL_COLUMNS, method, x, u, dt, dy);
+    status = step_param(model, &ALL_COLUMNS, method, x, u, dt, dy, NULL);
     for (i = 0; i < SR_NE && status == SR_OK; ++i)
         if (!all_finite(dy[i], NP)) status = SR_ERR_NONFINITE;
     if (status != SR_OK) return status;
@@ -506,26 +509,32 @@ int sr_step_param_jacobian_batch(const sr_model *model, int method, long n, cons
     return SR_OK;
 }
 
-int sr_step_param_jacobian_cols_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u,
-                                      sr_real dt, int ncols, const int *cols, sr_real *Jp, long *failed_row)
+/* sr_step_param_jacobian_cols_batch; with_next: each row's end state in x_next (n x SR_NX) too. */
+static int cols_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u, sr_real dt,
+                      int ncols, const int *cols, int with_next, sr_real *x_next, sr_real *Jp, long *failed_row)
 {
     colset cs;
     pi_column pi[NP];
     error_p dy;
+    sr_real end[SR_NX];
     long i;
     int k, c, status = arg_model(model, READS(WHOLE));
     if (failed_row) *failed_row = -1;
     if (status == SR_OK) status = arg_columns(ncols, cols);
-    if (status == SR_OK) status = arg_rows(n, x && Jp);
+    if (status == SR_OK) status = arg_rows(n, x && Jp && (x_next || !with_next));
     if (status == SR_OK && ((method != SR_LIE_EULER && method != SR_RKMK4) || arg_dt(dt) != SR_OK)) status = SR_ERR_ARG;
     if (status != SR_OK) return status;
     cs = columns_of(model, 0, ncols, cols, pi);
     for (i = 0; i < n; ++i) {
         sr_real *out = Jp + i * SR_NE * ncols;
-        status = step_param(model, &cs, method, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt, dy);
+        status = step_param(model, &cs, method, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt, dy, with_next ? end : NULL);
         for (k = 0; k < SR_NE && status == SR_OK; ++k) {
             if (!all_finite(dy[k], ncols)) status = SR_ERR_NONFINITE;
             for (c = 0; c < ncols; ++c) out[k * ncols + c] = dy[k][c];
+        }
+        if (status == SR_OK && with_next) {
+            if (!all_finite(end, SR_NX)) status = SR_ERR_NONFINITE;
+            memcpy(x_next + i * SR_NX, end, sizeof end);
         }
         if (status != SR_OK) {
             if (failed_row) *failed_row = i;
@@ -533,6 +542,19 @@ int sr_step_param_jacobian_cols_batch(const sr_model *model, int method, long n,
         }
     }
     return SR_OK;
+}
+
+int sr_step_param_jacobian_cols_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u,
+                                      sr_real dt, int ncols, const int *cols, sr_real *Jp, long *failed_row)
+{
+    return cols_batch(model, method, n, x, u, dt, ncols, cols, 0, NULL, Jp, failed_row);
+}
+
+int sr_step_and_param_jacobian_cols_batch(const sr_model *model, int method, long n, const sr_real *x,
+                                          const sr_real *u, sr_real dt, int ncols, const int *cols, sr_real *x_next,
+                                          sr_real *Jp, long *failed_row)
+{
+    return cols_batch(model, method, n, x, u, dt, ncols, cols, 1, x_next, Jp, failed_row);
 }
 
 int sr_step_jacobian_param_cols_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u,
@@ -552,7 +574,7 @@ int sr_step_jacobian_param_cols_batch(const sr_model *model, int method, long n,
     cs = columns_of(model, NS, ncols, cols, pi);
     for (i = 0; i < n; ++i) {
         sr_real *f = F + i * SR_NE * SR_NE, *out = Jp + i * SR_NE * ncols;
-        status = step_param(model, &cs, method, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt, dy);
+        status = step_param(model, &cs, method, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt, dy, NULL);
         for (k = 0; k < SR_NE && status == SR_OK; ++k) {
             if (!all_finite(dy[k], NS + ncols)) status = SR_ERR_NONFINITE;
             for (c = 0; c < NS; ++c) f[SR_NE * k + state_row(c)] = dy[k][c];

@@ -40,7 +40,7 @@ from ..params import SHAPES, Params, flat_names
 from ..state import IDX_E_NU, IDX_NU, NE, NV
 from .first_guess import _dpi_of, regressor_guess
 from .segments import dlocal_batch, dretract_batch, segment_blocks
-from .sensitivity import JACOBIANS, step_sensitivity
+from .sensitivity import JACOBIANS, step_and_sensitivity
 
 #: Where the fit starts the parameters: the regressor's linear least-squares first guess, or the nominal robot.
 STARTS = ("regressor", "nominal")
@@ -644,10 +644,10 @@ class _FullState:
         the evaluation's products)."""
         if self._cache[0] is None or not np.array_equal(self._cache[0], z):
             model = self.model(z)
-            pred = model.step(self.X[:-1], self.u, self.h, self.method)
+            pred, Jp = step_and_sensitivity(model, self.X[:-1], self.u, self.h, self.method, self.idx,
+                                            self.jacobian)
             e = self.X[1:, IDX_NU] - pred[:, IDX_NU]
-            Jp = step_sensitivity(model, self.X[:-1], self.u, self.h, self.method, self.idx,
-                                  self.jacobian)[:, IDX_E_NU]
+            Jp = Jp[:, IDX_E_NU]
             r = np.matmul(self.white, e[..., None])[..., 0]
             J = -np.matmul(self.white, Jp)
             self._cache = (z.copy(), (r.ravel(), J.reshape(-1, self.nf), None))

@@ -30,6 +30,15 @@ def step_sensitivity(model, x, u, h, method, idx, jacobian):
     return model.step_param_jacobian(x, u, h, method, columns=idx)
 
 
+def step_and_sensitivity(model, x, u, h, method, idx, jacobian):
+    """(x_next, Jp): the steps (B, 35) and `step_sensitivity`'s Jp.  The analytic source gives both
+    from one pass of the stages (`Model.step_and_param_jacobian`); the differences never evaluate
+    the robot at p itself, so theirs is one batched `Model.step` more."""
+    if jacobian == "analytic":
+        return model.step_and_param_jacobian(x, u, h, method, columns=idx)
+    return model.step(x, u, h, method), step_sensitivity(model, x, u, h, method, idx, jacobian)
+
+
 def step_jacobians(model, x, u, h, method, idx, jacobian):
     """(F, Jp): the steps' state Jacobians (B, 12, 12) and their sensitivities (B, 12, len(idx)) to
     the free entries idx at the same states x (B, 35), of the `jacobian` source: analytic in one

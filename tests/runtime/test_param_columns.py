@@ -19,9 +19,9 @@ SHUFFLED = [int(c) for c in np.random.default_rng(5).permutation(NPARAM)]
 FEW = [PARAMETER_NAMES.index(n) for n in ("k_S", "m_P", "r", "J_P_yy", "j_mY", "c_P_z")]
 
 
-def states(n, seed=0):
+def states(n, seed=0, params=GENERAL):
     rng = np.random.default_rng(seed)
-    return np.array([random_state(rng, GENERAL, max_speed=3.0) for _ in range(n)]), random_inputs(rng, n)
+    return np.array([random_state(rng, params, max_speed=3.0) for _ in range(n)]), random_inputs(rng, n)
 
 
 def columns_match(part, full, cols):
@@ -134,3 +134,44 @@ def test_the_c_function_names_the_row_of_a_state_it_cannot_step():
     X, _ = states(3)
     X[1, 0] = np.nan
     assert _call(model, X) == (lib.SR_ERR_NONFINITE, 1)
+
+
+def steps_match(a, b):
+    """a equals b (B, 35) to 1e-12 of each state's largest entry: rounding, not a different step."""
+    return bool(np.all(np.abs(a - b).max(axis=-1) <= 1e-12 * np.abs(b).max(axis=-1)))
+
+
+@pytest.mark.parametrize("method", ["lie-euler", "rkmk4"])
+@pytest.mark.parametrize("params", [GENERAL, None], ids=["general", "paper"])
+def test_the_step_from_the_sensitivity_pass_is_the_steppers_to_rounding(method, params):
+    model = Model(params)
+    X, U = states(6, seed=3, params=params)
+    nxt, _ = model.step_and_param_jacobian(X, U, 0.01, method, columns=FEW)
+    assert steps_match(nxt, model.step(X, U, 0.01, method))
+
+
+@pytest.mark.parametrize("method", ["lie-euler", "rkmk4"])
+def test_the_sensitivity_pass_that_steps_gives_step_param_jacobians_columns(method):
+    model = Model(GENERAL)
+    X, U = states(4, seed=4)
+    _, Jp = model.step_and_param_jacobian(X, U, 0.01, method, columns=FEW)
+    assert np.array_equal(Jp, model.step_param_jacobian(X, U, 0.01, method, columns=FEW))
+
+
+def test_the_step_check_fails_for_a_perturbed_step():
+    model = Model(GENERAL)
+    X, U = states(3, seed=5)
+    nxt, _ = model.step_and_param_jacobian(X, U, 0.01, "rkmk4", columns=FEW)
+    nxt[1, -1] += 1e-10 * np.abs(nxt[1]).max()
+    assert not steps_match(nxt, model.step(X, U, 0.01, "rkmk4"))
+    assert not steps_match(model.step(X, U, 0.01 * (1 + 1e-9), "rkmk4"), model.step(X, U, 0.01, "rkmk4"))
+
+
+def test_the_sensitivity_pass_that_steps_refuses_a_null_end_state():
+    model = Model(GENERAL)
+    X, U = states(2, seed=6)
+    Jp, failed = np.empty((2, NE, 1)), ffi.new("long *")
+    status = lib.sr_step_and_param_jacobian_cols_batch(
+        model._model, lib.SR_RKMK4, 2, ffi.cast("double *", ffi.from_buffer(X)), ffi.cast("double *", ffi.from_buffer(U)),
+        0.01, 1, ffi.new("int[]", [0]), ffi.NULL, ffi.cast("double *", ffi.from_buffer(Jp)), failed)
+    assert status == lib.SR_ERR_NULL
