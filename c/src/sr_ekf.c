@@ -196,17 +196,6 @@ static void torque_noise_of(const sr_real Minv[SR_NV * SR_NV], const sr_ekf_proc
         }
 }
 
-/* The same at x, M^-1 by its own evaluation (x valid): for a held disturbance's prior. */
-static int torque_noise(const sr_model *model, const sr_real x[SR_NX], const sr_ekf_process *q, sr_real dt,
-                        sr_real Q[SR_NV * SR_NV])
-{
-    sr_real a[SR_NV], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], Minv[SR_NV * SR_NV];
-    const int status = sr_internal_accel_jacobian_minv(model, x, sr_zero_u, a, Ja, Jb, Minv);
-    if (status != SR_OK) return status;
-    torque_noise_of(Minv, q, dt, Q);
-    return SR_OK;
-}
-
 /* How long of the predict's dt a held disturbance still drives: the rest of its period, at most dt
  * (0: none held). */
 static sr_real held_for(const sr_ekf_held *h, sr_real dt)
@@ -826,18 +815,79 @@ int sr_ekf_update_imu_axes(sr_ekf *ekf, const sr_model *model, const sr_real y[S
     return update(ekf, SR_EKF_IMU, SR_NIMU, r, H, Rd, gate);
 }
 
+/* The held sample's products (sr_ekf.h, "Held disturbance") from the nonzero entries of H and Hn
+ * (an IMU row of H reads at most 13 of the 18 columns; Hn's gyroscope rows are zero): r's
+ * prediction's share Hn a_hat in pred, Cov(e, r)^T = H P + Hn C^T (CT, rows of NBP, zero padded),
+ * B = H C + Hn A, S = H Cov(e, r) + Hn B^T + R on the upper triangle (mirrored), and
+ * Cov(r, z_j) = H C_j + Hn Cov(a, z_j) for every waiting fix (W). */
+static SR_LANES_CLONES void held_products(const sr_ekf *ekf, const sr_real *H, const sr_real *Hn,
+                                          const sr_real *sigma, sr_real *pred, sr_real *CT, sr_real *S,
+                                          sr_real *B, sr_real *W)
+{
+    const sr_ekf_held *h = &ekf->held;
+    sr_real val[SR_NIMU * NB], hv[SR_NIMU * SR_NV];
+    int col[SR_NIMU * NB], nnz[SR_NIMU], hc[SR_NIMU * SR_NV], nh[SR_NIMU], a, b, i, j, k;
+    for (i = 0; i < SR_NIMU; ++i) {
+        nnz[i] = nh[i] = 0;
+        for (k = 0; k < NB; ++k)
+            if (H[NB * i + k] != 0) {
+                val[NB * i + nnz[i]] = H[NB * i + k];
+                col[NB * i + nnz[i]++] = k;
+            }
+        for (k = 0; k < SR_NV; ++k)
+            if (Hn[SR_NV * i + k] != 0) {
+                hv[SR_NV * i + nh[i]] = Hn[SR_NV * i + k];
+                hc[SR_NV * i + nh[i]++] = k;
+            }
+    }
+    for (i = 0; i < SR_NIMU; ++i) {
+        sr_real *Ci = CT + NBP * i, *Bi = B + SR_NV * i;
+        const sr_real *v = val + NB * i, *w = hv + SR_NV * i;
+        const int *c = col + NB * i, *d = hc + SR_NV * i;
+        for (a = 0; a < NBP; ++a) Ci[a] = 0;
+        for (k = 0; k + 1 < nnz[i]; k += 2) rows_plus2(v[k], ekf->P + NB * c[k], v[k + 1], ekf->P + NB * c[k + 1], Ci);
+        if (k < nnz[i]) row_plus(v[k], ekf->P + NB * c[k], Ci);
+        for (b = 0; b < SR_NV; ++b) Bi[b] = 0;
+        for (k = 0; k < nnz[i]; ++k)
+            for (b = 0; b < SR_NV; ++b) Bi[b] += v[k] * h->cross[SR_NV * c[k] + b];
+        for (k = 0; k < nh[i]; ++k) {
+            const sr_real *Ck = h->cross + d[k];
+            pred[i] += w[k] * h->mean[d[k]];
+            for (a = 0; a < NB; ++a) Ci[a] += w[k] * Ck[SR_NV * a];
+            for (b = 0; b < SR_NV; ++b) Bi[b] += w[k] * h->cov[SR_NV * d[k] + b];
+        }
+    }
+    for (i = 0; i < SR_NIMU; ++i)
+        for (j = i; j < SR_NIMU; ++j) {
+            sr_real s = i == j ? sigma[i] * sigma[i] : 0;
+            for (k = 0; k < nnz[i]; ++k) s += val[NB * i + k] * CT[NBP * j + col[NB * i + k]];
+            for (k = 0; k < nh[i]; ++k) s += hv[SR_NV * i + k] * B[SR_NV * j + hc[SR_NV * i + k]];
+            S[SR_NIMU * i + j] = S[SR_NIMU * j + i] = s;
+        }
+    for (j = 0; j < SR_EKF_NDELAYED; ++j) {
+        const sr_real *Cj = ekf->delayed[j].C, *Aj = h->fix + 2 * SR_NV * j;
+        if (!ekf->delayed[j].marked) continue;
+        for (i = 0; i < SR_NIMU; ++i)
+            for (a = 0; a < 2; ++a) {
+                sr_real s = 0;
+                for (k = 0; k < nnz[i]; ++k) s += val[NB * i + k] * Cj[2 * col[NB * i + k] + a];
+                for (k = 0; k < nh[i]; ++k) s += hv[SR_NV * i + k] * Aj[2 * hc[SR_NV * i + k] + a];
+                W[MAXM * 2 * j + 2 * i + a] = s;
+            }
+    }
+}
+
 int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
                            int body, const sr_real mount[SR_NMOUNT], const sr_real sigma[SR_NIMU],
                            const sr_ekf_process *process, sr_real hold, sr_real gate)
 {
-    sr_real yh[SR_NIMU], H[SR_NIMU * NB], Hn[SR_NIMU * SR_NV], r[SR_NIMU], yd[SR_NIMU], Hd[SR_NIMU * NB];
-    sr_real CT[SR_NIMU * NBP] = {0}, S[SR_NIMU * SR_NIMU], L[SR_NIMU * SR_NIMU], B[SR_NIMU * SR_NV];
+    sr_real yh[SR_NIMU], H[SR_NIMU * NB], Hn[SR_NIMU * SR_NV], r[SR_NIMU], Minv[SR_NV * SR_NV];
+    sr_real CT[SR_NIMU * NBP], S[SR_NIMU * SR_NIMU], L[SR_NIMU * SR_NIMU], B[SR_NIMU * SR_NV];
     sr_real X[SR_NIMU * SR_NV], Sr[SR_NIMU], col[SR_NIMU], W[SR_EKF_NDELAYED * MAXM * 2];
-    const sr_real zero[SR_NV] = {0};
     sr_ekf_held before, *h;
     long applied, recovered;
     sr_real inflate;
-    int status = arg_model(model, READS(WHOLE)), a, b, i, j, k;
+    int status = arg_model(model, READS(WHOLE)), a, b, i, j;
     if (status != SR_OK) return status;
     if (!ekf || !y || !mount || !sigma || !process) return SR_ERR_NULL;
     before = ekf->held;
@@ -848,63 +898,27 @@ int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[S
     if (!valid_gate(gate) || !valid_process(process) || arg_dt(hold) != SR_OK) return SR_ERR_ARG;
     if (!all_finite(y, SR_NIMU) || (u && !all_finite(u, SR_NU))) return SR_ERR_NONFINITE;
     status = check_filter(model, ekf);
-    /* The state, biases, mount and u are checked: the Jacobian without its checks. */
-    if (status == SR_OK) status = sr_internal_imu_jacobian(model, ekf->x, u, body, mount, ekf->bias, yh, H);
-    /* The reading is linear in nu': Hn is the same at any nu', zero included. */
-    if (status == SR_OK) status = sr_imu_partials(model, ekf->x, zero, body, mount, ekf->bias, yd, Hd, Hn);
+    /* The state, biases, mount and u are checked: the Jacobian without its checks, with Hn (the
+     * reading is linear in nu': the same at any nu') and, when a period starts, M^-1 at x from the
+     * same evaluation of the accelerations' Jacobian. */
+    if (status == SR_OK)
+        status = sr_internal_imu_jacobian_minv(model, ekf->x, u, body, mount, ekf->bias, yh, H, Hn,
+                                               ekf->held.pending ? NULL : Minv);
     if (status != SR_OK) return status;
     if (ekf->constrained) constrain_sample(ekf, SR_NIMU, H);
 
     h = &ekf->held;
     if (!h->pending) {   /* a's prior: mean 0, Q_a = M^-1 D^2 M^-1 / hold, independent of e */
         memset(h, 0, sizeof *h);
-        status = torque_noise(model, ekf->x, process, 1 / hold, h->cov);
-        if (status != SR_OK) {
-            *h = before;
-            return status;
-        }
+        torque_noise_of(Minv, process, 1 / hold, h->cov);
         h->pending = 1;
         h->remaining = hold;
     }
-    /* Cov(e, r)^T = H P + Hn C^T, B = H C + Hn A, S = H Cov(e, r) + Hn B^T + R. */
-    for (i = 0; i < SR_NIMU; ++i) {
-        sr_real pred = yh[i];
-        for (b = 0; b < SR_NV; ++b) pred += Hn[SR_NV * i + b] * h->mean[b];
-        r[i] = y[i] - pred;
-        for (a = 0; a < NB; ++a) {
-            sr_real s = 0;
-            for (k = 0; k < NB; ++k) s += H[NB * i + k] * ekf->P[NB * k + a];
-            for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * h->cross[SR_NV * a + k];
-            CT[NBP * i + a] = s;
-        }
-        for (b = 0; b < SR_NV; ++b) {
-            sr_real s = 0;
-            for (k = 0; k < NB; ++k) s += H[NB * i + k] * h->cross[SR_NV * k + b];
-            for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * h->cov[SR_NV * k + b];
-            B[SR_NV * i + b] = s;
-        }
-    }
-    for (i = 0; i < SR_NIMU; ++i)
-        for (j = 0; j < SR_NIMU; ++j) {
-            sr_real s = i == j ? sigma[i] * sigma[i] : 0;
-            for (k = 0; k < NB; ++k) s += H[NB * i + k] * CT[NBP * j + k];
-            for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * B[SR_NV * j + k];
-            S[SR_NIMU * i + j] = s;
-        }
-    for (i = 0; i < SR_NIMU; ++i)   /* symmetric to the last bit: the Cholesky reads one triangle */
-        for (j = 0; j < i; ++j) S[SR_NIMU * i + j] = S[SR_NIMU * j + i] = SR_C(0.5) * (S[SR_NIMU * i + j] + S[SR_NIMU * j + i]);
-    /* Cov(r, z_j) = H C_j + Hn Cov(a, z_j) for every waiting fix. */
-    for (j = 0; j < SR_EKF_NDELAYED; ++j) {
-        const sr_real *Cj = ekf->delayed[j].C;
-        if (!ekf->delayed[j].marked) continue;
-        for (i = 0; i < SR_NIMU; ++i)
-            for (a = 0; a < 2; ++a) {
-                sr_real s = 0;
-                for (k = 0; k < NB; ++k) s += H[NB * i + k] * Cj[2 * k + a];
-                for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * h->fix[2 * SR_NV * j + 2 * k + a];
-                W[MAXM * 2 * j + 2 * i + a] = s;
-            }
-    }
+    /* r = y - h - Hn a_hat; Cov(e, r)^T = H P + Hn C^T, B = H C + Hn A, S = H Cov(e, r) + Hn B^T + R,
+     * Cov(r, z_j) for the waiting fixes. */
+    memcpy(r, yh, sizeof r);
+    held_products(ekf, H, Hn, sigma, r, CT, S, B, W);
+    for (i = 0; i < SR_NIMU; ++i) r[i] = y[i] - r[i];
     /* S^-1 r and X = S^-1 B for a's own revision after the error's. */
     status = cholesky(SR_NIMU, S, L);
     if (status != SR_OK) {
