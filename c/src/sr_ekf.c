@@ -852,7 +852,7 @@ static SR_LANES_CLONES void held_products(const sr_ekf *ekf, const sr_real *H, c
 {
     const sr_ekf_held *h = &ekf->held;
     sr_real val[SR_NIMU * NB], hv[SR_NIMU * SR_NV];
-    int col[SR_NIMU * NB], nnz[SR_NIMU], hc[SR_NIMU * SR_NV], nh[SR_NIMU], a, b, i, j, k;
+    int col[SR_NIMU * NB], nnz[SR_NIMU], hc[SR_NIMU * SR_NV], nh[SR_NIMU], a, i, j, k;
     for (i = 0; i < SR_NIMU; ++i) {
         nnz[i] = nh[i] = 0;
         for (k = 0; k < NB; ++k)
@@ -898,11 +898,12 @@ static SR_LANES_CLONES void held_products(const sr_ekf *ekf, const sr_real *H, c
             Bi[3] = b3;
             Bi[4] = b4;
         }
-        for (a = 0; a < NB; ++a) {
-            const sr_real *Ca = h->cross + SR_NV * a;
-            sr_real t = 0;
-            for (k = 0; k < nh[i]; ++k) t += w[k] * Ca[d[k]];
-            Ci[a] += t;
+    }
+    for (a = 0; a < NB; ++a) {   /* Hn C^T: row a of C in registers, for the rows Hn reads (the accelerometer's) */
+        const sr_real *Ca = h->cross + SR_NV * a, c0 = Ca[0], c1 = Ca[1], c2 = Ca[2], c3 = Ca[3], c4 = Ca[4];
+        for (i = 0; i < SR_NIMU; ++i) {
+            const sr_real *w = Hn + SR_NV * i;
+            if (nh[i]) CT[NBP * i + a] += (((w[0] * c0 + w[1] * c1) + w[2] * c2) + w[3] * c3) + w[4] * c4;
         }
     }
     for (i = 0; i < SR_NIMU; ++i)
