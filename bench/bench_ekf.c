@@ -2,8 +2,13 @@
  * one prediction (RKMK4, its step Jacobian, the process noise), one IMU update on the yoke and one
  * encoder update, over a recorded run; and the prediction alone, and each update alone.
  *
+ * The same sample is timed on the filter's default path too: the IMU read through
+ * sr_ekf_update_imu_held with the torque disturbance held over one IMU period (as estimate_log, the
+ * closed loop sr_sim.c and the firmware example read it), its prior drawn at every IMU sample.
+ *
  * usage: bench_ekf [SAMPLES [PARTS]]   (default 2000: 10 s at 200 Hz)
- * With PARTS (a sum of 1 predict, 2 IMU update, 4 encoder update; 0 none) only those parts run,
+ * With PARTS (a sum of 1 predict, 2 IMU update, 4 encoder update, 8 held IMU update; 0 none) only
+ * those parts run,
  * once over the samples: the program an instruction counter runs (bench/ekf_timing.py --callgrind
  * subtracts the run of PARTS 0, the setup).
  * Build (portable -O2, as the bench's C loop), from the repository's root:
@@ -29,6 +34,7 @@
 static sr_real U[NMAX][SR_NU], IMU[NMAX][SR_NIMU], ENC[NMAX][2];
 static const sr_real MOUNT[SR_NMOUNT] = {0, 0, -0.05, 1, 0, 0, 0, 1, 0, 0, 0, 1};
 static const sr_ekf_process PROCESS = {{0.01, 0.01, 0.01}, 0, 0};
+static const sr_real SIGMA[SR_NIMU] = {0.003, 0.003, 0.003, 0.02, 0.02, 0.02};
 
 static double now_ns(void)
 {
@@ -46,7 +52,7 @@ static void start_state(const sr_model *m, sr_real x[SR_NX])
     x[SR_X_q + 2] = m->p[SR_P_r];
 }
 
-/* parts: 1 predict, 2 IMU update, 4 encoder update. */
+/* parts: 1 predict, 2 IMU update, 4 encoder update, 8 held IMU update (the disturbance held over DT). */
 static int run(const sr_model *m, int n, int parts, double *ns)
 {
     sr_ekf ekf;
@@ -62,6 +68,8 @@ static int run(const sr_model *m, int n, int parts, double *ns)
         if (parts & 1) status = sr_ekf_predict(&ekf, m, SR_RKMK4, U[i], DT, &PROCESS);
         if (status == SR_OK && (parts & 2))
             status = sr_ekf_update_imu(&ekf, m, IMU[i], U[i], SR_BODY_yoke, MOUNT, 0.003, 0.02, gate);
+        if (status == SR_OK && (parts & 8))
+            status = sr_ekf_update_imu_held(&ekf, m, IMU[i], U[i], SR_BODY_yoke, MOUNT, SIGMA, &PROCESS, DT, gate);
         if (status == SR_OK && (parts & 4)) status = sr_ekf_update_encoders(&ekf, m, ENC[i], 0.0005, gate);
     }
     *ns = (now_ns() - t0) / n;
@@ -75,8 +83,9 @@ int main(int argc, char **argv)
         [SR_PAPER_r] = 0.3, [SR_PAPER_m_S] = 2.0, [SR_PAPER_k_S] = 0.16, [SR_PAPER_b] = 0.2, [SR_PAPER_h] = 0.5,
         [SR_PAPER_m_b] = 2.0, [SR_PAPER_m_h] = 5.0, [SR_PAPER_k_Y] = 0.04, [SR_PAPER_l] = 0.2, [SR_PAPER_m_P] = 1.0,
         [SR_PAPER_k_P] = 0.10, [SR_PAPER_g] = 9.81};
-    const char *names[] = {"predict_imu_encoders", "predict", "update_imu", "update_encoders"};
-    const int parts[] = {7, 1, 2, 4};
+    const char *names[] = {"predict_imu_encoders", "predict", "update_imu", "update_encoders",
+                           "held_predict_imu_encoders", "held_predict_imu"};
+    const int parts[] = {7, 1, 2, 4, 13, 9};
     sr_real params[SR_NPARAM], x[SR_NX];
     sr_model m;
     int n = argc > 1 ? atoi(argv[1]) : 2000, only, i, k, r;
@@ -93,12 +102,12 @@ int main(int argc, char **argv)
     }
     if (only >= 0) {
         double ns = 0;
-        if (only > 7 || run(&m, n, only, &ns) != SR_OK) return 1;
+        if (only > 15 || run(&m, n, only, &ns) != SR_OK) return 1;
         printf("{\"samples\": %d, \"parts\": %d, \"ns\": %.1f}\n", n, only, ns);
         return 0;
     }
     printf("{\"samples\": %d, \"dt\": %g", n, DT);
-    for (k = 0; k < 4; ++k) {
+    for (k = 0; k < 6; ++k) {
         double best = 1e300, ns = 0;
         for (r = 0; r < 11; ++r) {
             if (run(&m, n, parts[k], &ns) != SR_OK) return 1;

@@ -1,5 +1,7 @@
 """Builds and runs bench/bench_ekf.c (one 200 Hz sample of the error-state EKF: an RKMK4 predict, an
-IMU and an encoder update; each part alone too) in the portable -O2 build of the bench
+IMU and an encoder update; each part alone too; and the same sample on the filter's default path,
+the IMU through sr_ekf_update_imu_held with the disturbance held over one IMU period, whole and
+without the encoder update) in the portable -O2 build of the bench
 (runtime.bench.harness.ekf_sample), and prints its JSON.  With --baseline REV the same program is
 also built with the filter's sources (EKF_SOURCES: the filter, the step Jacobians, the
 accelerations' Jacobians and the sensors' Jacobians) as they were at the git revision REV, and the two run in turns (the same
@@ -33,7 +35,8 @@ from runtime.bench.timing import cpu_name  # noqa: E402
 #: The bench's EKF build (runtime.bench.harness.ekf_sample): portable, -O2, no contraction.
 FLAGS = [f for f in LIBRARY_FLAGS if f != "-O3"] + ["-O2", "-ffp-contract=off"]
 #: bench_ekf's PARTS: what each counted run does.
-PARTS = {"predict_imu_encoders": 7, "predict": 1, "update_imu": 2, "update_encoders": 4}
+PARTS = {"predict_imu_encoders": 7, "predict": 1, "update_imu": 2, "update_encoders": 4,
+         "held_predict_imu_encoders": 13, "held_predict_imu": 9}
 #: The sources of c/src that --baseline takes from the other revision: those a sample's own work runs in.
 EKF_SOURCES = ("sr_ekf.c", "sr_step_jacobians.c", "sr_jacobians.c", "sr_sensors.c")
 
@@ -92,7 +95,8 @@ def main():
                 out[label]["instructions_per_sample"] = {
                     name: round((instructions(exe, n, parts) - setup) / n) for name, parts in PARTS.items()}
     if args.baseline:
-        out["speedup"] = round(out["baseline"]["predict_imu_encoders_ns"] / out["current"]["predict_imu_encoders_ns"], 2)
+        for key, name in (("speedup", "predict_imu_encoders_ns"), ("held_speedup", "held_predict_imu_encoders_ns")):
+            out[key] = round(out["baseline"][name] / out["current"][name], 2)
     date = datetime.datetime.now().isoformat(timespec="seconds")
     text = json.dumps({"date": date, "cpu": cpu_name(), "load_average": os.getloadavg(), "baseline": args.baseline,
                        "samples": args.samples, "rounds": args.rounds, "builds": out}, indent=1)

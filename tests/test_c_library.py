@@ -287,13 +287,15 @@ def test_a_program_calling_a_fourth_order_step_links_it(build, tmp_path):
 
 def test_the_ekf_timing_driver_builds_warning_free_and_reports_every_part(build, tmp_path):
     """bench/bench_ekf.c (`make bench`'s EKF sample) against the library: strict C99, and one JSON
-    line with a time for the whole sample, each part, and the step Jacobian it is compared with."""
+    line with a time for the whole sample, each part, the sample on the default (held) path, and
+    the step Jacobian it is compared with."""
     exe = tmp_path / "bench_ekf"
     run([CC, "-std=c99", "-O2", "-Wall", "-Wextra", "-Wpedantic", "-Werror", f"-I{INCLUDE}", f"-I{ROOT / 'generated'}",
          str(ROOT / "bench" / "bench_ekf.c"), str(build / "libsphericalrobot.a"), "-lm", "-o", str(exe)])
     out = json.loads(run([str(exe), "5"]).stdout)
     assert out["samples"] == 5
-    for part in ("predict_imu_encoders", "predict", "update_imu", "update_encoders", "step_jacobian_rkmk4"):
+    for part in ("predict_imu_encoders", "predict", "update_imu", "update_encoders", "held_predict_imu_encoders",
+                 "held_predict_imu", "step_jacobian_rkmk4"):
         assert out[f"{part}_ns"] > 0
 
 

@@ -29,6 +29,7 @@
  * before nu. */
 typedef char layout_fits[(NE % 2 == 0 && SR_E_nu == SR_E_q + 2) ? 1 : -1];
 /* The predict's sparse F_d P F_d^T: the attitude first, the two joint angles, q, then the five rates. */
+typedef char nv_fits[SR_NV == 5 ? 1 : -1];   /* the held disturbance's rows of five, in registers */
 typedef char order_fits[(SR_E_xi_S == 0 && SR_E_th_Y == 3 && SR_E_th_P == 4 && SR_E_q == 5 && NE == SR_E_nu + 5) ? 1 : -1];
 
 static const sr_real pi_ = SR_C(3.14159265358979323846);
@@ -196,17 +197,6 @@ static void torque_noise_of(const sr_real Minv[SR_NV * SR_NV], const sr_ekf_proc
         }
 }
 
-/* The same at x, M^-1 by its own evaluation (x valid): for a held disturbance's prior. */
-static int torque_noise(const sr_model *model, const sr_real x[SR_NX], const sr_ekf_process *q, sr_real dt,
-                        sr_real Q[SR_NV * SR_NV])
-{
-    sr_real a[SR_NV], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], Minv[SR_NV * SR_NV];
-    const int status = sr_internal_accel_jacobian_minv(model, x, sr_zero_u, a, Ja, Jb, Minv);
-    if (status != SR_OK) return status;
-    torque_noise_of(Minv, q, dt, Q);
-    return SR_OK;
-}
-
 /* How long of the predict's dt a held disturbance still drives: the rest of its period, at most dt
  * (0: none held). */
 static sr_real held_for(const sr_ekf_held *h, sr_real dt)
@@ -218,28 +208,41 @@ static sr_real held_for(const sr_ekf_held *h, sr_real dt)
  * noise there: e' = Phi e + Gm a with Gm = g on nu's rows, a' = a, so x_nu += g a_hat,
  * P' += Phi C Gm^T + Gm C^T Phi^T + Gm A Gm^T (Phi = diag(F, I)) and next->cross = Phi C + Gm A.
  * next is the held disturbance after the predict: spent when its period is. */
-static void step_held(const sr_ekf_held *h, const sr_real F[NE * NE], sr_real g, sr_real dt, sr_real xn[SR_NX],
-                      sr_real *Pn, sr_ekf_held *next)
+static SR_LANES_CLONES void step_held(const sr_ekf_held *h, const sr_real F[NE * NE], sr_real g, sr_real dt,
+                                      sr_real xn[SR_NX], sr_real *Pn, sr_ekf_held *next)
 {
     sr_real *Y = next->cross;
     int i, j, k;
     *next = *h;
     if (!h->pending) return;
     for (i = 0; i < SR_NV; ++i) xn[SR_X_w_S + i] += g * h->mean[i];
-    for (i = 0; i < NB; ++i)
-        for (j = 0; j < SR_NV; ++j) {
-            sr_real s = 0;
-            if (i < NE)
-                for (k = 0; k < NE; ++k) s += F[NE * i + k] * h->cross[SR_NV * k + j];
-            else
-                s = h->cross[SR_NV * i + j];
-            Y[SR_NV * i + j] = s;   /* Phi C */
+    /* Phi C: row i of F C sums the rows of C (SR_NV numbers each), in the order of the columns. */
+    for (i = 0; i < NE; ++i) {   /* five sums in registers; F's zeros skipped (most of its rows are sparse) */
+        const sr_real *f = F + NE * i;
+        sr_real y0 = 0, y1 = 0, y2 = 0, y3 = 0, y4 = 0;
+        for (k = 0; k < NE; ++k) {
+            const sr_real fk = f[k], *c = h->cross + SR_NV * k;
+            if (fk == 0) continue;
+            y0 += fk * c[0];
+            y1 += fk * c[1];
+            y2 += fk * c[2];
+            y3 += fk * c[3];
+            y4 += fk * c[4];
         }
-    for (i = 0; i < NB; ++i)
+        Y[SR_NV * i] = y0;
+        Y[SR_NV * i + 1] = y1;
+        Y[SR_NV * i + 2] = y2;
+        Y[SR_NV * i + 3] = y3;
+        Y[SR_NV * i + 4] = y4;
+    }
+    for (i = 0; i < NB; ++i) {
+        const sr_real *y = Y + SR_NV * i;
+        sr_real *p = Pn + NB * i + SR_EB_nu;
         for (j = 0; j < SR_NV; ++j) {
-            Pn[NB * i + SR_EB_nu + j] += g * Y[SR_NV * i + j];
-            Pn[NB * (SR_EB_nu + j) + i] += g * Y[SR_NV * i + j];
+            p[j] += g * y[j];
+            Pn[NB * (SR_EB_nu + j) + i] += g * y[j];
         }
+    }
     for (i = 0; i < SR_NV; ++i)
         for (j = 0; j < SR_NV; ++j) {
             Pn[NB * (SR_EB_nu + i) + SR_EB_nu + j] += g * g * h->cov[SR_NV * i + j];
@@ -265,8 +268,8 @@ static void release_held(sr_ekf *ekf, sr_real g, const sr_ekf_held *next)
 
 /* x_next = the step of `method` (sr_step's bits) and F the transition matrix: the Lie-Euler step's
  * Jacobian at x, whatever the method (sr_ekf.h, "Transition matrix"), one evaluation of the
- * accelerations' Jacobian instead of one per stage; Minv = M^-1 at x from its factorisation, for
- * the process noise.  x valid, u finite, method and dt valid. */
+ * accelerations' Jacobian instead of one per stage; Minv (not NULL) = M^-1 at x from its
+ * factorisation, for the process noise.  x valid, u finite, method and dt valid. */
 static int step_and_transition(const sr_model *model, int method, const sr_real x[SR_NX], const sr_real u[SR_NU],
                                sr_real dt, sr_real x_next[SR_NX], sr_real F[NE * NE], sr_real Minv[SR_NV * SR_NV])
 {
@@ -423,11 +426,13 @@ SR_LANES_CLONES int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int metho
     if (arg_method(method) != SR_OK || arg_dt(dt) != SR_OK || !valid_process(process)) return SR_ERR_ARG;
     if (u && !all_finite(u, SR_NU)) return SR_ERR_NONFINITE;
     status = check_filter(model, ekf);
-    /* The state and u are checked: the step of `method`, and F (sr_ekf.h, "Transition matrix"). */
-    if (status == SR_OK) status = step_and_transition(model, method, ekf->x, u ? u : sr_zero_u, dt, xn, F, Minv);
     /* A held disturbance drives g of dt; the torque noise the rest (white, a share of Q_nu). */
     g = held_for(&ekf->held, dt);
     white = (dt - g) / dt;
+    /* The state and u are checked: the step of `method`, and F (sr_ekf.h, "Transition matrix");
+     * M^-1 only for a share of white noise. */
+    if (status == SR_OK)
+        status = step_and_transition(model, method, ekf->x, u ? u : sr_zero_u, dt, xn, F, white > 0 ? Minv : NULL);
     if (status != SR_OK) return status;
     if (white > 0) torque_noise_of(Minv, process, dt, Qnu);
 
@@ -550,20 +555,30 @@ SR_LANES_CLONES int sr_ekf_predict(sr_ekf *ekf, const sr_model *model, int metho
 /* A held disturbance a (sr_ekf.h, "Held disturbance") through an applied sample, e <- G (e - K r): its
  * cross-covariance moves as a waiting fix's, C <- G (C - K Wa) with Wa = Cov(r, a) (m x SR_NV); a
  * itself is not revised; a recovery's lambda scales all of its covariances.  KT as in apply (m rows of NBP). */
-static void carry_held(sr_ekf_held *h, int m, const sr_real *KT, const sr_real *Wa, const sr_real Jr[9],
-                       sr_real inflate)
+static SR_LANES_CLONES void carry_held(sr_ekf_held *h, int m, const sr_real *KT, const sr_real *Wa,
+                                       const sr_real Jr[9], sr_real inflate)
 {
     sr_real t[3 * SR_NV];
     int a, b, i;
     if (!h->pending) return;
-    for (a = 0; a < NB; ++a)
-        for (b = 0; b < SR_NV; ++b) {
-            sr_real s = h->cross[SR_NV * a + b];
-            for (i = 0; i < m; ++i) s -= KT[NBP * i + a] * Wa[SR_NV * i + b];
-            h->cross[SR_NV * a + b] = inflate * s;
+    for (a = 0; a < NB; ++a) {   /* row a of C, its SR_NV numbers in registers, less the sample's m terms in turn */
+        sr_real *c = h->cross + SR_NV * a, c0 = c[0], c1 = c[1], c2 = c[2], c3 = c[3], c4 = c[4];
+        for (i = 0; i < m; ++i) {
+            const sr_real k = KT[NBP * i + a], *w = Wa + SR_NV * i;
+            c0 -= k * w[0];
+            c1 -= k * w[1];
+            c2 -= k * w[2];
+            c3 -= k * w[3];
+            c4 -= k * w[4];
         }
-    for (i = 0; i < SR_NV * SR_NV; ++i) h->cov[i] *= inflate;
-    for (i = 0; i < SR_EKF_NDELAYED * SR_NV * 2; ++i) h->fix[i] *= inflate;
+        c[0] = inflate * c0;
+        c[1] = inflate * c1;
+        c[2] = inflate * c2;
+        c[3] = inflate * c3;
+        c[4] = inflate * c4;
+    }
+    for (i = 0; i < SR_NV * SR_NV && inflate != 1; ++i) h->cov[i] *= inflate;
+    for (i = 0; i < SR_EKF_NDELAYED * SR_NV * 2 && inflate != 1; ++i) h->fix[i] *= inflate;
     for (i = 0; i < 3; ++i)
         for (b = 0; b < SR_NV; ++b)
             t[SR_NV * i + b] = Jr[3 * i] * h->cross[SR_NV * SR_EB_xi_S + b]
@@ -826,18 +841,102 @@ int sr_ekf_update_imu_axes(sr_ekf *ekf, const sr_model *model, const sr_real y[S
     return update(ekf, SR_EKF_IMU, SR_NIMU, r, H, Rd, gate);
 }
 
+/* The held sample's products (sr_ekf.h, "Held disturbance") from the nonzero entries of H and Hn
+ * (an IMU row of H reads at most 13 of the 18 columns; Hn's gyroscope rows are zero): r's
+ * prediction's share Hn a_hat in pred, Cov(e, r)^T = H P + Hn C^T (CT, rows of NBP, zero padded),
+ * B = H C + Hn A, S = H Cov(e, r) + Hn B^T + R on the upper triangle (mirrored), and
+ * Cov(r, z_j) = H C_j + Hn Cov(a, z_j) for every waiting fix (W). */
+static SR_LANES_CLONES void held_products(const sr_ekf *ekf, const sr_real *H, const sr_real *Hn,
+                                          const sr_real *sigma, sr_real *pred, sr_real *CT, sr_real *S,
+                                          sr_real *B, sr_real *W)
+{
+    const sr_ekf_held *h = &ekf->held;
+    sr_real val[SR_NIMU * NB], hv[SR_NIMU * SR_NV];
+    int col[SR_NIMU * NB], nnz[SR_NIMU], hc[SR_NIMU * SR_NV], nh[SR_NIMU], a, i, j, k;
+    for (i = 0; i < SR_NIMU; ++i) {
+        nnz[i] = nh[i] = 0;
+        for (k = 0; k < NB; ++k)
+            if (H[NB * i + k] != 0) {
+                val[NB * i + nnz[i]] = H[NB * i + k];
+                col[NB * i + nnz[i]++] = k;
+            }
+        for (k = 0; k < SR_NV; ++k)
+            if (Hn[SR_NV * i + k] != 0) {
+                hv[SR_NV * i + nh[i]] = Hn[SR_NV * i + k];
+                hc[SR_NV * i + nh[i]++] = k;
+            }
+    }
+    for (i = 0; i < SR_NIMU; ++i) {
+        sr_real *Ci = CT + NBP * i, *Bi = B + SR_NV * i;
+        const sr_real *v = val + NB * i, *w = hv + SR_NV * i;
+        const int *c = col + NB * i, *d = hc + SR_NV * i;
+        for (a = 0; a < NBP; ++a) Ci[a] = 0;
+        for (k = 0; k + 1 < nnz[i]; k += 2) rows_plus2(v[k], ekf->P + NB * c[k], v[k + 1], ekf->P + NB * c[k + 1], Ci);
+        if (k < nnz[i]) row_plus(v[k], ekf->P + NB * c[k], Ci);
+        {   /* B's row: five sums in registers */
+            sr_real b0 = 0, b1 = 0, b2 = 0, b3 = 0, b4 = 0;
+            for (k = 0; k < nnz[i]; ++k) {
+                const sr_real *Ck = h->cross + SR_NV * c[k];
+                b0 += v[k] * Ck[0];
+                b1 += v[k] * Ck[1];
+                b2 += v[k] * Ck[2];
+                b3 += v[k] * Ck[3];
+                b4 += v[k] * Ck[4];
+            }
+            for (k = 0; k < nh[i]; ++k) {
+                const sr_real *Ak = h->cov + SR_NV * d[k];
+                b0 += w[k] * Ak[0];
+                b1 += w[k] * Ak[1];
+                b2 += w[k] * Ak[2];
+                b3 += w[k] * Ak[3];
+                b4 += w[k] * Ak[4];
+                pred[i] += w[k] * h->mean[d[k]];
+            }
+            Bi[0] = b0;
+            Bi[1] = b1;
+            Bi[2] = b2;
+            Bi[3] = b3;
+            Bi[4] = b4;
+        }
+    }
+    for (a = 0; a < NB; ++a) {   /* Hn C^T: row a of C in registers, for the rows Hn reads (the accelerometer's) */
+        const sr_real *Ca = h->cross + SR_NV * a, c0 = Ca[0], c1 = Ca[1], c2 = Ca[2], c3 = Ca[3], c4 = Ca[4];
+        for (i = 0; i < SR_NIMU; ++i) {
+            const sr_real *w = Hn + SR_NV * i;
+            if (nh[i]) CT[NBP * i + a] += (((w[0] * c0 + w[1] * c1) + w[2] * c2) + w[3] * c3) + w[4] * c4;
+        }
+    }
+    for (i = 0; i < SR_NIMU; ++i)
+        for (j = i; j < SR_NIMU; ++j) {
+            sr_real s = i == j ? sigma[i] * sigma[i] : 0;
+            for (k = 0; k < nnz[i]; ++k) s += val[NB * i + k] * CT[NBP * j + col[NB * i + k]];
+            for (k = 0; k < nh[i]; ++k) s += hv[SR_NV * i + k] * B[SR_NV * j + hc[SR_NV * i + k]];
+            S[SR_NIMU * i + j] = S[SR_NIMU * j + i] = s;
+        }
+    for (j = 0; j < SR_EKF_NDELAYED; ++j) {
+        const sr_real *Cj = ekf->delayed[j].C, *Aj = h->fix + 2 * SR_NV * j;
+        if (!ekf->delayed[j].marked) continue;
+        for (i = 0; i < SR_NIMU; ++i)
+            for (a = 0; a < 2; ++a) {
+                sr_real s = 0;
+                for (k = 0; k < nnz[i]; ++k) s += val[NB * i + k] * Cj[2 * col[NB * i + k] + a];
+                for (k = 0; k < nh[i]; ++k) s += hv[SR_NV * i + k] * Aj[2 * hc[SR_NV * i + k] + a];
+                W[MAXM * 2 * j + 2 * i + a] = s;
+            }
+    }
+}
+
 int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[SR_NIMU], const sr_real u[SR_NU],
                            int body, const sr_real mount[SR_NMOUNT], const sr_real sigma[SR_NIMU],
                            const sr_ekf_process *process, sr_real hold, sr_real gate)
 {
-    sr_real yh[SR_NIMU], H[SR_NIMU * NB], Hn[SR_NIMU * SR_NV], r[SR_NIMU], yd[SR_NIMU], Hd[SR_NIMU * NB];
-    sr_real CT[SR_NIMU * NBP] = {0}, S[SR_NIMU * SR_NIMU], L[SR_NIMU * SR_NIMU], B[SR_NIMU * SR_NV];
+    sr_real yh[SR_NIMU], H[SR_NIMU * NB], Hn[SR_NIMU * SR_NV], r[SR_NIMU], Minv[SR_NV * SR_NV];
+    sr_real CT[SR_NIMU * NBP], S[SR_NIMU * SR_NIMU], L[SR_NIMU * SR_NIMU], B[SR_NIMU * SR_NV];
     sr_real X[SR_NIMU * SR_NV], Sr[SR_NIMU], col[SR_NIMU], W[SR_EKF_NDELAYED * MAXM * 2];
-    const sr_real zero[SR_NV] = {0};
     sr_ekf_held before, *h;
     long applied, recovered;
     sr_real inflate;
-    int status = arg_model(model, READS(WHOLE)), a, b, i, j, k;
+    int status = arg_model(model, READS(WHOLE)), a, b, i, j;
     if (status != SR_OK) return status;
     if (!ekf || !y || !mount || !sigma || !process) return SR_ERR_NULL;
     before = ekf->held;
@@ -848,63 +947,27 @@ int sr_ekf_update_imu_held(sr_ekf *ekf, const sr_model *model, const sr_real y[S
     if (!valid_gate(gate) || !valid_process(process) || arg_dt(hold) != SR_OK) return SR_ERR_ARG;
     if (!all_finite(y, SR_NIMU) || (u && !all_finite(u, SR_NU))) return SR_ERR_NONFINITE;
     status = check_filter(model, ekf);
-    /* The state, biases, mount and u are checked: the Jacobian without its checks. */
-    if (status == SR_OK) status = sr_internal_imu_jacobian(model, ekf->x, u, body, mount, ekf->bias, yh, H);
-    /* The reading is linear in nu': Hn is the same at any nu', zero included. */
-    if (status == SR_OK) status = sr_imu_partials(model, ekf->x, zero, body, mount, ekf->bias, yd, Hd, Hn);
+    /* The state, biases, mount and u are checked: the Jacobian without its checks, with Hn (the
+     * reading is linear in nu': the same at any nu') and, when a period starts, M^-1 at x from the
+     * same evaluation of the accelerations' Jacobian. */
+    if (status == SR_OK)
+        status = sr_internal_imu_jacobian_minv(model, ekf->x, u, body, mount, ekf->bias, yh, H, Hn,
+                                               ekf->held.pending ? NULL : Minv);
     if (status != SR_OK) return status;
     if (ekf->constrained) constrain_sample(ekf, SR_NIMU, H);
 
     h = &ekf->held;
     if (!h->pending) {   /* a's prior: mean 0, Q_a = M^-1 D^2 M^-1 / hold, independent of e */
         memset(h, 0, sizeof *h);
-        status = torque_noise(model, ekf->x, process, 1 / hold, h->cov);
-        if (status != SR_OK) {
-            *h = before;
-            return status;
-        }
+        torque_noise_of(Minv, process, 1 / hold, h->cov);
         h->pending = 1;
         h->remaining = hold;
     }
-    /* Cov(e, r)^T = H P + Hn C^T, B = H C + Hn A, S = H Cov(e, r) + Hn B^T + R. */
-    for (i = 0; i < SR_NIMU; ++i) {
-        sr_real pred = yh[i];
-        for (b = 0; b < SR_NV; ++b) pred += Hn[SR_NV * i + b] * h->mean[b];
-        r[i] = y[i] - pred;
-        for (a = 0; a < NB; ++a) {
-            sr_real s = 0;
-            for (k = 0; k < NB; ++k) s += H[NB * i + k] * ekf->P[NB * k + a];
-            for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * h->cross[SR_NV * a + k];
-            CT[NBP * i + a] = s;
-        }
-        for (b = 0; b < SR_NV; ++b) {
-            sr_real s = 0;
-            for (k = 0; k < NB; ++k) s += H[NB * i + k] * h->cross[SR_NV * k + b];
-            for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * h->cov[SR_NV * k + b];
-            B[SR_NV * i + b] = s;
-        }
-    }
-    for (i = 0; i < SR_NIMU; ++i)
-        for (j = 0; j < SR_NIMU; ++j) {
-            sr_real s = i == j ? sigma[i] * sigma[i] : 0;
-            for (k = 0; k < NB; ++k) s += H[NB * i + k] * CT[NBP * j + k];
-            for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * B[SR_NV * j + k];
-            S[SR_NIMU * i + j] = s;
-        }
-    for (i = 0; i < SR_NIMU; ++i)   /* symmetric to the last bit: the Cholesky reads one triangle */
-        for (j = 0; j < i; ++j) S[SR_NIMU * i + j] = S[SR_NIMU * j + i] = SR_C(0.5) * (S[SR_NIMU * i + j] + S[SR_NIMU * j + i]);
-    /* Cov(r, z_j) = H C_j + Hn Cov(a, z_j) for every waiting fix. */
-    for (j = 0; j < SR_EKF_NDELAYED; ++j) {
-        const sr_real *Cj = ekf->delayed[j].C;
-        if (!ekf->delayed[j].marked) continue;
-        for (i = 0; i < SR_NIMU; ++i)
-            for (a = 0; a < 2; ++a) {
-                sr_real s = 0;
-                for (k = 0; k < NB; ++k) s += H[NB * i + k] * Cj[2 * k + a];
-                for (k = 0; k < SR_NV; ++k) s += Hn[SR_NV * i + k] * h->fix[2 * SR_NV * j + 2 * k + a];
-                W[MAXM * 2 * j + 2 * i + a] = s;
-            }
-    }
+    /* r = y - h - Hn a_hat; Cov(e, r)^T = H P + Hn C^T, B = H C + Hn A, S = H Cov(e, r) + Hn B^T + R,
+     * Cov(r, z_j) for the waiting fixes. */
+    memcpy(r, yh, sizeof r);
+    held_products(ekf, H, Hn, sigma, r, CT, S, B, W);
+    for (i = 0; i < SR_NIMU; ++i) r[i] = y[i] - r[i];
     /* S^-1 r and X = S^-1 B for a's own revision after the error's. */
     status = cholesky(SR_NIMU, S, L);
     if (status != SR_OK) {

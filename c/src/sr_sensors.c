@@ -138,13 +138,15 @@ int sr_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real
 
 /* SR_LANES_CLONES: with -DSR_CLONES also compiled for AVX2 (the same bits: no FMA, no
  * contraction), the accelerometer's chain rule four columns a vector (the filter's IMU update). */
-SR_LANES_CLONES int sr_internal_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int body,
-                             const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU],
-                             sr_real H[SR_NIMU * SR_NEB])
+SR_LANES_CLONES int sr_internal_imu_jacobian_minv(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU],
+                                                  int body, const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS],
+                                                  sr_real y[SR_NIMU], sr_real H[SR_NIMU * SR_NEB], sr_real *Hn_out,
+                                                  sr_real *Minv)
 {
     sr_real a[SR_NV], sc[SR_GEN_NSC], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], yy[SR_NIMU], HH[SR_NIMU * SR_NEB], Hn[SR_NIMU * SR_NV];
+    sr_real Mi[SR_NV * SR_NV];
     int status, i, j, k;
-    status = sr_internal_accel_jacobian(model, x, u ? u : sr_zero_u, a, Ja, Jb);
+    status = sr_internal_accel_jacobian_minv(model, x, u ? u : sr_zero_u, a, Ja, Jb, Minv ? Mi : NULL);
     if (status != SR_OK) return status;
     if (!all_finite(a, SR_NV) || !all_finite(Ja, SR_NV * SR_NE)) return SR_ERR_NONFINITE;
     sensor_constants(model, sc);
@@ -159,7 +161,16 @@ SR_LANES_CLONES int sr_internal_imu_jacobian(const sr_model *model, const sr_rea
     if (!all_finite(HH, SR_NIMU * SR_NEB)) return SR_ERR_NONFINITE;
     memcpy(y, yy, sizeof yy);
     memcpy(H, HH, sizeof HH);
+    if (Hn_out) memcpy(Hn_out, Hn, sizeof Hn);
+    if (Minv) memcpy(Minv, Mi, sizeof Mi);
     return SR_OK;
+}
+
+int sr_internal_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int body,
+                             const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU],
+                             sr_real H[SR_NIMU * SR_NEB])
+{
+    return sr_internal_imu_jacobian_minv(model, x, u, body, mount, bias, y, H, NULL, NULL);
 }
 
 int sr_imu_partials_batch(const sr_model *model, long n, const sr_real *x, const sr_real *nu_dot, int body,

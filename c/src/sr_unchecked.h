@@ -12,6 +12,7 @@
 
 #ifdef SR_USE_FLOAT /* float symbols carry _f, as in spherical_robot.h */
 #define sr_internal_imu_jacobian sr_internal_imu_jacobian_f
+#define sr_internal_imu_jacobian_minv sr_internal_imu_jacobian_minv_f
 #define sr_internal_encoders_jacobian sr_internal_encoders_jacobian_f
 #define sr_internal_retract sr_internal_retract_f
 #endif
@@ -21,6 +22,15 @@
 int sr_internal_imu_jacobian(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int body,
                              const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU],
                              sr_real H[SR_NIMU * SR_NEB]);
+
+/* The same, and (each if not NULL) Hn = dy/d(nu_dot) (SR_NIMU x SR_NV, as sr_imu_partials: the
+ * reading is linear in nu_dot, so Hn is the same at any nu_dot) and M^-1 at x (5 x 5, from the
+ * factorisation of the accelerations' Jacobian, sr_internal_accel_jacobian_minv; not tested for
+ * finiteness): the held disturbance's update and prior (sr_ekf_update_imu_held) from one
+ * evaluation. */
+int sr_internal_imu_jacobian_minv(const sr_model *model, const sr_real x[SR_NX], const sr_real u[SR_NU], int body,
+                                  const sr_real mount[SR_NMOUNT], const sr_real bias[SR_NBIAS], sr_real y[SR_NIMU],
+                                  sr_real H[SR_NIMU * SR_NEB], sr_real *Hn, sr_real *Minv);
 
 /* sr_encoders_jacobian for a valid x. */
 void sr_internal_encoders_jacobian(const sr_real x[SR_NX], sr_real y[2], sr_real H[2 * SR_NEB]);
