@@ -37,7 +37,7 @@ import threadpoolctl
 from ..model import Model
 from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_parameters
 from ..params import SHAPES, Params, flat_names
-from ..state import IDX_E_NU, IDX_NU, NE, NV
+from ..state import IDX_E_NU, IDX_E_XI_S, IDX_NU, IDX_RS, NE, NV
 from .first_guess import _dpi_of, regressor_guess
 from .segments import dlocal_batch, dretract_batch, segment_blocks
 from .sensitivity import JACOBIANS, step_and_sensitivity
@@ -584,6 +584,40 @@ class _Problem:
             self.progress()
         return self._cache[1]
 
+    def align_headings(self, z):
+        """Turn each segment's start about the vertical so that neighbouring segments agree in the
+        heading.  Fitted alone (`fit_starts`), a segment sees its heading only through its one or
+        two fixes and the filter's estimate, whose σ is a tenth of a radian over the first seconds:
+        neighbours then disagree at their ends by up to 0.3 rad, a rotation of whole segments that
+        the states' first stage does not close.  A turn δ about the vertical through a segment's
+        start is a symmetry of the IMU's and the encoders' readings on level ground (it moves the
+        fixes only), and it turns the segment's end by the same δ, so the heading differences
+        y_s (the next start's heading minus the end's) become y_s + δ_{s+1} − δ_s.  The turns
+        minimise Σ_s ((y_s + δ_{s+1} − δ_s)/c)² + Σ_s (δ_s/σ_s)², σ_s the filter's σ of the
+        heading at the segment's start and c the median |y_s| (the differences the model's own
+        errors leave; a smoother of the heading as a random walk): where the filter is sure the
+        heading stays, and an uncertain stretch takes its heading from its sure neighbours.  On a
+        slope the turn is no symmetry, and the starts are left as they are."""
+        if self.xsig is None or self.S < 2 or self.params.slope != 0.0:
+            return
+        theta, _, _ = self.split(z)
+        model, d = self.model(theta), self.data
+        R = self.xref[:, IDX_RS].reshape(-1, 3, 3)
+        lengths = self.ends - self.starts
+        Re = np.array([model.simulate(self.xref[s], d.h, lengths[s], u=d.u[k0:k0 + lengths[s]], method=self.method,
+                                      energy_tol=None)[-1, IDX_RS] for s, k0 in enumerate(self.starts[:-1])])
+        y = heading_of(R[1:] @ Re.reshape(-1, 3, 3).transpose(0, 2, 1))
+        # the heading's σ: the filter's σ of the shell's rotation (right-trivialised) along the vertical
+        sig = np.sqrt(np.sum(R[:, 2, :] ** 2 * self.xsig[:, IDX_E_XI_S] ** 2, axis=1))
+        c = max(float(np.median(np.abs(y))), DEFECT_FLOOR)
+        A = np.vstack([(np.eye(self.S, k=1) - np.eye(self.S))[:-1] / c, np.diag(1.0 / np.maximum(sig, DEFECT_FLOOR))])
+        delta = np.linalg.lstsq(A, np.concatenate([-y / c, np.zeros(self.S)]), rcond=None)[0]
+        cos, sin = np.cos(delta), np.sin(delta)
+        Rz = np.zeros((self.S, 3, 3))
+        Rz[:, 0, 0], Rz[:, 0, 1], Rz[:, 1, 0], Rz[:, 1, 1], Rz[:, 2, 2] = cos, -sin, sin, cos, 1.0
+        self.xref[:, IDX_RS] = (Rz @ R).reshape(-1, 9)
+        self._cache = (None, None)
+
     def z0(self):
         return np.concatenate([self.theta_start, self.b0, np.zeros(NE * self.S)])
 
@@ -665,6 +699,11 @@ class _FullState:
         return np.array(lo), np.array(hi)
 
 
+def heading_of(R):
+    """The angle [rad] about the vertical of rotations R (..., 3, 3) near one about it."""
+    return np.arctan2(R[..., 1, 0] - R[..., 0, 1], R[..., 0, 0] + R[..., 1, 1])
+
+
 def _start_guess(log, params, with_sigma=False):
     """The EKF's estimate at every IMU time and its final biases (the fit's starting point), and
     with `with_sigma` the filter's standard deviations of the 18 error coordinates there.  The
@@ -734,6 +773,7 @@ def _identify(log, params, free, segment, method, full_state, max_nfev, progress
         prob.theta_start = first_guess(log, params, free, prob, full_state, x_guess).theta
     if not full_state:
         prob.fit_starts(prob.z0())
+        prob.align_headings(prob.z0())
     lo, hi = prob.bounds()
     with np.errstate(invalid="ignore"):
         z0 = np.clip(prob.z0(), np.where(np.isfinite(lo), lo + 1e-12 * np.maximum(1, abs(lo)), lo),
