@@ -717,8 +717,11 @@ int sr_regressor_batch(const sr_model *model, long n, const sr_real *x, const sr
  * process noise but would saturate the torques on a transient (a start from rest, a large
  * offset): on path references with tight_band > 0 the gain's columns 0..9 are
  * (1 - w) K_path + w K_tight, with the weight w <= 1 - |e_y - e_y*| / tight_band, rising by at
- * most period / tight_rise per sample and not at all after a sample that clipped a torque,
- * falling at once.  The integral columns stay K_path's, so moving w moves no torque through the
+ * most period / tight_rise per sample and not at all after a sample that clipped a torque;
+ * after such a sample it falls by period / tight_fall instead (tight_fall > 0; 0: it holds), and
+ * at once when the bound falls, w >= -tight_wait: below 0 the gain is K_path's (a wait before
+ * the tight gains return).  Held at the limits, the tight gains on a robot off the model
+ * switch the steering torque between them for seconds and the robot leaves the path.  The integral columns stay K_path's, so moving w moves no torque through the
  * integrals (the integrators carry over unchanged between the gains). */
 /** @{ */
 #define SR_LQR_NZ 12               /**< entries of the error coordinates z */
@@ -760,6 +763,8 @@ typedef struct sr_lqr {
     sr_real tight_band;                            /**< [m], >= 0: K_tight's weight is at most 1 - |e_y| / tight_band; 0: K_tight unused */
     sr_real tight_rise;                            /**< [s], > 0 when tight_band > 0: K_tight's weight rises from 0 to 1 in no less than this */
     sr_real world_share;                           /**< in [0, 1]: the share of the integral of e_y held as a world vector along the path's left normal (it cancels a pull that turns with the heading, such as a slope's on a turning path); 0: all of it along the path */
+    sr_real tight_fall;                            /**< [s], >= 0: after a sample that clipped a torque K_tight's weight falls by period / tight_fall; 0: it holds */
+    sr_real tight_wait;                           /**< in [0, 1]: the weight falls to -tight_wait at the lowest; below 0 the gain is K_path, so the tight gains return up to tight_wait * tight_rise after a clip ends */
 } sr_lqr;
 
 /** What to track at this sample (from the reference). */
@@ -782,7 +787,7 @@ typedef struct sr_lqr_memory {
 } sr_lqr_memory;
 
 /** Checks a schedule: sizes in range, grids strictly increasing, every entry finite, period
- * and u_max > 0, kappa_rate, steady_rate and tight_band >= 0, tight_rise > 0 when tight_band > 0
+ * and u_max > 0, kappa_rate, steady_rate, tight_band and tight_fall >= 0, tight_wait in [0, 1], tight_rise > 0 when tight_band > 0
  * (K_tight is read only then).  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
 int sr_lqr_check(const sr_lqr *lqr);
 

@@ -18,7 +18,8 @@ static int valid_sizes(const sr_lqr *lqr)
     return lqr->n_speeds >= 1 && lqr->n_speeds <= SR_LQR_MAX_SPEEDS && lqr->n_curvatures >= 1
         && lqr->n_curvatures <= SR_LQR_MAX_CURVATURES && lqr->period > 0 && lqr->u_max > 0
         && lqr->kappa_rate >= 0 && lqr->steady_rate >= 0 && lqr->tight_band >= 0
-        && (lqr->tight_band == 0 || lqr->tight_rise > 0) && lqr->world_share >= 0 && lqr->world_share <= 1;
+        && (lqr->tight_band == 0 || lqr->tight_rise > 0) && lqr->world_share >= 0 && lqr->world_share <= 1
+        && lqr->tight_fall >= 0 && lqr->tight_wait >= 0 && lqr->tight_wait <= 1;
 }
 
 int sr_lqr_check(const sr_lqr *lqr)
@@ -27,6 +28,7 @@ int sr_lqr_check(const sr_lqr *lqr)
     if (!lqr) return SR_ERR_NULL;
     if (!all_finite(&lqr->period, 1) || !all_finite(&lqr->u_max, 1) || !all_finite(&lqr->kappa_rate, 1)
         || !all_finite(&lqr->steady_rate, 1) || !all_finite(&lqr->tight_band, 1) || !all_finite(&lqr->tight_rise, 1)
+        || !all_finite(&lqr->tight_fall, 1) || !all_finite(&lqr->tight_wait, 1)
         || !all_finite(&lqr->world_share, 1))
         return SR_ERR_NONFINITE;
     if (!valid_sizes(lqr)) return SR_ERR_ARG;
@@ -158,13 +160,15 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
         dz[j] = z[j] - (weight[0] * lqr->z_star[point[0]][j] + weight[1] * lqr->z_star[point[1]][j]
                         + weight[2] * lqr->z_star[point[2]][j] + weight[3] * lqr->z_star[point[3]][j]);
     /* The tight gains' weight: bounded by how near the path the robot is, rising slowly (a transient
-     * must have died down) and held after a clipped torque (the tight gains would clip it further). */
+     * must have died down) and falling after a clipped torque, below 0 (K_path's gain, a wait before
+     * the tight gains return): held at the limits, they switch the steering torque between them. */
     if (target->path && lqr->tight_band > 0) {
         sr_real bound = 1 - SR_FABS(dz[9]) / lqr->tight_band, prev = memory->tight;
-        sr_real rise = memory->saturated ? prev : prev + lqr->period / lqr->tight_rise;
+        sr_real rise = !memory->saturated ? prev + lqr->period / lqr->tight_rise
+                     : (lqr->tight_fall > 0 ? prev - lqr->period / lqr->tight_fall : prev);
         bound = bound < 0 ? 0 : bound;
         tight = rise < bound ? rise : bound;
-        tight = tight > 1 ? 1 : tight;
+        tight = tight > 1 ? 1 : (tight < -lqr->tight_wait ? -lqr->tight_wait : tight);
     }
     for (k = 0; k < SR_NU; ++k) {
         sr_real acc = 0;

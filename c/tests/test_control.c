@@ -264,6 +264,48 @@ static void test_the_tight_gains_weigh_in_as_the_error_allows_and_are_checked(vo
     CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_ARG);
 }
 
+static void test_the_tight_gains_weight_falls_after_a_clipped_torque_to_minus_its_wait(void)
+{
+    sr_model m;
+    sr_lqr lqr;
+    sr_lqr_memory mem;
+    sr_real x[SR_NX], u[SR_NU];
+    int k;
+    sr_lqr_target t = {SR_C(0.2), 0, 0, 0, 1};
+    paper_simulation_model(&m);
+    empty_schedule(&lqr, 1);
+    lqr.tight_band = SR_C(0.02);
+    lqr.tight_rise = SR_C(0.04);                         /* two samples from 0 to 1 */
+    lqr.tight_fall = SR_C(0.1);                          /* five samples from 1 to 0 */
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_OK);
+    sr_lqr_reset(&mem);
+    reference_state(0.2, 0.0, 0.3, x);
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &t, &mem, u, NULL), SR_OK);
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &t, &mem, u, NULL), SR_OK);
+    CHECK_NEAR(mem.tight, 1.0, TEST_EPS);
+    mem.saturated = 1;                                   /* as after a clipped torque */
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &t, &mem, u, NULL), SR_OK);
+    CHECK_NEAR(mem.tight, 1.0 - 0.02 / 0.1, TEST_EPS);   /* the fall: one period / tight_fall */
+    lqr.tight_fall = 0;                                  /* no fall time: the weight holds */
+    mem.saturated = 1;
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &t, &mem, u, NULL), SR_OK);
+    CHECK_NEAR(mem.tight, 1.0 - 0.02 / 0.1, TEST_EPS);
+    lqr.tight_fall = SR_C(0.1);
+    lqr.tight_wait = SR_C(0.3);                         /* below 0 to -0.3 (K_path's gain) */
+    for (k = 0; k < 6; ++k) {
+        mem.saturated = 1;
+        CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &t, &mem, u, NULL), SR_OK);
+    }
+    CHECK_NEAR(mem.tight, -0.3, TEST_EPS);               /* 0.8 - 6 * 0.2 = -0.4, held at -0.3 */
+    lqr.tight_wait = SR_C(1.5);
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_ARG);
+    lqr.tight_wait = 0;
+    lqr.tight_fall = SR_C(-0.1);
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_ARG);
+    lqr.tight_fall = (sr_real)NAN;
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_NONFINITE);
+}
+
 static void test_bad_input_gives_status_and_leaves_outputs_untouched(void)
 {
     sr_model m;
@@ -321,5 +363,6 @@ void suite_control(void)
     RUN_TEST(test_the_cross_track_integral_holds_while_the_error_moves);
     RUN_TEST(test_the_operating_curvature_follows_a_jump_at_its_rate);
     RUN_TEST(test_the_tight_gains_weigh_in_as_the_error_allows_and_are_checked);
+    RUN_TEST(test_the_tight_gains_weight_falls_after_a_clipped_torque_to_minus_its_wait);
     RUN_TEST(test_bad_input_gives_status_and_leaves_outputs_untouched);
 }

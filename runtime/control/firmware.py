@@ -94,8 +94,9 @@ def header(task, controller):
         f"{_real(controller.u_max)}, {_real(controller.gains.kappa_rate)}, {_real(controller.gains.steady_rate_m_s)},",
         "    /* K_tight */ " + ("{" + ",\n     ".join(_array(s.K_tight[i, j]) for i, j in points) + "}"
                                if s.K_tight is not None else "{{0}}") + ",",
-        f"    /* tight_band, tight_rise, world_share */ {_real(controller._c.tight_band)}, "
-        f"{_real(controller._c.tight_rise)}, {_real(controller._c.world_share)}",
+        f"    /* tight_band, tight_rise, world_share, tight_fall, tight_wait */ {_real(controller._c.tight_band)}, "
+        f"{_real(controller._c.tight_rise)}, {_real(controller._c.world_share)}, {_real(controller._c.tight_fall)}, "
+        f"{_real(controller._c.tight_wait)}",
         "};",
         "",
         "#endif /* LQR_TASK_H */",

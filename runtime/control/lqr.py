@@ -56,6 +56,8 @@ class LqrGains:
     tight_band_m: float = 0.1         # their weight is at most 1 − |e_y| / tight_band_m (0: no tight gains)
     tight_rise_s: float = 10.0        # ... and rises from 0 to 1 in no less than this [s]
     world_share: float = 0.0          # the share of ∫e_y held as a world vector along the path's normal
+    tight_fall_s: float = 10.0        # ... and after a clipped torque falls by 1 in this [s] (0: it holds) ...
+    tight_wait: float = 0.25          # ... to −tight_wait (below 0 the path's gains: a wait of up to tight_wait·tight_rise_s)
     #: The ranges of the settings (runtime/control/ranges.py: those of a task file's keys).
     RANGES: typing.ClassVar[dict] = LQR_RANGES
 
@@ -131,9 +133,11 @@ def tight_gain(K_path, K_riccati):
     return K
 
 
-def to_c(schedule, period, u_max, kappa_rate, steady_rate, tight_band=0.0, tight_rise=1.0, world_share=0.0):
+def to_c(schedule, period, u_max, kappa_rate, steady_rate, tight_band=0.0, tight_rise=1.0, world_share=0.0, tight_fall=0.0,
+         tight_wait=0.0):
     """The schedule as the C struct `sr_lqr` (cffi), checked by `sr_lqr_check`; the tight gains are
-    scheduled in within `tight_band` [m] of the path, over `tight_rise` [s], when the schedule has them;
+    scheduled in within `tight_band` [m] of the path, over `tight_rise` [s] (and out by 1 per `tight_fall` [s]
+    after a clipped torque, to a weight −`tight_wait`, below 0 K_path's; 0: held), when the schedule has them;
     `world_share` of the cross-track integral is held in the world frame."""
     nv, nk = len(schedule.speeds), len(schedule.curvatures)
     if nv > lib.SR_LQR_MAX_SPEEDS or nk > lib.SR_LQR_MAX_CURVATURES:
@@ -156,6 +160,8 @@ def to_c(schedule, period, u_max, kappa_rate, steady_rate, tight_band=0.0, tight
     c.tight_band = tight_band if schedule.K_tight is not None else 0.0
     c.tight_rise = tight_rise
     c.world_share = world_share
+    c.tight_fall = tight_fall
+    c.tight_wait = tight_wait
     status = lib.sr_lqr_check(c)
     if status != lib.SR_OK:
         raise ValueError(f"controller: the LQR schedule is not valid for the C controller "
@@ -185,7 +191,7 @@ class Lqr(SlopeFeedforward, Controller):
         flat = params.replace(slope=0.0)
         self.schedule = schedule if schedule is not None else design_schedule(flat, rate, u_max, gains)
         self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate, gains.steady_rate_m_s,
-                       gains.tight_band_m, gains.tight_rise_s, gains.world_share)
+                       gains.tight_band_m, gains.tight_rise_s, gains.world_share, gains.tight_fall_s, gains.tight_wait)
         self._model = Model(flat)
         self._init_slope(params, flat, self.schedule, gains)
         self._memory = ffi.new("sr_lqr_memory *")

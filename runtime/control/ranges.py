@@ -39,6 +39,8 @@ LQR_RANGES = {
     "tight_band_m": Range(0, 100, "m", "how near the path the tight gains act (0: not at all)"),
     "tight_rise_s": Range(1e-3, 1e4, "s", "how slowly the tight gains come in"),
     "world_share": Range(0, 1, "", "the share of the cross-track integral held in the world frame"),
+    "tight_fall_s": Range(0, 1e4, "s", "how fast the tight gains leave after a clipped torque (0: they hold)"),
+    "tight_wait": Range(0, 1, "", "how far below 0 their weight falls after a clip (a wait before they return)"),
 }
 
 #: `NmpcGains`: the LQR's and the horizon's.

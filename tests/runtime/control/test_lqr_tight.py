@@ -1,6 +1,6 @@
 """The LQR's tight path gains (c/src/sr_control.c, runtime/control/lqr_law.py): the C law equals the
-NumPy law with them scheduled in, their weight is bounded by the error, rises slowly and holds after a
-clipped torque, the integrators keep their torque across the schedule, and near the path they narrow
+NumPy law with them scheduled in, their weight is bounded by the error, rises slowly and falls after a
+clipped torque (holds without a fall time), below 0 to wait before they return, the integrators keep their torque across the schedule, and near the path they narrow
 the loop's wander under the sensor set's torque noise."""
 import numpy as np
 import pytest
@@ -43,9 +43,9 @@ def near_path_target(rng):
 
 def test_the_tight_schedule_equals_the_numpy_law_over_runs_near_the_path():
     rng = np.random.default_rng(5)
-    c = controller()
+    c = controller(lqr.LqrGains(**GRID, tight_rise_s=0.2, tight_fall_s=1.0))
     g = c.gains
-    weights = []
+    weights, falls = [], 0
     for _ in range(5):
         c.reset(None)
         integrals, kappa, weight, clipped = np.zeros(2), None, 0.0, False
@@ -54,13 +54,17 @@ def test_the_tight_schedule_equals_the_numpy_law_over_runs_near_the_path():
             raw = c.compute(0.0, x, target)
             raw_np, u_np, integrals, kappa, weight = numpy_law(
                 c.schedule, PARAMS.r, x, target, integrals, kappa, c.period, U_MAX, g.kappa_rate, g.steady_rate_m_s,
-                tight_before=weight, clipped_before=clipped, tight_band=g.tight_band_m, tight_rise=g.tight_rise_s)
+                tight_before=weight, clipped_before=clipped, tight_band=g.tight_band_m, tight_rise=g.tight_rise_s,
+                tight_fall=g.tight_fall_s, tight_wait=g.tight_wait)
+            falls += clipped and 0 < weight < weights[-1] if weights else 0
             clipped = bool(np.any(np.abs(raw_np) > U_MAX))
             assert np.allclose(raw, raw_np, rtol=1e-10, atol=1e-12)
             assert c.tight_weight == pytest.approx(weight, rel=0, abs=1e-15)
             assert np.allclose(c.integrals, integrals, rtol=1e-12, atol=1e-14)
             weights.append(weight)
     assert max(weights) > 0.02          # the tight gains did act in these runs
+    assert falls > 0                    # ... and fell after clipped torques
+    assert min(weights) < 0             # ... below 0 (the path's gains)
 
 
 def test_the_comparison_fails_when_the_reference_leaves_the_tight_gains_out():
@@ -94,8 +98,35 @@ def test_the_weight_is_bounded_by_the_cross_track_error_and_falls_at_once():
     assert c.tight_weight == 0.0
 
 
-def test_the_weight_does_not_rise_after_a_clipped_torque():
-    c = controller()
+def test_the_weight_falls_by_one_period_over_the_fall_time_after_a_clipped_torque():
+    c = controller(lqr.LqrGains(**GRID, tight_rise_s=0.02, tight_fall_s=0.1))     # one sample up, five down
+    x = initial_state(R_S=so3.rot_z(-np.pi / 2), w_S=(-1.0, 0.0, 0.0), w_Y=1.0, r=PARAMS.r)
+    c.compute(0.0, x, Target(0.3, 0.0, 0.0, 0.0))
+    assert c.tight_weight == 1.0 and c._memory.saturated == 0
+    at_rest = initial_state(r=PARAMS.r)                 # asked to roll at 0.5 m/s: the torques clip
+    c.compute(0.0, at_rest, Target(0.5, 0.0, 0.0, 0.0))
+    assert c._memory.saturated == 1 and c.tight_weight == 1.0      # the clip is read at the next sample
+    c.compute(0.0, at_rest, Target(0.5, 0.0, 0.0, 0.0))
+    assert c.tight_weight == pytest.approx(1.0 - 0.2, rel=1e-12)
+    c.compute(0.0, at_rest, Target(0.5, 0.0, 0.0, 0.0))
+    assert c.tight_weight == pytest.approx(1.0 - 0.4, rel=1e-12)
+
+
+@pytest.mark.parametrize("wait", [0.0, 0.25])
+def test_the_weight_falls_no_lower_than_minus_the_wait(wait):
+    c = controller(lqr.LqrGains(**GRID, tight_fall_s=0.1, tight_wait=wait))
+    at_rest = initial_state(r=PARAMS.r)                 # the torques clip at every sample
+    weights = []
+    for _ in range(10):
+        c.compute(0.0, at_rest, Target(0.5, 0.0, 0.0, 0.0))
+        weights.append(c.tight_weight)
+    assert weights[0] == pytest.approx(0.02 / GAINS.tight_rise_s)      # the first sample: nothing clipped before
+    assert weights[1] == pytest.approx(max(weights[0] - 0.2, -wait))
+    assert weights[-1] == -wait
+
+
+def test_the_weight_holds_after_a_clipped_torque_without_a_fall_time():
+    c = controller(lqr.LqrGains(**GRID, tight_fall_s=0.0))
     at_rest = initial_state(r=PARAMS.r)                 # asked to roll at 0.5 m/s: the torques clip
     c.compute(0.0, at_rest, Target(0.5, 0.0, 0.0, 0.0))
     assert c._memory.saturated == 1
