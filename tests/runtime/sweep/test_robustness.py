@@ -125,11 +125,19 @@ def _no_operating_point(*args, **kwargs):
     raise ValueError("operating_point: no steady rolling found")
 
 
+def _designed(spec):
+    """`spec` with its controller's LQR schedule designed (and cached) on the real operating points,
+    so that a test which then replaces `operating_point` fails only the plant's steady torque,
+    whatever ran before it."""
+    spec.run_chunk(0, 1)
+    return spec
+
+
 def test_a_plant_without_a_steady_operating_point_is_run_and_counted_apart_under_its_reason(tmp_path, monkeypatch):
     import runtime.control.lqr_design as lqr_design
     from runtime.sweep.robustness import APART_NO_OPERATING_POINT, APART_REASONS
     from runtime.sweep.robustness_summary import group_stats, summary_text
-    spec = load_sweep(str(_sweep(tmp_path)))
+    spec = _designed(load_sweep(str(_sweep(tmp_path))))
     monkeypatch.setattr(lqr_design, "operating_point", _no_operating_point)
     row = spec.run_chunk(0, 1)
     assert row["counted_apart"][0] == APART_NO_OPERATING_POINT and math.isnan(row["steady_torque_nm"][0])
@@ -143,7 +151,7 @@ def test_a_plant_without_a_steady_operating_point_is_run_and_counted_apart_under
 def test_a_plant_whose_steady_torque_exceeds_the_limit_is_counted_apart_under_its_reason(tmp_path, monkeypatch):
     import runtime.control.lqr_design as lqr_design
     from runtime.sweep.robustness import APART_TORQUE
-    spec = load_sweep(str(_sweep(tmp_path)))
+    spec = _designed(load_sweep(str(_sweep(tmp_path))))
     monkeypatch.setattr(lqr_design, "operating_point", lambda *a, **k: (None, np.array([9.0, 0.0])))
     row = spec.run_chunk(0, 1)
     assert row["counted_apart"][0] == APART_TORQUE and row["steady_torque_nm"][0] >= 9.0
