@@ -90,6 +90,12 @@ int sr_boxqp_solve(int n, const sr_real *H, const sr_real *g, const sr_real *lb,
 #endif
 /** Unknowns of the condensed QP at the largest horizon. */
 #define SR_NMPC_MAX_QP (SR_NU * SR_NMPC_MAX_HORIZON)
+/** Halvings of a recovery's Gauss-Newton step before it is dropped (sr_nmpc_step). */
+#define SR_NMPC_HALVINGS 6
+#ifndef SR_NMPC_RECOVERY_SAMPLES
+/** Samples after a failed start that start with the recovery too (may be set at build time). */
+#define SR_NMPC_RECOVERY_SAMPLES 20
+#endif
 
 /** The controller's design (read-only during control; runtime/control/nmpc.py's NmpcC fills it
  * from the same design as the Python NMPC).  Grid point (i, j), speed i and curvature j, is entry
@@ -145,8 +151,11 @@ typedef struct sr_nmpc_memory {
     sr_real kappa_last;             /**< the last sample's curvature at the foot point [1/m] */
     int have_last;                  /**< z_last, v_last, kappa_last and u_last are those of a solved sample */
     long samples;                   /**< samples since the reset */
-    long restarts;                  /**< samples whose warm start failed and were solved afresh */
+    long restarts;                  /**< samples whose warm or cold start failed (solved by the recovery or failed) */
+    long recoveries;                /**< samples that ran the recovery (after a failed start or a failed sample) */
     long failures;                  /**< samples with no solution at all (the torques u* held) */
+    int failing;                    /**< consecutive failed samples up to the last (0: the last was solved) */
+    int recovering;                 /**< samples still to start with the recovery (SR_NMPC_RECOVERY_SAMPLES after a failed start) */
     int have_guess;                 /**< Z, U hold a solution to warm-start from */
     int have_u_last;                /**< u_last is set */
     int qp_iterations;              /**< factorisations of the last QP */
