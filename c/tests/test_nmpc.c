@@ -272,6 +272,55 @@ static void test_step_status_codes_leave_u_and_memory_untouched(void)
     CHECK_STATUS(sr_nmpc_reset(NULL), SR_ERR_NULL);
 }
 
+/* A guess whose nodes cannot be predicted (the warm start fails): the sample is solved by the
+ * recovery from the guess's torques, and the next SR_NMPC_RECOVERY_SAMPLES samples start with it. */
+static void test_a_failed_warm_start_is_solved_by_the_recovery(void)
+{
+    static sr_nmpc_memory mem;
+    sr_nmpc d;
+    sr_model m;
+    sr_real x[SR_NX], u[SR_NU];
+    sr_nmpc_target t = {SR_C(0.3), 0, 0, SR_C(0.01), 1, NULL};
+    int k;
+    paper_simulation_model(&m);
+    small_design(&d);
+    sr_nmpc_reset(&mem);
+    make_state(x, 0.0, 0.0, 0.3);
+    CHECK_STATUS(sr_nmpc_step(&d, &mem, &m, x, &t, u), SR_OK);
+    CHECK(mem.restarts == 0 && mem.recoveries == 0 && mem.recovering == 0);
+    for (k = 0; k < (SR_NMPC_MAX_HORIZON + 1) * SR_NMPC_NZ; ++k) mem.Z[k] = SR_C(1e30);
+    CHECK_STATUS(sr_nmpc_step(&d, &mem, &m, x, &t, u), SR_OK);
+    CHECK(mem.restarts == 1 && mem.recoveries == 1 && mem.failures == 0 && mem.failing == 0);
+    CHECK(mem.recovering == SR_NMPC_RECOVERY_SAMPLES && mem.have_guess);
+    CHECK(fabs(u[0]) <= 0.5 && fabs(u[1]) <= 0.5 && fabs(mem.Z[0]) < 1);
+    CHECK_STATUS(sr_nmpc_step(&d, &mem, &m, x, &t, u), SR_OK);
+    CHECK(mem.restarts == 1 && mem.recoveries == 2 && mem.recovering == SR_NMPC_RECOVERY_SAMPLES - 1);
+}
+
+/* A sample that nothing can predict (a shell acceleration beyond any rollout) holds the reference's
+ * torques and counts a failure; once the prediction is possible again the next sample is solved by
+ * the recovery and the count of consecutive failures is cleared. */
+static void test_a_failed_sample_is_recovered_from(void)
+{
+    static sr_nmpc_memory mem;
+    sr_nmpc d;
+    sr_model m;
+    sr_real x[SR_NX], u[SR_NU];
+    sr_nmpc_target t = {SR_C(0.3), 0, 0, SR_C(0.01), 1, NULL};
+    paper_simulation_model(&m);
+    small_design(&d);
+    d.disturbance_gain = 0;
+    sr_nmpc_reset(&mem);
+    make_state(x, 0.0, 0.0, 0.3);
+    mem.shell_accel[0] = SR_C(1e30);
+    CHECK_STATUS(sr_nmpc_step(&d, &mem, &m, x, &t, u), SR_OK);
+    CHECK(mem.failures == 1 && mem.failing == 1 && !mem.have_guess && u[0] == 0 && u[1] == 0);
+    CHECK(mem.recovering == SR_NMPC_RECOVERY_SAMPLES);
+    mem.shell_accel[0] = 0;
+    CHECK_STATUS(sr_nmpc_step(&d, &mem, &m, x, &t, u), SR_OK);
+    CHECK(mem.failures == 1 && mem.failing == 0 && mem.have_guess && mem.recoveries == 2);
+}
+
 void suite_nmpc(void)
 {
     RUN_TEST(test_boxqp_meets_the_optimality_conditions_on_random_problems);
@@ -282,4 +331,6 @@ void suite_nmpc(void)
     RUN_TEST(test_node_on_a_straight_path_reads_the_step_of_the_full_model);
     RUN_TEST(test_step_keeps_the_torques_within_the_limits_and_counts_samples);
     RUN_TEST(test_step_status_codes_leave_u_and_memory_untouched);
+    RUN_TEST(test_a_failed_warm_start_is_solved_by_the_recovery);
+    RUN_TEST(test_a_failed_sample_is_recovered_from);
 }
