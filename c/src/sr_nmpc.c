@@ -663,17 +663,26 @@ int sr_nmpc_step(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, con
         P = (path ? d->P_path : d->P_heading)[i * d->n_curvatures + jj];
         q = path ? d->q_path : d->q_heading;
     }
-    /* After a failed sample, and for SR_NMPC_RECOVERY_SAMPLES samples after a failed start, the start
-     * is the recovery's; else the guess's, and when its iterations fail, the recovery's. */
+    /* After a failed sample, and for SR_NMPC_RECOVERY_SAMPLES samples after a failed restart, the
+     * start is the recovery's.  Else the guess's; when its iterations fail, the reference's; when
+     * those fail too, the recovery's. */
     if (m->failing > 0 || m->recovering > 0) {
         if (m->recovering > 0) m->recovering--;
         m->recoveries++;
-        failed = recover(d, m, model, z, v, q, P, !cold && m->failing == 0);
+        failed = recover(d, m, model, z, v, q, P, m->failing == 0);
     } else if (iterate(d, m, model, z, v, q, P, cold ? d->cold_iterations : d->iterations)) {
         m->restarts++;
-        m->recoveries++;
-        m->recovering = SR_NMPC_RECOVERY_SAMPLES;
-        failed = recover(d, m, model, z, v, q, P, !cold);
+        failed = 1;
+        if (!cold) { /* a cold start was from the reference already */
+            memcpy(m->Z, m->zs, (size_t)(N + 1) * NZ * sizeof(sr_real));
+            memcpy(m->U, m->us, (size_t)N * SR_NU * sizeof(sr_real));
+            failed = iterate(d, m, model, z, v, q, P, d->cold_iterations);
+        }
+        if (failed) {
+            m->recoveries++;
+            m->recovering = SR_NMPC_RECOVERY_SAMPLES;
+            failed = recover(d, m, model, z, v, q, P, 1);
+        }
     } else {
         failed = 0;
     }

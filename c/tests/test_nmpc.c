@@ -200,6 +200,9 @@ static void test_node_on_a_straight_path_reads_the_step_of_the_full_model(void)
 
 /* A design of one grid point: rolling at 0.3 m/s on the paper's robot needs (u*, z*) which the
  * test does not know, so u* = 0 and z* = 0 with weights that only ask for a small error. */
+
+
+
 static void small_design(sr_nmpc *d)
 {
     int i;
@@ -272,9 +275,9 @@ static void test_step_status_codes_leave_u_and_memory_untouched(void)
     CHECK_STATUS(sr_nmpc_reset(NULL), SR_ERR_NULL);
 }
 
-/* A guess whose nodes cannot be predicted (the warm start fails): the sample is solved by the
- * recovery from the guess's torques, and the next SR_NMPC_RECOVERY_SAMPLES samples start with it. */
-static void test_a_failed_warm_start_is_solved_by_the_recovery(void)
+/* A guess whose nodes cannot be predicted (the warm start fails): the sample starts once more from
+ * the reference, which solves it, and the recovery is not needed. */
+static void test_a_failed_warm_start_is_solved_from_the_reference(void)
 {
     static sr_nmpc_memory mem;
     sr_nmpc d;
@@ -290,11 +293,33 @@ static void test_a_failed_warm_start_is_solved_by_the_recovery(void)
     CHECK(mem.restarts == 0 && mem.recoveries == 0 && mem.recovering == 0);
     for (k = 0; k < (SR_NMPC_MAX_HORIZON + 1) * SR_NMPC_NZ; ++k) mem.Z[k] = SR_C(1e30);
     CHECK_STATUS(sr_nmpc_step(&d, &mem, &m, x, &t, u), SR_OK);
-    CHECK(mem.restarts == 1 && mem.recoveries == 1 && mem.failures == 0 && mem.failing == 0);
-    CHECK(mem.recovering == SR_NMPC_RECOVERY_SAMPLES && mem.have_guess);
+    CHECK(mem.restarts == 1 && mem.recoveries == 0 && mem.failures == 0 && mem.recovering == 0 && mem.have_guess);
     CHECK(fabs(u[0]) <= 0.5 && fabs(u[1]) <= 0.5 && fabs(mem.Z[0]) < 1);
-    CHECK_STATUS(sr_nmpc_step(&d, &mem, &m, x, &t, u), SR_OK);
-    CHECK(mem.restarts == 1 && mem.recoveries == 2 && mem.recovering == SR_NMPC_RECOVERY_SAMPLES - 1);
+}
+
+/* A reference whose nodes cannot be predicted (an operating point's shell rate far beyond the
+ * model's range): every start from it fails, and the recovery's rollout from the measured state
+ * solves the sample and the next SR_NMPC_RECOVERY_SAMPLES samples (the restart from the reference
+ * alone failed every sample and held the reference's torques). */
+static void test_a_reference_that_cannot_be_predicted_is_solved_by_the_recovery(void)
+{
+    static sr_nmpc_memory mem;
+    sr_nmpc d;
+    sr_model m;
+    sr_real x[SR_NX], u[SR_NU];
+    sr_nmpc_target t = {SR_C(0.3), 0, 0, SR_C(0.01), 1, NULL};
+    int k;
+    paper_simulation_model(&m);
+    small_design(&d);
+    d.z_star[0][4] = 1000; /* rad/s */
+    sr_nmpc_reset(&mem);
+    make_state(x, 0.0, 0.0, 0.3);
+    for (k = 0; k < 3; ++k) {
+        CHECK_STATUS(sr_nmpc_step(&d, &mem, &m, x, &t, u), SR_OK);
+        CHECK(fabs(u[0]) <= 0.5 && fabs(u[1]) <= 0.5);
+    }
+    CHECK(mem.failures == 0 && mem.failing == 0 && mem.restarts == 1 && mem.recoveries == 3);
+    CHECK(mem.recovering == SR_NMPC_RECOVERY_SAMPLES - 2 && mem.have_guess);
 }
 
 /* A sample that nothing can predict (a shell acceleration beyond any rollout) holds the reference's
@@ -331,6 +356,7 @@ void suite_nmpc(void)
     RUN_TEST(test_node_on_a_straight_path_reads_the_step_of_the_full_model);
     RUN_TEST(test_step_keeps_the_torques_within_the_limits_and_counts_samples);
     RUN_TEST(test_step_status_codes_leave_u_and_memory_untouched);
-    RUN_TEST(test_a_failed_warm_start_is_solved_by_the_recovery);
+    RUN_TEST(test_a_failed_warm_start_is_solved_from_the_reference);
+    RUN_TEST(test_a_reference_that_cannot_be_predicted_is_solved_by_the_recovery);
     RUN_TEST(test_a_failed_sample_is_recovered_from);
 }

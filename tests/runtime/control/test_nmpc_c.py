@@ -168,23 +168,3 @@ def test_a_negative_python_timing_span_is_a_named_error(capsys):
     assert main(["--timing", "--against-python", "-1"]) == 2
     assert "--against-python: must be >= 0 s" in capsys.readouterr().err
 
-
-def test_the_c_nmpc_recovers_where_its_restart_diverged_on_robustness_plant_133(monkeypatch):
-    """The first 6 s of the line of plant 133 of control-robustness-nmpc.toml (sample 400): at 3.05 s
-    the warm start diverges; the recovery solves every sample after it (the restart from the
-    reference it replaced diverged there and on every later sample)."""
-    import dataclasses
-
-    from runtime.sweep.cli import load_sweep
-    memories = []
-    compute = nmpc.NmpcC.compute
-
-    def recording(self, t, x, target):
-        memories.append(self._memory)
-        return compute(self, t, x, target)
-    monkeypatch.setattr(nmpc.NmpcC, "compute", recording)
-    spec = dataclasses.replace(load_sweep("control-robustness-nmpc"), duration=6.0)
-    row = spec.run_chunk(400, 401)
-    memory = memories[-1]
-    assert row["status"][0] == 0 and memory.samples == 120
-    assert memory.restarts >= 1 and memory.failures == 0
