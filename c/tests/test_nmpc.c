@@ -275,26 +275,45 @@ static void test_step_status_codes_leave_u_and_memory_untouched(void)
     CHECK_STATUS(sr_nmpc_reset(NULL), SR_ERR_NULL);
 }
 
+/* The recovery tests' case: the paper's robot rolling at 0.3 m/s on a straight path, small_design,
+ * a reset memory (static: the memory is about 160 kB). */
+typedef struct recovery_case {
+    sr_nmpc_memory mem;
+    sr_nmpc d;
+    sr_model m;
+    sr_real x[SR_NX], u[SR_NU];
+    sr_nmpc_target t;
+} recovery_case;
+
+static recovery_case *recovery_start(void)
+{
+    static recovery_case c;
+    const sr_nmpc_target t = {SR_C(0.3), 0, 0, SR_C(0.01), 1, NULL};
+    paper_simulation_model(&c.m);
+    small_design(&c.d);
+    sr_nmpc_reset(&c.mem);
+    make_state(c.x, 0.0, 0.0, 0.3);
+    c.t = t;
+    return &c;
+}
+
+static int recovery_step(recovery_case *c)
+{
+    return sr_nmpc_step(&c->d, &c->mem, &c->m, c->x, &c->t, c->u);
+}
+
 /* A guess whose nodes cannot be predicted (the warm start fails): the sample starts once more from
  * the reference, which solves it, and the recovery is not needed. */
 static void test_a_failed_warm_start_is_solved_from_the_reference(void)
 {
-    static sr_nmpc_memory mem;
-    sr_nmpc d;
-    sr_model m;
-    sr_real x[SR_NX], u[SR_NU];
-    sr_nmpc_target t = {SR_C(0.3), 0, 0, SR_C(0.01), 1, NULL};
+    recovery_case *c = recovery_start();
     int k;
-    paper_simulation_model(&m);
-    small_design(&d);
-    sr_nmpc_reset(&mem);
-    make_state(x, 0.0, 0.0, 0.3);
-    CHECK_STATUS(sr_nmpc_step(&d, &mem, &m, x, &t, u), SR_OK);
-    CHECK(mem.restarts == 0 && mem.recoveries == 0 && mem.recovering == 0);
-    for (k = 0; k < (SR_NMPC_MAX_HORIZON + 1) * SR_NMPC_NZ; ++k) mem.Z[k] = SR_C(1e30);
-    CHECK_STATUS(sr_nmpc_step(&d, &mem, &m, x, &t, u), SR_OK);
-    CHECK(mem.restarts == 1 && mem.recoveries == 0 && mem.failures == 0 && mem.recovering == 0 && mem.have_guess);
-    CHECK(fabs(u[0]) <= 0.5 && fabs(u[1]) <= 0.5 && fabs(mem.Z[0]) < 1);
+    CHECK_STATUS(recovery_step(c), SR_OK);
+    CHECK(c->mem.restarts == 0 && c->mem.recoveries == 0 && c->mem.recovering == 0);
+    for (k = 0; k < (SR_NMPC_MAX_HORIZON + 1) * SR_NMPC_NZ; ++k) c->mem.Z[k] = SR_C(1e30);
+    CHECK_STATUS(recovery_step(c), SR_OK);
+    CHECK(c->mem.restarts == 1 && c->mem.recoveries == 0 && c->mem.failures == 0 && c->mem.recovering == 0);
+    CHECK(c->mem.have_guess && fabs(c->u[0]) <= 0.5 && fabs(c->u[1]) <= 0.5 && fabs(c->mem.Z[0]) < 1);
 }
 
 /* A reference whose nodes cannot be predicted (an operating point's shell rate far beyond the
@@ -303,23 +322,15 @@ static void test_a_failed_warm_start_is_solved_from_the_reference(void)
  * alone failed every sample and held the reference's torques). */
 static void test_a_reference_that_cannot_be_predicted_is_solved_by_the_recovery(void)
 {
-    static sr_nmpc_memory mem;
-    sr_nmpc d;
-    sr_model m;
-    sr_real x[SR_NX], u[SR_NU];
-    sr_nmpc_target t = {SR_C(0.3), 0, 0, SR_C(0.01), 1, NULL};
+    recovery_case *c = recovery_start();
     int k;
-    paper_simulation_model(&m);
-    small_design(&d);
-    d.z_star[0][4] = 1000; /* rad/s */
-    sr_nmpc_reset(&mem);
-    make_state(x, 0.0, 0.0, 0.3);
+    c->d.z_star[0][4] = 1000; /* rad/s */
     for (k = 0; k < 3; ++k) {
-        CHECK_STATUS(sr_nmpc_step(&d, &mem, &m, x, &t, u), SR_OK);
-        CHECK(fabs(u[0]) <= 0.5 && fabs(u[1]) <= 0.5);
+        CHECK_STATUS(recovery_step(c), SR_OK);
+        CHECK(fabs(c->u[0]) <= 0.5 && fabs(c->u[1]) <= 0.5);
     }
-    CHECK(mem.failures == 0 && mem.failing == 0 && mem.restarts == 1 && mem.recoveries == 3);
-    CHECK(mem.recovering == SR_NMPC_RECOVERY_SAMPLES - 2 && mem.have_guess);
+    CHECK(c->mem.failures == 0 && c->mem.failing == 0 && c->mem.restarts == 1 && c->mem.recoveries == 3);
+    CHECK(c->mem.recovering == SR_NMPC_RECOVERY_SAMPLES - 2 && c->mem.have_guess);
 }
 
 /* A sample that nothing can predict (a shell acceleration beyond any rollout) holds the reference's
@@ -327,23 +338,15 @@ static void test_a_reference_that_cannot_be_predicted_is_solved_by_the_recovery(
  * the recovery and the count of consecutive failures is cleared. */
 static void test_a_failed_sample_is_recovered_from(void)
 {
-    static sr_nmpc_memory mem;
-    sr_nmpc d;
-    sr_model m;
-    sr_real x[SR_NX], u[SR_NU];
-    sr_nmpc_target t = {SR_C(0.3), 0, 0, SR_C(0.01), 1, NULL};
-    paper_simulation_model(&m);
-    small_design(&d);
-    d.disturbance_gain = 0;
-    sr_nmpc_reset(&mem);
-    make_state(x, 0.0, 0.0, 0.3);
-    mem.shell_accel[0] = SR_C(1e30);
-    CHECK_STATUS(sr_nmpc_step(&d, &mem, &m, x, &t, u), SR_OK);
-    CHECK(mem.failures == 1 && mem.failing == 1 && !mem.have_guess && u[0] == 0 && u[1] == 0);
-    CHECK(mem.recovering == SR_NMPC_RECOVERY_SAMPLES);
-    mem.shell_accel[0] = 0;
-    CHECK_STATUS(sr_nmpc_step(&d, &mem, &m, x, &t, u), SR_OK);
-    CHECK(mem.failures == 1 && mem.failing == 0 && mem.have_guess && mem.recoveries == 2);
+    recovery_case *c = recovery_start();
+    c->d.disturbance_gain = 0;
+    c->mem.shell_accel[0] = SR_C(1e30);
+    CHECK_STATUS(recovery_step(c), SR_OK);
+    CHECK(c->mem.failures == 1 && c->mem.failing == 1 && !c->mem.have_guess && c->u[0] == 0 && c->u[1] == 0);
+    CHECK(c->mem.recovering == SR_NMPC_RECOVERY_SAMPLES);
+    c->mem.shell_accel[0] = 0;
+    CHECK_STATUS(recovery_step(c), SR_OK);
+    CHECK(c->mem.failures == 1 && c->mem.failing == 0 && c->mem.have_guess && c->mem.recoveries == 2);
 }
 
 void suite_nmpc(void)
