@@ -279,18 +279,19 @@ static void test_step_status_codes_leave_u_and_memory_untouched(void)
  * a reset memory (static: the memory is about 160 kB). */
 typedef struct recovery_case {
     sr_nmpc_memory mem;
-    sr_nmpc d;
+    sr_nmpc *d; /* the caller's (on its stack: static, the M7 test image's RAM overflows) */
     sr_model m;
     sr_real x[SR_NX], u[SR_NU];
     sr_nmpc_target t;
 } recovery_case;
 
-static recovery_case *recovery_start(void)
+static recovery_case *recovery_start(sr_nmpc *d)
 {
     static recovery_case c;
     const sr_nmpc_target t = {SR_C(0.3), 0, 0, SR_C(0.01), 1, NULL};
     paper_simulation_model(&c.m);
-    small_design(&c.d);
+    c.d = d;
+    small_design(d);
     sr_nmpc_reset(&c.mem);
     make_state(c.x, 0.0, 0.0, 0.3);
     c.t = t;
@@ -299,14 +300,15 @@ static recovery_case *recovery_start(void)
 
 static int recovery_step(recovery_case *c)
 {
-    return sr_nmpc_step(&c->d, &c->mem, &c->m, c->x, &c->t, c->u);
+    return sr_nmpc_step(c->d, &c->mem, &c->m, c->x, &c->t, c->u);
 }
 
 /* A guess whose nodes cannot be predicted (the warm start fails): the sample starts once more from
  * the reference, which solves it, and the recovery is not needed. */
 static void test_a_failed_warm_start_is_solved_from_the_reference(void)
 {
-    recovery_case *c = recovery_start();
+    sr_nmpc d;
+    recovery_case *c = recovery_start(&d);
     int k;
     CHECK_STATUS(recovery_step(c), SR_OK);
     CHECK(c->mem.restarts == 0 && c->mem.recoveries == 0 && c->mem.recovering == 0);
@@ -322,9 +324,10 @@ static void test_a_failed_warm_start_is_solved_from_the_reference(void)
  * alone failed every sample and held the reference's torques). */
 static void test_a_reference_that_cannot_be_predicted_is_solved_by_the_recovery(void)
 {
-    recovery_case *c = recovery_start();
+    sr_nmpc d;
+    recovery_case *c = recovery_start(&d);
     int k;
-    c->d.z_star[0][4] = 1000; /* rad/s */
+    d.z_star[0][4] = 1000; /* rad/s */
     for (k = 0; k < 3; ++k) {
         CHECK_STATUS(recovery_step(c), SR_OK);
         CHECK(fabs(c->u[0]) <= 0.5 && fabs(c->u[1]) <= 0.5);
@@ -338,8 +341,9 @@ static void test_a_reference_that_cannot_be_predicted_is_solved_by_the_recovery(
  * the recovery and the count of consecutive failures is cleared. */
 static void test_a_failed_sample_is_recovered_from(void)
 {
-    recovery_case *c = recovery_start();
-    c->d.disturbance_gain = 0;
+    sr_nmpc d;
+    recovery_case *c = recovery_start(&d);
+    d.disturbance_gain = 0;
     c->mem.shell_accel[0] = SR_C(1e30);
     CHECK_STATUS(recovery_step(c), SR_OK);
     CHECK(c->mem.failures == 1 && c->mem.failing == 1 && !c->mem.have_guess && c->u[0] == 0 && c->u[1] == 0);
