@@ -90,6 +90,12 @@ int sr_boxqp_solve(int n, const sr_real *H, const sr_real *g, const sr_real *lb,
 #endif
 /** Unknowns of the condensed QP at the largest horizon. */
 #define SR_NMPC_MAX_QP (SR_NU * SR_NMPC_MAX_HORIZON)
+/** Halvings of a recovery's Gauss-Newton step before it is dropped (sr_nmpc_step). */
+#define SR_NMPC_HALVINGS 6
+#ifndef SR_NMPC_RECOVERY_SAMPLES
+/** Samples after a failed restart from the reference that start with the recovery too (may be set at build time). */
+#define SR_NMPC_RECOVERY_SAMPLES 20
+#endif
 
 /** The controller's design (read-only during control; runtime/control/nmpc.py's NmpcC fills it
  * from the same design as the Python NMPC).  Grid point (i, j), speed i and curvature j, is entry
@@ -145,8 +151,11 @@ typedef struct sr_nmpc_memory {
     sr_real kappa_last;             /**< the last sample's curvature at the foot point [1/m] */
     int have_last;                  /**< z_last, v_last, kappa_last and u_last are those of a solved sample */
     long samples;                   /**< samples since the reset */
-    long restarts;                  /**< samples whose warm start failed and were solved afresh */
+    long restarts;                  /**< samples whose start failed (restarted from the reference, then recovered or failed) */
+    long recoveries;                /**< samples that ran the recovery (sr_nmpc_step) */
     long failures;                  /**< samples with no solution at all (the torques u* held) */
+    int failing;                    /**< consecutive failed samples up to the last (0: the last was solved) */
+    int recovering;                 /**< samples still to start with the recovery (SR_NMPC_RECOVERY_SAMPLES after a failed restart) */
     int have_guess;                 /**< Z, U hold a solution to warm-start from */
     int have_u_last;                /**< u_last is set */
     int qp_iterations;              /**< factorisations of the last QP */
@@ -192,9 +201,22 @@ int sr_nmpc_node(const sr_model *model, const sr_real z[SR_NMPC_NZ], const sr_re
 
 /** One sample: the torques u for the next period from the measured state x and the target (the
  * real-time iteration: update the torque offset, shift the last solution when a node has passed,
- * linearise the nodes, condense, solve the torque-limited QP, advance the integral).  A sample whose iterations fail
- * from the warm start is solved afresh from the reference (memory->restarts); one that fails
- * from there too returns the reference's torques u*_0 (memory->failures) and SR_OK.  Checks the
+ * linearise the nodes, condense, solve the torque-limited QP, advance the integral).
+ *
+ * Recovery.  A sample whose iterations fail from its start (a prediction or a QP not finite;
+ * memory->restarts) starts once more from the reference (cold_iterations; a cold start was from
+ * there already).  When that fails too, the sample is solved by the recovery, and so are the
+ * SR_NMPC_RECOVERY_SAMPLES samples after it and every sample after one with no solution
+ * (memory->recoveries counts them).
+ * The recovery cannot diverge: it starts from the guess's torques or the reference's u* - d (clipped
+ * to +-u_max), whichever costs less when rolled out by the prediction model from the measured state,
+ * and takes up to cold_iterations Gauss-Newton steps on these gap-free nodes, each QP's step halved
+ * up to SR_NMPC_HALVINGS times until the rolled-out nodes are finite and the objective falls (a step
+ * that does not is dropped and the iterations end).  Only when no rollout is finite does a sample
+ * fail: it returns the reference's torques u*_0 - d clipped (memory->failures, memory->failing the
+ * consecutive failures, cleared by the next solved sample) and SR_OK.
+ *
+ * Checks the
  * design (sr_nmpc_check: SR_ERR_ARG, SR_ERR_NONFINITE), x in full (sr_check_state), the target's
  * and the memory's integral and heading for finiteness.  Returns SR_OK, SR_ERR_NULL, SR_ERR_MODEL, SR_ERR_ARG, SR_ERR_NONFINITE,
  * SR_ERR_NOT_ROTATION or SR_ERR_CONSTRAINT; u and the memory are written only on SR_OK, u within

@@ -59,7 +59,8 @@ int sr_nmpc_reset(sr_nmpc_memory *memory)
     if (!memory) return SR_ERR_NULL;
     memory->have_guess = memory->have_u_last = 0;
     memory->heading = memory->integral = 0;
-    memory->samples = memory->restarts = memory->failures = 0;
+    memory->samples = memory->restarts = memory->recoveries = memory->failures = 0;
+    memory->failing = memory->recovering = 0;
     memory->qp_iterations = memory->saturated = 0;
     memory->u_last[0] = memory->u_last[1] = 0;
     memory->disturbance[0] = memory->disturbance[1] = 0;
@@ -459,6 +460,101 @@ static int iterate(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, c
     return 0;
 }
 
+/* ---- Recovery: damped single shooting ---------------------------------------------------------- */
+
+/* The nodes Z of the torques U from z0 (Z_0 = z0, Z_{k+1} the prediction of Z_k under U_k + d, as
+ * iteration()'s nodes); nonzero when a prediction is not finite. */
+static int rollout(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, const sr_real z0[NZ], sr_real v,
+                   const sr_real *U, sr_real *Z)
+{
+    const sr_real T = d->period * (sr_real)d->node_periods;
+    sr_real ud[SR_NU];
+    int j, k;
+    memcpy(Z, z0, NZ * sizeof(sr_real));
+    for (k = 0; k < d->horizon; ++k) {
+        ud[0] = U[k * SR_NU] + m->disturbance[0];
+        ud[1] = U[k * SR_NU + 1] + m->disturbance[1];
+        if (node(model, Z + k * NZ, ud, v, m->kappa[k], T, Z + (k + 1) * NZ, NULL, NULL) != SR_OK) return 1;
+        for (j = 0; j < 3; ++j) Z[(k + 1) * NZ + Z_SHELL + j] += T * m->shell_accel[j];
+    }
+    return 0;
+}
+
+/* Twice the QP's objective at gap-free nodes Z and torques U: the weighted errors of nodes 1 .. N - 1,
+ * the cost-to-go of node N, the torques' distance from the reference and their changes. */
+static sr_real objective(const sr_nmpc *d, const sr_nmpc_memory *m, const sr_real q[NZ], const sr_real *P,
+                         const sr_real *Z, const sr_real *U)
+{
+    const int N = d->horizon;
+    sr_real J = 0, e[NZ];
+    int i, j, k;
+    for (k = 1; k < N; ++k)
+        for (i = 0; i < NZ; ++i) {
+            const sr_real ek = Z[k * NZ + i] - m->zs[k * NZ + i];
+            J += q[i] * ek * ek;
+        }
+    for (i = 0; i < NZ; ++i) e[i] = Z[N * NZ + i] - m->zs[N * NZ + i];
+    for (i = 0; i < NZ; ++i)
+        for (j = 0; j < NZ; ++j) J += e[i] * P[i * NZ + j] * e[j];
+    for (k = 0; k < N * SR_NU; ++k) {
+        const sr_real du = U[k] - m->us[k];
+        J += d->r * du * du;
+        if (m->have_u_last && d->r_step > 0) {
+            const sr_real step = U[k] - (k < SR_NU ? m->u_last[k] : U[k - SR_NU]);
+            J += d->r_step * step * step;
+        }
+    }
+    return J;
+}
+
+/* U clipped to the torque limits and rolled out from z0 into Z, *J its objective; nonzero when the
+ * rollout or the objective is not finite. */
+static int start(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, const sr_real z0[NZ], sr_real v,
+                 const sr_real q[NZ], const sr_real *P, sr_real *U, sr_real *Z, sr_real *J)
+{
+    int i;
+    for (i = 0; i < SR_NU * d->horizon; ++i) U[i] = U[i] > d->u_max ? d->u_max : (U[i] < -d->u_max ? -d->u_max : U[i]);
+    if (rollout(d, m, model, z0, v, U, Z)) return 1;
+    *J = objective(d, m, q, P, Z, U);
+    return !all_finite(J, 1);
+}
+
+/* A start that cannot diverge: the torques of the guess in m->U (if guess) or the reference's,
+ * whichever's rollout from the measured z0 costs less, then up to cold_iterations Gauss-Newton
+ * steps on these gap-free nodes, each QP's step halved (up to SR_NMPC_HALVINGS times) until the
+ * rolled-out nodes are finite and the objective falls; a step that does not is dropped and the
+ * iterations end.  The result in m->Z, m->U; nonzero only when neither start rolls out. */
+static int recover(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, const sr_real z0[NZ], sr_real v,
+                   const sr_real q[NZ], const sr_real *P, int guess)
+{
+    const int N = d->horizon, nq = SR_NU * N;
+    sr_real J = 0, Jn = 0, alpha;
+    int it, h, i, from_guess;
+    from_guess = guess && !start(d, m, model, z0, v, q, P, m->U, m->Z, &J);
+    memcpy(m->Un, m->us, (size_t)nq * sizeof(sr_real));
+    if (start(d, m, model, z0, v, q, P, m->Un, m->Zn, &Jn)) {
+        if (!from_guess) return 1;
+    } else if (!from_guess || Jn < J) {
+        J = Jn;
+        memcpy(m->Z, m->Zn, (size_t)(N + 1) * NZ * sizeof(sr_real));
+        memcpy(m->U, m->Un, (size_t)nq * sizeof(sr_real));
+    }
+    for (it = 0; it < d->cold_iterations; ++it) {
+        if (iteration(d, m, model, z0, v, q, P)) break;
+        for (h = 0, alpha = 1; h <= SR_NMPC_HALVINGS; ++h, alpha *= SR_C(0.5)) {
+            for (i = 0; i < nq; ++i) m->Un[i] = m->U[i] + alpha * m->dU[i];
+            if (rollout(d, m, model, z0, v, m->Un, m->Zn)) continue;
+            Jn = objective(d, m, q, P, m->Zn, m->Un);
+            if (all_finite(&Jn, 1) && Jn < J) break;
+        }
+        if (h > SR_NMPC_HALVINGS) break;
+        J = Jn;
+        memcpy(m->Z, m->Zn, (size_t)(N + 1) * NZ * sizeof(sr_real));
+        memcpy(m->U, m->Un, (size_t)nq * sizeof(sr_real));
+    }
+    return 0;
+}
+
 /* The rows of z the offsets are estimated from: the pendulum and the rates (3 .. 8), which do not
  * depend on where the reference's nearest point falls. */
 #define D_FIRST 3
@@ -567,21 +663,40 @@ int sr_nmpc_step(const sr_nmpc *d, sr_nmpc_memory *m, const sr_model *model, con
         P = (path ? d->P_path : d->P_heading)[i * d->n_curvatures + jj];
         q = path ? d->q_path : d->q_heading;
     }
-    failed = iterate(d, m, model, z, v, q, P, cold ? d->cold_iterations : d->iterations);
-    if (failed) { /* a warm start gone bad: once more from the reference */
+    /* After a failed sample, and for SR_NMPC_RECOVERY_SAMPLES samples after a failed restart, the
+     * start is the recovery's.  Else the guess's; when its iterations fail, the reference's; when
+     * those fail too, the recovery's. */
+    if (m->failing > 0 || m->recovering > 0) {
+        if (m->recovering > 0) m->recovering--;
+        m->recoveries++;
+        failed = recover(d, m, model, z, v, q, P, m->failing == 0);
+    } else if (iterate(d, m, model, z, v, q, P, cold ? d->cold_iterations : d->iterations)) {
         m->restarts++;
-        memcpy(m->Z, m->zs, (size_t)(N + 1) * NZ * sizeof(sr_real));
-        memcpy(m->U, m->us, (size_t)N * SR_NU * sizeof(sr_real));
-        failed = iterate(d, m, model, z, v, q, P, d->cold_iterations);
+        failed = 1;
+        if (!cold) { /* a cold start was from the reference already */
+            memcpy(m->Z, m->zs, (size_t)(N + 1) * NZ * sizeof(sr_real));
+            memcpy(m->U, m->us, (size_t)N * SR_NU * sizeof(sr_real));
+            failed = iterate(d, m, model, z, v, q, P, d->cold_iterations);
+        }
+        if (failed) {
+            m->recoveries++;
+            m->recovering = SR_NMPC_RECOVERY_SAMPLES;
+            failed = recover(d, m, model, z, v, q, P, 1);
+        }
+    } else {
+        failed = 0;
     }
     m->samples++;
     if (failed) { /* no prediction at all: hold the reference's torques */
         m->failures++;
+        m->failing++;
+        m->recovering = SR_NMPC_RECOVERY_SAMPLES;
         m->have_guess = m->have_last = 0;
         for (j = 0; j < SR_NU; ++j) u[j] = m->us[j] > d->u_max ? d->u_max : (m->us[j] < -d->u_max ? -d->u_max : m->us[j]);
         m->saturated = SR_FABS(u[0]) >= d->u_max || SR_FABS(u[1]) >= d->u_max;
         return SR_OK;
     }
+    m->failing = 0;
     m->have_guess = 1;
     m->have_u_last = 1;
     m->u_last[0] = m->U[0];

@@ -200,6 +200,9 @@ static void test_node_on_a_straight_path_reads_the_step_of_the_full_model(void)
 
 /* A design of one grid point: rolling at 0.3 m/s on the paper's robot needs (u*, z*) which the
  * test does not know, so u* = 0 and z* = 0 with weights that only ask for a small error. */
+
+
+
 static void small_design(sr_nmpc *d)
 {
     int i;
@@ -272,6 +275,84 @@ static void test_step_status_codes_leave_u_and_memory_untouched(void)
     CHECK_STATUS(sr_nmpc_reset(NULL), SR_ERR_NULL);
 }
 
+/* The recovery tests' case: the paper's robot rolling at 0.3 m/s on a straight path, small_design,
+ * a reset memory (static: the memory is about 160 kB). */
+typedef struct recovery_case {
+    sr_nmpc_memory mem;
+    sr_nmpc *d; /* the caller's (on its stack: static, the M7 test image's RAM overflows) */
+    sr_model m;
+    sr_real x[SR_NX], u[SR_NU];
+    sr_nmpc_target t;
+} recovery_case;
+
+static recovery_case *recovery_start(sr_nmpc *d)
+{
+    static recovery_case c;
+    const sr_nmpc_target t = {SR_C(0.3), 0, 0, SR_C(0.01), 1, NULL};
+    paper_simulation_model(&c.m);
+    c.d = d;
+    small_design(d);
+    sr_nmpc_reset(&c.mem);
+    make_state(c.x, 0.0, 0.0, 0.3);
+    c.t = t;
+    return &c;
+}
+
+static int recovery_step(recovery_case *c)
+{
+    return sr_nmpc_step(c->d, &c->mem, &c->m, c->x, &c->t, c->u);
+}
+
+/* A guess whose nodes cannot be predicted (the warm start fails): the sample starts once more from
+ * the reference, which solves it, and the recovery is not needed. */
+static void test_a_failed_warm_start_is_solved_from_the_reference(void)
+{
+    sr_nmpc d;
+    recovery_case *c = recovery_start(&d);
+    int k;
+    CHECK_STATUS(recovery_step(c), SR_OK);
+    CHECK(c->mem.restarts == 0 && c->mem.recoveries == 0 && c->mem.recovering == 0);
+    for (k = 0; k < (SR_NMPC_MAX_HORIZON + 1) * SR_NMPC_NZ; ++k) c->mem.Z[k] = SR_C(1e30);
+    CHECK_STATUS(recovery_step(c), SR_OK);
+    CHECK(c->mem.restarts == 1 && c->mem.recoveries == 0 && c->mem.failures == 0 && c->mem.recovering == 0);
+    CHECK(c->mem.have_guess && fabs(c->u[0]) <= 0.5 && fabs(c->u[1]) <= 0.5 && fabs(c->mem.Z[0]) < 1);
+}
+
+/* A reference whose nodes cannot be predicted (an operating point's shell rate far beyond the
+ * model's range): every start from it fails, and the recovery's rollout from the measured state
+ * solves the sample and the next SR_NMPC_RECOVERY_SAMPLES samples (the restart from the reference
+ * alone failed every sample and held the reference's torques). */
+static void test_a_reference_that_cannot_be_predicted_is_solved_by_the_recovery(void)
+{
+    sr_nmpc d;
+    recovery_case *c = recovery_start(&d);
+    int k;
+    d.z_star[0][4] = 1000; /* rad/s */
+    for (k = 0; k < 3; ++k) {
+        CHECK_STATUS(recovery_step(c), SR_OK);
+        CHECK(fabs(c->u[0]) <= 0.5 && fabs(c->u[1]) <= 0.5);
+    }
+    CHECK(c->mem.failures == 0 && c->mem.failing == 0 && c->mem.restarts == 1 && c->mem.recoveries == 3);
+    CHECK(c->mem.recovering == SR_NMPC_RECOVERY_SAMPLES - 2 && c->mem.have_guess);
+}
+
+/* A sample that nothing can predict (a shell acceleration beyond any rollout) holds the reference's
+ * torques and counts a failure; once the prediction is possible again the next sample is solved by
+ * the recovery and the count of consecutive failures is cleared. */
+static void test_a_failed_sample_is_recovered_from(void)
+{
+    sr_nmpc d;
+    recovery_case *c = recovery_start(&d);
+    d.disturbance_gain = 0;
+    c->mem.shell_accel[0] = SR_C(1e30);
+    CHECK_STATUS(recovery_step(c), SR_OK);
+    CHECK(c->mem.failures == 1 && c->mem.failing == 1 && !c->mem.have_guess && c->u[0] == 0 && c->u[1] == 0);
+    CHECK(c->mem.recovering == SR_NMPC_RECOVERY_SAMPLES);
+    c->mem.shell_accel[0] = 0;
+    CHECK_STATUS(recovery_step(c), SR_OK);
+    CHECK(c->mem.failures == 1 && c->mem.failing == 0 && c->mem.have_guess && c->mem.recoveries == 2);
+}
+
 void suite_nmpc(void)
 {
     RUN_TEST(test_boxqp_meets_the_optimality_conditions_on_random_problems);
@@ -282,4 +363,7 @@ void suite_nmpc(void)
     RUN_TEST(test_node_on_a_straight_path_reads_the_step_of_the_full_model);
     RUN_TEST(test_step_keeps_the_torques_within_the_limits_and_counts_samples);
     RUN_TEST(test_step_status_codes_leave_u_and_memory_untouched);
+    RUN_TEST(test_a_failed_warm_start_is_solved_from_the_reference);
+    RUN_TEST(test_a_reference_that_cannot_be_predicted_is_solved_by_the_recovery);
+    RUN_TEST(test_a_failed_sample_is_recovered_from);
 }

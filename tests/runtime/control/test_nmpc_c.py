@@ -167,3 +167,4 @@ def test_the_bench_line_gives_the_python_to_c_ratio_of_each_percentile():
 def test_a_negative_python_timing_span_is_a_named_error(capsys):
     assert main(["--timing", "--against-python", "-1"]) == 2
     assert "--against-python: must be >= 0 s" in capsys.readouterr().err
+
