@@ -35,6 +35,7 @@ class LqrGains:
     the full torque.  Tuned on the shipped tasks (docs/control.md, "LQR")."""
     tilt_rad: float = 1.0             # E_x: the yoke's tilt about its hinge (the pendulum's lever), left loose
     attitude_rad: float = 0.1         # E_y, E_z: the yoke's lean and heading
+    heading_rad: float = 0.0          # E_z alone (0: attitude_rad): the heading's own size, the lean left at attitude_rad
     pendulum_rad: float = 0.3         # θ_P
     rolling_rate_rad_s: float = 0.2   # Ω_x, the shell's rolling rate: the speed (v = r |Ω_x|)
     rate_rad_s: float = 0.5           # Ω_y, Ω_z
@@ -74,7 +75,8 @@ class LqrGains:
 
     def weights(self, u_max):
         """These bounds as the design's Riccati weights, with the torque bound `u_max` [N m]."""
-        return design.Weights(attitude_rad=(self.tilt_rad, self.attitude_rad, self.attitude_rad), pendulum_rad=self.pendulum_rad,
+        heading = self.heading_rad if self.heading_rad > 0 else self.attitude_rad
+        return design.Weights(attitude_rad=(self.tilt_rad, self.attitude_rad, heading), pendulum_rad=self.pendulum_rad,
                               rate_rad_s=(self.rolling_rate_rad_s, self.rate_rad_s, self.rate_rad_s),
                               yoke_rate_rad_s=self.joint_rate_rad_s, pendulum_rate_rad_s=self.joint_rate_rad_s, cross_track_m=self.cross_track_m,
                               cross_track_integral_m_s=self.cross_track_integral_m_s,

@@ -10,9 +10,12 @@ standard deviations of the cross-track error, of the heading (E_z, the yoke's at
 the vertical) and of the torques, and, by a Monte Carlo of the same linear loop, how often the
 heading stays inside a band for a given time: the chance that a noisy heading step "settles".
 
-Why this exists: it separates what gains can change from what they cannot.  Turning the heading
-weight up (or the torque's down, to unbounded torques) leaves a floor, set by the shell's torque
-about the vertical, which the motors reach only through the pendulum's lean (`main` prints it).
+Why this exists: it separates what gains can change from what they cannot.  The heading wanders
+from the shell's torque about the vertical, which the motors reach only through the pendulum's
+lean: a heading weight that weighs the lean alike (`attitude_rad`, E_y and E_z together) holds back
+the lean it steers with and stops at a floor near 1°, however free the torque; the heading's own
+weight (`heading_rad`, the lean left at its size) goes far below it, at the cost of pendulum
+torque (`main` prints both).
 """
 import argparse
 import dataclasses
@@ -115,8 +118,9 @@ def band_hold_fraction(w, band_rad, duration_s, rate=50.0, runs=2000, seed=0):
 def main(argv=()):
     """`python -m runtime noise-floor`: the LQR's steady wander on the shipped tasks' operating points
     under the sensor set's process noise: on the paths at the shipped gains, tighter cross-track
-    weights and with the shipped tight gains fully scheduled in, on the heading step at the shipped gains, a tighter heading weight, and with the torque
-    nearly free (the floor no gains go below)."""
+    weights and with the shipped tight gains fully scheduled in, on the heading step at the shipped gains, tighter
+    heading weights with the lean weighed alike (`attitude_rad`) and apart (`heading_rad`), and each with the torque
+    nearly free (the floor no such gains go below)."""
     parser = argparse.ArgumentParser(prog="python -m runtime noise-floor")
     parser.add_argument("--sensors", default="default", help="a shipped sensor set or a sensors file")
     parser.add_argument("--hold", type=float, default=18.4,
@@ -133,11 +137,15 @@ def main(argv=()):
     except ValueError as exc:
         parser.error(f"--sensors: {exc}")
     params = load_task("circle").scenario.params
-    shipped, floor = ("shipped", LqrGains(), 0.5), ("attitude_rad 0.001, torque weight 50 N·m", LqrGains(attitude_rad=0.001), 50.0)
+    shipped = ("shipped", LqrGains(), 0.5)
+    floor = ("attitude_rad 0.001, torque weight 50 N·m", LqrGains(attitude_rad=0.001), 50.0)
+    own_floor = ("heading_rad 0.001, torque weight 50 N·m", LqrGains(heading_rad=0.001), 50.0)
     on_path = (shipped, ("cross_track_m 0.05", LqrGains(cross_track_m=0.05), 0.5),
                ("cross_track_m 0.02", LqrGains(cross_track_m=0.02), 0.5),
                ("shipped, tight gains scheduled in", LqrGains(), 0.5, True))
-    heading = (shipped, ("attitude_rad 0.03", LqrGains(attitude_rad=0.03), 0.5), floor)
+    heading = (shipped, ("attitude_rad 0.03", LqrGains(attitude_rad=0.03), 0.5), floor,
+               ("heading_rad 0.03", LqrGains(heading_rad=0.03), 0.5), ("heading_rad 0.02", LqrGains(heading_rad=0.02), 0.5),
+               own_floor)
     cases = (("circle R = 2 m", 0.5, True, on_path), ("line", 0.0, True, on_path), ("heading step", 0.0, False, heading))
     print("| case | gains | cross-track σ [mm] | heading σ [°] | torque σ (yoke, pendulum) [N·m] "
           f"| heading within ±3° for {args.hold:g} s |")

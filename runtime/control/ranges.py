@@ -26,6 +26,7 @@ LQR_RANGES = {
     **{name: _ERROR_SIZE for name in ("tilt_rad", "attitude_rad", "pendulum_rad", "rolling_rate_rad_s", "rate_rad_s",
                                       "joint_rate_rad_s", "cross_track_m", "cross_track_integral_m_s",
                                       "speed_integral_rad", "tight_cross_track_m")},
+    "heading_rad": Range(0, 1e6, "rad", "the heading's own Bryson size (0: attitude_rad's)"),
     "v_min": Range(0, 10, "m/s", "the design grid's speeds"), "v_max": Range(0, 10, "m/s", "the design grid's speeds"),
     "n_speeds": Range(1, lib.SR_LQR_MAX_SPEEDS, "", "the C controller's grid holds SR_LQR_MAX_SPEEDS", whole=True),
     "kappa_max": Range(0, 100, "1/m", "a turn of 1 cm radius at most"),

@@ -228,3 +228,15 @@ def test_the_crossing_check_fails_without_the_preview():
     """On the law whose tight gains hold after a clipped torque (tight_fall_s = 0): with the fall the
     tight gains leave the crossing's clipped turn, and that alone keeps it near 0.18 m."""
     assert _figure8_crossing_error(lqr.LqrGains(preview_m=0.0, smoothing_m=0.0, tight_fall_s=0.0)) > 0.2
+
+
+def test_the_heading_weight_alone_moves_only_the_headings_riccati_weight():
+    base, own = lqr.LqrGains().weights(0.5).q_diagonal(), lqr.LqrGains(heading_rad=0.02).weights(0.5).q_diagonal()
+    assert own[2] == pytest.approx(1 / 0.02 ** 2)
+    assert np.array_equal(np.delete(own, 2), np.delete(base, 2))
+    assert np.array_equal(lqr.LqrGains(heading_rad=0.0).weights(0.5).q_diagonal(), base)
+
+
+def test_a_negative_heading_weight_is_refused_by_name():
+    with pytest.raises(ValueError, match="heading_rad"):
+        lqr.LqrGains(heading_rad=-0.1)

@@ -49,6 +49,16 @@ def test_a_tighter_heading_weight_narrows_the_heading_but_not_below_the_floor(he
     assert tight.heading_rad > math.radians(1.0)
 
 
+def test_the_headings_own_weight_goes_below_the_floor_of_the_lean_weighed_alike(heading_loop):
+    # attitude_rad weighs the lean (the steering) as the heading: with the torque nearly free it stops
+    # above 1 degree; heading_rad leaves the lean at its size and goes below it within the 0.5 N m limit.
+    coupled = noise_floor.wander(PARAMS, DENSITIES, 0.3, path=False, u_max=50.0, gains=LqrGains(attitude_rad=0.001))
+    own = noise_floor.wander(PARAMS, DENSITIES, 0.3, path=False, gains=LqrGains(heading_rad=0.02))
+    assert coupled.heading_rad > math.radians(1.0)
+    assert own.heading_rad < 0.8 * coupled.heading_rad
+    assert own.torque_n_m.max() < 0.5 / 3
+
+
 def test_a_path_loop_reports_its_cross_track_wander():
     w = noise_floor.wander(PARAMS, DENSITIES, 0.3, kappa=0.0, path=True)
     assert 0.005 < w.cross_track_m < 0.1
