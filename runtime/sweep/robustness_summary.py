@@ -185,11 +185,14 @@ def robustness_figure(table, spec, size=(11.0, 4.0)):
     ecdf.legend(fontsize=7)
     slope.set_xlabel(f"|slope| [fraction of the plant's climbing limit]")
     slope.set_ylabel("second-half cross-track RMS [mm]")
-    bars.set_xticks(range(len(groups)), [f"{g['task']}\n{g['controller']}" for g in groups], fontsize=7)
+    bars.set_xticks(range(len(groups)), [f"{g['task']}\n{g['controller']}\n{g['success']} / {g['n']}"
+                                         for g in groups], fontsize=7)
     bars.axhline(95, color="0.4", ls="--", lw=0.8)
     bars.set_ylabel(f"runs that succeed [%] ({100 * CONFIDENCE:g} % interval)")
     bars.set_ylim(0, 100)
-    fig.suptitle(f"{spec.name}: {len(np.unique(cols['plant']))} plants", fontsize=10)
+    runs = len(cols["sample"])
+    fig.suptitle(f"{spec.name}: {runs} runs on {len(np.unique(cols['plant']))} plants"
+                 + ("" if runs >= spec.samples else f" (unfinished: {spec.samples} runs in all)"), fontsize=10)
     return fig
 
 

@@ -268,6 +268,16 @@ def test_a_combination_missing_runs_is_summarised_as_unfinished(combined, tmp_pa
     assert "| line | lqr | 2 | 0 | 0 |" in summary and "| line | lqr-slope | 0 | 0 | 0 |" in summary
 
 
+def test_the_figure_names_each_groups_successes_and_runs_and_an_unfinished_sweep(tmp_path):
+    from runtime.sweep.robustness_summary import robustness_figure
+    spec = load_sweep(str(_sweep(tmp_path)))
+    rows = spec.run_chunk(0, 2)
+    rows["success"] = np.array([1, 0], dtype=np.int32)
+    fig = robustness_figure(rows, spec)
+    assert [t.get_text() for t in fig.axes[2].get_xticklabels()] == ["line\nlqr\n1 / 2"]
+    assert fig.get_suptitle() == "small: 2 runs on 2 plants (unfinished: 3 runs in all)"
+
+
 def test_combining_a_folder_twice_or_a_sweep_of_other_plants_is_refused(combined, tmp_path, capsys):
     from runtime.sweep.robustness import from_identity, in_sweep
     _, _, parts, whole_path = combined
