@@ -185,7 +185,7 @@ def robustness_figure(table, spec, size=(11.0, 4.0)):
     ecdf.legend(fontsize=7)
     slope.set_xlabel(f"|slope| [fraction of the plant's climbing limit]")
     slope.set_ylabel("second-half cross-track RMS [mm]")
-    bars.set_xticks(range(len(groups)), [f"{g['task']}\n{g['controller']}\n{g['success']} / {g['n']}"
+    bars.set_xticks(range(len(groups)), [f"{g['task']}\n{g['controller']}\n{g['success']}/{g['n']}"
                                          for g in groups], fontsize=7)
     bars.axhline(95, color="0.4", ls="--", lw=0.8)
     bars.set_ylabel(f"runs that succeed [%] ({100 * CONFIDENCE:g} % interval)")

@@ -274,7 +274,7 @@ def test_the_figure_names_each_groups_successes_and_runs_and_an_unfinished_sweep
     rows = spec.run_chunk(0, 2)
     rows["success"] = np.array([1, 0], dtype=np.int32)
     fig = robustness_figure(rows, spec)
-    assert [t.get_text() for t in fig.axes[2].get_xticklabels()] == ["line\nlqr\n1 / 2"]
+    assert [t.get_text() for t in fig.axes[2].get_xticklabels()] == ["line\nlqr\n1/2"]
     assert fig.get_suptitle() == "small: 2 runs on 2 plants (unfinished: 3 runs in all)"
 
 
