@@ -18,15 +18,17 @@ import os
 import pathlib
 import sys
 
+import numpy as np
+
 from ..errors import SimulationStopped
 from ..model import Model
 from ..atomic import write_text
 from ..state import IDX_Q
 from .runner import CONNECT_TIMEOUT, SERIAL, run_sweep, scheduler_address
-from .robustness import RobustnessSpec, with_nominal
+from .robustness import RobustnessSpec, from_identity, in_sweep, with_nominal
 from .robustness_summary import summary_text, write_robustness_figure
 from .spec import MAX_SAMPLES, load_sweep, shipped_sweeps
-from .store import MANIFEST, SweepIncomplete, SweepStore
+from .store import MANIFEST, SweepIncomplete, SweepStore, chunk_schema
 from .summary import percentile_table, write_summary_figure
 
 #: Most worker processes of the embedded LocalCluster, per core (more only share the cores).
@@ -94,6 +96,9 @@ def build_parser():
                         "centre_of_mass, slope, start)")
     p.add_argument("--finished", action="store_true",
                    help="a robustness sweep: summarise the verified runs in --out so far, running nothing")
+    p.add_argument("--combine", nargs="+", metavar="DIR",
+                   help="a robustness sweep: summarise into --out the verified runs in these sweeps' folders "
+                        "(the same plants, some of its tasks and controllers each), running nothing")
     return p
 
 
@@ -117,24 +122,61 @@ def robustness_outputs(spec, table, args):
     return summary
 
 
+def _verified_runs(spec, folder, option):
+    """The verified rows of the sweep `spec` in `folder` (an Arrow table), finished or not."""
+    import pyarrow as pa
+    store = SweepStore.open(folder, spec, lambda: None)
+    tables = [table for a, b in store.chunks() if store.chunk_path(a, b).exists()
+              for table in [store.read_chunk(a, b)[0]] if table is not None]
+    if not tables:
+        raise ValueError(f"{option}: {folder} holds no verified runs yet")
+    return pa.concat_tables(tables)
+
+
+def _summarise(spec, table, args):
+    """Writes and prints the summary of the runs `table` of `spec` (marked unfinished if some are missing)."""
+    summary = robustness_outputs(spec, table, args)
+    if table.num_rows < spec.samples:
+        summary = f"Unfinished: {table.num_rows} of the sweep's {spec.samples} runs.\n\n" + summary
+        write_text(f"{args.out}/summary.md", summary + "\n")
+    print(summary)
+    return 0
+
+
 def _finished(spec, args):
     """Summarises the verified chunks of an unfinished robustness sweep (OUT/summary.md, .png)."""
-    import pyarrow as pa
     if not isinstance(spec, RobustnessSpec):
         raise ValueError("--finished: only for a robustness sweep (a sweep file with [control])")
     if not (pathlib.Path(args.out) / MANIFEST).is_file():
         raise ValueError(f"--out: {args.out} holds no sweep")
-    store = SweepStore.open(args.out, spec, lambda: None)
-    tables = [table for a, b in store.chunks() if store.chunk_path(a, b).exists()
-              for table in [store.read_chunk(a, b)[0]] if table is not None]
-    if not tables:
-        raise ValueError(f"--finished: {args.out} holds no verified runs yet")
-    table = pa.concat_tables(tables)
-    summary = (f"Unfinished: {table.num_rows} of the sweep's {spec.samples} runs.\n\n"
-               + robustness_outputs(spec, table, args))
-    write_text(f"{args.out}/summary.md", summary + "\n")
-    print(summary)
-    return 0
+    return _summarise(spec, _verified_runs(spec, args.out, "--finished"), args)
+
+
+def _combined(spec, args):
+    """Summarises into --out the verified runs of the sweeps in the --combine folders, each a part of
+    `spec` (the same plants; some of its tasks and controllers), as runs of `spec`."""
+    import json
+    import pyarrow as pa
+    if not isinstance(spec, RobustnessSpec):
+        raise ValueError("--combine: only for a robustness sweep (a sweep file with [control])")
+    parts = []
+    for folder in args.combine:
+        manifest = pathlib.Path(folder) / MANIFEST
+        if not manifest.is_file():
+            raise ValueError(f"--combine: {folder} holds no sweep")
+        record = json.loads(manifest.read_text(encoding="utf-8"))
+        part = from_identity(record.get("identity"), record.get("sweep", folder), str(manifest))
+        table = _verified_runs(part, folder, "--combine")
+        parts.append(in_sweep(table.to_pydict(), part, spec, f"--combine: {folder}"))
+    columns = {name: np.concatenate([p[name] for p in parts]) for name in parts[0]}
+    samples, first = np.unique(columns["sample"], return_index=True)
+    if len(samples) < len(columns["sample"]):
+        twice = np.setdiff1d(np.arange(len(columns["sample"])), first)[0]
+        raise ValueError(f"--combine: sample {columns['sample'][twice]} of {spec.name} is in more than one folder")
+    table = pa.table({name: values[first] for name, values in columns.items()},
+                     schema=chunk_schema(spec))
+    pathlib.Path(args.out).mkdir(parents=True, exist_ok=True)
+    return _summarise(spec, table, args)
 
 
 def _rerun(spec, sample, nominal=()):
@@ -162,6 +204,8 @@ def main(argv):
             spec = spec.with_samples(args.samples)
         if args.rerun is not None:
             return _rerun(spec, args.rerun, [g for g in args.nominal.split(",") if g])
+        if args.combine:
+            return _combined(spec, args)
         if args.finished:
             return _finished(spec, args)
         table = run_sweep(spec, args.out, scheduler=args.scheduler, workers=args.workers,

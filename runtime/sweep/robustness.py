@@ -206,6 +206,47 @@ class RobustnessSpec:
         return columns
 
 
+#: What two robustness sweeps must share for their runs to be runs of one study: the same plants
+#: (seed and ranges), the same sensors and the same rule (`in_sweep`).
+SAME_PLANTS = ("seed", "sensors", "mass", "damping", "centre_of_mass_m", "slope_fraction", "position_m",
+               "heading_deg", "rms_m", "coverage", "duration")
+
+
+def from_identity(identity, name, source):
+    """The RobustnessSpec whose `identity()` is `identity` (as a sweep folder's manifest holds it)."""
+    fields = dict(identity.get("robustness", {})) if isinstance(identity, dict) else {}
+    try:
+        fields["tasks"], fields["controllers"] = tuple(fields["tasks"]), tuple(fields["controllers"])
+        return RobustnessSpec(name=name, source=source, **fields)
+    except (KeyError, TypeError) as exc:
+        raise ValueError(f"{source}: not the identity of a robustness sweep ({exc})") from None
+
+
+def in_sweep(columns, part, whole, where):
+    """The rows `columns` ({column: array}) of the sweep `part` as rows of the sweep `whole`: the
+    task, controller and sample renumbered (sample = plant x C + the run's place in `whole`).
+    `whole` must draw the same plants and judge by the same rule (SAME_PLANTS) and run every task
+    and controller of `part`; ValueError naming `where` and the difference otherwise."""
+    for key in SAME_PLANTS:
+        if getattr(part, key) != getattr(whole, key):
+            raise ValueError(f"{where}: its sweep's {key} is {getattr(part, key)!r}, {whole.name}'s is "
+                             f"{getattr(whole, key)!r}: not the same plants and rule")
+    for key in ("tasks", "controllers"):
+        extra = [name for name in getattr(part, key) if name not in getattr(whole, key)]
+        if extra:
+            raise ValueError(f"{where}: its {key} {extra} are not among {whole.name}'s {list(getattr(whole, key))}")
+    out = {name: np.asarray(values) for name, values in columns.items()}
+    out["task"] = np.array([whole.tasks.index(t) for t in part.tasks], dtype=np.int64)[out["task"]]
+    out["controller"] = np.array([whole.controllers.index(c) for c in part.controllers],
+                                 dtype=np.int64)[out["controller"]]
+    out["sample"] = out["plant"] * len(whole.combos) + out["task"] * len(whole.controllers) + out["controller"]
+    beyond = out["sample"] >= whole.samples
+    if beyond.any():
+        raise ValueError(f"{where}: plant {int(out['plant'][beyond][0])} is beyond {whole.name}'s "
+                         f"{whole.samples} runs (--samples)")
+    return out
+
+
 def is_robustness(data):
     """True for the table of a robustness sweep file (it has `[control]`)."""
     return isinstance(data, dict) and "control" in data

@@ -112,17 +112,18 @@ def summary_text(table, spec, command):
              f"along the path ≥ {100 * spec.coverage:g} % of the reference's; {100 * CONFIDENCE:g} % intervals "
              "Clopper–Pearson.", "",
              "| task | controller | runs | counted apart | stopped | succeed | fraction | 95 % interval | "
-             "RMS p50 [mm] | p95 [mm] | max [mm] | least progress | estimate off > 3 cm |",
-             "|---|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|"]
+             "RMS p50 [mm] | p95 [mm] | max [mm] | progress p5 | least progress | estimate off > 3 cm |",
+             "|---|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|"]
     for g in groups:
         rms = g["rms"]
         pct = np.percentile(rms, [50, 95]) if len(rms) else [math.nan] * 2
         low, high = g["ci"]
-        least = np.nanmin(g["progress"]) if np.isfinite(g["progress"]).any() else math.nan
+        done = g["progress"][np.isfinite(g["progress"])]
+        least, p5 = (done.min(), np.percentile(done, 5)) if len(done) else (math.nan, math.nan)
         lines.append(f"| {g['task']} | {g['controller']} | {g['runs']} | {g['apart']} | {g['stopped']} | "
                      f"{g['success']} / {g['n']} | {100 * g['fraction']:.1f} % | "
                      f"{100 * low:.1f}–{100 * high:.1f} % | {_mm(pct[0])} | {_mm(pct[1])} | "
-                     f"{_mm(rms.max() if len(rms) else math.nan)} | {least:.3f} | {g['estimate_off']} |")
+                     f"{_mm(rms.max() if len(rms) else math.nan)} | {p5:.3f} | {least:.3f} | {g['estimate_off']} |")
     lines += ["", "Why runs are counted apart, and why the others fail (each failure under its first cause: a "
               "stopped run, then an estimate more than "
               f"{1e3 * ESTIMATE_OFF_M:g} mm off, a stall below {100 * spec.coverage:g} % progress, an offset):", "",
@@ -184,11 +185,14 @@ def robustness_figure(table, spec, size=(11.0, 4.0)):
     ecdf.legend(fontsize=7)
     slope.set_xlabel(f"|slope| [fraction of the plant's climbing limit]")
     slope.set_ylabel("second-half cross-track RMS [mm]")
-    bars.set_xticks(range(len(groups)), [f"{g['task']}\n{g['controller']}" for g in groups], fontsize=7)
+    bars.set_xticks(range(len(groups)), [f"{g['task']}\n{g['controller']}\n{g['success']}/{g['n']}"
+                                         for g in groups], fontsize=7)
     bars.axhline(95, color="0.4", ls="--", lw=0.8)
     bars.set_ylabel(f"runs that succeed [%] ({100 * CONFIDENCE:g} % interval)")
     bars.set_ylim(0, 100)
-    fig.suptitle(f"{spec.name}: {len(np.unique(cols['plant']))} plants", fontsize=10)
+    runs = len(cols["sample"])
+    fig.suptitle(f"{spec.name}: {runs} runs on {len(np.unique(cols['plant']))} plants"
+                 + ("" if runs >= spec.samples else f" (unfinished: {spec.samples} runs in all)"), fontsize=10)
     return fig
 
 

@@ -246,3 +246,105 @@ def test_the_line_lqr_holds_a_plant_near_its_torque_limits_by_dropping_the_tight
     row = spec.run_chunk(84, 85)
     assert row["plant"][0] == 84 and row["progress"][0] > 0.9
     assert row["success"][0] == 1 and row["cross_track_rms_m"][0] < 0.028
+
+
+WHOLE = SMALL.replace("samples = 3", "samples = 8").replace('tasks = ["line"]', 'tasks = ["line", "circle"]') \
+    .replace('controllers = ["lqr"]', 'controllers = ["lqr", "lqr-slope"]')
+#: Two one-controller parts of WHOLE: the same plants, its tasks in another order in one of them.
+PARTS = (SMALL.replace("samples = 3", "samples = 4").replace('tasks = ["line"]', 'tasks = ["circle", "line"]')
+         .replace('controllers = ["lqr"]', 'controllers = ["lqr-slope"]'),
+         SMALL.replace("samples = 3", "samples = 4").replace('tasks = ["line"]', 'tasks = ["line", "circle"]'))
+
+
+def _run(tmp_path, name, text):
+    path, out = tmp_path / f"{name}.toml", tmp_path / name
+    path.write_text(text)
+    assert main(["sweep", str(path), "--out", str(out), "--scheduler", "serial", "--no-progress"]) == 0
+    return path, out
+
+
+@pytest.fixture(scope="module")
+def combined(tmp_path_factory):
+    """(the whole sweep's folder, the folder its two parts were combined into, the parts' folders)."""
+    tmp = tmp_path_factory.mktemp("combine")
+    whole_path, whole = _run(tmp, "whole", WHOLE)
+    parts = [_run(tmp, f"part{i}", text)[1] for i, text in enumerate(PARTS)]
+    out = tmp / "combined"
+    assert main(["sweep", str(whole_path), "--out", str(out), "--combine", *map(str, parts)]) == 0
+    return whole, out, parts, whole_path
+
+
+def test_one_controllers_sweeps_combine_into_the_rows_and_summary_of_the_sweep_of_both(combined):
+    import pyarrow as pa
+    from runtime.sweep.robustness import from_identity
+    from runtime.sweep.robustness_summary import summary_text
+    whole, out, _, whole_path = combined
+    rows = pq.read_table(whole / "results.parquet").to_pydict()
+    summary = (whole / "summary.md").read_text()
+    assert "Unfinished" not in (out / "summary.md").read_text()
+    assert (out / "summary.md").read_text().replace(str(out), str(whole)) == summary   # but the --out of its reruns
+    assert (out / "summary.png").stat().st_size > 0
+    # the combined table itself: every row of the whole sweep, renumbered into its samples
+    spec = load_sweep(str(whole_path))
+    assert summary_text(pa.table(rows), spec, f"python -m runtime sweep {whole_path} --out {whole}") + "\n" == summary
+    assert rows["sample"] == list(range(8)) and set(rows["controller"]) == {0, 1} and set(rows["task"]) == {0, 1}
+    assert from_identity(spec.identity(), spec.name, spec.source).identity() == spec.identity()
+
+
+def test_a_combination_missing_runs_is_summarised_as_unfinished(combined, tmp_path):
+    whole, _, parts, whole_path = combined
+    out = tmp_path / "half"
+    assert main(["sweep", str(whole_path), "--out", str(out), "--combine", str(parts[1])]) == 0
+    summary = (out / "summary.md").read_text()
+    assert summary.startswith("Unfinished: 4 of the sweep's 8 runs.")
+    assert "| line | lqr | 2 | 0 | 0 |" in summary and "| line | lqr-slope | 0 | 0 | 0 |" in summary
+
+
+def test_the_figure_names_each_groups_successes_and_runs_and_an_unfinished_sweep(tmp_path):
+    from runtime.sweep.robustness_summary import robustness_figure
+    spec = load_sweep(str(_sweep(tmp_path)))
+    rows = spec.run_chunk(0, 2)
+    rows["success"] = np.array([1, 0], dtype=np.int32)
+    fig = robustness_figure(rows, spec)
+    assert [t.get_text() for t in fig.axes[2].get_xticklabels()] == ["line\nlqr\n1/2"]
+    assert fig.get_suptitle() == "small: 2 runs on 2 plants (unfinished: 3 runs in all)"
+
+
+def test_combining_a_folder_twice_or_a_sweep_of_other_plants_is_refused(combined, tmp_path, capsys):
+    from runtime.sweep.robustness import from_identity, in_sweep
+    _, _, parts, whole_path = combined
+    assert main(["sweep", str(whole_path), "--out", str(tmp_path / "o"), "--combine", str(parts[0]),
+                 str(parts[0])]) == 2
+    assert "is in more than one folder" in capsys.readouterr().err
+    spec = load_sweep(str(whole_path))
+    other = from_identity({"robustness": {**spec.identity()["robustness"], "seed": 8}}, "other", "x")
+    with pytest.raises(ValueError, match="there: its sweep's seed is 8, whole's is 7"):
+        in_sweep({}, other, spec, "there")
+    wider = from_identity({"robustness": {**spec.identity()["robustness"], "controllers": ["nmpc-c"]}}, "o", "x")
+    with pytest.raises(ValueError, match=r"there: its controllers \['nmpc-c'\] are not among"):
+        in_sweep({}, wider, spec, "there")
+
+
+def test_finished_summarises_the_runs_on_disk_of_a_sweep_not_yet_merged(combined, tmp_path, capsys):
+    import shutil
+    _, _, parts, _ = combined
+    folder = tmp_path / "part"
+    shutil.copytree(parts[1], folder)
+    (folder / "results.parquet").unlink()
+    next((folder / "chunks").iterdir()).unlink()      # one chunk of two runs not done yet
+    path = tmp_path / "part.toml"
+    path.write_text(PARTS[1])
+    assert main(["sweep", str(path), "--out", str(folder), "--finished"]) == 0
+    assert (folder / "summary.md").read_text().startswith("Unfinished: 2 of the sweep's 4 runs.")
+
+
+def test_the_summary_gives_the_runs_fifth_percentile_of_progress(tmp_path):
+    from runtime.sweep.robustness_summary import summary_text
+    spec = load_sweep(str(_sweep(tmp_path)))
+    rows = spec.run_chunk(0, 1)
+    n = 21                         # progress 0.00, 0.05, ..., 1.00: the 5th percentile is 0.05
+    many = {name: np.repeat(values, n) for name, values in rows.items()}
+    many["progress"] = np.linspace(0.0, 1.0, n)
+    many["sample"], many["plant"] = np.arange(n), np.arange(n)
+    line = next(l for l in summary_text(many, spec, "cmd").splitlines() if l.startswith("| line | lqr | 21 |"))
+    assert line.split(" | ")[-3:-1] == ["0.050", "0.000"]
