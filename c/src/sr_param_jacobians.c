@@ -570,7 +570,7 @@ int sr_step_param_jacobian_batch(const sr_model *model, int method, long n, cons
 
 /* SR_PARAM_LANES: the states a block takes through RKMK4's stages together (rkmk4_param_lanes), 0
  * for none.  8 where the compiler has vectors of doubles to run the lanes kernels on (x86-64,
- * AArch64), at about 95 KB of stack for the block; 0 elsewhere (a Cortex-M gains nothing from it). */
+ * AArch64), at about 120 KB of stack with its callees; 0 elsewhere (a Cortex-M gains nothing from it). */
 #ifndef SR_PARAM_LANES
 #if defined(__x86_64__) || defined(__aarch64__)
 #define SR_PARAM_LANES 8
