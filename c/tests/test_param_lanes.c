@@ -13,7 +13,7 @@
 #include <math.h>
 #include <string.h>
 
-#define N 37 /* four full blocks of 8 and a short one; an odd count for the vector loops' tails */
+#define N 21 /* two full blocks of 8 and a short one; an odd count for the vector loops' tails */
 #define NROBOTS 3
 #define NCOLS 6
 
@@ -54,6 +54,12 @@ typedef struct {
     sr_real M[N][15], f[N][SR_NV], df[N][SR_NV * SR_NE], dfdu[N][SR_NV * SR_NU], dM[N][75], Y[N][SR_NV * SR_NPI];
 } kernel_rows;
 
+/* One workspace for all the tests (they run one after the other): the Cortex-M targets' RAM. */
+static struct {
+    sr_real x[N][SR_NX], u[N][SR_NU], a[N][SR_NV], next[N][SR_NX], Jp[N][SR_NE * NCOLS], ref[N][SR_NE * NCOLS];
+    kernel_rows out;
+} ws;
+
 static void lanes_rows(const sr_model *m, sr_real x[N][SR_NX], sr_real u[N][SR_NU], sr_real a[N][SR_NV],
                        kernel_rows *out)
 {
@@ -70,49 +76,55 @@ static void lanes_rows(const sr_model *m, sr_real x[N][SR_NX], sr_real u[N][SR_N
 static int equal_to_scalar_kernels(const sr_model *m, sr_real x[N][SR_NX], sr_real u[N][SR_NU],
                                    sr_real a[N][SR_NV], const kernel_rows *out)
 {
-    static kernel_rows one;
+    sr_real M[15], f[SR_NV], df[SR_NV * SR_NE], dfdu[SR_NV * SR_NU], dM[75], Y[SR_NV * SR_NPI];
     int i;
     for (i = 0; i < N; ++i) {
-        if (sr_gen_general_accel_jacobian_terms(m->cg, x[i], u[i], one.M[i], one.f[i], one.df[i], one.dfdu[i],
-                                                one.dM[i]) != SR_GEN_OK
-            || sr_gen_regressor(m->p, x[i], a[i], one.Y[i]) != SR_GEN_OK)
+        if (sr_gen_general_accel_jacobian_terms(m->cg, x[i], u[i], M, f, df, dfdu, dM) != SR_GEN_OK
+            || sr_gen_regressor(m->p, x[i], a[i], Y) != SR_GEN_OK)
+            return 0;
+        if (memcmp(M, out->M[i], sizeof M) || memcmp(f, out->f[i], sizeof f) || memcmp(df, out->df[i], sizeof df)
+            || memcmp(dfdu, out->dfdu[i], sizeof dfdu) || memcmp(dM, out->dM[i], sizeof dM) || memcmp(Y, out->Y[i], sizeof Y))
             return 0;
     }
-    return memcmp(&one, out, sizeof one) == 0;
+    return 1;
 }
 
 static void test_lanes_kernels_equal_the_scalar_kernels_bit_for_bit(void)
 {
-    static sr_real x[N][SR_NX], u[N][SR_NU], a[N][SR_NV];
-    static kernel_rows out;
+    sr_real(*x)[SR_NX] = ws.x;
+    sr_real(*u)[SR_NU] = ws.u;
+    sr_real(*a)[SR_NV] = ws.a;
+    kernel_rows *out = &ws.out;
     test_rng rng = {29};
     sr_model m;
     int r;
     for (r = 0; r < NROBOTS; ++r) {
         random_robot(&rng, &m);
         random_rows(&rng, &m, x, u, a);
-        lanes_rows(&m, x, u, a, &out);
-        CHECK(equal_to_scalar_kernels(&m, x, u, a, &out));
+        lanes_rows(&m, x, u, a, out);
+        CHECK(equal_to_scalar_kernels(&m, x, u, a, out));
     }
 }
 
 /* The comparison above sees a one-ulp change of one output of one lane, in each kernel. */
 static void test_kernel_comparison_sees_one_ulp_of_one_lane(void)
 {
-    static sr_real x[N][SR_NX], u[N][SR_NU], a[N][SR_NV];
-    static kernel_rows out;
+    sr_real(*x)[SR_NX] = ws.x;
+    sr_real(*u)[SR_NU] = ws.u;
+    sr_real(*a)[SR_NV] = ws.a;
+    kernel_rows *out = &ws.out;
     test_rng rng = {31};
     sr_model m;
     random_robot(&rng, &m);
     random_rows(&rng, &m, x, u, a);
-    lanes_rows(&m, x, u, a, &out);
-    CHECK(equal_to_scalar_kernels(&m, x, u, a, &out));
-    out.dM[N - 1][40] = next_up(out.dM[N - 1][40]);
-    CHECK(!equal_to_scalar_kernels(&m, x, u, a, &out));
-    out.dM[N - 1][40] = -next_up(-out.dM[N - 1][40]);   /* back down one ulp */
-    CHECK(equal_to_scalar_kernels(&m, x, u, a, &out));
-    out.Y[3][SR_NPI + 2] = next_up(out.Y[3][SR_NPI + 2]);
-    CHECK(!equal_to_scalar_kernels(&m, x, u, a, &out));
+    lanes_rows(&m, x, u, a, out);
+    CHECK(equal_to_scalar_kernels(&m, x, u, a, out));
+    out->dM[N - 1][40] = next_up(out->dM[N - 1][40]);
+    CHECK(!equal_to_scalar_kernels(&m, x, u, a, out));
+    out->dM[N - 1][40] = -next_up(-out->dM[N - 1][40]);   /* back down one ulp */
+    CHECK(equal_to_scalar_kernels(&m, x, u, a, out));
+    out->Y[3][SR_NPI + 2] = next_up(out->Y[3][SR_NPI + 2]);
+    CHECK(!equal_to_scalar_kernels(&m, x, u, a, out));
 }
 
 /* A fit's free entries, r among them (its column carries the rolling kinematics too). */
@@ -140,16 +152,22 @@ static double relative_difference(const sr_real *a, const sr_real *b, long n)
  * sr_step_jacobian_param_cols_batch (the stages one state at a time, the state columns beside). */
 static void state_by_state(const sr_model *m, sr_real x[N][SR_NX], sr_real u[N][SR_NU], sr_real Jp[N][SR_NE * NCOLS])
 {
-    static sr_real F[N][SR_NE * SR_NE];
-    CHECK_STATUS(sr_step_jacobian_param_cols_batch(m, SR_RKMK4, N, x[0], u[0], SR_C(0.01), NCOLS, COLS, F[0], Jp[0],
-                                                   NULL),
-                 SR_OK);
+    sr_real F[SR_NE * SR_NE];
+    int i;
+    for (i = 0; i < N; ++i)
+        CHECK_STATUS(sr_step_jacobian_param_cols_batch(m, SR_RKMK4, 1, x[i], u[i], SR_C(0.01), NCOLS, COLS, F, Jp[i], NULL),
+                     SR_OK);
 }
 
 static void test_lockstep_sensitivity_equals_the_state_by_state_path(void)
 {
-    static sr_real x[N][SR_NX], u[N][SR_NU], a[N][SR_NV], next[N][SR_NX], Jp[N][SR_NE * NCOLS], ref[N][SR_NE * NCOLS];
-    static sr_real one_next[SR_NX];
+    sr_real(*x)[SR_NX] = ws.x;
+    sr_real(*u)[SR_NU] = ws.u;
+    sr_real(*a)[SR_NV] = ws.a;
+    sr_real(*next)[SR_NX] = ws.next;
+    sr_real(*Jp)[SR_NE * NCOLS] = ws.Jp;
+    sr_real(*ref)[SR_NE * NCOLS] = ws.ref;
+    sr_real one_next[SR_NX];
     test_rng rng = {37};
     sr_model m;
     long row = 5;
@@ -171,7 +189,12 @@ static void test_lockstep_sensitivity_equals_the_state_by_state_path(void)
 /* The comparison above sees a change of 1e-12 of one entry of one state's sensitivity. */
 static void test_sensitivity_comparison_sees_a_perturbed_state(void)
 {
-    static sr_real x[N][SR_NX], u[N][SR_NU], a[N][SR_NV], next[N][SR_NX], Jp[N][SR_NE * NCOLS], ref[N][SR_NE * NCOLS];
+    sr_real(*x)[SR_NX] = ws.x;
+    sr_real(*u)[SR_NU] = ws.u;
+    sr_real(*a)[SR_NV] = ws.a;
+    sr_real(*next)[SR_NX] = ws.next;
+    sr_real(*Jp)[SR_NE * NCOLS] = ws.Jp;
+    sr_real(*ref)[SR_NE * NCOLS] = ws.ref;
     test_rng rng = {41};
     sr_model m;
     random_robot(&rng, &m);
@@ -189,7 +212,12 @@ static void test_sensitivity_comparison_sees_a_perturbed_state(void)
  * row with its status, and the rows before it, in its block too, are written as the others. */
 static void test_a_bad_row_in_a_block_is_reported_at_its_row(void)
 {
-    static sr_real x[N][SR_NX], u[N][SR_NU], a[N][SR_NV], next[N][SR_NX], Jp[N][SR_NE * NCOLS], ref[N][SR_NE * NCOLS];
+    sr_real(*x)[SR_NX] = ws.x;
+    sr_real(*u)[SR_NU] = ws.u;
+    sr_real(*a)[SR_NV] = ws.a;
+    sr_real(*next)[SR_NX] = ws.next;
+    sr_real(*Jp)[SR_NE * NCOLS] = ws.Jp;
+    sr_real(*ref)[SR_NE * NCOLS] = ws.ref;
     test_rng rng = {43};
     sr_model m;
     long row = 0;
