@@ -91,40 +91,32 @@ static int equal_to_scalar_kernels(const sr_model *m, sr_real x[N][SR_NX], sr_re
 
 static void test_lanes_kernels_equal_the_scalar_kernels_bit_for_bit(void)
 {
-    sr_real(*x)[SR_NX] = ws.x;
-    sr_real(*u)[SR_NU] = ws.u;
-    sr_real(*a)[SR_NV] = ws.a;
-    kernel_rows *out = &ws.out;
     test_rng rng = {29};
     sr_model m;
     int r;
     for (r = 0; r < NROBOTS; ++r) {
         random_robot(&rng, &m);
-        random_rows(&rng, &m, x, u, a);
-        lanes_rows(&m, x, u, a, out);
-        CHECK(equal_to_scalar_kernels(&m, x, u, a, out));
+        random_rows(&rng, &m, ws.x, ws.u, ws.a);
+        lanes_rows(&m, ws.x, ws.u, ws.a, &ws.out);
+        CHECK(equal_to_scalar_kernels(&m, ws.x, ws.u, ws.a, &ws.out));
     }
 }
 
 /* The comparison above sees a one-ulp change of one output of one lane, in each kernel. */
 static void test_kernel_comparison_sees_one_ulp_of_one_lane(void)
 {
-    sr_real(*x)[SR_NX] = ws.x;
-    sr_real(*u)[SR_NU] = ws.u;
-    sr_real(*a)[SR_NV] = ws.a;
-    kernel_rows *out = &ws.out;
     test_rng rng = {31};
     sr_model m;
     random_robot(&rng, &m);
-    random_rows(&rng, &m, x, u, a);
-    lanes_rows(&m, x, u, a, out);
-    CHECK(equal_to_scalar_kernels(&m, x, u, a, out));
-    out->dM[N - 1][40] = next_up(out->dM[N - 1][40]);
-    CHECK(!equal_to_scalar_kernels(&m, x, u, a, out));
-    out->dM[N - 1][40] = -next_up(-out->dM[N - 1][40]);   /* back down one ulp */
-    CHECK(equal_to_scalar_kernels(&m, x, u, a, out));
-    out->Y[3][SR_NPI + 2] = next_up(out->Y[3][SR_NPI + 2]);
-    CHECK(!equal_to_scalar_kernels(&m, x, u, a, out));
+    random_rows(&rng, &m, ws.x, ws.u, ws.a);
+    lanes_rows(&m, ws.x, ws.u, ws.a, &ws.out);
+    CHECK(equal_to_scalar_kernels(&m, ws.x, ws.u, ws.a, &ws.out));
+    ws.out.dM[N - 1][40] = next_up(ws.out.dM[N - 1][40]);
+    CHECK(!equal_to_scalar_kernels(&m, ws.x, ws.u, ws.a, &ws.out));
+    ws.out.dM[N - 1][40] = -next_up(-ws.out.dM[N - 1][40]);   /* back down one ulp */
+    CHECK(equal_to_scalar_kernels(&m, ws.x, ws.u, ws.a, &ws.out));
+    ws.out.Y[3][SR_NPI + 2] = next_up(ws.out.Y[3][SR_NPI + 2]);
+    CHECK(!equal_to_scalar_kernels(&m, ws.x, ws.u, ws.a, &ws.out));
 }
 
 /* A fit's free entries, r among them (its column carries the rolling kinematics too). */
@@ -159,77 +151,68 @@ static void state_by_state(const sr_model *m, sr_real x[N][SR_NX], sr_real u[N][
                      SR_OK);
 }
 
+/* The sensitivity on COLS of the workspace's N states in one batch call, into ws.next and ws.Jp. */
+static int batch(const sr_model *m, long *row)
+{
+    return sr_step_and_param_jacobian_cols_batch(m, SR_RKMK4, N, ws.x[0], ws.u[0], SR_C(0.01), NCOLS, COLS, ws.next[0],
+                                                 ws.Jp[0], row);
+}
+
+/* How far the first rows of the batch's sensitivity are from the state-by-state path's. */
+static double batch_error(long rows)
+{
+    return relative_difference(ws.Jp[0], ws.ref[0], rows * SR_NE * NCOLS);
+}
+
+/* A random robot, N random states and the state-by-state path's sensitivity at them (ws.ref). */
+static void new_case(test_rng *rng, sr_model *m)
+{
+    random_robot(rng, m);
+    random_rows(rng, m, ws.x, ws.u, ws.a);
+    state_by_state(m, ws.x, ws.u, ws.ref);
+}
+
+#define SENSITIVITY_TOL (TEST_EPS > 1e-10 ? 1e-5 : 1e-13)
+
 static void test_lockstep_sensitivity_equals_the_state_by_state_path(void)
 {
-    sr_real(*x)[SR_NX] = ws.x;
-    sr_real(*u)[SR_NU] = ws.u;
-    sr_real(*a)[SR_NV] = ws.a;
-    sr_real(*next)[SR_NX] = ws.next;
-    sr_real(*Jp)[SR_NE * NCOLS] = ws.Jp;
-    sr_real(*ref)[SR_NE * NCOLS] = ws.ref;
     sr_real one_next[SR_NX];
     test_rng rng = {37};
     sr_model m;
     long row = 5;
     int r;
     for (r = 0; r < NROBOTS; ++r) {
-        random_robot(&rng, &m);
-        random_rows(&rng, &m, x, u, a);
-        CHECK_STATUS(sr_step_and_param_jacobian_cols_batch(&m, SR_RKMK4, N, x[0], u[0], SR_C(0.01), NCOLS, COLS,
-                                                           next[0], Jp[0], &row),
-                     SR_OK);
-        CHECK(row == -1);
-        state_by_state(&m, x, u, ref);
-        CHECK(relative_difference(Jp[0], ref[0], (long)N * SR_NE * NCOLS) <= (TEST_EPS > 1e-10 ? 1e-5 : 1e-13));
-        CHECK_STATUS(sr_step(&m, SR_RKMK4, x[N - 1], u[N - 1], SR_C(0.01), one_next), SR_OK);
-        CHECK(relative_difference(next[N - 1], one_next, SR_NX) <= (TEST_EPS > 1e-10 ? 1e-5 : 1e-12));
+        new_case(&rng, &m);
+        CHECK_STATUS(batch(&m, &row), SR_OK);
+        CHECK(row == -1 && batch_error(N) <= SENSITIVITY_TOL);
+        CHECK_STATUS(sr_step(&m, SR_RKMK4, ws.x[N - 1], ws.u[N - 1], SR_C(0.01), one_next), SR_OK);
+        CHECK(relative_difference(ws.next[N - 1], one_next, SR_NX) <= (TEST_EPS > 1e-10 ? 1e-5 : 1e-12));
     }
 }
 
 /* The comparison above sees a change of 1e-12 of one entry of one state's sensitivity. */
 static void test_sensitivity_comparison_sees_a_perturbed_state(void)
 {
-    sr_real(*x)[SR_NX] = ws.x;
-    sr_real(*u)[SR_NU] = ws.u;
-    sr_real(*a)[SR_NV] = ws.a;
-    sr_real(*next)[SR_NX] = ws.next;
-    sr_real(*Jp)[SR_NE * NCOLS] = ws.Jp;
-    sr_real(*ref)[SR_NE * NCOLS] = ws.ref;
     test_rng rng = {41};
     sr_model m;
-    random_robot(&rng, &m);
-    random_rows(&rng, &m, x, u, a);
-    CHECK_STATUS(sr_step_and_param_jacobian_cols_batch(&m, SR_RKMK4, N, x[0], u[0], SR_C(0.01), NCOLS, COLS, next[0],
-                                                       Jp[0], NULL),
-                 SR_OK);
-    state_by_state(&m, x, u, ref);
-    CHECK(relative_difference(Jp[0], ref[0], (long)N * SR_NE * NCOLS) <= (TEST_EPS > 1e-10 ? 1e-5 : 1e-13));
-    Jp[N / 2][SR_NE * NCOLS / 2] += (sr_real)((TEST_EPS > 1e-10 ? 1e-4 : 1e-12) * largest(ref[0], (long)N * SR_NE * NCOLS));
-    CHECK(relative_difference(Jp[0], ref[0], (long)N * SR_NE * NCOLS) > (TEST_EPS > 1e-10 ? 1e-5 : 1e-13));
+    new_case(&rng, &m);
+    CHECK_STATUS(batch(&m, NULL), SR_OK);
+    CHECK(batch_error(N) <= SENSITIVITY_TOL);
+    ws.Jp[N / 2][SR_NE * NCOLS / 2] += (sr_real)((TEST_EPS > 1e-10 ? 1e-4 : 1e-12) * largest(ws.ref[0], (long)N * SR_NE * NCOLS));
+    CHECK(batch_error(N) > SENSITIVITY_TOL);
 }
 
 /* A state the lanes cannot take (a non-finite torque in the middle of a block) is reported at its
  * row with its status, and the rows before it, in its block too, are written as the others. */
 static void test_a_bad_row_in_a_block_is_reported_at_its_row(void)
 {
-    sr_real(*x)[SR_NX] = ws.x;
-    sr_real(*u)[SR_NU] = ws.u;
-    sr_real(*a)[SR_NV] = ws.a;
-    sr_real(*next)[SR_NX] = ws.next;
-    sr_real(*Jp)[SR_NE * NCOLS] = ws.Jp;
-    sr_real(*ref)[SR_NE * NCOLS] = ws.ref;
     test_rng rng = {43};
     sr_model m;
     long row = 0;
-    random_robot(&rng, &m);
-    random_rows(&rng, &m, x, u, a);
-    state_by_state(&m, x, u, ref);
-    u[19][1] = (sr_real)NAN;
-    CHECK_STATUS(sr_step_and_param_jacobian_cols_batch(&m, SR_RKMK4, N, x[0], u[0], SR_C(0.01), NCOLS, COLS, next[0],
-                                                       Jp[0], &row),
-                 SR_ERR_NONFINITE);
-    CHECK(row == 19);
-    CHECK(relative_difference(Jp[0], ref[0], 19L * SR_NE * NCOLS) <= (TEST_EPS > 1e-10 ? 1e-5 : 1e-13));
+    new_case(&rng, &m);
+    ws.u[19][1] = (sr_real)NAN;
+    CHECK_STATUS(batch(&m, &row), SR_ERR_NONFINITE);
+    CHECK(row == 19 && batch_error(19) <= SENSITIVITY_TOL);
 }
 
 void suite_param_lanes(void)
