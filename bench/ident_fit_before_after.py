@@ -2,9 +2,11 @@
 seed 0, both parameter sets, analytic and "fd" Jacobians) with the Python package as it is and as
 it was at a git revision, in turns in separate processes at the same load, `--rounds` times; each
 keeps its best time.  The compiled library is the working tree's for both (the revision's Python
-runs on it), so this measures changes to the fit's Python only.
+runs on it), so this measures changes to the fit's Python only; with --with-c the revision's C
+(generated/, c/, bindings/) is built too (setup.py build_ext --inplace, a few minutes) and its
+Python runs on its own library: changes to both.
 
-    .venv/bin/python bench/ident_fit_before_after.py --baseline REV [--rounds N] [--out DIR]
+    .venv/bin/python bench/ident_fit_before_after.py --baseline REV [--with-c] [--rounds N] [--out DIR]
 
 The result is kept, with the date, the CPU and the load, as fit-before-after-<date and time>.json in
 --out (bench/results/identify).
@@ -57,18 +59,24 @@ def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--baseline", required=True, help="the git revision of the 'before' Python package")
     parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--name", help="the result's file name without .json (default: with the date and time)")
+    parser.add_argument("--with-c", action="store_true", help="build and use the revision's compiled library too")
     parser.add_argument("--out", type=pathlib.Path, default=ROOT / "bench" / "results" / "identify")
     args = parser.parse_args(argv)
     best = {"before": {}, "after": {}}
     estimates = {"before": {}, "after": {}}
     load = [os.getloadavg()]
     with tempfile.TemporaryDirectory() as tmp:
-        archive = subprocess.run(["git", "archive", args.baseline, "runtime"], cwd=ROOT, check=True,
+        trees = ["runtime"] + (["bindings", "c", "generated", "setup.py", "pyproject.toml"] if args.with_c else [])
+        archive = subprocess.run(["git", "archive", args.baseline, *trees], cwd=ROOT, check=True,
                                  capture_output=True).stdout
         old = pathlib.Path(tmp) / "before"
         old.mkdir()
         with tarfile.open(fileobj=__import__("io").BytesIO(archive)) as tar:
             tar.extractall(old)
+        if args.with_c:
+            subprocess.run([sys.executable, "setup.py", "-q", "build_ext", "--inplace"], cwd=old, check=True,
+                           capture_output=True)
         for _ in range(args.rounds):
             for version, path in (("before", old), ("after", ROOT)):
                 for key, (cpu, estimate, nfev) in run(path, DEFAULT_PARAMS).items():
@@ -90,9 +98,9 @@ def main(argv):
               f"{row['after']['analytic_cpu_s']:.3f} s / {row['after']['fd_cpu_s']:.3f} s "
               f"({row['after']['speedup_cpu']:.2f}x)")
     date = datetime.datetime.now().isoformat(timespec="seconds")
-    record = {"date": date, "cpu": cpu_name(), "baseline": args.baseline, "rounds": args.rounds,
+    record = {"date": date, "cpu": cpu_name(), "baseline": args.baseline, "baseline_c": args.with_c, "rounds": args.rounds,
               "load_start_end": load, "what": __doc__.split("\n\n")[0].replace("\n", " "), "fits": rows}
-    print("written:", write_new_file(args.out, "fit-before-after-" + date.replace(":", "-"), ".json",
+    print("written:", write_new_file(args.out, args.name or "fit-before-after-" + date.replace(":", "-"), ".json",
                                      json.dumps(record, indent=1) + "\n"))
     return 0
 

@@ -12,7 +12,8 @@ need more than 10, and at the default the loop stays scalar; one output array wi
 outputs per state does not vectorise either); and the expressions of the parameters alone (the
 regressor's sin and cos of the slope) are computed once before the loop (a call in the loop keeps
 it scalar).  Nothing here is written to generated/: a measurement, for the
-decision whether the generator and the sensitivity path should take this form.
+decision whether the generator and the sensitivity path should take this form.  (They took it: the generator
+now emits sr_gen_*_lanes with the same hoisting, `emit.hoisted`, which this script uses.)
 
     .venv/bin/python bench/ident_lanes_projection.py [--out DIR]
 
@@ -39,23 +40,6 @@ from runtime.atomic import write_new_file  # noqa: E402
 from runtime.bench.timing import cpu_name  # noqa: E402
 
 KERNELS = ("general_accel_jacobian_terms", "regressor")
-ASSIGNMENT = re.compile(r"^\s*const sr_real (\w+) = (.*);$")
-NAME = re.compile(r"\b[A-Za-z_]\w*\b")
-
-
-def hoisted(body, once):
-    """(before the loop, in the loop): the body's assignments that read only `once` names (and
-    those before them), moved out; every other line kept in order."""
-    known, before, inside = set(once), [], []
-    for line in body:
-        m = ASSIGNMENT.match(line)
-        names = set(NAME.findall(m.group(2))) - {"SR_C"} if m else None
-        if m and all(n in known or n.startswith("SR_GEN_") for n in names):
-            known.add(m.group(1))
-            before.append(line)
-        else:
-            inside.append(line)
-    return before, inside
 
 
 def lanes_text(kernel, layouts):
@@ -68,7 +52,7 @@ def lanes_text(kernel, layouts):
     entries = E.input_entries(kernel, used, layouts)
     once = [f"    const sr_real {s.name} = {a}[{i}];" for s, a, i in entries if a not in per_lane]
     each = [f"    const sr_real {s.name} = {a}[{per_lane[a]} + {i}];" for s, a, i in entries if a in per_lane]
-    before, inside = hoisted(body, [s.name for s, a, _ in entries if a not in per_lane])
+    before, inside = E.hoisted(body, [s.name for s, a, _ in entries if a not in per_lane])
     args = [E.INPUT_DOCS[kernel.inputs[0]][0], "long n"]
     args += [f"const sr_real *restrict {a}, long {a}_stride" for a in kernel.inputs[1:]]
     args += [f"sr_real *restrict {o.name}, long {o.name}_stride" for o in kernel.outputs]

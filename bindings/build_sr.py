@@ -127,6 +127,14 @@ static int sr_py_inertia_batch(const sr_model *model, long n, const double *x, d
 # runs only if it is built with the same flag).
 NATIVE = ["-march=native"] if os.environ.get("SR_NATIVE") == "1" else []
 
+#: GCC's limit of run-time alias tests per vectorised loop (--param vect-max-version-for-alias-checks),
+#: raised for the lanes kernels; other compilers have no such parameter (clang warns on it).
+VECT_ALIAS_CHECKS = (["--param=vect-max-version-for-alias-checks=100"]
+                     if "Free Software Foundation" in subprocess.run([*compiler(), "--version"], capture_output=True,
+                                                                     text=True).stdout else [])
+
+COMPILE_ARGS = ["-std=c99", "-O3", "-ffp-contract=off", "-DSR_CLONES", *VECT_ALIAS_CHECKS, *NATIVE]
+
 ffibuilder = cffi.FFI()
 ffibuilder.cdef(CDEF + PY_ENTRIES_CDEF)
 ffibuilder.set_source(
@@ -138,7 +146,9 @@ ffibuilder.set_source(
     # -O3: GCC vectorises the batch calls' lanes loops (sr_gen_accel_lanes) only with its full cost
     # model; without -ffast-math it changes no result (tests/bindings: batch == single, bit for bit).
     # -DSR_CLONES: the batch loops also for AVX2, picked at load time (c/include/sr_real.h, SR_LANES_CLONES).
-    extra_compile_args=["-std=c99", "-O3", "-ffp-contract=off", "-DSR_CLONES", *NATIVE],
+    # The alias checks: the lanes kernels of several output arrays (sr_gen_general_accel_jacobian_terms_lanes,
+    # five) need more run-time alias tests than GCC 12 makes by default (10); below that their loop stays scalar.
+    extra_compile_args=COMPILE_ARGS,
 )
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 19c6a7b61f2be7e1], SymPy 1.14.0. */
+/* GENERATED FILE, DO NOT EDIT: written by `make generate` (python -m derive) from the derive/ package [sha256 of its sources 51effb25c19c215e], SymPy 1.14.0. */
 /*
  * Symbolic kernels of the spherical-robot model (Fiori 2024), derived in derive/.
  * Internal to the library: use the checked API of c/include/spherical_robot.h.
@@ -257,6 +257,8 @@
 #define sr_gen_contact_force sr_gen_contact_force_f
 #define sr_gen_general_contact_force sr_gen_general_contact_force_f
 #define sr_gen_accel_lanes sr_gen_accel_lanes_f
+#define sr_gen_general_accel_jacobian_terms_lanes sr_gen_general_accel_jacobian_terms_lanes_f
+#define sr_gen_regressor_lanes sr_gen_regressor_lanes_f
 #endif
 
 /* Derived constants of Section 2.3 from the twelve parameters, c[0..11] = (r, l, g, m_P, m_R, j_S, j_xx, j_yy, j_P, k_S, k_Y, k_P), then the parameter-only subexpressions of the kernels, computed once per model:
@@ -428,5 +430,9 @@ int sr_gen_contact_force(const sr_real c[SR_GEN_NCONST], const sr_real x[SR_GEN_
 int sr_gen_general_contact_force(const sr_real cg[SR_GEN_GENERAL_NCONST], const sr_real x[SR_GEN_NX], const sr_real nud[SR_GEN_NV], sr_real F[3]);
 /* sr_gen_accel on n states, for the batch calls: one loop without branches that the compiler vectorises across states (the same expressions, so each lane's result is the scalar kernel's, bit for bit); every output is written, and ok[i] is cleared where the scalar kernel would fail (or its outputs' sum overflows: decide such a state by the scalar kernel). GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic), for AVX2 too (SR_LANES_CLONES). */
 void sr_gen_accel_lanes(const sr_real c[SR_GEN_NCONST], long n, const sr_real *restrict x, long x_stride, const sr_real *restrict u, long u_stride, sr_real *restrict a, long a_stride, sr_real *restrict ok);
+/* sr_gen_general_accel_jacobian_terms on n states, for the batch calls: one loop without branches that the compiler vectorises across states (the same expressions, so each lane's result is the scalar kernel's, bit for bit); every output is written, and ok[i] is cleared where the scalar kernel would fail (or its outputs' sum overflows: decide such a state by the scalar kernel). GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic), for AVX2 too (SR_LANES_CLONES), with more run-time alias tests of its output arrays than GCC 12 makes by default (--param vect-max-version-for-alias-checks=100, in the builds). */
+void sr_gen_general_accel_jacobian_terms_lanes(const sr_real cg[SR_GEN_GENERAL_NCONST], long n, const sr_real *restrict x, long x_stride, const sr_real *restrict u, long u_stride, sr_real *restrict M, long M_stride, sr_real *restrict f, long f_stride, sr_real *restrict df, long df_stride, sr_real *restrict dfdu, long dfdu_stride, sr_real *restrict dM, long dM_stride, sr_real *restrict ok);
+/* sr_gen_regressor on n states, for the batch calls: one loop without branches that the compiler vectorises across states (the same expressions, so each lane's result is the scalar kernel's, bit for bit); every output is written, and ok[i] is cleared where the scalar kernel would fail (or its outputs' sum overflows: decide such a state by the scalar kernel). GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic), for AVX2 too (SR_LANES_CLONES). */
+void sr_gen_regressor_lanes(const sr_real p[SR_GEN_NPARAM], long n, const sr_real *restrict x, long x_stride, const sr_real *restrict nud, long nud_stride, sr_real *restrict Y, long Y_stride, sr_real *restrict ok);
 
 #endif /* SR_GENERATED_H */

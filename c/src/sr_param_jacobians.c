@@ -19,6 +19,11 @@
  * the same stages (the directions of the start state's error, which the actions move by A(th) as
  * well): asked for with the parameter columns at the same states, it shares each stage's
  * derivative kernel, factorisation and solve with them instead of running its own stages.
+ *
+ * A batch of RKMK4 sensitivities of a general robot on free columns (a fit's) runs blocks of
+ * states through the stages in lockstep (rkmk4_param_lanes): each stage's two generated kernels in
+ * their lanes forms, vectorised across the block, everything else state by state in the same order
+ * as one state's path, so each state's result is that path's.
  */
 #include "sr_checks.h"
 #include "sr_dexpinv.h"
@@ -178,23 +183,30 @@ static const sr_real *general_constants(const sr_model *model, sr_real cg[SR_GEN
  * Y(x, nu') pi - B u with B of the gear ratios only, so the bracket is Y d(pi)/dp, and Y (about half
  * the bracket's operations, SR_GEN_REGRESSOR_FLOPS) serves any number of columns at a few products
  * each; otherwise the generated bracket, its chosen columns moved into place. */
+/* -d(M nu' - f)/d(d, p) = -Y d(pi)/dp on the columns cs (every one moving pi alone), Y the regressor. */
+static void regressor_columns(const colset *cs, const sr_real Y[SR_NV * SR_NPI], sr_real D[SR_NV][NW])
+{
+    int i, c, e;
+    for (i = 0; i < SR_NV; ++i) {
+        for (c = 0; c < cs->ns; ++c) D[i][c] = 0;
+        for (c = cs->ns; c < cs->n; ++c) {
+            const pi_column *d = cs->pi + (c - cs->ns);
+            sr_real t = 0;
+            for (e = 0; e < d->n; ++e) t += Y[SR_NPI * i + d->k[e]] * d->v[e];
+            D[i][c] = -t;
+        }
+    }
+}
+
 static int residual_columns(const sr_model *model, const colset *cs, const sr_real x[SR_NX], const sr_real a[SR_NV],
                             sr_real D[SR_NV][NW])
 {
     sr_real all[SR_NV * NP];
-    int i, c, e, status;
+    int i, c, status;
     if (cs->pi) {
         sr_real Y[SR_NV * SR_NPI];
         status = sr_gen_regressor(model->p, x, a, Y);
-        for (i = 0; i < SR_NV && status == SR_OK; ++i) {
-            for (c = 0; c < cs->ns; ++c) D[i][c] = 0;
-            for (c = cs->ns; c < cs->n; ++c) {
-                const pi_column *d = cs->pi + (c - cs->ns);
-                sr_real t = 0;
-                for (e = 0; e < d->n; ++e) t += Y[SR_NPI * i + d->k[e]] * d->v[e];
-                D[i][c] = -t;
-            }
-        }
+        if (status == SR_OK) regressor_columns(cs, Y, D);
         return status;
     }
     status = sr_gen_general_param_residual_jacobian(model->p, x, a, all);
@@ -205,18 +217,11 @@ static int residual_columns(const sr_model *model, const colset *cs, const sr_re
     return status;
 }
 
-/* A general robot's stage: nu' = a and its whole derivative along the stage's dy on the columns
- * cs, D = Ja dy + d(nu')/dp = M^-1 ((df - (dM) a) dy - d(M nu' - f)/dp), from one kernel for M, f
- * and their state derivatives and one factorisation: Ja itself is never formed, and the solve runs
- * on the few columns only. */
-static int general_stage_rows(const sr_model *model, const colset *cs, const sr_real y[SR_NX],
-                              const sr_real u[SR_NU], const error_p dy, sr_real a[SR_NV], sr_real D[SR_NV][NW])
+/* A general stage's a = M^-1 f from the kernel's M (upper triangle) and f; L, inv its factor. */
+static int stage_accel(const sr_real Mu[15], const sr_real f[SR_NV], sr_real L[SR_NV * SR_NV], sr_real inv[SR_NV],
+                       sr_real a[SR_NV])
 {
-    sr_real Mu[15], f[SR_NV], df[SR_NV * SR_NE], dfdu[SR_NV * SR_NU], dM[5 * 15], L[SR_NV * SR_NV], inv[SR_NV];
-    sr_real g[SR_NV][SR_NE];
-    const int nc = cs->n;
-    int i, j, k, c, status = sr_internal_general_accel_jacobian_terms(model, y, u, Mu, f, df, dfdu, dM);
-    if (status == SR_OK) status = sr_internal_cholesky(Mu, L, inv);
+    int i, k, status = sr_internal_cholesky(Mu, L, inv);
     if (status != SR_OK) return status;
     for (i = 0; i < SR_NV; ++i) {   /* a = M^-1 f */
         sr_real t = f[i];
@@ -228,8 +233,17 @@ static int general_stage_rows(const sr_model *model, const colset *cs, const sr_
         for (k = i + 1; k < SR_NV; ++k) t -= L[SR_NV * k + i] * a[k];
         a[i] = t * inv[i];
     }
-    status = residual_columns(model, cs, y, a, D);
-    if (status != SR_OK) return status;
+    return SR_OK;
+}
+
+/* A general stage's D = M^-1 ((df - (dM) a) dy + D) on the columns cs, D holding -d(M nu' - f)/dp. */
+static void stage_columns(const colset *cs, const sr_real df[SR_NV * SR_NE], const sr_real dM[5 * 15],
+                          const sr_real L[SR_NV * SR_NV], const sr_real inv[SR_NV], const sr_real a[SR_NV],
+                          const error_p dy, sr_real D[SR_NV][NW])
+{
+    sr_real g[SR_NV][SR_NE];
+    const int nc = cs->n;
+    int i, j, k, c;
     for (i = 0; i < SR_NV; ++i) {
         for (k = 0; k < SR_NE; ++k) g[i][k] = df[SR_NE * i + k];
         for (k = 0; k < 5; ++k)   /* the configuration directions d_xi_S, d_th_Y, d_th_P move M */
@@ -241,6 +255,21 @@ static int general_stage_rows(const sr_model *model, const colset *cs, const sr_
         }
     }
     sr_internal_cholesky_solve(L, inv, NW, nc, &D[0][0]);
+}
+
+/* A general robot's stage: nu' = a and its whole derivative along the stage's dy on the columns
+ * cs, D = Ja dy + d(nu')/dp = M^-1 ((df - (dM) a) dy - d(M nu' - f)/dp), from one kernel for M, f
+ * and their state derivatives and one factorisation: Ja itself is never formed, and the solve runs
+ * on the few columns only. */
+static int general_stage_rows(const sr_model *model, const colset *cs, const sr_real y[SR_NX],
+                              const sr_real u[SR_NU], const error_p dy, sr_real a[SR_NV], sr_real D[SR_NV][NW])
+{
+    sr_real Mu[15], f[SR_NV], df[SR_NV * SR_NE], dfdu[SR_NV * SR_NU], dM[5 * 15], L[SR_NV * SR_NV], inv[SR_NV];
+    int status = sr_internal_general_accel_jacobian_terms(model, y, u, Mu, f, df, dfdu, dM);
+    if (status == SR_OK) status = stage_accel(Mu, f, L, inv, a);
+    if (status == SR_OK) status = residual_columns(model, cs, y, a, D);
+    if (status != SR_OK) return status;
+    stage_columns(cs, df, dM, L, inv, a, dy, D);
     return SR_OK;
 }
 
@@ -338,28 +367,22 @@ static void start_rows(int ns, int nc, error_p dy)
     for (c = 0; c < ns; ++c) dy[state_row(c)][c] = 1;
 }
 
-/* The vector field f at y and df = J_f(y) dy + df/dp(y) on the columns cs (dy NULL: y is the
- * step's start, dy = 0). */
-static int field_rows(const sr_model *model, const sr_real *constants, const colset *cs, const sr_real y[SR_NX],
-                      const sr_real u[SR_NU], const error_p dy, sr_real f[SR_NT], tangent_p df)
+/* df on the columns cs from the stage's d(nu')/d(d, p) Jp, at y with the field f (its accelerations
+ * included): the kinematic rows' derivatives along dy (dy NULL: 0) and q'/r in the column of r; the
+ * accelerations' rows Jp, to which a stage of the paper's robot adds Ja dy. */
+static void field_columns(const sr_model *model, const colset *cs, const sr_real y[SR_NX], const error_p dy,
+                          const sr_real f[SR_NT], const sr_real Jp[SR_NV][NW], tangent_p df)
 {
     const sr_real *R = y + SR_X_R_S, *w = y + SR_X_w_S, r = model->p[SR_P_r];
     const int nc = cs->n;
     const size_t row = (size_t)nc * sizeof(sr_real);
-    sr_real a[SR_NV], Jp[SR_NV][NW], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU], p[2][3], wxp[2][3];
-    int i, j, c, status;
-    const int general_stage = dy && model->general;
-    sr_internal_kinematics(model, y, f);
-    if (general_stage) status = general_stage_rows(model, cs, y, u, dy, f + SR_T_V, Jp);
-    else status = accel_param_jacobian(model, constants, cs, y, u, f + SR_T_V, Jp);
-    if (status == SR_OK && dy && !general_stage) status = sr_internal_accel_jacobian(model, y, u, a, Ja, Jb);
-    /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
-    if (status != SR_OK) return status == SR_ERR_SINGULAR && !all_finite(y, SR_NX) ? SR_ERR_NONFINITE : status;
+    sr_real p[2][3], wxp[2][3];
+    int i, j, c;
     for (i = 0; i < SR_T_V; ++i) memset(df[i], 0, row);
     for (i = 0; i < SR_NV; ++i) memcpy(df[SR_T_V + i], Jp[i], row);
     if (cs->r_col >= 0)   /* q' is linear in r */
         for (i = 0; i < 2; ++i) df[SR_T_Q + i][cs->r_col] = f[SR_T_Q + i] / r;
-    if (!dy) return SR_OK;
+    if (!dy) return;
     for (i = 0; i < 3; ++i) memcpy(df[SR_T_S + i], dy[SR_E_nu + i], row);   /* th_S' = w_S */
     memcpy(df[SR_T_Y], dy[SR_E_nu + 3], row);
     memcpy(df[SR_T_P], dy[SR_E_nu + 4], row);
@@ -375,13 +398,68 @@ static int field_rows(const sr_model *model, const sr_real *constants, const col
             for (c = 0; c < nc; ++c)
                 df[SR_T_Q + i][c] += p[i][j] * dy[SR_E_nu + j][c] + wxp[i][j] * dy[SR_E_xi_S + j][c];
     }
-    for (i = 0; i < SR_NV && !general_stage; ++i)   /* the accelerations: Ja dy (q's columns of Ja are zero) */
+}
+
+/* The vector field f at y and df = J_f(y) dy + df/dp(y) on the columns cs (dy NULL: y is the
+ * step's start, dy = 0). */
+static int field_rows(const sr_model *model, const sr_real *constants, const colset *cs, const sr_real y[SR_NX],
+                      const sr_real u[SR_NU], const error_p dy, sr_real f[SR_NT], tangent_p df)
+{
+    const int nc = cs->n;
+    sr_real a[SR_NV], Jp[SR_NV][NW], Ja[SR_NV * SR_NE], Jb[SR_NV * SR_NU];
+    int i, j, c, status;
+    const int general_stage = dy && model->general;
+    sr_internal_kinematics(model, y, f);
+    if (general_stage) status = general_stage_rows(model, cs, y, u, dy, f + SR_T_V, Jp);
+    else status = accel_param_jacobian(model, constants, cs, y, u, f + SR_T_V, Jp);
+    if (status == SR_OK && dy && !general_stage) status = sr_internal_accel_jacobian(model, y, u, a, Ja, Jb);
+    /* A stage state that overflowed fails the pivot test (NaN): report what happened. */
+    if (status != SR_OK) return status == SR_ERR_SINGULAR && !all_finite(y, SR_NX) ? SR_ERR_NONFINITE : status;
+    field_columns(model, cs, y, dy, f, (const sr_real(*)[NW])Jp, df);
+    for (i = 0; i < SR_NV && dy && !general_stage; ++i)   /* the accelerations: Ja dy (q's columns of Ja are zero) */
         for (j = 0; j < SR_NE; ++j) {
             const sr_real m = Ja[SR_NE * i + j];
             if (j == SR_E_q || j == SR_E_q + 1) continue;
             for (c = 0; c < nc; ++c) df[SR_T_V + i][c] += m * dy[j][c];
         }
     return SR_OK;
+}
+
+/* RKMK4's stage s > 1 after its field: k_S = dexp^-1(th, f_S), dk_S = P df_S + Q dth_S on the nc
+ * columns (K_s, dK its field and df on entry), and dsum += b_s dK. */
+static void stage_combine(int nc, const sr_real th[SR_NT], const tangent_p dth, sr_real b_s, sr_real K_s[SR_NT],
+                          tangent_p dK, tangent_p dsum)
+{
+    sr_real P[9], Q[9], kS[3], dS[3][NW];
+    int i, j, c;
+    dexpinv_and_derivatives(th, K_s, kS, P, Q);
+    for (i = 0; i < 3; ++i)
+        for (c = 0; c < nc; ++c) {
+            dS[i][c] = 0;
+            for (j = 0; j < 3; ++j) dS[i][c] += P[3 * i + j] * dK[SR_T_S + j][c] + Q[3 * i + j] * dth[SR_T_S + j][c];
+        }
+    for (i = 0; i < 3; ++i) {
+        K_s[SR_T_S + i] = kS[i];
+        memcpy(dK[SR_T_S + i], dS[i], (size_t)nc * sizeof(sr_real));
+    }
+    for (i = 0; i < SR_NT; ++i)
+        for (c = 0; c < nc; ++c) dsum[i][c] += b_s * dK[i][c];
+}
+
+/* RKMK4's end from the four stages' K and dsum = sum_k b_k dK_k: dy, and x_end (unless NULL). */
+static void step_end(const colset *cs, const sr_real x[SR_NX], sr_real h, const sr_real K[4][SR_NT], const tangent_p dsum,
+                     error_p dy, sr_real *x_end)
+{
+    const sr_real b[4] = {h / 6, h / 3, h / 3, h / 6};
+    sr_real th[SR_NT], D[9];
+    int i, s;
+    for (i = 0; i < SR_NT; ++i) {   /* as the stepper's combine */
+        th[i] = 0;
+        for (s = 0; s < 4; ++s) th[i] += b[s] * K[s][i];
+    }
+    if (cs->ns || x_end) so3_exp_minus_identity(th + SR_T_S, D);
+    if (x_end) act_increment(x, D, th, NULL, x_end);   /* the step itself, as the stepper's advance */
+    action_rows(cs->ns, cs->n, th, D, dsum, dy);
 }
 
 /* RKMK4 with the state held: K1 = f(x), K_s = dexp^-1(th_s, f(x . exp(th_s))), th_s = a_s h K_(s-1),
@@ -412,31 +490,10 @@ static int rkmk4_param(const sr_model *model, const colset *cs, const sr_real x[
         act_increment(x, D, th, NULL, y);   /* the stepper's stage state */
         action_rows(cs->ns, nc, th, D, (const sr_real(*)[NW])dth, dstage);
         status = field_rows(model, constants, cs, y, u, (const sr_real(*)[NW])dstage, K[s], dK);
-        if (status == SR_OK) {   /* k_S = dexp^-1(th, f_S): dk_S = P df_S + Q dth_S */
-            sr_real P[9], Q[9], kS[3], dS[3][NW];
-            int j;
-            dexpinv_and_derivatives(th, K[s], kS, P, Q);
-            for (i = 0; i < 3; ++i)
-                for (c = 0; c < nc; ++c) {
-                    dS[i][c] = 0;
-                    for (j = 0; j < 3; ++j) dS[i][c] += P[3 * i + j] * dK[SR_T_S + j][c] + Q[3 * i + j] * dth[SR_T_S + j][c];
-                }
-            for (i = 0; i < 3; ++i) {
-                K[s][SR_T_S + i] = kS[i];
-                memcpy(dK[SR_T_S + i], dS[i], (size_t)nc * sizeof(sr_real));
-            }
-            for (i = 0; i < SR_NT; ++i)
-                for (c = 0; c < nc; ++c) dsum[i][c] += b[s] * dK[i][c];
-        }
+        if (status == SR_OK) stage_combine(nc, th, (const sr_real(*)[NW])dth, b[s], K[s], dK, dsum);
     }
     if (status != SR_OK) return status;
-    for (i = 0; i < SR_NT; ++i) {   /* as the stepper's combine */
-        th[i] = 0;
-        for (s = 0; s < 4; ++s) th[i] += b[s] * K[s][i];
-    }
-    if (cs->ns || x_end) so3_exp_minus_identity(th + SR_T_S, D);
-    if (x_end) act_increment(x, D, th, NULL, x_end);   /* the step itself, as the stepper's advance */
-    action_rows(cs->ns, nc, th, D, (const sr_real(*)[NW])dsum, dy);
+    step_end(cs, x, h, (const sr_real(*)[SR_NT])K, (const sr_real(*)[NW])dsum, dy, x_end);
     return SR_OK;
 }
 
@@ -509,6 +566,112 @@ int sr_step_param_jacobian_batch(const sr_model *model, int method, long n, cons
     return SR_OK;
 }
 
+/* ---- RKMK4 on a block of states in lockstep ---------------------------------------------------- */
+
+/* SR_PARAM_LANES: the states a block takes through RKMK4's stages together (rkmk4_param_lanes), 0
+ * for none.  8 where the compiler has vectors of doubles to run the lanes kernels on (x86-64,
+ * AArch64), at about 120 KB of stack with its callees; 0 elsewhere (a Cortex-M gains nothing from it). */
+#ifndef SR_PARAM_LANES
+#if defined(__x86_64__) || defined(__aarch64__)
+#define SR_PARAM_LANES 8
+#else
+#define SR_PARAM_LANES 0
+#endif
+#endif
+
+#if SR_PARAM_LANES > 0
+#define LANES SR_PARAM_LANES
+
+/* RKMK4's sensitivity on the columns cs (no state columns, every one moving pi alone) of a general
+ * robot at m <= LANES states x (rows SR_NX apart; u rows u_stride apart, 0 for one row), checked by
+ * the caller: the same arithmetic as rkmk4_param state by state, but each stage's two generated
+ * kernels (M, f and their state derivatives; the regressor) run on all the block's stage states at
+ * once in their lanes forms (sr_gen_*_lanes, vectorised across the states, each lane the scalar
+ * kernel's bits).  Jp (m x SR_NE x nc) and x_next (m x SR_NX, unless NULL) written; SR_OK, else
+ * nonzero where any state fails (a singular M, a flag the lanes cleared, a non-finite result): then
+ * the caller redoes the block state by state, which reports the failing row. */
+static int rkmk4_param_lanes(const sr_model *model, const colset *cs, int m, const sr_real *x, const sr_real *u,
+                             long u_stride, sr_real h, sr_real *Jp, sr_real *x_next)
+{
+    static const sr_real a_diag[3] = {SR_C(0.5), SR_C(0.5), SR_C(1.0)};
+    const sr_real b[4] = {h / 6, h / 3, h / 3, h / 6};
+    const int nc = cs->n;
+    sr_real K[LANES][4][SR_NT], th[LANES][SR_NT], D[LANES][9], y[LANES][SR_NX], ok[LANES];
+    sr_real Mu[LANES][15], f[LANES][SR_NV], df[LANES][SR_NV * SR_NE], dfdu[LANES][SR_NV * SR_NU], dM[LANES][5 * 15];
+    sr_real L[LANES][SR_NV * SR_NV], inv[LANES][SR_NV], Y[LANES][SR_NV * SR_NPI], Jr[SR_NV][NW], end[SR_NX];
+    tangent_p dK[LANES], dsum[LANES], dth;
+    error_p dstage;
+    int l, s, i, c, status = SR_OK;
+    for (l = 0; l < m && status == SR_OK; ++l) {   /* K1 = f(x): M and f alone, as accel_param_jacobian */
+        sr_internal_kinematics(model, x + SR_NX * l, K[l][0]);
+        status = sr_gen_general_system(model->cg, x + SR_NX * l, u + u_stride * l, Mu[l], f[l]);
+        if (status == SR_OK) status = sr_internal_cholesky(Mu[l], L[l], inv[l]);
+        for (i = 0; i < SR_NV; ++i) K[l][0][SR_T_V + i] = f[l][i];
+        if (status == SR_OK) sr_internal_cholesky_solve(L[l], inv[l], 1, 1, K[l][0] + SR_T_V);
+    }
+    if (status != SR_OK) return status;
+    for (s = 0; s < 4; ++s) {
+        const sr_real *ys = s ? &y[0][0] : x;
+        const sr_real hs = s ? a_diag[s - 1] * h : 0;
+        if (s) {   /* the stage states, then M, f and their derivatives there */
+            for (l = 0; l < m; ++l) {
+                for (i = 0; i < SR_NT; ++i) th[l][i] = hs * K[l][s - 1][i];
+                so3_exp_minus_identity(th[l] + SR_T_S, D[l]);
+                act_increment(x + SR_NX * l, D[l], th[l], NULL, y[l]);
+            }
+            sr_gen_general_accel_jacobian_terms_lanes(model->cg, m, ys, SR_NX, u, u_stride, Mu[0], 15, f[0], SR_NV, df[0],
+                                                      SR_NV * SR_NE, dfdu[0], SR_NV * SR_NU, dM[0], 5 * 15, ok);
+            for (l = 0; l < m && status == SR_OK; ++l) {
+                sr_internal_kinematics(model, y[l], K[l][s]);
+                status = ok[l] == 1 ? stage_accel(Mu[l], f[l], L[l], inv[l], K[l][s] + SR_T_V) : SR_ERR_NONFINITE;
+            }
+            if (status != SR_OK) return status;
+        }
+        sr_gen_regressor_lanes(model->p, m, ys, SR_NX, K[0][s] + SR_T_V, 4 * SR_NT, Y[0], SR_NV * SR_NPI, ok);
+        for (l = 0; l < m; ++l) {
+            if (ok[l] != 1) return SR_ERR_NONFINITE;
+            regressor_columns(cs, Y[l], Jr);
+            if (!s) {
+                sr_internal_cholesky_solve(L[l], inv[l], NW, nc, &Jr[0][0]);
+                field_columns(model, cs, x + SR_NX * l, NULL, K[l][0], (const sr_real(*)[NW])Jr, dK[l]);
+                for (i = 0; i < SR_NT; ++i)
+                    for (c = 0; c < nc; ++c) dsum[l][i][c] = b[0] * dK[l][i][c];
+                continue;
+            }
+            for (i = 0; i < SR_NT; ++i)
+                for (c = 0; c < nc; ++c) dth[i][c] = hs * dK[l][i][c];
+            action_rows(0, nc, th[l], D[l], (const sr_real(*)[NW])dth, dstage);
+            stage_columns(cs, df[l], dM[l], L[l], inv[l], K[l][s] + SR_T_V, (const sr_real(*)[NW])dstage, Jr);
+            field_columns(model, cs, y[l], (const sr_real(*)[NW])dstage, K[l][s], (const sr_real(*)[NW])Jr, dK[l]);
+            stage_combine(nc, th[l], (const sr_real(*)[NW])dth, b[s], K[l][s], dK[l], dsum[l]);
+        }
+    }
+    for (l = 0; l < m; ++l) {
+        sr_real *out = Jp + (long)l * SR_NE * nc;
+        step_end(cs, x + SR_NX * l, h, (const sr_real(*)[SR_NT])K[l], (const sr_real(*)[NW])dsum[l], dstage, end);
+        for (i = 0; i < SR_NE; ++i) {
+            if (!all_finite(dstage[i], nc)) return SR_ERR_NONFINITE;
+            for (c = 0; c < nc; ++c) out[i * nc + c] = dstage[i][c];
+        }
+        if (x_next) {
+            if (!all_finite(end, SR_NX)) return SR_ERR_NONFINITE;
+            memcpy(x_next + SR_NX * l, end, sizeof end);
+        }
+    }
+    return SR_OK;
+}
+
+/* Whether the block of LANES states from row i (fewer at the end of n) passes step_param's checks:
+ * each state valid, its torques (u not NULL) finite. */
+static int lanes_checked(const sr_model *model, const sr_real *x, const sr_real *u, long i, long n)
+{
+    long k;
+    for (k = i; k < n && k < i + LANES; ++k)
+        if (sr_internal_check_state(model, x + k * SR_NX) != SR_OK || (u && !all_finite(u + k * SR_NU, SR_NU))) return 0;
+    return 1;
+}
+#endif
+
 /* sr_step_param_jacobian_cols_batch; with_next: each row's end state in x_next (n x SR_NX) too. */
 static int cols_batch(const sr_model *model, int method, long n, const sr_real *x, const sr_real *u, sr_real dt,
                       int ncols, const int *cols, int with_next, sr_real *x_next, sr_real *Jp, long *failed_row)
@@ -527,6 +690,16 @@ static int cols_batch(const sr_model *model, int method, long n, const sr_real *
     cs = columns_of(model, 0, ncols, cols, pi);
     for (i = 0; i < n; ++i) {
         sr_real *out = Jp + i * SR_NE * ncols;
+#if SR_PARAM_LANES > 0
+        if (i % LANES == 0 && method == SR_RKMK4 && model->general && cs.pi && lanes_checked(model, x, u, i, n)) {
+            const int m = n - i < LANES ? (int)(n - i) : LANES;
+            if (rkmk4_param_lanes(model, &cs, m, x + i * SR_NX, u ? u + i * SR_NU : sr_zero_u, u ? SR_NU : 0, dt, out,
+                                  with_next ? x_next + i * SR_NX : NULL) == SR_OK) {
+                i += m - 1;
+                continue;
+            }
+        }
+#endif
         status = step_param(model, &cs, method, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt, dy, with_next ? end : NULL);
         for (k = 0; k < SR_NE && status == SR_OK; ++k) {
             if (!all_finite(dy[k], ncols)) status = SR_ERR_NONFINITE;

@@ -51,6 +51,7 @@ int main(void)
     suite_control();
     suite_trig();
     suite_accel_batch();
+    suite_param_lanes();
     suite_step_batch();
     suite_model_validity();
     suite_sensors();

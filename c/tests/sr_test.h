@@ -73,6 +73,7 @@ void suite_jacobians(void);
 void suite_control(void);
 void suite_trig(void);
 void suite_accel_batch(void);
+void suite_param_lanes(void);
 void suite_step_batch(void);
 void suite_model_validity(void);
 void suite_sensors(void);

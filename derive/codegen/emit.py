@@ -6,6 +6,7 @@ what is derived: sizes, layout macros, flop counts and prototypes.
 """
 import hashlib
 import pathlib
+import re
 
 import sympy as sp
 
@@ -45,7 +46,7 @@ def input_entries(kernel, used, layouts):
 
 #: The arrays that hold one state's data; a lanes kernel reads them per lane, the others once.
 #: The strides are arguments: GCC 12 vectorises the loop with them, not with constant strides of 35.
-PER_LANE = {"x": "x_stride*i", "u": "u_stride*i"}
+PER_LANE = {"x": "x_stride*i", "u": "u_stride*i", "nud": "nud_stride*i"}
 
 
 def scalar_guard(condition, status):
@@ -99,18 +100,26 @@ def signature(kernel):
     return f"int {PREFIX}{kernel.name}({', '.join(args)})"
 
 
+def lanes_outputs(kernel):
+    """The names of a lanes kernel's output arrays: `a` for the solve, else its outputs'."""
+    return ["a"] if kernel.solve else [o.name for o in kernel.outputs]
+
+
 def lanes_signature(kernel):
-    """sr_gen_<name>_lanes: the kernel on n states; the rows of x, u and the outputs stride
-    entries apart (u_stride 0 repeats one row), a flag per state (1 or 0)."""
-    if not kernel.solve or kernel.inputs != ("c", "x", "u"):
-        raise ValueError(f"kernel {kernel.name}: lanes are emitted for the solve of (c, x, u) only")
-    return (f"void {PREFIX}{kernel.name}_lanes({INPUT_DOCS['c'][0]}, long n, const sr_real *restrict x, long x_stride, "
-            "const sr_real *restrict u, long u_stride, sr_real *restrict a, long a_stride, sr_real *restrict ok)")
+    """sr_gen_<name>_lanes: the kernel on n states; its first input read once (the model's array),
+    the rows of the others (x, u, nud) and of every output array stride entries apart (a stride 0
+    repeats one input row), a flag per state (1 or 0)."""
+    once, each = kernel.inputs[0], kernel.inputs[1:]
+    if once in PER_LANE or not each or any(a not in PER_LANE for a in each):
+        raise ValueError(f"kernel {kernel.name}: lanes are emitted for a model array, then rows of {sorted(PER_LANE)}")
+    args = [INPUT_DOCS[once][0], "long n"] + [f"const sr_real *restrict {a}, long {a}_stride" for a in each]
+    args += [f"sr_real *restrict {name}, long {name}_stride" for name in lanes_outputs(kernel)]
+    return f"void {PREFIX}{kernel.name}_lanes({', '.join(args)}, sr_real *restrict ok)"
 
 
 def kernel_body(kernel, guard, row=""):
     """(symbols read, body lines after the reads) of a kernel, its tests written by `guard`, its
-    outputs at `out[row + k]`."""
+    outputs at `out[row + k]` (`{name}` in row: the output array's name)."""
     scheduler = Scheduler(Printer())
     defined = [symbol for symbol, _ in kernel.definitions]
     exprs = [value for _, value in kernel.definitions] + [e for o in kernel.outputs for e in o.exprs]
@@ -130,7 +139,7 @@ def kernel_body(kernel, guard, row=""):
     if kernel.solve:
         lines, results = emit_shell_solve(scheduler, "a", S.R_Y, {s.name for s in defined}, guard)
         body += lines
-    results = [(target.replace("[", f"[{row}", 1), value) for target, value in results]
+    results = [(target.replace("[", "[" + row.format(name=target.split("[")[0]), 1), value) for target, value in results]
     return used, body + emit_results(scheduler, results, kernel.finite_or_untouched, guard)
 
 
@@ -187,18 +196,43 @@ def lanes_doc(kernel):
             " compiler vectorises across states (the same expressions, so each lane's result is the scalar"
             " kernel's, bit for bit); every output is written, and ok[i] is cleared where the scalar kernel"
             " would fail (or its outputs' sum overflows: decide such a state by the scalar kernel)."
-            " GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic), for AVX2 too (SR_LANES_CLONES). */")
+            " GCC vectorises it at -O3 (or -O2 -fvect-cost-model=dynamic), for AVX2 too (SR_LANES_CLONES)"
+            + (", with more run-time alias tests of its output arrays than GCC 12 makes by default"
+               " (--param vect-max-version-for-alias-checks=100, in the builds)" if len(lanes_outputs(kernel)) > 1 else "")
+            + ". */")
+
+
+ASSIGNMENT = re.compile(r"^\s*const sr_real (\w+) = (.*);$")
+NAME = re.compile(r"\b[A-Za-z_]\w*\b")
+
+
+def hoisted(body, once):
+    """(before the loop, in the loop): the body's assignments that read only the names `once` (the
+    model array's entries), the SR_GEN_ functions and what is so assigned before them, moved out of
+    the loop; every other line kept in order.  GCC 12 keeps a loop with a call (the sine of the
+    slope) scalar."""
+    known, before, inside = set(once), [], []
+    for line in body:
+        m = ASSIGNMENT.match(line)
+        names = set(NAME.findall(m.group(2))) - {"SR_C"} if m else None
+        if m and all(n in known or n.startswith("SR_GEN_") for n in names):
+            known.add(m.group(1))
+            before.append(line)
+        else:
+            inside.append(line)
+    return before, inside
 
 
 def emit_lanes(kernel, layouts):
     """C text of sr_gen_<name>_lanes (see `lanes_doc`)."""
-    used, body = kernel_body(kernel, lane_guard, row="a_stride*i + ")
+    used, body = kernel_body(kernel, lane_guard, row="{name}_stride*i + ")
     entries = input_entries(kernel, used, layouts)
     once = [f"    const sr_real {sym.name} = {array}[{index}];" for sym, array, index in entries if array not in PER_LANE]
     each = [f"    const sr_real {sym.name} = {array}[{PER_LANE[array]} + {index}];"
             for sym, array, index in entries if array in PER_LANE]
-    loop = each + ["    sr_real good = 1;"] + body + ["    ok[i] = good;"]
-    return "\n".join([lanes_doc(kernel), "SR_LANES_CLONES " + lanes_signature(kernel), "{", *once, "    long i;",
+    before, inside = hoisted(body, [sym.name for sym, array, _ in entries if array not in PER_LANE])
+    loop = each + ["    sr_real good = 1;"] + inside + ["    ok[i] = good;"]
+    return "\n".join([lanes_doc(kernel), "SR_LANES_CLONES " + lanes_signature(kernel), "{", *once, *before, "    long i;",
                       "    for (i = 0; i < n; ++i) {", *("    " + line for line in loop), "    }", "}", ""])
 
 

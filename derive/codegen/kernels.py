@@ -161,7 +161,7 @@ def param_kernels():
                ("p", "x", "nud"), (Output("dR", tuple(PD.residual_param_jacobian()), "d(M nu_dot - f)/dp, row-major 5 x SR_GEN_NPARAM"),)),
         Kernel("regressor", "The regressor Y (5 x SR_GEN_NPI, row-major, columns SR_PI_*): M ν̇ − f(u = 0) = Y π, π the"
                " inertial parameters and dampings (derive.param_derivatives.INERTIAL_PARAMETERS).",
-               ("p", "x", "nud"), (Output("Y", tuple(PD.regressor()), "Y, row-major 5 x SR_GEN_NPI"),)),
+               ("p", "x", "nud"), (Output("Y", tuple(PD.regressor()), "Y, row-major 5 x SR_GEN_NPI"),), lanes=True),
     )
 
 
@@ -202,7 +202,8 @@ def accel_jacobian_terms(robot, name, inputs):
          Output("f", tuple(f), "f"),
          Output("df", tuple(J.rhs_jacobian(robot)), "df/dd, row-major 5 x SR_GEN_NE"),
          Output("dfdu", tuple(J.rhs_input_jacobian(robot)), "df/du, row-major 5 x 2"),
-         Output("dM", tuple(m[i, j] for m in dM for i, j in upper), "dM/dd_k, k < 5, upper triangles")))
+         Output("dM", tuple(m[i, j] for m in dM for i, j in upper), "dM/dd_k, k < 5, upper triangles")),
+        lanes=True)
 
 
 def sensor_kernels():

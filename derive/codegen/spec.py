@@ -19,4 +19,5 @@ class Kernel:
     solve: bool = False    # outputs are the locals of joint_first_system; write ν̇ = M⁻¹ f instead
     definitions: tuple = ()  # (symbol, expression) intermediates the outputs use (newton_euler.Program)
     finite_or_untouched: bool = True  # write the outputs only if all are finite, else return SR_GEN_NONFINITE
-    lanes: bool = False    # also emit sr_gen_<name>_lanes: the kernel over n states, branch-free (emit.emit_lanes)
+    lanes: bool = False    # also emit sr_gen_<name>_lanes: the kernel over n states, branch-free (emit.emit_lanes);
+    #                        its first input a model array (read once), the others rows of x, u or nud

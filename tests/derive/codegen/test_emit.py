@@ -160,3 +160,88 @@ def test_the_read_set_check_fails_for_a_perturbed_header(perturb):
 def test_index_ranges_are_the_runs_of_consecutive_indices():
     assert emit.index_ranges((6, 7, 8, 30)) == ((6, 9), (30, 31))
     assert emit.index_ranges(()) == ()
+
+
+# -- the lanes forms: the kernels over n states, vectorised across them -------------------------------
+#: The kernels emitted in lanes form (kernels.py's `lanes=True`): the batch accelerations, and the
+#: analytic parameter sensitivity's two kernels, which its RKMK4 stages run on blocks of states.
+LANES = {"accel", "general_accel_jacobian_terms", "regressor"}
+
+
+def lanes_functions(source):
+    """{kernel: (lines before the loop, lines in the loop)} of the generated source's sr_gen_*_lanes."""
+    found = {}
+    for name, body in re.findall(r"^SR_LANES_CLONES void sr_gen_(\w+)_lanes\(.*?\n\{\n(.*?)\n\}\n", source, re.M | re.S):
+        before, _, loop = body.partition("    for (i = 0; i < n; ++i) {\n")
+        found[name] = (before.splitlines(), loop.splitlines())
+    return found
+
+
+def lanes_loop_faults(source):
+    """Lanes loops that read a model array (p, c, cg) or call a function (the sine of the slope) per
+    state: GCC 12 keeps such a loop scalar, so those belong before it."""
+    return {name: line for name, (_, loop) in lanes_functions(source).items() for line in loop
+            if re.search(r"= (p|c|cg)\[\d+\];|SR_GEN_[A-Z]+\(", line)}
+
+
+def test_the_flagged_kernels_and_only_they_have_lanes_forms():
+    source = (ROOT / "generated" / "sr_generated.c").read_text()
+    header = (ROOT / "generated" / "sr_generated.h").read_text()
+    assert set(lanes_functions(source)) == LANES
+    assert set(re.findall(r"^void sr_gen_(\w+)_lanes\(", header, re.M)) == LANES
+
+
+def test_lanes_loops_read_the_model_once_and_call_nothing():
+    source = (ROOT / "generated" / "sr_generated.c").read_text()
+    assert lanes_loop_faults(source) == {}
+    before, _ = lanes_functions(source)["regressor"]
+    assert any("SR_GEN_SIN(slope)" in line for line in before)   # what was hoisted, to be checked
+
+
+def test_the_lanes_loop_check_fails_for_an_expression_of_the_parameters_left_in_the_loop():
+    source = (ROOT / "generated" / "sr_generated.c").read_text()
+    line = next(l for l in lanes_functions(source)["regressor"][0] if "SR_GEN_SIN(slope)" in l)
+    loop = "    for (i = 0; i < n; ++i) {\n"
+    start = source.index("void sr_gen_regressor_lanes(")
+    at = source.index(loop, start) + len(loop)
+    moved = source[:start] + source[start:at].replace(line + "\n", "") + "    " + line + "\n" + source[at:]
+    assert lanes_loop_faults(moved) == {"regressor": "    " + line}
+
+
+def test_hoisting_moves_the_assignments_of_the_model_arrays_entries_alone():
+    body = ["    const sr_real t0 = SR_GEN_SIN(slope);", "    const sr_real t1 = t0*w_Sx;",
+            "    const sr_real t2 = g*t0 + SR_C(2.0);", "    good = (t1 > 0) ? good : 0;", "    const sr_real t3 = t2*t1;"]
+    before, inside = emit.hoisted(body, ["slope", "g"])
+    assert before == [body[0], body[2]] and inside == [body[1], body[3], body[4]]
+
+
+@pytest.mark.parametrize("inputs", [("x", "u"), ("p",), ("p", "x", "sc")], ids=["no model array", "no rows", "other rows"])
+def test_lanes_are_refused_for_inputs_other_than_a_model_array_then_rows(inputs):
+    from derive.codegen.spec import Kernel
+    with pytest.raises(ValueError, match="lanes are emitted for a model array"):
+        emit.lanes_signature(Kernel("k", "doc", inputs, ()))
+
+
+def vectorised_lanes(extra_flags, tmp_path):
+    """The lanes kernels whose loop GCC reports vectorised when it compiles generated/ with the Python
+    extension's flags (bindings/build_sr.py), `extra_flags` replacing the alias-check limit."""
+    import bindings.build_sr as B
+    flags = [f for f in B.COMPILE_ARGS if f not in B.VECT_ALIAS_CHECKS and f != "-DSR_CLONES"] + extra_flags
+    source = (ROOT / "generated" / "sr_generated.c").read_text()
+    done = subprocess.run([*B.compiler(), *flags, "-Igenerated", "-Ic/include", "-fopt-info-vec-optimized", "-c",
+                           "generated/sr_generated.c", "-o", str(tmp_path / "out.o")], cwd=ROOT, check=True,
+                          capture_output=True, text=True)
+    lines = {int(n) for n in re.findall(r"sr_generated\.c:(\d+):\d+: optimized: loop vectorized", done.stderr)}
+    starts = {m.group(1): source[:m.start()].count("\n") + 1
+              for m in re.finditer(r"^SR_LANES_CLONES void sr_gen_(\w+)_lanes\(", source, re.M)}
+    ends = sorted(starts.values()) + [source.count("\n") + 1]
+    return {name for name, first in starts.items() if any(first < n < ends[ends.index(first) + 1] for n in lines)}
+
+
+@pytest.mark.skipif(shutil.which("gcc") is None, reason="GCC's vectoriser report")
+def test_the_extensions_flags_vectorise_every_lanes_loop(tmp_path):
+    import bindings.build_sr as B
+    assert B.VECT_ALIAS_CHECKS, "the extension is built by GCC here"
+    assert vectorised_lanes(B.VECT_ALIAS_CHECKS, tmp_path) == LANES
+    # without the raised limit GCC 12 leaves the kernel of five output arrays scalar: the flag is needed
+    assert "general_accel_jacobian_terms" not in vectorised_lanes([], tmp_path)
