@@ -1,0 +1,217 @@
+"""The linear surrogate of a consistency run (`python -m runtime surrogate`, docs/estimation.md,
+"Consistency"): a Kalman filter consistent by construction with the EKF's own slow modes.
+
+The NumPy reference of the filter (runtime/verification/ekf_reference.py) is run over one seeded
+sense run exactly as `estimate_log` runs the C filter, and records every linear map of its
+(augmented) error and every noise it assumes: the predicts' F and Q, the updates' I − K H and
+K R Kᵀ (the gates' decisions included: a refused sample maps nothing), the resets, the clones of
+late fixes, the held disturbance's block.  Those maps are then driven with exactly those noises
+from a start drawn from the filter's P0: each draw is the error of a linear-Gaussian truth whose
+model, noises and gains are the filter's, so its covariance is the filter's P at every step, and
+`consistency` scores blocks of such draws as it scores the runs.  The share of samples in the
+band per block is then the statistic's own spread for this filter's error correlations over time.
+
+    rec = record_run("line", "default", seed=0)
+    e = simulate(rec, runs=1000, seed=1)          # (1000, m, 18) physical components
+    blocks = block_statistics(rec, e, block=50)   # per block of 50: share in band, ±3σ shares
+"""
+import argparse
+import json
+
+import numpy as np
+
+from ..ekf import RECOVER_AFTER, start_from_measurements
+from ..verification.ekf_reference import NB, EkfReference
+from .consistency import COMPONENTS, NEES_TARGET, WITHIN_TARGET, consistency, run_once
+
+
+class RecordingReference(EkfReference):
+    """The reference that keeps its error's linear maps and noises (`ops`): ("map", rows, cols, M)
+    for e[rows] ← M e[cols] (the other entries kept), ("resize", index) for e ← e[index] with −1 a
+    new zero entry, ("noise", rows, L) for e[rows] += L z, z standard normal, and ("sample",) each
+    time P is read."""
+
+    def __init__(self, *args, **kwargs):
+        self.ops = []
+        super().__init__(*args, **kwargs)
+
+    def linear(self, T):
+        n_new, n_old = T.shape
+        if n_new != n_old:
+            unit = np.abs(T).sum(axis=1) > 0
+            self.ops.append(("resize", np.where(unit, np.argmax(T, axis=1), -1)))
+            return
+        rows = np.flatnonzero(np.any(T != np.eye(n_old), axis=1))
+        if len(rows):
+            cols = np.flatnonzero(np.any(T[rows] != 0, axis=0))
+            self.ops.append(("map", rows, cols, T[np.ix_(rows, cols)].copy()))
+
+    def noise(self, rows, C):
+        w, V = np.linalg.eigh(0.5 * (C + C.T))
+        keep = w > 1e-14 * max(w.max(), 1e-300)
+        if keep.any():
+            self.ops.append(("noise", np.asarray(rows), V[:, keep] * np.sqrt(w[keep])))
+
+
+class ReferenceFilter:
+    """`Ekf`'s methods over a RecordingReference started where an `Ekf` starts (its x, biases, P,
+    noise, mount, gates, method, constraint and recovery policy)."""
+
+    def __init__(self, ekf):
+        self.ekf, n = ekf, ekf.noise
+        self.ref = RecordingReference(ekf.model, ekf.x, ekf.biases, ekf.P, method=ekf.method,
+                                      recover_after=ekf.recover_after, constrained=ekf.constrained)
+        self.psd = (n.torque_psd,) * 3
+        self.imu_sigma = np.array([n.gyro] * 3 + list(n.accel))
+
+    def predict(self, u, dt):
+        n = self.ekf.noise
+        self.ref.predict(u, dt, self.psd, n.gyro_bias_rw, n.accel_bias_rw)
+
+    def update_imu(self, y, u):
+        n, gate = self.ekf.noise, self.ekf.gate["imu"]
+        if n.torque_hold > 0:
+            return self.ref.update_imu_held(y, u, self.ekf.mount, self.imu_sigma, self.psd, n.torque_hold, gate)
+        return self.ref.update_imu(y, u, self.ekf.mount, n.gyro, n.accel, gate)
+
+    def update_encoders(self, y):
+        return self.ref.update_encoders(y, self.ekf.noise.encoder, self.ekf.gate["encoders"])
+
+    def update_position(self, y):
+        return self.ref.update_position(y, self.ekf.noise.position, self.ekf.gate["position"])
+
+    def mark_position(self, slot):
+        self.ref.mark_position(slot)
+
+    def update_position_delayed(self, slot, y):
+        return self.ref.update_position_delayed(slot, y, self.ekf.noise.position, self.ekf.gate["position"])
+
+    def update_heading(self, y):
+        return self.ref.update_heading(y, self.ekf.heading_mount, self.ekf.noise.heading, self.ekf.gate["heading"])
+
+    @property
+    def x(self):
+        return self.ref.x.copy()
+
+    @property
+    def biases(self):
+        return self.ref.b.copy()
+
+    @property
+    def P(self):
+        self.ref.ops.append(("sample",))
+        return self.ref.P
+
+    @property
+    def sigma(self):
+        return np.sqrt(np.diag(self.ref.P))
+
+    @property
+    def counters(self):
+        r = self.ref
+        return {k: {"accepted": r.accepted[k], "gated": r.gated[k], "recovered": r.recovered[k], "nis": r.nis[k]}
+                for k in r.accepted}
+
+
+def _reference_start(model, **kwargs):
+    return ReferenceFilter(start_from_measurements(model, recover_after=RECOVER_AFTER, **kwargs))
+
+
+def record_run(run, sensors, seed, duration=None, accel_noise="held"):
+    """One consistency run (`run_once`'s) with the NumPy reference as the filter: its result
+    ({"t", "e", "P", ...}, the components from SETTLE_S on) and the recorded "ops", "P0" (18, 18),
+    "T" (m, 18, 18: the filter's errors to the physical components at the scored samples),
+    "scored" (the indices of the scored samples among the "sample" ops)."""
+    recorded = {}
+
+    def make_filter(model, **kwargs):
+        f = _reference_start(model, **kwargs)
+        recorded["filter"] = f
+        return f
+
+    result = run_once(run, sensors, seed, duration=duration, accel_noise=accel_noise, make_filter=make_filter)
+    f = recorded["filter"]
+    result["ops"], result["P0"] = f.ref.ops, f.ekf.P
+    return result
+
+
+def simulate(rec, runs, seed):
+    """`runs` draws of the linear-Gaussian truth of the recorded filter: the error starts from
+    N(0, P0), moves by the recorded maps and receives the recorded noises; its current block at the
+    scored samples in the physical components (runs, m, 18)."""
+    rng = np.random.default_rng(seed)
+    e = rng.standard_normal((runs, NB)) @ np.linalg.cholesky(rec["P0"]).T
+    samples = []
+    for op in rec["ops"]:
+        kind = op[0]
+        if kind == "map":
+            _, rows, cols, M = op
+            e[:, rows] = e[:, cols] @ M.T
+        elif kind == "noise":
+            _, rows, L = op
+            e[:, rows] += rng.standard_normal((runs, L.shape[1])) @ L.T
+        elif kind == "resize":
+            index = op[1]
+            e = np.where(index >= 0, e[:, np.maximum(index, 0)], 0.0)
+        else:
+            samples.append(e[:, :NB].copy())
+    d = np.stack(samples, axis=1)[:, rec["scored"]]
+    return np.einsum("mij,rmj->rmi", rec["T"], d)
+
+
+def block_statistics(rec, e, block=50):
+    """`consistency` over consecutive blocks of `block` draws, each draw a run with the recorded P:
+    per block the share of samples in the band and the share within ±3σ per component."""
+    out = []
+    for k in range(len(e) // block):
+        runs = [{"t": rec["t"], "e": draws, "P": rec["P"], "fixes": rec["fixes"]}
+                for draws in e[k * block:(k + 1) * block]]
+        report = consistency(runs)
+        out.append({"inside": report["inside"], "within_3_sigma": report["within_3_sigma"],
+                    "mean_anees": float(np.mean(report["anees"]))})
+    return out
+
+
+def summarise(blocks):
+    """The distribution of the blocks' statistics."""
+    inside = np.array([b["inside"] for b in blocks])
+    worst = np.array([min(b["within_3_sigma"].values()) for b in blocks])
+    return {"blocks": len(blocks), "inside_mean": float(inside.mean()),
+            "inside_quantiles": {q: float(np.quantile(inside, q)) for q in (0.05, 0.1, 0.25, 0.5)},
+            "inside_min": float(inside.min()),
+            "share_below_target": float(np.mean(inside < NEES_TARGET)),
+            "share_at_or_below_0_797": float(np.mean(inside <= 0.797)),
+            "worst_within_mean": float(worst.mean()),
+            "share_within_below_target": float(np.mean(worst < WITHIN_TARGET)),
+            "within_below_target_per_component": {
+                c: float(np.mean([b["within_3_sigma"][c] < WITHIN_TARGET for b in blocks])) for c in COMPONENTS}}
+
+
+def build_parser():
+    p = argparse.ArgumentParser(prog="python -m runtime surrogate", description=__doc__.split("\n\n")[0])
+    p.add_argument("run", help="a shipped scenario or task name, or a file")
+    p.add_argument("--sensors", default="default")
+    p.add_argument("--seed", type=int, default=0, help="the sense run whose filter is recorded")
+    p.add_argument("--duration", type=float, default=None)
+    p.add_argument("--draws", type=int, default=1000)
+    p.add_argument("--block", type=int, default=50)
+    p.add_argument("--out", default=None, help="a JSON file for the summary and the blocks")
+    return p
+
+
+def main(argv):
+    args = build_parser().parse_args(argv)
+    if args.draws < args.block or args.block < 2:
+        raise SystemExit("--draws, --block: expected draws >= block >= 2")
+    rec = record_run(args.run, args.sensors, args.seed, duration=args.duration)
+    e = simulate(rec, args.draws, seed=[args.seed, 2])
+    blocks = block_statistics(rec, e, args.block)
+    out = {"run": args.run, "seed": args.seed, "draws": args.draws, "block": args.block,
+           "recovered": {k: v["recovered"] for k, v in rec["counters"].items()},
+           "summary": summarise(blocks), "blocks": blocks}
+    text = json.dumps(out, indent=1)
+    if args.out:
+        with open(args.out, "w") as fh:
+            fh.write(text)
+    print(json.dumps(out["summary"], indent=1))
+    return 0

@@ -1,0 +1,96 @@
+"""The linear surrogate of a consistency run (runtime/estimation/surrogate.py): the recording NumPy
+reference is the C filter over a short line run; the draws of the recorded linear system have the
+filter's covariance (their NEES averages to the dimension within its standard error), and that
+check fails when one recorded noise or map is left out; blocks of draws are scored as
+`consistency` scores runs."""
+import numpy as np
+import pytest
+
+from runtime.estimation.consistency import nees, nees_band, run_once
+from runtime.estimation.surrogate import RecordingReference, block_statistics, record_run, simulate
+from runtime.verification.ekf_reference import NB
+
+from .test_tasks import short
+
+DRAWS = 600
+
+
+@pytest.fixture(scope="module")
+def recorded():
+    return record_run(short("line"), None, seed=0)
+
+
+def test_the_recording_reference_is_the_c_filter_over_a_short_line_run(recorded):
+    c = run_once(short("line"), None, seed=0)
+    sigma = np.sqrt(np.diagonal(c["P"], axis1=1, axis2=2))
+    assert np.max(np.abs(np.sqrt(np.diagonal(recorded["P"], axis1=1, axis2=2)) - sigma) / sigma) <= 1e-8
+    assert np.max(np.abs(recorded["e"] - c["e"]) / sigma) <= 1e-8
+
+
+def in_band(rec, e):
+    """The share of the scored samples whose average NEES over the draws lies in its 95 % band."""
+    anees = np.mean([nees(draw, rec["P"]) for draw in e], axis=0)
+    low, high = nees_band(18, len(e))
+    return float(np.mean((anees >= low) & (anees <= high)))
+
+
+def nees_offset(rec, e):
+    """How far the draws' NEES, averaged over the scored samples and the draws, lies from the 18
+    of a consistent filter, in standard errors (the draws are independent, the samples of one
+    draw are not: the standard error is the spread of the draws' own averages over √draws)."""
+    per_draw = np.array([nees(draw, rec["P"]).mean() for draw in e])
+    return float((per_draw.mean() - 18.0) / (per_draw.std(ddof=1) / np.sqrt(len(per_draw))))
+
+
+def test_the_surrogates_draws_have_the_filters_covariance(recorded):
+    assert abs(nees_offset(recorded, simulate(recorded, DRAWS, seed=1))) <= 4.0
+
+
+def test_blocks_of_the_surrogate_are_scored_as_consistency_scores_runs(recorded):
+    e = simulate(recorded, 100, seed=1)
+    blocks = block_statistics(recorded, e, block=50)
+    assert len(blocks) == 2
+    assert blocks[0]["inside"] == pytest.approx(in_band(recorded, e[:50]))
+
+
+class Muted(RecordingReference):
+    """Records nothing of `kind` ("noise" or "linear") while the methods `within` run."""
+    within, kind = (), None
+
+    def __getattribute__(self, name):
+        attr = super().__getattribute__(name)
+        if name in type(self).within:
+            def muted(*args, **kwargs):
+                self.muting = True
+                try:
+                    return attr(*args, **kwargs)
+                finally:
+                    self.muting = False
+            return muted
+        return attr
+
+    def noise(self, rows, C):
+        if not (getattr(self, "muting", False) and self.kind == "noise" and len(rows) > 5):
+            super().noise(rows, C)
+
+    def linear(self, T):
+        if not (getattr(self, "muting", False) and self.kind == "linear"):
+            super().linear(T)
+
+
+class WithoutUpdateNoise(Muted):
+    """The updates' K R Kᵀ left out (the held disturbance's own prior kept)."""
+    within, kind = ("_update", "update_imu_held"), "noise"
+
+
+class WithoutPredictMap(Muted):
+    """The predicts' maps left out: the error stays where it was, their noise added."""
+    within, kind = ("predict",), "linear"
+
+
+@pytest.mark.parametrize("broken", [WithoutUpdateNoise, WithoutPredictMap])
+def test_the_covariance_check_fails_for_a_surrogate_without_one_term(broken, monkeypatch):
+    from runtime.estimation import surrogate
+    monkeypatch.setattr(surrogate, "RecordingReference", broken)
+    rec = record_run(short("line"), None, seed=0)
+    assert abs(nees_offset(rec, simulate(rec, DRAWS, seed=1))) > 10.0
