@@ -17,6 +17,7 @@ band per block is then the statistic's own spread for this filter's error correl
 """
 import argparse
 import json
+import sys
 
 import numpy as np
 
@@ -28,11 +29,12 @@ from .consistency import COMPONENTS, NEES_TARGET, WITHIN_TARGET, consistency, ru
 class RecordingReference(EkfReference):
     """The reference that keeps its error's linear maps and noises (`ops`): ("map", rows, cols, M)
     for e[rows] ← M e[cols] (the other entries kept), ("resize", index) for e ← e[index] with −1 a
-    new zero entry, ("noise", rows, L) for e[rows] += L z, z standard normal, and ("sample",) each
-    time P is read."""
+    new zero entry, ("noise", rows, L, context, gain) for e[rows] += L z, z standard normal (an
+    update's noise −K v with K its `gain`; `context` what the filter was doing, set by its user),
+    and ("sample",) each time P is read."""
 
     def __init__(self, *args, **kwargs):
-        self.ops = []
+        self.ops, self.context = [], None
         super().__init__(*args, **kwargs)
 
     def linear(self, T):
@@ -46,11 +48,10 @@ class RecordingReference(EkfReference):
             cols = np.flatnonzero(np.any(T[rows] != 0, axis=0))
             self.ops.append(("map", rows, cols, T[np.ix_(rows, cols)].copy()))
 
-    def noise(self, rows, C):
+    def noise(self, rows, C, gain=None):
         w, V = np.linalg.eigh(0.5 * (C + C.T))
         keep = w > 1e-14 * max(w.max(), 1e-300)
-        if keep.any():
-            self.ops.append(("noise", np.asarray(rows), V[:, keep] * np.sqrt(w[keep])))
+        self.ops.append(("noise", np.asarray(rows), V[:, keep] * np.sqrt(w[keep]), self.context, gain))
 
 
 class ReferenceFilter:
@@ -62,31 +63,45 @@ class ReferenceFilter:
         self.ref = RecordingReference(ekf.model, ekf.x, ekf.biases, ekf.P, method=ekf.method,
                                       recover_after=ekf.recover_after, constrained=ekf.constrained)
         self.psd = (n.torque_psd,) * 3
+        self.t, self.count = 0.0, {}
         self.imu_sigma = np.array([n.gyro] * 3 + list(n.accel))
+
+    def _at(self, kind):
+        """Sets the reference's context: (kind, the sample's index among its kind's, time)."""
+        i = self.count.get(kind, 0)
+        self.count[kind] = i + 1
+        self.ref.context = (kind, i, self.t)
 
     def predict(self, u, dt):
         n = self.ekf.noise
+        self.ref.context = ("predict", self.t, self.t + dt)
         self.ref.predict(u, dt, self.psd, n.gyro_bias_rw, n.accel_bias_rw)
+        self.t += dt
 
     def update_imu(self, y, u):
         n, gate = self.ekf.noise, self.ekf.gate["imu"]
+        self._at("imu")
         if n.torque_hold > 0:
             return self.ref.update_imu_held(y, u, self.ekf.mount, self.imu_sigma, self.psd, n.torque_hold, gate)
         return self.ref.update_imu(y, u, self.ekf.mount, n.gyro, n.accel, gate)
 
     def update_encoders(self, y):
+        self._at("encoders")
         return self.ref.update_encoders(y, self.ekf.noise.encoder, self.ekf.gate["encoders"])
 
     def update_position(self, y):
+        self._at("position")
         return self.ref.update_position(y, self.ekf.noise.position, self.ekf.gate["position"])
 
     def mark_position(self, slot):
         self.ref.mark_position(slot)
 
     def update_position_delayed(self, slot, y):
+        self._at("position")
         return self.ref.update_position_delayed(slot, y, self.ekf.noise.position, self.ekf.gate["position"])
 
     def update_heading(self, y):
+        self._at("heading")
         return self.ref.update_heading(y, self.ekf.heading_mount, self.ekf.noise.heading, self.ekf.gate["heading"])
 
     @property
@@ -121,7 +136,7 @@ def record_run(run, sensors, seed, duration=None, accel_noise="held"):
     """One consistency run (`run_once`'s) with the NumPy reference as the filter: its result
     ({"t", "e", "P", ...}, the components from SETTLE_S on) and the recorded "ops", "P0" (18, 18),
     "T" (m, 18, 18: the filter's errors to the physical components at the scored samples),
-    "scored" (the indices of the scored samples among the "sample" ops)."""
+    "scored" (the indices of the scored samples among the "sample" ops), the start "x0", "b0"."""
     recorded = {}
 
     def make_filter(model, **kwargs):
@@ -131,7 +146,7 @@ def record_run(run, sensors, seed, duration=None, accel_noise="held"):
 
     result = run_once(run, sensors, seed, duration=duration, accel_noise=accel_noise, make_filter=make_filter)
     f = recorded["filter"]
-    result["ops"], result["P0"] = f.ref.ops, f.ekf.P
+    result["ops"], result["P0"], result["x0"], result["b0"] = f.ref.ops, f.ekf.P, f.ekf.x, f.ekf.biases
     return result
 
 
@@ -148,7 +163,7 @@ def simulate(rec, runs, seed):
             _, rows, cols, M = op
             e[:, rows] = e[:, cols] @ M.T
         elif kind == "noise":
-            _, rows, L = op
+            rows, L = op[1], op[2]
             e[:, rows] += rng.standard_normal((runs, L.shape[1])) @ L.T
         elif kind == "resize":
             index = op[1]
@@ -201,8 +216,9 @@ def build_parser():
 
 def main(argv):
     args = build_parser().parse_args(argv)
-    if args.draws < args.block or args.block < 2:
-        raise SystemExit("--draws, --block: expected draws >= block >= 2")
+    if args.block < 2 or args.draws < args.block:
+        print(f"--draws, --block: expected draws >= block >= 2, got {args.draws} and {args.block}", file=sys.stderr)
+        return 2
     rec = record_run(args.run, args.sensors, args.seed, duration=args.duration)
     e = simulate(rec, args.draws, seed=[args.seed, 2])
     blocks = block_statistics(rec, e, args.block)

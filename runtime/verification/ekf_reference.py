@@ -33,7 +33,7 @@ H − H N (Nᵀ N)⁻¹ Nᵀ, both written out as such.
 
 Every change of P_aug is announced to two hooks that do nothing here: `linear(T)` (the augmented
 error e ← T e, T of any shape: a step, a gain, a reset, a clone, a block appended or dropped) and
-`noise(rows, C)` (then e[rows] += w, w of covariance C); a gated sample announces nothing.  A
+`noise(rows, C, gain)` (then e[rows] += w, w of covariance C; for an update −K v, v its sample's noise); a gated sample announces nothing.  A
 subclass that records them has the linear error system the filter assumes
 (runtime/estimation/surrogate.py).
 """
@@ -117,8 +117,9 @@ class EkfReference:
     def linear(self, T):
         """Hook: the augmented error has become T e (T (new size, old size))."""
 
-    def noise(self, rows, C):
-        """Hook: the augmented error's entries `rows` have then received noise of covariance C."""
+    def noise(self, rows, C, gain=None):
+        """Hook: the augmented error's entries `rows` have then received noise of covariance C (an
+        update's K R Kᵀ, with its `gain` K)."""
 
     def transform(self, A):
         """The current error e ← A e with the clones kept: P_aug ← T P_aug Tᵀ, T = diag(A, I)
@@ -286,7 +287,7 @@ class EkfReference:
         e = K @ r
         P = self.joseph(K, H, R)
         self.transform(np.eye(NB) - K @ H)
-        self.noise(np.r_[0:NB], K @ R @ K.T)
+        self.noise(np.r_[0:NB], K @ R @ K.T, K)
         self.P = P
         self.inject(e)
         self.reset(e)
@@ -340,7 +341,7 @@ class EkfReference:
         T = np.eye(n)
         T[rows] -= K @ H_aug
         self.linear(T)
-        self.noise(rows, K @ R @ K.T)
+        self.noise(rows, K @ R @ K.T, K)
         self.P_aug = T @ self.P_aug @ T.T
         self.P_aug[np.ix_(rows, rows)] += K @ R @ K.T
         e = K[:NB] @ r
@@ -392,7 +393,7 @@ class EkfReference:
         T = np.eye(len(self.P_aug))
         T[:NB] -= K @ H_aug
         self.linear(T)
-        self.noise(np.r_[0:NB], K @ R @ K.T)
+        self.noise(np.r_[0:NB], K @ R @ K.T, K)
         self.P_aug = T @ self.P_aug @ T.T
         self.P = self.P + K @ R @ K.T
         e = K @ r

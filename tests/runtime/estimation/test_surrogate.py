@@ -2,12 +2,14 @@
 reference is the C filter over a short line run; the draws of the recorded linear system have the
 filter's covariance (their NEES averages to the dimension within its standard error), and that
 check fails when one recorded noise or map is left out; blocks of draws are scored as
-`consistency` scores runs."""
+`consistency` scores runs; the command writes them and refuses a bad block size."""
+import json
+
 import numpy as np
 import pytest
 
 from runtime.estimation.consistency import nees, nees_band, run_once
-from runtime.estimation.surrogate import RecordingReference, block_statistics, record_run, simulate
+from runtime.estimation.surrogate import RecordingReference, block_statistics, main, record_run, simulate
 from runtime.verification.ekf_reference import NB
 
 from .test_tasks import short
@@ -69,9 +71,9 @@ class Muted(RecordingReference):
             return muted
         return attr
 
-    def noise(self, rows, C):
+    def noise(self, rows, C, gain=None):
         if not (getattr(self, "muting", False) and self.kind == "noise" and len(rows) > 5):
-            super().noise(rows, C)
+            super().noise(rows, C, gain)
 
     def linear(self, T):
         if not (getattr(self, "muting", False) and self.kind == "linear"):
@@ -94,3 +96,16 @@ def test_the_covariance_check_fails_for_a_surrogate_without_one_term(broken, mon
     monkeypatch.setattr(surrogate, "RecordingReference", broken)
     rec = record_run(short("line"), None, seed=0)
     assert abs(nees_offset(rec, simulate(rec, DRAWS, seed=1))) > 10.0
+
+
+def test_the_command_writes_the_blocks_and_their_summary(tmp_path):
+    out = tmp_path / "surrogate.json"
+    assert main(["line", "--duration", "4", "--draws", "100", "--block", "50", "--out", str(out)]) == 0
+    report = json.loads(out.read_text())
+    assert len(report["blocks"]) == report["summary"]["blocks"] == 2
+    assert report["summary"]["inside_mean"] == pytest.approx(np.mean([b["inside"] for b in report["blocks"]]))
+
+
+def test_the_command_refuses_fewer_draws_than_a_block(capsys):
+    assert main(["line", "--draws", "10", "--block", "50"]) == 2
+    assert "--draws" in capsys.readouterr().err
