@@ -38,6 +38,7 @@ class RecordingReference(EkfReference):
         super().__init__(*args, **kwargs)
 
     def linear(self, T):
+        """Records e ← T e: a resize (T not square) or the rows T changes, on the columns they read."""
         n_new, n_old = T.shape
         if n_new != n_old:
             unit = np.abs(T).sum(axis=1) > 0
@@ -49,6 +50,7 @@ class RecordingReference(EkfReference):
             self.ops.append(("map", rows, cols, T[np.ix_(rows, cols)].copy()))
 
     def noise(self, rows, C, gain=None):
+        """Records a noise of covariance C on `rows` as a factor L (C = L Lᵀ), with its context and gain."""
         w, V = np.linalg.eigh(0.5 * (C + C.T))
         keep = w > 1e-14 * max(w.max(), 1e-300)
         self.ops.append(("noise", np.asarray(rows), V[:, keep] * np.sqrt(w[keep]), self.context, gain))
@@ -73,12 +75,14 @@ class ReferenceFilter:
         self.ref.context = (kind, i, self.t)
 
     def predict(self, u, dt):
+        """`Ekf.predict`."""
         n = self.ekf.noise
         self.ref.context = ("predict", self.t, self.t + dt)
         self.ref.predict(u, dt, self.psd, n.gyro_bias_rw, n.accel_bias_rw)
         self.t += dt
 
     def update_imu(self, y, u):
+        """`Ekf.update_imu`: the held update when the noise holds the disturbance, else per axis."""
         n, gate = self.ekf.noise, self.ekf.gate["imu"]
         self._at("imu")
         if n.torque_hold > 0:
@@ -86,43 +90,53 @@ class ReferenceFilter:
         return self.ref.update_imu(y, u, self.ekf.mount, n.gyro, n.accel, gate)
 
     def update_encoders(self, y):
+        """`Ekf.update_encoders`."""
         self._at("encoders")
         return self.ref.update_encoders(y, self.ekf.noise.encoder, self.ekf.gate["encoders"])
 
     def update_position(self, y):
+        """`Ekf.update_position`."""
         self._at("position")
         return self.ref.update_position(y, self.ekf.noise.position, self.ekf.gate["position"])
 
     def mark_position(self, slot):
+        """`Ekf.mark_position`."""
         self.ref.mark_position(slot)
 
     def update_position_delayed(self, slot, y):
+        """`Ekf.update_position_delayed`."""
         self._at("position")
         return self.ref.update_position_delayed(slot, y, self.ekf.noise.position, self.ekf.gate["position"])
 
     def update_heading(self, y):
+        """`Ekf.update_heading`."""
         self._at("heading")
         return self.ref.update_heading(y, self.ekf.heading_mount, self.ekf.noise.heading, self.ekf.gate["heading"])
 
     @property
     def x(self):
+        """The state (35,)."""
         return self.ref.x.copy()
 
     @property
     def biases(self):
+        """The biases (6,)."""
         return self.ref.b.copy()
 
     @property
     def P(self):
+        """The covariance (18, 18); reading it marks a sample in the recorded maps."""
         self.ref.ops.append(("sample",))
         return self.ref.P
 
     @property
     def sigma(self):
+        """The error state's standard deviations (18,)."""
         return np.sqrt(np.diag(self.ref.P))
 
     @property
     def counters(self):
+        """`Ekf.counters`: per kind accepted, gated, recovered and the last NIS."""
         r = self.ref
         return {k: {"accepted": r.accepted[k], "gated": r.gated[k], "recovered": r.recovered[k], "nis": r.nis[k]}
                 for k in r.accepted}
@@ -203,21 +217,33 @@ def summarise(blocks):
 
 
 def build_parser():
+    """The command's arguments."""
+    from ..cli_types import duration, whole_number as whole
     p = argparse.ArgumentParser(prog="python -m runtime surrogate", description=__doc__.split("\n\n")[0])
-    p.add_argument("run", help="a shipped scenario or task name, or a file")
-    p.add_argument("--sensors", default="default")
-    p.add_argument("--seed", type=int, default=0, help="the sense run whose filter is recorded")
-    p.add_argument("--duration", type=float, default=None)
-    p.add_argument("--draws", type=int, default=1000)
-    p.add_argument("--block", type=int, default=50)
-    p.add_argument("--out", default=None, help="a JSON file for the summary and the blocks")
+    p.add_argument("run", metavar="SCENARIO|TASK", help="a shipped scenario or task, or a .toml file")
+    p.add_argument("--sensors", metavar="FILE", default="default", help="a sensor set (default: the default set)")
+    p.add_argument("--seed", type=whole(0), default=0, help="the sense run whose filter is recorded (default 0)")
+    p.add_argument("--duration", type=duration, help="simulate only this long [s]")
+    p.add_argument("--draws", type=whole(2), default=1000, help="draws of the linear system (default 1000)")
+    p.add_argument("--block", type=whole(2), default=50, help="draws scored together, as runs (default 50)")
+    p.add_argument("--out", metavar="FILE", help="a JSON file for the summary and every block")
     return p
 
 
 def main(argv):
+    """`python -m runtime surrogate`: records the run, draws, scores the blocks, prints the summary;
+    exit status 2 on a bad argument."""
+    from .sense import load_run
+    from ..sensor_set import load_sensor_set
     args = build_parser().parse_args(argv)
-    if args.block < 2 or args.draws < args.block:
-        print(f"--draws, --block: expected draws >= block >= 2, got {args.draws} and {args.block}", file=sys.stderr)
+    if args.draws < args.block:
+        print(f"--draws: expected at least --block ({args.block}), got {args.draws}", file=sys.stderr)
+        return 2
+    try:
+        load_run(args.run)
+        load_sensor_set(args.sensors)
+    except ValueError as exc:
+        print(exc, file=sys.stderr)
         return 2
     rec = record_run(args.run, args.sensors, args.seed, duration=args.duration)
     e = simulate(rec, args.draws, seed=[args.seed, 2])
