@@ -22,6 +22,8 @@ import sys
 import numpy as np
 
 from ..ekf import RECOVER_AFTER, start_from_measurements
+from ..model import Model
+from ..state import IDX_E_NU, NE
 from ..verification.ekf_reference import NB, EkfReference
 from .consistency import COMPONENTS, NEES_TARGET, WITHIN_TARGET, consistency, run_once
 
@@ -77,7 +79,8 @@ class ReferenceFilter:
     def predict(self, u, dt):
         """`Ekf.predict`."""
         n = self.ekf.noise
-        self.ref.context = ("predict", self.t, self.t + dt)
+        white = dt - (min(dt, self.ref.held_remaining) if self.ref.held is not None else 0.0)
+        self.ref.context = ("predict", self.t, self.t + dt, white)
         self.ref.predict(u, dt, self.psd, n.gyro_bias_rw, n.accel_bias_rw)
         self.t += dt
 
@@ -188,6 +191,80 @@ def simulate(rec, runs, seed):
     return np.einsum("mij,rmj->rmi", rec["T"], d)
 
 
+def truth_draws(run, sensors, seed, duration=None):
+    """What the truth of `record_run`'s run drew, as the filter's linear model takes it: per sample
+    the measurement noise (reading less the noiseless reading of the truth, so the encoders'
+    quantisation too) by kind, the torque disturbance's acceleration M⁻¹ w per step ("a"), the
+    biases per step ("b"), the step ("dt"), the truth's start ("x0"; "model" the truth's robot)."""
+    import math
+    from ..sensor_sim import STREAMS
+    from .. import sensors as readings
+    from .estimate import claimed_params
+    from .sense import load_run, simulate_log
+    from ..sensor_set import SensorSet, load_sensor_set
+    task = load_run(run) if isinstance(run, str) else run
+    sensors = sensors if sensors is None or isinstance(sensors, SensorSet) else load_sensor_set(sensors)
+    if duration is not None:
+        import dataclasses
+        from ..scenario import Scenario
+        scenario = task if isinstance(task, Scenario) else task.scenario
+        short = scenario.with_overrides(steps=max(1, round(duration / scenario.dt)))
+        task = short if isinstance(task, Scenario) else dataclasses.replace(task, scenario=short)
+    log = simulate_log(task, sensors, seed=seed)
+    model = Model(claimed_params(log))
+    xs, bs, dt, spec = log.truth_states(), log.truth_biases(), float(log.meta["dt"]), log.sensors
+    stream = np.random.default_rng(np.random.SeedSequence(seed).spawn(len(STREAMS))[STREAMS.index("process")])
+    q_std = spec.process.generalized() / math.sqrt(dt)
+    a = np.array([np.linalg.solve(model.inertia(xs[k]), stream.normal(0.0, 1.0, 5) * q_std)
+                  for k in range(len(xs) - 1)])
+
+    def step(t):
+        return int(round(t / dt))
+
+    imu = [log.imu.data[i] - readings.imu(model, xs[step(t)], model.accel(xs[step(t)], log.torque_at(t))
+                                          + (a[step(t)] if step(t) < len(a) else 0.0),
+                                          mount=spec.imu.mount, bias=bs[step(t)])
+           for i, t in enumerate(log.imu.t)]
+    out = {"imu": np.array(imu), "a": a, "b": bs, "dt": dt, "x0": xs[0], "model": model,
+           "encoders": np.array([log.encoders.data[i] - readings.encoders(model, xs[step(t)])
+                                 for i, t in enumerate(log.encoders.t)])}
+    if log.fixes is not None and len(log.fixes):
+        out["position"] = np.array([log.fixes.select("x", "y")[i] - readings.position(model, xs[step(t)])
+                                    for i, t in enumerate(log.fixes["t_measured"])])
+    return out
+
+
+def driven(rec, draws):
+    """The recorded linear system driven by the truth's own draws (`truth_draws`) from the run's
+    start error: e ← T e at every map; at every noise the draw it stands for (an update's −K v, the
+    held disturbance's a, the biases' steps, M⁻¹ w over the part of a step no held a covers); the current error at the
+    scored samples in the physical components (m, 18), to compare with the run's own ("e")."""
+    dt, model = draws["dt"], draws["model"]
+    e = np.concatenate([model.local(rec["x0"], draws["x0"]), draws["b"][0] - rec["b0"]])
+    samples = []
+    for op in rec["ops"]:
+        if op[0] == "map":
+            _, rows, cols, M = op
+            e[rows] = M @ e[cols]
+        elif op[0] == "resize":
+            e = np.where(op[1] >= 0, e[np.maximum(op[1], 0)], 0.0)
+        elif op[0] == "noise":
+            _, rows, L, context, gain = op
+            if context[0] == "predict":
+                k0, k1 = int(round(context[1] / dt)), int(round(context[2] / dt))
+                e[rows[NE:NB]] += draws["b"][k1] - draws["b"][k0]
+                if k0 < len(draws["a"]):         # the part of the step no held disturbance covers
+                    e[rows[IDX_E_NU]] += draws["a"][k0] * context[3]
+            elif gain is None:
+                k = int(round(context[2] / dt))
+                e[rows] += draws["a"][k] if k < len(draws["a"]) else 0.0
+            else:
+                e[rows] -= gain @ draws[context[0]][context[1]]
+        else:
+            samples.append(e[:NB].copy())
+    return np.einsum("mij,mj->mi", rec["T"], np.stack(samples)[rec["scored"]])
+
+
 def block_statistics(rec, e, block=50):
     """`consistency` over consecutive blocks of `block` draws, each draw a run with the recorded P:
     per block the share of samples in the band and the share within ±3σ per component."""
@@ -228,6 +305,8 @@ def build_parser():
     p.add_argument("--draws", type=whole(2), default=1000, help="draws of the linear system (default 1000)")
     p.add_argument("--block", type=whole(2), default=50, help="draws scored together, as runs (default 50)")
     p.add_argument("--out", metavar="FILE", help="a JSON file for the summary and every block")
+    p.add_argument("--driven", type=whole(1), metavar="N", help="instead: seeds seed … seed + N − 1, each "
+                   "run's error²/σ² and its linear model's driven by its own draws (`driven`)")
     return p
 
 
@@ -246,6 +325,8 @@ def main(argv):
     except ValueError as exc:
         print(exc, file=sys.stderr)
         return 2
+    if args.driven:
+        return _main_driven(args)
     rec = record_run(args.run, args.sensors, args.seed, duration=args.duration)
     e = simulate(rec, args.draws, seed=[args.seed, 2])
     blocks = block_statistics(rec, e, args.block)
@@ -257,4 +338,30 @@ def main(argv):
         with open(args.out, "w") as fh:
             fh.write(text)
     print(json.dumps(out["summary"], indent=1))
+    return 0
+
+
+def compare_driven(run, sensors, seeds, duration=None):
+    """Per seed the mean error² / σ² per component of the run and of its linear model driven by
+    its own draws: {"seeds", "components", "run" (n, 18), "linear" (n, 18)}."""
+    real, linear = [], []
+    for seed in seeds:
+        rec = record_run(run, sensors, seed, duration=duration)
+        lin = driven(rec, truth_draws(run, sensors, seed, duration=duration))
+        var = np.diagonal(rec["P"], axis1=1, axis2=2)
+        real.append(np.mean(rec["e"] ** 2 / var, axis=0))
+        linear.append(np.mean(lin ** 2 / var, axis=0))
+    return {"seeds": list(seeds), "components": list(COMPONENTS), "run": np.array(real), "linear": np.array(linear)}
+
+
+def _main_driven(args):
+    out = compare_driven(args.run, args.sensors, range(args.seed, args.seed + args.driven), args.duration)
+    table = {"seeds": out["seeds"], "components": out["components"],
+             "run": out["run"].tolist(), "linear": out["linear"].tolist(),
+             "mean": {c: [float(out["run"][:, k].mean()), float(out["linear"][:, k].mean())]
+                      for k, c in enumerate(COMPONENTS)}}
+    if args.out:
+        with open(args.out, "w") as fh:
+            fh.write(json.dumps(table, indent=1))
+    print(json.dumps(table["mean"], indent=1))
     return 0

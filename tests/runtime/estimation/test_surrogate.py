@@ -2,14 +2,17 @@
 reference is the C filter over a short line run; the draws of the recorded linear system have the
 filter's covariance (their NEES averages to the dimension within its standard error), and that
 check fails when one recorded noise or map is left out; blocks of draws are scored as
-`consistency` scores runs; the command writes them and refuses a bad block size."""
+`consistency` scores runs; driven by the truth's own draws the recorded linear system tracks the
+run's own error, and does not without one of those draws; the command writes the blocks and
+refuses a bad block size."""
 import json
 
 import numpy as np
 import pytest
 
 from runtime.estimation.consistency import nees, nees_band, run_once
-from runtime.estimation.surrogate import RecordingReference, block_statistics, main, record_run, simulate
+from runtime.estimation.surrogate import (RecordingReference, block_statistics, driven, main, record_run, simulate,
+                                          truth_draws)
 from runtime.verification.ekf_reference import NB
 
 from .test_tasks import short
@@ -109,3 +112,32 @@ def test_the_command_writes_the_blocks_and_their_summary(tmp_path):
 def test_the_command_refuses_fewer_draws_than_a_block(capsys):
     assert main(["line", "--draws", "10", "--block", "50"]) == 2
     assert "--draws" in capsys.readouterr().err
+
+
+@pytest.fixture(scope="module")
+def draws():
+    return truth_draws(short("line"), None, seed=0)
+
+
+def tracking(rec, lin):
+    """The RMS over the samples and the components of the run's error less the linear system's, in σ."""
+    sigma = np.sqrt(np.diagonal(rec["P"], axis1=1, axis2=2))
+    return float(np.sqrt(np.mean(((rec["e"] - lin) / sigma) ** 2)))
+
+
+def test_driven_by_the_truths_draws_the_linear_model_tracks_the_runs_error(recorded, draws):
+    assert tracking(recorded, driven(recorded, draws)) <= 0.25
+
+
+@pytest.mark.parametrize("left_out", ["imu", "encoders", "a"])
+def test_the_tracking_fails_without_one_of_the_truths_draws(recorded, draws, left_out):
+    assert tracking(recorded, driven(recorded, {**draws, left_out: 0 * draws[left_out]})) > 0.25
+
+
+def test_the_command_compares_a_run_with_its_driven_linear_model(tmp_path):
+    out = tmp_path / "driven.json"
+    assert main(["line", "--duration", "4", "--driven", "1", "--out", str(out)]) == 0
+    report = json.loads(out.read_text())
+    assert report["seeds"] == [0]
+    k = report["components"].index("tilt_x")
+    assert report["mean"]["tilt_x"] == pytest.approx([report["run"][0][k], report["linear"][0][k]])
