@@ -27,6 +27,7 @@ COMMANDS = {
     "sense": ("runtime.estimation.sense", "simulate the sensors along a scenario or task: a log and its truth"),
     "estimate": ("runtime.estimation.estimate", "run the EKF over a sensor log: the estimate, its sigmas, the errors"),
     "consistency": ("runtime.estimation.consistency", "Monte Carlo consistency of the EKF (NEES, 3 sigma) over seeded runs, on Dask"),
+    "surrogate": ("runtime.estimation.surrogate", "the linear-Gaussian surrogate of a consistency run: the in-band share's spread for a consistent filter"),
     "estimation-figures": ("runtime.estimation.figures", "regenerate docs/estimation.md's frames and estimate figures"),
     "base-parameters": ("runtime.identification.base_parameters", "the identifiable combinations of the inertial parameters (docs/identification.md)"),
     "excite": ("runtime.identification.excite", "a D-optimal torque program for identifying named parameters, as a scenario"),

@@ -73,14 +73,16 @@ def nees_band(dims, runs, probability=BAND):
 
 
 def run_once(run, sensors, seed, duration=None, plant_mismatch=False, every=EVERY, accel_noise="held",
-             constrained=None):
+             constrained=None, make_filter=None):
     """One Monte Carlo run: the sensors `sensors` (a SensorSet, a shipped set's name or a file)
     simulated along `run` (a shipped scenario or task name, a file, or the object) with `seed`,
     the filter over the log (accelerometer rule `accel_noise`, observability constraint `constrained`
     (None: `estimate_log`'s rule), `estimate_log`), started from the truth's
     heading off by a seeded N(0, 10°) draw.  Returns {"seed", "t" (m,), "e" (m, 18), "P" (m, 18, 18) (COMPONENTS,
     from SETTLE_S on), "metrics" (`errors`), "counters", "fixes" (whether the set has fixes or a
-    heading)}."""
+    heading)}.  With `make_filter` (`estimate_log`'s, None: the C filter) also "T" (m, 18, 18), the
+    filter's errors to the components, and "scored", the indices of the scored rows among the rows
+    whose covariance was read."""
     from ..sensor_set import SensorSet, load_sensor_set
     from ..scenario import Scenario
     from .sense import load_run, simulate_log
@@ -94,8 +96,9 @@ def run_once(run, sensors, seed, duration=None, plant_mismatch=False, every=EVER
     # The operator's heading at the start is the truth's off by a draw of the σ the start rule
     # assumes: started at the truth's, the filter would look conservative in heading by design.
     heading = start_heading(log) + np.random.default_rng([seed, 1]).normal(0.0, START_HEADING_SIGMA)
+    options = {} if make_filter is None else {"make_filter": make_filter}
     result = estimate_log(log, heading=heading, covariance_every=every, accel_noise=accel_noise,
-                          constrained=constrained)
+                          constrained=constrained, **options)
     model = Model(claimed_params(log))
     rows = result.P_rows
     start = min(SETTLE_S, result.t[-1] / 2)
@@ -108,9 +111,12 @@ def run_once(run, sensors, seed, duration=None, plant_mismatch=False, every=EVER
     T = transform(x, log.sensors.imu.mount.body)
     e = np.einsum("nij,nj->ni", T, np.column_stack([d, db]))
     P = T @ result.P[keep] @ np.transpose(T, (0, 2, 1))
-    return {"seed": int(seed), "t": result.t[rows], "e": e, "P": P, "metrics": errors(log, result),
-            "counters": result.counters,
-            "fixes": log.sensors.fixes is not None or log.sensors.heading is not None}
+    out = {"seed": int(seed), "t": result.t[rows], "e": e, "P": P, "metrics": errors(log, result),
+           "counters": result.counters,
+           "fixes": log.sensors.fixes is not None or log.sensors.heading is not None}
+    if make_filter is not None:
+        out["T"], out["scored"] = T, np.flatnonzero(keep)
+    return out
 
 
 def drift(e, sigma):

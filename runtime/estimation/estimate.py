@@ -98,7 +98,7 @@ def prediction_method(log):
 
 
 def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progress=None, covariance_every=None,
-                 accel_noise="held", constrained=None):
+                 accel_noise="held", constrained=None, make_filter=start_from_measurements):
     """Run the filter over `log` (runtime.estimation.logs.Log) for the robot `params` (None: the one
     the log claims, else the paper's simulation robot), started by the start rule (the first
     START_SAMPLES accelerometer samples, the first encoder sample, the first fix and heading if the
@@ -109,7 +109,8 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
     `ekf_noise`'s accelerometer rule ("held", the default, "largest", "each") when `noise` is None.  `constrained`:
     the filter's observability constraint (`Ekf`'s; docs/estimation.md, "Observability constraint"),
     None: on when the log has neither fixes nor a heading (nothing that sees the heading and the
-    position), off otherwise."""
+    position), off otherwise.  `make_filter`: what makes the filter from the start rule's arguments (another
+    filter with `Ekf`'s methods, such as runtime.estimation.surrogate's recording reference)."""
     if constrained is not None and not isinstance(constrained, bool):
         raise ValueError(f"constrained: expected True, False or None (on without fixes and heading), got {constrained!r}")
     if covariance_every is not None and (isinstance(covariance_every, bool) or not isinstance(
@@ -131,10 +132,10 @@ def estimate_log(log, params=None, noise=None, gate=0.999, heading=None, progres
         start["fix"] = log.fixes.select("x", "y")[0]
     if log.heading is not None and len(log.heading):
         start["heading"] = float(log.heading["psi"][0])
-    ekf = start_from_measurements(model, noise=noise, mount=sensors.imu.mount, gate=gate,
-                                  heading_prior=start_heading(log) if heading is None else heading,
-                                  rate_sigma=MOVING_RATE_SIGMA if moving_at_start(log) else 0.01,
-                                  method=prediction_method(log), constrained=constrained, **start)
+    ekf = make_filter(model, noise=noise, mount=sensors.imu.mount, gate=gate,
+                      heading_prior=start_heading(log) if heading is None else heading,
+                      rate_sigma=MOVING_RATE_SIGMA if moving_at_start(log) else 0.01,
+                      method=prediction_method(log), constrained=constrained, **start)
     late = []                                   # (t_measured, index) of the fixes that arrive late
     if log.fixes is not None and len(log.fixes):
         measured = log.fixes["t_measured"]

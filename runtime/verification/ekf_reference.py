@@ -30,6 +30,12 @@ see in the error coordinates (`unobservable`), is taken at the start and after e
 predicted state, and moved by every reset (N ← G N); the predict's F is replaced by
 F − (F N − N') (Nᵀ N)⁻¹ Nᵀ with N' at the new state, the IMU's and the encoders' H by
 H − H N (Nᵀ N)⁻¹ Nᵀ, both written out as such.
+
+Every change of P_aug is announced to two hooks that do nothing here: `linear(T)` (the augmented
+error e ← T e, T of any shape: a step, a gain, a reset, a clone, a block appended or dropped) and
+`noise(rows, C, gain)` (then e[rows] += w, w of covariance C; for an update −K v, v its sample's noise); a gated sample announces nothing.  A
+subclass that records them has the linear error system the filter assumes
+(runtime/estimation/surrogate.py).
 """
 import numpy as np
 
@@ -108,11 +114,19 @@ class EkfReference:
     def P(self, value):
         self.P_aug[:NB, :NB] = value
 
+    def linear(self, T):
+        """Hook: the augmented error has become T e (T (new size, old size))."""
+
+    def noise(self, rows, C, gain=None):
+        """Hook: the augmented error's entries `rows` have then received noise of covariance C (an
+        update's K R Kᵀ, with its `gain` K)."""
+
     def transform(self, A):
         """The current error e ← A e with the clones kept: P_aug ← T P_aug Tᵀ, T = diag(A, I)
         (the current block itself is set by the equation's own method)."""
         T = np.eye(len(self.P_aug))
         T[:NB, :NB] = A
+        self.linear(T)
         P = self.P
         self.P_aug = T @ self.P_aug @ T.T
         self.P = P
@@ -123,6 +137,7 @@ class EkfReference:
         n = len(self.P_aug)
         k = n - (NV if self.held is not None else 0)     # before the held disturbance's block
         T = np.vstack([np.eye(n)[:k], np.eye(NB, n), np.eye(n)[k:]])
+        self.linear(T)
         self.P_aug = T @ self.P_aug @ T.T
         self.clones[slot] = self.x.copy()
 
@@ -131,6 +146,7 @@ class EkfReference:
         if slot in self.clones:
             k = NB * (1 + list(self.clones).index(slot))
             keep = np.r_[0:k, k + NB:len(self.P_aug)]
+            self.linear(np.eye(len(self.P_aug))[keep])
             self.P_aug = self.P_aug[np.ix_(keep, keep)]
             del self.clones[slot]
 
@@ -169,10 +185,13 @@ class EkfReference:
             T = np.eye(n)
             T[:NE, :NE] = F
             T[IDX_E_NU, n - NV:] = g * np.eye(NV)
+            self.linear(T)
+            self.noise(np.r_[0:NB], Q)
             self.P_aug = T @ self.P_aug @ T.T
             self.P = self.P + Q
             self.held_remaining -= g
             if not self.held_remaining > 1e-9 * dt:
+                self.linear(np.eye(n)[:n - NV])
                 self.P_aug = self.P_aug[:n - NV, :n - NV]
                 self.held = None
             return
@@ -183,6 +202,7 @@ class EkfReference:
         Phi = np.eye(NB)
         Phi[:NE, :NE] = F
         self.transform(Phi)
+        self.noise(np.r_[0:NB], Q)
         self.P = P
 
     def constrain_transition(self, F):
@@ -267,6 +287,7 @@ class EkfReference:
         e = K @ r
         P = self.joseph(K, H, R)
         self.transform(np.eye(NB) - K @ H)
+        self.noise(np.r_[0:NB], K @ R @ K.T, K)
         self.P = P
         self.inject(e)
         self.reset(e)
@@ -294,6 +315,8 @@ class EkfReference:
             n = len(self.P_aug)
             P_aug = np.zeros((n + NV, n + NV))
             P_aug[:n, :n], P_aug[n:, n:] = self.P_aug, Qa
+            self.linear(np.eye(n + NV, n))
+            self.noise(np.r_[n:n + NV], Qa)
             self.P_aug, self.held, self.held_remaining = P_aug, np.zeros(NV), hold
         n = len(self.P_aug)
         H_aug = np.zeros((6, n))
@@ -306,6 +329,7 @@ class EkfReference:
         lam = self.admission("imu", nis, gate)
         if lam is None:
             if new:
+                self.linear(np.eye(n)[:n - NV])
                 self.P_aug, self.held = self.P_aug[:n - NV, :n - NV], None
             return False
         if lam != 1.0:
@@ -316,6 +340,8 @@ class EkfReference:
         K = np.linalg.solve(S, H_aug @ self.P_aug[:, rows]).T
         T = np.eye(n)
         T[rows] -= K @ H_aug
+        self.linear(T)
+        self.noise(rows, K @ R @ K.T, K)
         self.P_aug = T @ self.P_aug @ T.T
         self.P_aug[np.ix_(rows, rows)] += K @ R @ K.T
         e = K[:NB] @ r
@@ -366,6 +392,8 @@ class EkfReference:
         K = np.linalg.solve(S, H_aug @ self.P_aug[:, :NB]).T
         T = np.eye(len(self.P_aug))
         T[:NB] -= K @ H_aug
+        self.linear(T)
+        self.noise(np.r_[0:NB], K @ R @ K.T, K)
         self.P_aug = T @ self.P_aug @ T.T
         self.P = self.P + K @ R @ K.T
         e = K @ r
