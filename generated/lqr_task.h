@@ -540,7 +540,9 @@ static const sr_lqr LQR_TASK_SCHEDULE = {
         SR_C(-5.281310206835861), SR_C(0.13258243023949434), SR_C(-0.07829169530903524), SR_C(-2.6113563450398796), SR_C(-0.05694952247904448), SR_C(-0.9735174058418693),
         SR_C(1.4869120776697804), SR_C(-2.1512513435541254), SR_C(22.585902034844214), SR_C(1.956401672570674), SR_C(5.063635989630936), SR_C(-4.606578788361187),
         SR_C(23.794729828942955), SR_C(0.5759096228334586), SR_C(0.4827267069160485), SR_C(12.089666887022034), SR_C(0.4520748547183346), SR_C(-0.1049584712461158)}},
-    /* tight_band, tight_rise, world_share, tight_fall, tight_wait */ SR_C(0.1), SR_C(10.0), SR_C(0.0), SR_C(10.0), SR_C(0.25)
+    /* tight_band, tight_rise, world_share, tight_fall, tight_wait */ SR_C(0.1), SR_C(10.0), SR_C(0.0), SR_C(10.0), SR_C(0.25),
+    /* K_heading_tight */ {{0}},
+    /* heading_band, heading_rise */ SR_C(0.0), SR_C(2.0)
 };
 
 #endif /* LQR_TASK_H */

@@ -722,7 +722,13 @@ int sr_regressor_batch(const sr_model *model, long n, const sr_real *x, const sr
  * at once when the bound falls, w >= -tight_wait: below 0 the gain is K_path's (a wait before
  * the tight gains return).  Held at the limits, the tight gains on a robot off the model
  * switch the steering torque between them for seconds and the robot leaves the path.  The integral columns stay K_path's, so moving w moves no torque through the
- * integrals (the integrators carry over unchanged between the gains). */
+ * integrals (the integrators carry over unchanged between the gains).
+ * Heading references have the same mechanism on the heading: with heading_band > 0 the gain's
+ * columns 0..9 are (1 - w) K_heading + w K_heading_tight, w <= 1 - |z[2] - z*[2]| / heading_band
+ * (z[2], the yaw of the attitude error: the heading error), rising by at most
+ * period / heading_rise per sample, after a clipped sample as above (tight_fall, tight_wait);
+ * the integral columns stay K_heading's.  Stiffer heading gains hold the heading closer under
+ * the process noise but, as a linear law on the saturating steering, lose a large step. */
 /** @{ */
 #define SR_LQR_NZ 12               /**< entries of the error coordinates z */
 #ifndef SR_LQR_MAX_SPEEDS
@@ -765,6 +771,9 @@ typedef struct sr_lqr {
     sr_real world_share;                           /**< in [0, 1]: the share of the integral of e_y held as a world vector along the path's left normal (it cancels a pull that turns with the heading, such as a slope's on a turning path); 0: all of it along the path */
     sr_real tight_fall;                            /**< [s], >= 0: after a sample that clipped a torque K_tight's weight falls by period / tight_fall; 0: it holds */
     sr_real tight_wait;                           /**< in [0, 1]: the weight falls to -tight_wait at the lowest; below 0 the gain is K_path, so the tight gains return up to tight_wait * tight_rise after a clip ends */
+    sr_real K_heading_tight[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_NU * SR_LQR_NZ]; /**< stiffer heading gains for heading references, scheduled in near the heading (their integral columns are not read) */
+    sr_real heading_band;                          /**< [rad], >= 0: K_heading_tight's weight is at most 1 - |heading error| / heading_band; 0: K_heading_tight unused */
+    sr_real heading_rise;                          /**< [s], > 0 when heading_band > 0: K_heading_tight's weight rises from 0 to 1 in no less than this */
 } sr_lqr;
 
 /** What to track at this sample (from the reference). */
@@ -782,13 +791,13 @@ typedef struct sr_lqr_memory {
     sr_real kappa;         /**< the operating point's curvature [1/m] */
     int started;           /**< 0 until the first sample */
     int saturated;         /**< out: the last sample clipped a torque */
-    sr_real tight;         /**< K_tight's weight in [0, 1] at the last sample */
+    sr_real tight;         /**< the tight gains' weight (K_tight's on a path, K_heading_tight's on a heading) at the last sample */
     sr_real world[2];      /**< the world part of the integral of e_y (x, y) [m s]: z[10] is integrals[0] plus its component along the path's left normal */
 } sr_lqr_memory;
 
 /** Checks a schedule: sizes in range, grids strictly increasing, every entry finite, period
  * and u_max > 0, kappa_rate, steady_rate, tight_band and tight_fall >= 0, tight_wait in [0, 1], tight_rise > 0 when tight_band > 0
- * (K_tight is read only then).  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
+ * (K_tight is read only then), heading_band >= 0, heading_rise > 0 when heading_band > 0 (K_heading_tight is read only then).  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
 int sr_lqr_check(const sr_lqr *lqr);
 
 /** Zeroes the memory.  Returns SR_OK or SR_ERR_NULL. */

@@ -19,7 +19,8 @@ static int valid_sizes(const sr_lqr *lqr)
         && lqr->n_curvatures <= SR_LQR_MAX_CURVATURES && lqr->period > 0 && lqr->u_max > 0
         && lqr->kappa_rate >= 0 && lqr->steady_rate >= 0 && lqr->tight_band >= 0
         && (lqr->tight_band == 0 || lqr->tight_rise > 0) && lqr->world_share >= 0 && lqr->world_share <= 1
-        && lqr->tight_fall >= 0 && lqr->tight_wait >= 0 && lqr->tight_wait <= 1;
+        && lqr->tight_fall >= 0 && lqr->tight_wait >= 0 && lqr->tight_wait <= 1 && lqr->heading_band >= 0
+        && (lqr->heading_band == 0 || lqr->heading_rise > 0);
 }
 
 int sr_lqr_check(const sr_lqr *lqr)
@@ -29,7 +30,7 @@ int sr_lqr_check(const sr_lqr *lqr)
     if (!all_finite(&lqr->period, 1) || !all_finite(&lqr->u_max, 1) || !all_finite(&lqr->kappa_rate, 1)
         || !all_finite(&lqr->steady_rate, 1) || !all_finite(&lqr->tight_band, 1) || !all_finite(&lqr->tight_rise, 1)
         || !all_finite(&lqr->tight_fall, 1) || !all_finite(&lqr->tight_wait, 1)
-        || !all_finite(&lqr->world_share, 1))
+        || !all_finite(&lqr->world_share, 1) || !all_finite(&lqr->heading_band, 1) || !all_finite(&lqr->heading_rise, 1))
         return SR_ERR_NONFINITE;
     if (!valid_sizes(lqr)) return SR_ERR_ARG;
     n = lqr->n_speeds * lqr->n_curvatures;
@@ -38,7 +39,8 @@ int sr_lqr_check(const sr_lqr *lqr)
     for (i = 0; i < n; ++i)
         if (!all_finite(lqr->z_star[i], SR_LQR_NZ) || !all_finite(lqr->u_star[i], SR_NU)
             || !all_finite(lqr->K_path[i], SR_NU * SR_LQR_NZ) || !all_finite(lqr->K_heading[i], SR_NU * SR_LQR_NZ)
-            || (lqr->tight_band > 0 && !all_finite(lqr->K_tight[i], SR_NU * SR_LQR_NZ)))
+            || (lqr->tight_band > 0 && !all_finite(lqr->K_tight[i], SR_NU * SR_LQR_NZ))
+            || (lqr->heading_band > 0 && !all_finite(lqr->K_heading_tight[i], SR_NU * SR_LQR_NZ)))
             return SR_ERR_NONFINITE;
     for (i = 1; i < lqr->n_speeds; ++i)
         if (!(lqr->speeds[i] > lqr->speeds[i - 1])) return SR_ERR_ARG;
@@ -123,7 +125,7 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
                    sr_real u_raw[SR_NU])
 {
     sr_real z[SR_LQR_NZ], dz[SR_LQR_NZ], out[SR_NU], raw[SR_NU], kappa, step, wv, wk;
-    sr_real weight[4], k_int[SR_NU][2], step_int[2], tight = 0, normal[2], integrals[2];
+    sr_real weight[4], k_int[SR_NU][2], step_int[2], tight = 0, normal[2], integrals[2], band;
     int status = arg_model(model, READS(STATE)), i0, i1, j0, j1, k, j, n, point[4], clipped = 0;
     if (status != SR_OK) return status;
     if (!lqr || !x || !target || !memory || !u) return SR_ERR_NULL;
@@ -162,9 +164,11 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
     /* The tight gains' weight: bounded by how near the path the robot is, rising slowly (a transient
      * must have died down) and falling after a clipped torque, below 0 (K_path's gain, a wait before
      * the tight gains return): held at the limits, they switch the steering torque between them. */
-    if (target->path && lqr->tight_band > 0) {
-        sr_real bound = 1 - SR_FABS(dz[9]) / lqr->tight_band, prev = memory->tight;
-        sr_real rise = !memory->saturated ? prev + lqr->period / lqr->tight_rise
+    /* On a heading reference the same with the heading error z[2] against heading_band. */
+    band = target->path ? lqr->tight_band : lqr->heading_band;
+    if (band > 0) {
+        sr_real bound = 1 - SR_FABS(dz[target->path ? 9 : 2]) / band, prev = memory->tight;
+        sr_real rise = !memory->saturated ? prev + lqr->period / (target->path ? lqr->tight_rise : lqr->heading_rise)
                      : (lqr->tight_fall > 0 ? prev - lqr->period / lqr->tight_fall : prev);
         bound = bound < 0 ? 0 : bound;
         tight = rise < bound ? rise : bound;
@@ -175,7 +179,7 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
         k_int[k][0] = k_int[k][1] = 0;
         for (i0 = 0; i0 < 4; ++i0) {
             const sr_real *K = (target->path ? lqr->K_path : lqr->K_heading)[point[i0]] + k * SR_LQR_NZ;
-            const sr_real *T = lqr->K_tight[point[i0]] + k * SR_LQR_NZ;
+            const sr_real *T = (target->path ? lqr->K_tight : lqr->K_heading_tight)[point[i0]] + k * SR_LQR_NZ;
             sr_real kdz = 0;
             for (j = 0; j < SR_LQR_NZ; ++j) kdz += K[j] * dz[j];
             if (tight > 0)

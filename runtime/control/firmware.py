@@ -96,7 +96,10 @@ def header(task, controller):
                                if s.K_tight is not None else "{{0}}") + ",",
         f"    /* tight_band, tight_rise, world_share, tight_fall, tight_wait */ {_real(controller._c.tight_band)}, "
         f"{_real(controller._c.tight_rise)}, {_real(controller._c.world_share)}, {_real(controller._c.tight_fall)}, "
-        f"{_real(controller._c.tight_wait)}",
+        f"{_real(controller._c.tight_wait)},",
+        "    /* K_heading_tight */ " + ("{" + ",\n     ".join(_array(s.K_heading_tight[i, j]) for i, j in points) + "}"
+                                       if s.K_heading_tight is not None else "{{0}}") + ",",
+        f"    /* heading_band, heading_rise */ {_real(controller._c.heading_band)}, {_real(controller._c.heading_rise)}",
         "};",
         "",
         "#endif /* LQR_TASK_H */",

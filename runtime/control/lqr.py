@@ -59,6 +59,9 @@ class LqrGains:
     world_share: float = 0.0          # the share of ∫e_y held as a world vector along the path's normal
     tight_fall_s: float = 10.0        # ... and after a clipped torque falls by 1 in this [s] (0: it holds) ...
     tight_wait: float = 0.25          # ... to −tight_wait (below 0 the path's gains: a wait of up to tight_wait·tight_rise_s)
+    heading_band_rad: float = 0.0     # heading references: stiffer heading gains' weight ≤ 1 − |heading error| / this (0: none)
+    tight_heading_rad: float = 0.03   # ... designed with this heading size (the other sizes as above)
+    heading_rise_s: float = 2.0       # ... rising from 0 to 1 in no less than this [s] (after a clip as tight_fall_s, tight_wait)
     #: The ranges of the settings (runtime/control/ranges.py: those of a task file's keys).
     RANGES: typing.ClassVar[dict] = LQR_RANGES
 
@@ -72,6 +75,10 @@ class LqrGains:
     def tight_weights(self, u_max):
         """The tight path gains' Riccati weights: these bounds with the cross-track error `tight_cross_track_m`."""
         return dataclasses.replace(self.weights(u_max), cross_track_m=self.tight_cross_track_m)
+
+    def tight_heading_weights(self, u_max):
+        """The stiffer heading gains' Riccati weights: these bounds with the heading size `tight_heading_rad`."""
+        return dataclasses.replace(self, heading_rad=self.tight_heading_rad).weights(u_max)
 
     def weights(self, u_max):
         """These bounds as the design's Riccati weights, with the torque bound `u_max` [N m]."""
@@ -105,6 +112,7 @@ def _design(params, rate, u_max, gains):
     z_star, u_star = np.zeros((nv, nk, design.NZ)), np.zeros((nv, nk, 2))
     K_path, K_heading = np.zeros((nv, nk, 2, design.NZ)), np.zeros((nv, nk, 2, design.NZ))
     K_tight = np.zeros((nv, nk, 2, design.NZ)) if gains.tight_band_m > 0 else None
+    K_heading_tight = np.zeros((nv, nk, 2, design.NZ)) if gains.heading_band_rad > 0 else None
     weights = gains.weights(u_max)
     # Each curvature's operating point starts from its neighbour's, outward from the straightest.
     order = np.argsort(np.abs(curvatures), kind="stable")
@@ -123,24 +131,29 @@ def _design(params, rate, u_max, gains):
             K_heading[i, j] = design.gains(A, B, 1.0 / rate, weights, path=False)
             if K_tight is not None:
                 K_tight[i, j] = tight_gain(K_path[i, j], design.gains(A, B, 1.0 / rate, gains.tight_weights(u_max)))
-    return Schedule(speeds, curvatures, z_star, u_star, K_path, K_heading, K_tight)
+            if K_heading_tight is not None:
+                K_heading_tight[i, j] = tight_gain(K_heading[i, j], design.gains(
+                    A, B, 1.0 / rate, gains.tight_heading_weights(u_max), path=False))
+    return Schedule(speeds, curvatures, z_star, u_star, K_path, K_heading, K_tight, K_heading_tight)
 
 
 def tight_gain(K_path, K_riccati):
-    """The tight path gain as the C law reads it: the tight design's K on the robot's and the path's
-    coordinates, the shipped K_path's on the integrators (the law never moves the integrals' gains, so
-    scheduling the tight gain in or out moves no torque through them)."""
+    """The tight gain as the C law reads it: the tight design's K on the robot's and the path's
+    coordinates, the shipped gain's (K_path's, or K_heading's for the heading gains) on the integrators
+    (the law never moves the integrals' gains, so scheduling the tight gain in or out moves no torque
+    through them)."""
     K = np.array(K_riccati, dtype=float)
     K[:, design.Z_IY:] = np.asarray(K_path)[:, design.Z_IY:]
     return K
 
 
 def to_c(schedule, period, u_max, kappa_rate, steady_rate, tight_band=0.0, tight_rise=1.0, world_share=0.0, tight_fall=0.0,
-         tight_wait=0.0):
+         tight_wait=0.0, heading_band=0.0, heading_rise=1.0):
     """The schedule as the C struct `sr_lqr` (cffi), checked by `sr_lqr_check`; the tight gains are
     scheduled in within `tight_band` [m] of the path, over `tight_rise` [s] (and out by 1 per `tight_fall` [s]
     after a clipped torque, to a weight −`tight_wait`, below 0 K_path's; 0: held), when the schedule has them;
-    `world_share` of the cross-track integral is held in the world frame."""
+    `world_share` of the cross-track integral is held in the world frame; the stiffer heading gains, when
+    the schedule has them, within `heading_band` [rad] of a heading reference's heading over `heading_rise` [s]."""
     nv, nk = len(schedule.speeds), len(schedule.curvatures)
     if nv > lib.SR_LQR_MAX_SPEEDS or nk > lib.SR_LQR_MAX_CURVATURES:
         raise ValueError(f"controller: the design grid has {nv} speeds and {nk} curvatures; the C controller "
@@ -158,12 +171,16 @@ def to_c(schedule, period, u_max, kappa_rate, steady_rate, tight_band=0.0, tight
             c.K_heading[n][0:2 * design.NZ] = schedule.K_heading[i, j].ravel().tolist()
             if schedule.K_tight is not None:
                 c.K_tight[n][0:2 * design.NZ] = schedule.K_tight[i, j].ravel().tolist()
+            if schedule.K_heading_tight is not None:
+                c.K_heading_tight[n][0:2 * design.NZ] = schedule.K_heading_tight[i, j].ravel().tolist()
     c.period, c.u_max, c.kappa_rate, c.steady_rate = period, u_max, kappa_rate, steady_rate
     c.tight_band = tight_band if schedule.K_tight is not None else 0.0
     c.tight_rise = tight_rise
     c.world_share = world_share
     c.tight_fall = tight_fall
     c.tight_wait = tight_wait
+    c.heading_band = heading_band if schedule.K_heading_tight is not None else 0.0
+    c.heading_rise = heading_rise
     status = lib.sr_lqr_check(c)
     if status != lib.SR_OK:
         raise ValueError(f"controller: the LQR schedule is not valid for the C controller "
@@ -193,7 +210,8 @@ class Lqr(SlopeFeedforward, Controller):
         flat = params.replace(slope=0.0)
         self.schedule = schedule if schedule is not None else design_schedule(flat, rate, u_max, gains)
         self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate, gains.steady_rate_m_s,
-                       gains.tight_band_m, gains.tight_rise_s, gains.world_share, gains.tight_fall_s, gains.tight_wait)
+                       gains.tight_band_m, gains.tight_rise_s, gains.world_share, gains.tight_fall_s, gains.tight_wait,
+                       gains.heading_band_rad, gains.heading_rise_s)
         self._model = Model(flat)
         self._init_slope(params, flat, self.schedule, gains)
         self._memory = ffi.new("sr_lqr_memory *")

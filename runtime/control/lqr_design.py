@@ -243,7 +243,8 @@ def gains(A, B, period, weights=Weights(), path=True):
 @dataclasses.dataclass(frozen=True)
 class Schedule:
     """Operating points on a grid: z_star (nv, nk, NZ), u_star (nv, nk, 2), K_path / K_heading (nv, nk, 2, NZ),
-    and K_tight (nv, nk, 2, NZ) or None: the tighter path gains scheduled in near the path."""
+    and K_tight (nv, nk, 2, NZ) or None: the tighter path gains scheduled in near the path; K_heading_tight
+    likewise: the stiffer heading gains scheduled in near a heading reference's heading."""
     speeds: np.ndarray
     curvatures: np.ndarray
     z_star: np.ndarray
@@ -251,6 +252,7 @@ class Schedule:
     K_path: np.ndarray
     K_heading: np.ndarray
     K_tight: np.ndarray = None
+    K_heading_tight: np.ndarray = None
 
     def at(self, v, kappa):
         """(z*, u*, K_path, K_heading) bilinearly interpolated, clamped to the grid."""
@@ -273,3 +275,9 @@ class Schedule:
         if self.K_tight is None:
             return None
         return dataclasses.replace(self, K_path=self.K_tight).at(v, kappa)[2]
+
+    def heading_tight_at(self, v, kappa):
+        """K_heading_tight interpolated as `at` interpolates the others (None without them)."""
+        if self.K_heading_tight is None:
+            return None
+        return dataclasses.replace(self, K_path=self.K_heading_tight).at(v, kappa)[2]

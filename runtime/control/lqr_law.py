@@ -9,7 +9,9 @@ and ∫e_y only while the error is steady (|ė_y| ≤ `steady_rate`).  On a path
 w = min(max(0, 1 − |e_y − e_y*| / tight_band), w_before + period / tight_rise) clamped to
 [−tight_wait, 1], where after a clipped sample the second term is w_before − period / tight_fall
 (w_before when tight_fall is 0); below 0 the gain is K_path's, so after a long clip the tight gains
-return tight_wait · tight_rise later; the integrators' columns stay K_path's.  A share `world_share` of
+return tight_wait · tight_rise later; the integrators' columns stay K_path's.  On a heading reference
+with `heading_band` > 0 the same weight, with the heading error z[2] − z*[2] against heading_band and
+`heading_rise`, moves the gain toward K_heading_tight (its integrators' columns K_heading's).  A share `world_share` of
 ∫e_y is held as a world vector W along the path's left normal n(ψ) = (−sin ψ, cos ψ): z[10] reads
 I + n·W, and a step s of ∫e_y adds (1 − share) s to I and share·s·n to W (pass the integrals as
 (I, ∫speed, W_x, W_y) to carry W).
@@ -22,7 +24,7 @@ from .geometry import cross_track_rate
 
 def numpy_law(schedule, r, x, target, integrals, kappa_before, period, u_max, kappa_rate, steady_rate,
               tight_before=0.0, clipped_before=False, tight_band=0.0, tight_rise=1.0, world_share=0.0,
-              tight_fall=0.0, tight_wait=0.0):
+              tight_fall=0.0, tight_wait=0.0, heading_band=0.0, heading_rise=1.0):
     """(u_raw, u, integrals after, κ of the operating point, the tight gains' weight) of one sample;
     `integrals` (2,) or (4,) with the world part W, returned in the same form."""
     path = target.cross_track is not None
@@ -40,13 +42,15 @@ def numpy_law(schedule, r, x, target, integrals, kappa_before, period, u_max, ka
     dz = z - z_star
     K = K_path if path else K_heading
     weight = 0.0
-    if path and tight_band > 0:
+    band, rise_s, error = (tight_band, tight_rise, dz[design.Z_EY]) if path else (heading_band, heading_rise, dz[2])
+    if band > 0:
         fall = period / tight_fall if tight_fall > 0 else 0.0
-        rise = tight_before - fall if clipped_before else tight_before + period / tight_rise
-        weight = float(np.clip(min(rise, max(0.0, 1.0 - abs(dz[design.Z_EY]) / tight_band)), -tight_wait, 1.0))
+        rise = tight_before - fall if clipped_before else tight_before + period / rise_s
+        weight = float(np.clip(min(rise, max(0.0, 1.0 - abs(error) / band)), -tight_wait, 1.0))
         robot_and_path = slice(0, design.Z_IY)
         K = K.copy()
-        K[:, robot_and_path] += max(weight, 0.0) * (schedule.tight_at(target.speed, kappa)[:, robot_and_path] - K[:, robot_and_path])
+        tight = schedule.tight_at(target.speed, kappa) if path else schedule.heading_tight_at(target.speed, kappa)
+        K[:, robot_and_path] += max(weight, 0.0) * (tight[:, robot_and_path] - K[:, robot_and_path])
     raw = u_star - K @ dz
     u = np.clip(raw, -u_max, u_max)
     e_y = dz[design.Z_EY]

@@ -42,6 +42,9 @@ LQR_RANGES = {
     "world_share": Range(0, 1, "", "the share of the cross-track integral held in the world frame"),
     "tight_fall_s": Range(0, 1e4, "s", "how fast the tight gains leave after a clipped torque (0: they hold)"),
     "tight_wait": Range(0, 1, "", "how far below 0 their weight falls after a clip (a wait before they return)"),
+    "heading_band_rad": Range(0, 3.2, "rad", "how near the heading the stiffer heading gains act (0: not at all)"),
+    "tight_heading_rad": _ERROR_SIZE,
+    "heading_rise_s": Range(1e-3, 1e4, "s", "how slowly the stiffer heading gains come in"),
 }
 
 #: `NmpcGains`: the LQR's and the horizon's.
@@ -49,6 +52,7 @@ NMPC_RANGES = {
     **LQR_RANGES,
     "tight_band_m": Range(0, 0, "m", "the NMPC has no tight gains (an LQR setting): 0 only"),
     "world_share": Range(0, 0, "", "the NMPC holds no world-frame integral (an LQR setting): 0 only"),
+    "heading_band_rad": Range(0, 0, "rad", "the NMPC has no scheduled heading gains (an LQR setting): 0 only"),
     "torque_step_n_m": Range(1e-6, 1e6, "N m", "a torque change worth the full cost"),
     "disturbance_gain": Range(0, 1, "", "the share of the torque offset's update taken per sample (0: no estimate)"),
     "horizon": Range(1, 200, "", "nodes of the horizon: the QP has 2N unknowns and a dense (2N)^2 Hessian",

@@ -540,7 +540,9 @@ static const sr_lqr LQR_TASK_SCHEDULE = {
         SR_C(-5.183589583734689), SR_C(0.13224356665000508), SR_C(-0.07711265262585312), SR_C(-2.556534897428795), SR_C(-0.05604170464964873), SR_C(-0.9541526256961389),
         SR_C(1.3938073691058803), SR_C(-2.0293251333330793), SR_C(20.57266207207872), SR_C(1.7449341342791538), SR_C(4.626363418127415), SR_C(-4.25946566130456),
         SR_C(21.652274572906396), SR_C(0.5247194822671502), SR_C(0.43909738629029027), SR_C(10.976881666463841), SR_C(0.41195987380173826), SR_C(-0.09528655005578615)}},
-    /* tight_band, tight_rise, world_share, tight_fall, tight_wait */ SR_C(0.1), SR_C(10.0), SR_C(0.0), SR_C(10.0), SR_C(0.25)
+    /* tight_band, tight_rise, world_share, tight_fall, tight_wait */ SR_C(0.1), SR_C(10.0), SR_C(0.0), SR_C(10.0), SR_C(0.25),
+    /* K_heading_tight */ {{0}},
+    /* heading_band, heading_rise */ SR_C(0.0), SR_C(2.0)
 };
 
 #endif /* LQR_TASK_H */
