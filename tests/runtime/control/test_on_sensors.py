@@ -104,11 +104,11 @@ def test_the_control_command_runs_every_task_on_the_sensors_it_is_given(tmp_path
 HEADING_WANDER_DEG = 1.0
 
 
-def heading_wander_deg(gains=None, seeds=(0, 1, 2), after=10.0):
+def heading_wander_deg(gains=None, seeds=(0, 1, 2), after=10.0, kind="nmpc-c"):
     """RMS of the true heading's error from `after` s to the end of heading-step-sensors on the C NMPC
-    (the task file's weights, or `gains`), pooled over noise seeds."""
+    or the LQR (`kind`; the task file's weights, or `gains`), pooled over noise seeds."""
     from runtime.control.geometry import heading, wrap_angle
-    task = load_task("heading-step-sensors").with_controller("nmpc-c")
+    task = load_task("heading-step-sensors").with_controller(kind)
     if gains is not None:
         task = dataclasses.replace(task, controllers=(dataclasses.replace(task.controllers[0], gains=gains),))
     errors = []
@@ -129,3 +129,12 @@ def test_the_c_nmpc_holds_the_stepped_heading_within_the_wander_the_band_allows(
 def test_without_the_tasks_heading_weights_the_c_nmpc_wanders_beyond_it():
     from runtime.control.nmpc import NmpcGains
     assert heading_wander_deg(NmpcGains()) > HEADING_WANDER_DEG
+
+
+def test_the_lqr_with_the_tasks_heading_gains_holds_the_stepped_heading_within_the_wander_the_band_allows():
+    assert heading_wander_deg(kind="lqr") < HEADING_WANDER_DEG
+
+
+def test_without_the_tasks_heading_gains_the_lqr_wanders_beyond_it():
+    from runtime.control.lqr import LqrGains
+    assert heading_wander_deg(LqrGains(), kind="lqr") > HEADING_WANDER_DEG
