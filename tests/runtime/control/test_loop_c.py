@@ -64,8 +64,10 @@ def test_a_gain_off_by_a_part_in_a_billion_is_told_apart(runs):
     (python, _), _ = runs
     task = _task("circle", "lqr", "default")
     controller = Lqr(task.scenario.params, task.rate, U_MAX, task.controllers[0].gains)
+    nz = controller.schedule.K_path.shape[3]
     for n in range(controller.schedule.K_path.shape[0] * controller.schedule.K_path.shape[1]):
-        controller._c.K_path[n][9] *= 1 + 1e-9                 # the cross-track gain
+        for torque in range(2):                                # the cross-track gain of either torque
+            controller._c.K_path[n][torque * nz + 9] *= 1 + 1e-9
     c, _ = _run("c-loop", controller=controller)
     with pytest.raises(AssertionError):
         assert_same_run(python, c)

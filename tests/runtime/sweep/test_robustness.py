@@ -214,6 +214,17 @@ def test_the_circle_lqr_holds_a_plant_whose_slow_offset_the_former_integral_boun
     assert row["success"][0] == 1 and row["cross_track_rms_m"][0] < 0.028
 
 
+def test_the_circle_lqr_holds_a_plant_that_left_the_path_with_the_steering_torque_clipped(tmp_path):
+    # Plant 84 of the shipped study: with the heading sized as the lean (0.2 rad) and the curvature
+    # previewed 0.3 m ahead, the pendulum's torque clips on about 88 % of the samples and the robot
+    # leaves the circle (about 0.8 m RMS, 0.75 of the path); the circle task's heading at 0.4 rad
+    # and 0.6 m preview hold it to about 17 mm (docs/control.md, "Robustness over many robots").
+    spec = load_sweep(str(_sweep(tmp_path, CIRCLE_PLANTS.replace("samples = 20", "samples = 100"))))
+    row = spec.run_chunk(84, 85)
+    assert row["plant"][0] == 84 and row["progress"][0] > 0.9 and row["saturated_fraction"][0] < 0.4
+    assert row["success"][0] == 1 and row["cross_track_rms_m"][0] < 0.025
+
+
 LINE_PLANTS = CIRCLE_PLANTS.replace("on the circle", "on the line").replace('tasks = ["circle"]', 'tasks = ["line"]')
 
 
