@@ -123,11 +123,19 @@ def robustness_outputs(spec, table, args):
 
 
 def _verified_runs(spec, folder, option):
-    """The verified rows of the sweep `spec` in `folder` (an Arrow table), finished or not."""
+    """The verified rows of the sweep `spec` in `folder` (an Arrow table), finished or not.  A chunk
+    file on disk that fails verification is refused by name: summarising without it would report
+    its runs as missing, not as altered or foreign."""
     import pyarrow as pa
     store = SweepStore.open(folder, spec, lambda: None)
-    tables = [table for a, b in store.chunks() if store.chunk_path(a, b).exists()
-              for table in [store.read_chunk(a, b)[0]] if table is not None]
+    tables = []
+    for a, b in store.chunks():
+        path = store.chunk_path(a, b)
+        if path.exists():
+            table, why = store.read_chunk(a, b)
+            if table is None:
+                raise ValueError(f"{option}: {path} is not a verified chunk of {spec.name}: {why}")
+            tables.append(table)
     if not tables:
         raise ValueError(f"{option}: {folder} holds no verified runs yet")
     return pa.concat_tables(tables)

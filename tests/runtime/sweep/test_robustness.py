@@ -311,6 +311,19 @@ def test_a_combination_missing_runs_is_summarised_as_unfinished(combined, tmp_pa
     assert "| line | lqr | 2 | 0 | 0 |" in summary and "| line | lqr-slope | 0 | 0 | 0 |" in summary
 
 
+def test_combining_a_folder_with_an_altered_chunk_names_the_chunk_instead_of_dropping_its_runs(combined, tmp_path, capsys):
+    import shutil
+    _, _, parts, whole_path = combined
+    copy = tmp_path / "altered"
+    shutil.copytree(parts[1], copy)
+    chunk = sorted((copy / "chunks").glob("*.parquet"))[0]
+    chunk.write_bytes(b"not parquet")
+    assert main(["sweep", str(whole_path), "--out", str(tmp_path / "o"), "--combine", str(parts[0]), str(copy)]) == 2
+    err = capsys.readouterr().err
+    assert chunk.name in err and "not a verified chunk" in err and "not a readable Parquet file" in err
+    assert not (tmp_path / "o" / "summary.md").exists()
+
+
 def test_the_figure_names_each_groups_successes_and_runs_and_an_unfinished_sweep(tmp_path):
     from runtime.sweep.robustness_summary import robustness_figure
     spec = load_sweep(str(_sweep(tmp_path)))
