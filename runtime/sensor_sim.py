@@ -32,6 +32,12 @@ from .state import IDX_NU, initial_state
 #: The random streams of a run, each its own child of the seed: changing one sensor's rate or noise
 #: leaves the others' draws alone.  A new stream goes at the end: the others keep their draws.
 STREAMS = ("process", "bias", "imu", "encoders", "fixes", "heading", "bias_walk")
+
+
+def random_streams(seed):
+    """{stream name: numpy Generator} of a run seeded `seed`, one independent stream per name in
+    STREAMS (a stream's draws do not move when another stream draws more or less)."""
+    return dict(zip(STREAMS, map(np.random.default_rng, np.random.SeedSequence(seed).spawn(len(STREAMS)))))
 #: The sensor kinds, in the order samples of one time are applied.
 KINDS = ("imu", "encoders", "fixes", "heading")
 #: The numbers of one reading of each sensor.
@@ -56,7 +62,7 @@ class SensorSimulation:
         self.plant, self.sensors, self.dt, self.method = plant, sensors, dt, method
         self.disturbance_in_accel = disturbance_in_accel
         duration = steps * dt
-        self.rng = dict(zip(STREAMS, map(np.random.default_rng, np.random.SeedSequence(seed).spawn(len(STREAMS)))))
+        self.rng = random_streams(seed)
         spec = sensors.imu
         self.bias = np.concatenate([self.rng["bias"].normal(0.0, spec.gyro_bias, 3),
                                     self.rng["bias"].normal(0.0, spec.accel_bias, 3)])

@@ -72,6 +72,18 @@ def nees_band(dims, runs, probability=BAND):
     return (float(chi2.ppf(tail, runs * dims)) / runs, float(chi2.ppf(1 - tail, runs * dims)) / runs)
 
 
+def load_task(run, duration=None):
+    """The scenario or task `run` (a path, or one already loaded), its first `duration` [s] when given."""
+    from ..scenario import Scenario
+    from .sense import load_run
+    task = load_run(run) if isinstance(run, str) else run
+    if duration is not None:
+        scenario = task if isinstance(task, Scenario) else task.scenario
+        short = scenario.with_overrides(steps=max(1, round(duration / scenario.dt)))
+        task = short if isinstance(task, Scenario) else dataclasses.replace(task, scenario=short)
+    return task
+
+
 def run_once(run, sensors, seed, duration=None, plant_mismatch=False, every=EVERY, accel_noise="held",
              constrained=None, make_filter=None):
     """One Monte Carlo run: the sensors `sensors` (a SensorSet, a shipped set's name or a file)
@@ -84,13 +96,8 @@ def run_once(run, sensors, seed, duration=None, plant_mismatch=False, every=EVER
     filter's errors to the components, and "scored", the indices of the scored rows among the rows
     whose covariance was read."""
     from ..sensor_set import SensorSet, load_sensor_set
-    from ..scenario import Scenario
-    from .sense import load_run, simulate_log
-    task = load_run(run) if isinstance(run, str) else run
-    if duration is not None:
-        scenario = task if isinstance(task, Scenario) else task.scenario
-        short = scenario.with_overrides(steps=max(1, round(duration / scenario.dt)))
-        task = short if isinstance(task, Scenario) else dataclasses.replace(task, scenario=short)
+    from .sense import simulate_log
+    task = load_task(run, duration)
     sensors = sensors if sensors is None or isinstance(sensors, SensorSet) else load_sensor_set(sensors)
     log = simulate_log(task, sensors, seed=seed, plant_mismatch=plant_mismatch)
     # The operator's heading at the start is the truth's off by a draw of the σ the start rule

@@ -197,23 +197,17 @@ def truth_draws(run, sensors, seed, duration=None):
     quantisation too) by kind, the torque disturbance's acceleration M⁻¹ w per step ("a"), the
     biases per step ("b"), the step ("dt"), the truth's start ("x0"; "model" the truth's robot)."""
     import math
-    from ..sensor_sim import STREAMS
+    from ..sensor_sim import random_streams
     from .. import sensors as readings
+    from .consistency import load_task
     from .estimate import claimed_params
-    from .sense import load_run, simulate_log
+    from .sense import simulate_log
     from ..sensor_set import SensorSet, load_sensor_set
-    task = load_run(run) if isinstance(run, str) else run
     sensors = sensors if sensors is None or isinstance(sensors, SensorSet) else load_sensor_set(sensors)
-    if duration is not None:
-        import dataclasses
-        from ..scenario import Scenario
-        scenario = task if isinstance(task, Scenario) else task.scenario
-        short = scenario.with_overrides(steps=max(1, round(duration / scenario.dt)))
-        task = short if isinstance(task, Scenario) else dataclasses.replace(task, scenario=short)
-    log = simulate_log(task, sensors, seed=seed)
+    log = simulate_log(load_task(run, duration), sensors, seed=seed)
     model = Model(claimed_params(log))
     xs, bs, dt, spec = log.truth_states(), log.truth_biases(), float(log.meta["dt"]), log.sensors
-    stream = np.random.default_rng(np.random.SeedSequence(seed).spawn(len(STREAMS))[STREAMS.index("process")])
+    stream = random_streams(seed)["process"]
     q_std = spec.process.generalized() / math.sqrt(dt)
     a = np.array([np.linalg.solve(model.inertia(xs[k]), stream.normal(0.0, 1.0, 5) * q_std)
                   for k in range(len(xs) - 1)])
