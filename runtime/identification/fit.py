@@ -229,6 +229,26 @@ def _inverse_cholesky(S):
     return Linv
 
 
+@functools.cache
+def _geqrf_work(shape):
+    """LAPACK's workspace size for dgeqrf on a matrix of `shape` (its query; what SciPy's `qr` asks
+    for every call)."""
+    return int(scipy.linalg.lapack.dgeqrf(np.zeros(shape), lwork=-1)[-2][0])
+
+
+def _upper_triangle(M, n):
+    """The first n rows of R (n, M's columns; zero rows below M's) of M = Q R: the R of
+    `scipy.linalg.qr(M, mode="r")`, the same LAPACK call (dgeqrf) without SciPy's checks and
+    workspace query per call."""
+    qr, _, _, info = scipy.linalg.lapack.dgeqrf(M, lwork=_geqrf_work(M.shape), overwrite_a=True)
+    if info < 0:
+        raise ValueError(f"dgeqrf: illegal value in argument {-info}")
+    R = np.zeros((n, M.shape[1]))
+    k = min(n, M.shape[0])
+    R[:k] = np.triu(qr[:k])
+    return R
+
+
 class _Problem:
     """The multiple-shooting problem of a sensor log."""
 
@@ -261,6 +281,7 @@ class _Problem:
         self.chol = None
         self._stacked = (None, None)       # (the whitenings, `stack_whitenings` of them)
         self._cache = (None, None)
+        self.layouts = {}                   # where each set of segments' readings sit (segments._layout)
         self.nfev = 0
         self.progress = None
         self.hold_parameters = False        # the parameters' columns zero: only the states and biases move
@@ -489,7 +510,10 @@ class _Problem:
         (rows (S, K, R) the row of each step's place or -1, unit (S, K, R) what a row is divided
         by first (the end-state difference's floor, else 1), H (S, K, R, 12), L⁻¹ (S, K, R, R),
         gains (S, K, 12, R)), K the most steps of a segment, R the most rows of a step; padding
-        is zero, so it neither reads nor moves anything."""
+        is zero, so it neither reads nor moves anything.  Then the places of the segments' rows
+        stacked one after the other (`whiten_all`'s one gather and one scatter): (offsets (S + 1,)
+        where each segment's rows start, at (S, K, R) the stacked row of each place, its last
+        row, a zero row, for the padding; back (rows,) the flat place of each stacked row)."""
         S, K = len(whites), max(len(w) for w in whites)
         R = max(st[0].stop - st[0].start for w in whites for st in w)
         rows, unit = np.full((S, K, R), -1), np.ones((S, K, R))
@@ -503,18 +527,25 @@ class _Problem:
                     unit[s, k, :m] = DEFECT_FLOOR
                 else:
                     gains[s, k, :, :m] = gain
-        return rows, unit, H, Linv, gains
+        sizes = np.array([max(st[0].stop for st in w) for w in whites])
+        offsets = np.concatenate([[0], np.cumsum(sizes)])
+        at = np.where(rows >= 0, rows + offsets[:S, None, None], offsets[S])
+        back = np.empty(offsets[S], dtype=int)
+        valid = rows >= 0
+        back[at[valid]] = np.flatnonzero(valid)
+        return rows, unit, H, Linv, gains, offsets, at, back
 
     @staticmethod
     def whiten_all(stacked, Ms):
         """[W_s M_s] for every segment s at once (`stack_whitenings`): `whiten`'s recursion, one
         step of all segments together."""
-        rows, unit, H, Linv, gains = stacked
+        rows, unit, H, Linv, gains, offsets, at, back = stacked
         S, K, R = rows.shape
         m = max(M.shape[1] for M in Ms)
-        Y = np.zeros((S, K, R, m))
+        stacked_rows = np.zeros((offsets[S] + 1, m))        # the last row the padding's zeros
         for s, M in enumerate(Ms):
-            Y[s, :, :, :M.shape[1]] = np.vstack([M, np.zeros((1, M.shape[1]))])[rows[s]]   # -1: the zero row
+            stacked_rows[offsets[s]:offsets[s + 1], :M.shape[1]] = M
+        Y = stacked_rows[at]
         Y /= unit[..., None]
         out = np.empty_like(Y)
         mean = np.zeros((S, NE, m))
@@ -522,13 +553,8 @@ class _Problem:
             innovation = Y[:, k] - H[:, k] @ mean
             out[:, k] = Linv[:, k] @ innovation
             mean += gains[:, k] @ innovation
-        result = []
-        for s, M in enumerate(Ms):
-            valid = rows[s] >= 0
-            W = np.empty(M.shape)
-            W[rows[s][valid]] = out[s][valid][:, :M.shape[1]]
-            result.append(W)
-        return result
+        W = out.reshape(-1, m)[back]
+        return [W[offsets[s]:offsets[s + 1], :M.shape[1]] for s, M in enumerate(Ms)]
 
     def assemble(self, z):
         """(residuals, sparse Jacobian, segment blocks) at z.  Each segment's whitened residuals r_s
@@ -556,9 +582,8 @@ class _Problem:
             Ms.append(np.hstack(parts + [blk["r"][:, None]]))
             colsets.append(cols)
         for M, cols in zip(self.whiten_all(self._stacked[1], Ms), colsets):
-            R = scipy.linalg.qr(M, mode="r", overwrite_a=True, check_finite=False)[0]
-            m = R.shape[1] - 1
-            R = np.vstack([R, np.zeros((max(0, m + 1 - R.shape[0]), m + 1))])[:m + 1]
+            m = M.shape[1] - 1
+            R = _upper_triangle(M, m + 1)
             r = R[:, m].copy()
             r[m] = abs(r[m])
             cols = np.concatenate(cols)

@@ -91,6 +91,45 @@ def _simulate(prob, model, segs, x0, sensitivities):
     return X, G
 
 
+def _layout(prob, segs):
+    """Where the readings of the segments `segs` sit, the same at every evaluation (kept in
+    `prob.layouts` per segs): "counts" the nodes of each segment, "seg_of", "local" and "gnode" per
+    node its segment's position in segs, its index in the segment and in the log; "li" the nodes
+    with an IMU sample and "imu_rows" those samples; "lk" {1 encoders, 2 fixes} likewise with
+    "kind_rows"; the reading rows ordered by time, at one time IMU, encoders, fix ("order" of the
+    kinds' rows stacked in that order): their "node", "kinds", noise "sig", the "bounds" of each
+    segment's rows, and "nodes" each segment's log nodes."""
+    key = segs.tobytes()
+    cached = prob.layouts.get(key)
+    if cached is not None:
+        return cached
+    d = prob.data
+    counts = prob.ends[segs] - prob.starts[segs] + (segs == prob.S - 1)
+    seg_of = np.repeat(np.arange(len(segs)), counts)
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    local = np.arange(len(seg_of)) - first[seg_of]
+    gnode = prob.starts[segs][seg_of] + local
+    lay = {"counts": counts, "seg_of": seg_of, "local": local, "gnode": gnode, "lk": {}, "kind_rows": {}}
+    parts = []                  # (node, kind, sig) per kind
+    li = np.flatnonzero(d.imu_row[gnode] >= 0)
+    lay["li"], lay["imu_rows"] = li, d.imu_row[gnode[li]]
+    if li.size:
+        parts.append((np.repeat(li, 6), 0, np.tile(prob.sig_imu, li.size)))
+    for kind, rows_of, sig in ((1, d.enc_row, prob.sig_enc), (2, d.fix_row, prob.sig_fix)):
+        lk = np.flatnonzero(rows_of[gnode] >= 0)
+        lay["lk"][kind], lay["kind_rows"][kind] = lk, rows_of[gnode[lk]]
+        if lk.size:
+            parts.append((np.repeat(lk, 2), kind, np.full(2 * lk.size, float(sig))))
+    node = np.concatenate([p[0] for p in parts])
+    kinds = np.concatenate([np.full(len(p[0]), p[1]) for p in parts])
+    order = np.lexsort((kinds, node))           # stable: each reading's components stay in order
+    lay.update(order=order, node=node[order], kinds=kinds[order], sig=np.concatenate([p[2] for p in parts])[order],
+               bounds=np.searchsorted(seg_of[node[order]], np.arange(len(segs) + 1)),
+               nodes=[gnode[seg_of == i] for i in range(len(segs))])
+    prob.layouts[key] = lay
+    return lay
+
+
 def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True):
     """The blocks of the segments `segs` (indices into prob's segments, ascending) of the
     multiple-shooting problem `prob` (runtime.identification.fit._Problem) on the robot `model`:
@@ -102,53 +141,43 @@ def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True):
     d, nf = prob.data, prob.nf
     segs = np.asarray(segs)
     X, G = _simulate(prob, model, segs, np.atleast_2d(x0), sensitivities)
-    # every node of every segment, in the log's order: its segment (position in segs) and local index
-    counts = prob.ends[segs] - prob.starts[segs] + (segs == prob.S - 1)
-    seg_of = np.repeat(np.arange(len(segs)), counts)
-    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    local = np.arange(len(seg_of)) - first[seg_of]
-    gnode = prob.starts[segs][seg_of] + local
+    lay = _layout(prob, segs)
+    counts, seg_of, local, gnode, node, kinds, order, sig = (lay[k] for k in (
+        "counts", "seg_of", "local", "gnode", "node", "kinds", "order", "sig"))
     Xn = np.concatenate([X[i][:c] for i, c in enumerate(counts)])
     Gn = np.concatenate([G[i][:c] for i, c in enumerate(counts)])
     un = d.u[gnode]
     nudot = model.accel(Xn, un)
     Ja = accel_state_jacobian(model, Xn, un, prob.jacobian)
     Jpa = np.zeros((len(Xn), NV, nf))          # ∂ν̇/∂θ where an IMU reads it
-    parts = []                  # (node, kind, r, Hx, Hn, sig, Hb) per kind
-    li = np.flatnonzero(d.imu_row[gnode] >= 0)
+    parts = []                  # (r, Hx, Hn, Hb) per kind, in the layout's order of kinds
+    li = lay["li"]
     if li.size:
         y, H, Hn = imu_partials_batch(model, Xn[li], nudot[li], mount=prob.mount, bias=b)
         Hx = H[:, :, :NE] + Hn @ Ja[li]
         if sensitivities:
             Jpa[li] = accel_sensitivity(model, Xn[li], un[li], prob.idx, prob.jacobian)
-        r = prob.log.imu.data[d.imu_row[gnode[li]]] - y
-        parts.append((np.repeat(li, 6), 0, r.ravel(), Hx.reshape(-1, NE), Hn.reshape(-1, NV),
-                      np.tile(prob.sig_imu, li.size), H[:, :, NE:].reshape(-1, 6)))
-    for kind, rows_of, batch, sig in ((1, d.enc_row, encoders_jacobian_batch, prob.sig_enc),
-                                      (2, d.fix_row, position_jacobian_batch, prob.sig_fix)):
-        lk = np.flatnonzero(rows_of[gnode] >= 0)
+        r = prob.log.imu.data[lay["imu_rows"]] - y
+        parts.append((r.ravel(), Hx.reshape(-1, NE), Hn.reshape(-1, NV), H[:, :, NE:].reshape(-1, 6)))
+    for kind, batch in ((1, encoders_jacobian_batch), (2, position_jacobian_batch)):
+        lk = lay["lk"][kind]
         if not lk.size:
             continue
         y, H = batch(model, Xn[lk])
         if kind == 1:
-            r = _wrap(prob.log.encoders.data[rows_of[gnode[lk]]] - y)
+            r = _wrap(prob.log.encoders.data[lay["kind_rows"][kind]] - y)
         else:
-            r = prob.fix_xy[rows_of[gnode[lk]]] - y
+            r = prob.fix_xy[lay["kind_rows"][kind]] - y
         Hx = H[:, :, :NE]
-        parts.append((np.repeat(lk, 2), kind, r.ravel(), Hx.reshape(-1, NE), np.zeros((2 * lk.size, NV)),
-                      np.full(2 * lk.size, float(sig)), np.zeros((2 * lk.size, 6))))
-    node = np.concatenate([p[0] for p in parts])
-    kinds = np.concatenate([np.full(len(p[0]), p[1]) for p in parts])
-    order = np.lexsort((kinds, node))           # stable: each reading's components stay in order
-    node, kinds = node[order], kinds[order]
-    r, Hx, Hn, sig, Hb = (np.concatenate([p[i] for p in parts])[order] for i in range(2, 7))
+        parts.append((r.ravel(), Hx.reshape(-1, NE), np.zeros((2 * lk.size, NV)), np.zeros((2 * lk.size, 6))))
+    r, Hx, Hn, Hb = (np.concatenate([p[i] for p in parts])[order] for i in range(4))
     r = r / sig
     # per row, as a segment alone forms them (the same products in the same order, bit for bit)
     Phi_n, Sens_n = Gn[:, :, :NE], Gn[:, :, NE:]
     th = -(np.einsum("rj,rjk->rk", Hx, Sens_n[node]) + np.einsum("rj,rjk->rk", Hn, Jpa[node])) / sig[:, None]
     xs = -np.einsum("rj,rjk->rk", Hx, Phi_n[node]) / sig[:, None]
     Hb = -Hb / sig[:, None]
-    bounds = np.searchsorted(seg_of[node], np.arange(len(segs) + 1))
+    bounds = lay["bounds"]
     if nxt is not None:
         has = np.flatnonzero(nxt[2])
         ends = np.array([X[i][-1] for i in has]).reshape(-1, NX)
@@ -161,7 +190,7 @@ def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True):
         Phi, Sens = G[i][:, :, :NE], G[i][:, :, NE:]
         blk = {"r": r[sl], "th": th[sl], "b": Hb[sl], "x": xs[sl] @ D[i], "next": None,
                "rows": {"node": local[node[sl]], "kind": kinds[sl], "Hx": Hx[sl], "Hn": Hn[sl], "sig": sig[sl]},
-               "X": X[i], "Phi": Phi, "nodes": gnode[seg_of == i], "model": model, "n_out": sl.stop - sl.start}
+               "X": X[i], "Phi": Phi, "nodes": lay["nodes"][i], "model": model, "n_out": sl.stop - sl.start}
         j = where.get(i) if nxt is not None else None
         if j is not None:
             blk["r"] = np.concatenate([blk["r"], defects[j]])
