@@ -566,6 +566,16 @@ int sr_step_param_jacobian_batch(const sr_model *model, int method, long n, cons
     return SR_OK;
 }
 
+/* Row k of a step's F (SR_NE entries) from row k of dy's NS state columns: the carried directions
+ * in place, the identity on q's (nothing depends on q: see NS). */
+static void state_columns(const sr_real dy_k[NW], int k, sr_real F_k[SR_NE])
+{
+    int c;
+    for (c = 0; c < NS; ++c) F_k[state_row(c)] = dy_k[c];
+    F_k[SR_E_q] = (sr_real)(k == SR_E_q);
+    F_k[SR_E_q + 1] = (sr_real)(k == SR_E_q + 1);
+}
+
 /* ---- RKMK4 on a block of states in lockstep ---------------------------------------------------- */
 
 /* SR_PARAM_LANES: the states a block takes through RKMK4's stages together (rkmk4_param_lanes), 0
@@ -582,16 +592,18 @@ int sr_step_param_jacobian_batch(const sr_model *model, int method, long n, cons
 #if SR_PARAM_LANES > 0
 #define LANES SR_PARAM_LANES
 
-/* RKMK4's sensitivity on the columns cs (no state columns, every one moving pi alone) of a general
- * robot at m <= LANES states x (rows SR_NX apart; u rows u_stride apart, 0 for one row), checked by
- * the caller: the same arithmetic as rkmk4_param state by state, but each stage's two generated
- * kernels (M, f and their state derivatives; the regressor) run on all the block's stage states at
- * once in their lanes forms (sr_gen_*_lanes, vectorised across the states, each lane the scalar
- * kernel's bits).  Jp (m x SR_NE x nc) and x_next (m x SR_NX, unless NULL) written; SR_OK, else
- * nonzero where any state fails (a singular M, a flag the lanes cleared, a non-finite result): then
- * the caller redoes the block state by state, which reports the failing row. */
+/* RKMK4's sensitivity on the columns cs (every parameter column moving pi alone; no state columns,
+ * or the NS of a step's F before them) of a general robot at m <= LANES states x (rows SR_NX apart;
+ * u rows u_stride apart, 0 for one row), checked by the caller: the same arithmetic as rkmk4_param
+ * state by state, but each stage's two generated kernels (M, f and their state derivatives; the
+ * regressor) run on all the block's stage states at once in their lanes forms (sr_gen_*_lanes,
+ * vectorised across the states, each lane the scalar kernel's bits).  Jp (m x SR_NE x the parameter
+ * columns), F (m x SR_NE x SR_NE, with state columns only, as sr_step_jacobian_param_cols_batch
+ * writes it) and x_next (m x SR_NX, unless NULL) written; SR_OK, else nonzero where any state fails
+ * (a singular M, a flag the lanes cleared, a non-finite result): then the caller redoes the block
+ * state by state, which reports the failing row. */
 static int rkmk4_param_lanes(const sr_model *model, const colset *cs, int m, const sr_real *x, const sr_real *u,
-                             long u_stride, sr_real h, sr_real *Jp, sr_real *x_next)
+                             long u_stride, sr_real h, sr_real *F, sr_real *Jp, sr_real *x_next)
 {
     static const sr_real a_diag[3] = {SR_C(0.5), SR_C(0.5), SR_C(1.0)};
     const sr_real b[4] = {h / 6, h / 3, h / 3, h / 6};
@@ -602,7 +614,15 @@ static int rkmk4_param_lanes(const sr_model *model, const colset *cs, int m, con
     tangent_p dK[LANES], dsum[LANES], dth;
     error_p dstage;
     int l, s, i, c, status = SR_OK;
-    for (l = 0; l < m && status == SR_OK; ++l) {   /* K1 = f(x): M and f alone, as accel_param_jacobian */
+    if (cs->ns) {   /* K1 = f(x) with the state columns: x's stage as every later one (general_stage_rows) */
+        sr_gen_general_accel_jacobian_terms_lanes(model->cg, m, x, SR_NX, u, u_stride, Mu[0], 15, f[0], SR_NV, df[0],
+                                                  SR_NV * SR_NE, dfdu[0], SR_NV * SR_NU, dM[0], 5 * 15, ok);
+        for (l = 0; l < m && status == SR_OK; ++l) {
+            sr_internal_kinematics(model, x + SR_NX * l, K[l][0]);
+            status = ok[l] == 1 ? stage_accel(Mu[l], f[l], L[l], inv[l], K[l][0] + SR_T_V) : SR_ERR_NONFINITE;
+        }
+    }
+    for (l = 0; l < m && status == SR_OK && !cs->ns; ++l) {   /* K1 = f(x): M and f alone, as accel_param_jacobian */
         sr_internal_kinematics(model, x + SR_NX * l, K[l][0]);
         status = sr_gen_general_system(model->cg, x + SR_NX * l, u + u_stride * l, Mu[l], f[l]);
         if (status == SR_OK) status = sr_internal_cholesky(Mu[l], L[l], inv[l]);
@@ -631,27 +651,36 @@ static int rkmk4_param_lanes(const sr_model *model, const colset *cs, int m, con
         for (l = 0; l < m; ++l) {
             if (ok[l] != 1) return SR_ERR_NONFINITE;
             regressor_columns(cs, Y[l], Jr);
-            if (!s) {
+            if (!s && cs->ns) {   /* the start's own error carried: start_rows, then the stage's columns */
+                start_rows(cs->ns, nc, dstage);
+                stage_columns(cs, df[l], dM[l], L[l], inv[l], K[l][0] + SR_T_V, (const sr_real(*)[NW])dstage, Jr);
+                field_columns(model, cs, x + SR_NX * l, (const sr_real(*)[NW])dstage, K[l][0], (const sr_real(*)[NW])Jr,
+                              dK[l]);
+            } else if (!s) {
                 sr_internal_cholesky_solve(L[l], inv[l], NW, nc, &Jr[0][0]);
                 field_columns(model, cs, x + SR_NX * l, NULL, K[l][0], (const sr_real(*)[NW])Jr, dK[l]);
+            }
+            if (!s) {
                 for (i = 0; i < SR_NT; ++i)
                     for (c = 0; c < nc; ++c) dsum[l][i][c] = b[0] * dK[l][i][c];
                 continue;
             }
             for (i = 0; i < SR_NT; ++i)
                 for (c = 0; c < nc; ++c) dth[i][c] = hs * dK[l][i][c];
-            action_rows(0, nc, th[l], D[l], (const sr_real(*)[NW])dth, dstage);
+            action_rows(cs->ns, nc, th[l], D[l], (const sr_real(*)[NW])dth, dstage);
             stage_columns(cs, df[l], dM[l], L[l], inv[l], K[l][s] + SR_T_V, (const sr_real(*)[NW])dstage, Jr);
             field_columns(model, cs, y[l], (const sr_real(*)[NW])dstage, K[l][s], (const sr_real(*)[NW])Jr, dK[l]);
             stage_combine(nc, th[l], (const sr_real(*)[NW])dth, b[s], K[l][s], dK[l], dsum[l]);
         }
     }
     for (l = 0; l < m; ++l) {
-        sr_real *out = Jp + (long)l * SR_NE * nc;
+        const int np = nc - cs->ns;
+        sr_real *out = Jp + (long)l * SR_NE * np;
         step_end(cs, x + SR_NX * l, h, (const sr_real(*)[SR_NT])K[l], (const sr_real(*)[NW])dsum[l], dstage, end);
         for (i = 0; i < SR_NE; ++i) {
             if (!all_finite(dstage[i], nc)) return SR_ERR_NONFINITE;
-            for (c = 0; c < nc; ++c) out[i * nc + c] = dstage[i][c];
+            if (cs->ns) state_columns(dstage[i], i, F + ((long)l * SR_NE + i) * SR_NE);
+            for (c = 0; c < np; ++c) out[i * np + c] = dstage[i][cs->ns + c];
         }
         if (x_next) {
             if (!all_finite(end, SR_NX)) return SR_ERR_NONFINITE;
@@ -693,8 +722,8 @@ static int cols_batch(const sr_model *model, int method, long n, const sr_real *
 #if SR_PARAM_LANES > 0
         if (i % LANES == 0 && method == SR_RKMK4 && model->general && cs.pi && lanes_checked(model, x, u, i, n)) {
             const int m = n - i < LANES ? (int)(n - i) : LANES;
-            if (rkmk4_param_lanes(model, &cs, m, x + i * SR_NX, u ? u + i * SR_NU : sr_zero_u, u ? SR_NU : 0, dt, out,
-                                  with_next ? x_next + i * SR_NX : NULL) == SR_OK) {
+            if (rkmk4_param_lanes(model, &cs, m, x + i * SR_NX, u ? u + i * SR_NU : sr_zero_u, u ? SR_NU : 0, dt, NULL,
+                                  out, with_next ? x_next + i * SR_NX : NULL) == SR_OK) {
                 i += m - 1;
                 continue;
             }
@@ -747,12 +776,20 @@ int sr_step_jacobian_param_cols_batch(const sr_model *model, int method, long n,
     cs = columns_of(model, NS, ncols, cols, pi);
     for (i = 0; i < n; ++i) {
         sr_real *f = F + i * SR_NE * SR_NE, *out = Jp + i * SR_NE * ncols;
+#if SR_PARAM_LANES > 0
+        if (i % LANES == 0 && method == SR_RKMK4 && model->general && cs.pi && lanes_checked(model, x, u, i, n)) {
+            const int m = n - i < LANES ? (int)(n - i) : LANES;
+            if (rkmk4_param_lanes(model, &cs, m, x + i * SR_NX, u ? u + i * SR_NU : sr_zero_u, u ? SR_NU : 0, dt, f, out,
+                                  NULL) == SR_OK) {
+                i += m - 1;
+                continue;
+            }
+        }
+#endif
         status = step_param(model, &cs, method, x + i * SR_NX, u ? u + i * SR_NU : NULL, dt, dy, NULL);
         for (k = 0; k < SR_NE && status == SR_OK; ++k) {
             if (!all_finite(dy[k], NS + ncols)) status = SR_ERR_NONFINITE;
-            for (c = 0; c < NS; ++c) f[SR_NE * k + state_row(c)] = dy[k][c];
-            f[SR_NE * k + SR_E_q] = (sr_real)(k == SR_E_q);   /* nothing depends on q: see NS */
-            f[SR_NE * k + SR_E_q + 1] = (sr_real)(k == SR_E_q + 1);
+            state_columns(dy[k], k, f + SR_NE * k);
             for (c = 0; c < ncols; ++c) out[k * ncols + c] = dy[k][NS + c];
         }
         if (status != SR_OK) {

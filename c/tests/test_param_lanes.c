@@ -1,10 +1,12 @@
 /*
  * test_param_lanes.c -- the lanes forms of the parameter sensitivity's two generated kernels
  * (sr_gen_general_accel_jacobian_terms_lanes, sr_gen_regressor_lanes) and the RKMK4 sensitivity
- * that runs them on blocks of states in lockstep (sr_step_and_param_jacobian_cols_batch,
- * c/src/sr_param_jacobians.c): each lane is the scalar kernel's bit for bit, on random robots and
- * states, and the batched sensitivity equals the state-by-state path's (the parameter columns of
- * sr_step_jacobian_param_cols_batch, which runs the stages one state at a time).
+ * that runs them on blocks of states in lockstep (sr_step_and_param_jacobian_cols_batch and
+ * sr_step_jacobian_param_cols_batch, c/src/sr_param_jacobians.c, where every free column moves pi
+ * alone): each lane is the scalar kernel's bit for bit, on random robots and states; the batched
+ * sensitivity equals the one-state path's (sr_step_param_jacobian, all columns, its bracket
+ * generated, not the regressor's), and the batched step Jacobian F the state-by-state path's bit for
+ * bit (sr_step_jacobian_param_cols_batch with r among the columns, which the lanes never take).
  */
 #include "sr_test.h"
 
@@ -57,6 +59,7 @@ typedef struct {
 /* One workspace for all the tests (they run one after the other): the Cortex-M targets' RAM. */
 static struct {
     sr_real x[N][SR_NX], u[N][SR_NU], a[N][SR_NV], next[N][SR_NX], Jp[N][SR_NE * NCOLS], ref[N][SR_NE * NCOLS];
+    sr_real F[N][SR_NE * SR_NE], Fref[N][SR_NE * SR_NE], all[SR_NE * SR_NPARAM], cols_r[SR_NE * (NCOLS + 1)];
     kernel_rows out;
 } ws;
 
@@ -119,8 +122,10 @@ static void test_kernel_comparison_sees_one_ulp_of_one_lane(void)
     CHECK(!equal_to_scalar_kernels(&m, ws.x, ws.u, ws.a, &ws.out));
 }
 
-/* A fit's free entries, r among them (its column carries the rolling kinematics too). */
-static const int COLS[NCOLS] = {SR_P_k_S, SR_P_m_P, SR_P_r, SR_P_J_P_yy, SR_P_j_mY, SR_P_c_P_z};
+/* A fit's free entries, each moving pi alone (the lanes' case); COLS_R the same and r, whose column
+ * (the rolling kinematics) keeps a batch on the state-by-state path. */
+static const int COLS[NCOLS] = {SR_P_k_S, SR_P_m_P, SR_P_c_Y_x, SR_P_J_P_yy, SR_P_j_mY, SR_P_c_P_z};
+static const int COLS_R[NCOLS + 1] = {SR_P_k_S, SR_P_m_P, SR_P_c_Y_x, SR_P_J_P_yy, SR_P_j_mY, SR_P_c_P_z, SR_P_r};
 
 /* Largest |v| of an n-vector. */
 static double largest(const sr_real *v, long n)
@@ -140,15 +145,21 @@ static double relative_difference(const sr_real *a, const sr_real *b, long n)
     return d / largest(b, n);
 }
 
-/* The state-by-state path's sensitivity on COLS at the N states: the parameter columns of
- * sr_step_jacobian_param_cols_batch (the stages one state at a time, the state columns beside). */
-static void state_by_state(const sr_model *m, sr_real x[N][SR_NX], sr_real u[N][SR_NU], sr_real Jp[N][SR_NE * NCOLS])
+/* The one-state paths at the N states: the sensitivity on COLS, COLS' columns of
+ * sr_step_param_jacobian (every column, the bracket generated), into Jp; the step Jacobian F of
+ * sr_step_jacobian_param_cols_batch on COLS_R, one state at a time (r's column: no lanes), into F. */
+static void state_by_state(const sr_model *m, sr_real x[N][SR_NX], sr_real u[N][SR_NU], sr_real Jp[N][SR_NE * NCOLS],
+                           sr_real F[N][SR_NE * SR_NE])
 {
-    sr_real F[SR_NE * SR_NE];
-    int i;
-    for (i = 0; i < N; ++i)
-        CHECK_STATUS(sr_step_jacobian_param_cols_batch(m, SR_RKMK4, 1, x[i], u[i], SR_C(0.01), NCOLS, COLS, F, Jp[i], NULL),
+    int i, k, c;
+    for (i = 0; i < N; ++i) {
+        CHECK_STATUS(sr_step_param_jacobian(m, SR_RKMK4, x[i], u[i], SR_C(0.01), ws.all), SR_OK);
+        for (k = 0; k < SR_NE; ++k)
+            for (c = 0; c < NCOLS; ++c) Jp[i][k * NCOLS + c] = ws.all[k * SR_NPARAM + COLS[c]];
+        CHECK_STATUS(sr_step_jacobian_param_cols_batch(m, SR_RKMK4, 1, x[i], u[i], SR_C(0.01), NCOLS + 1, COLS_R, F[i],
+                                                       ws.cols_r, NULL),
                      SR_OK);
+    }
 }
 
 /* The sensitivity on COLS of the workspace's N states in one batch call, into ws.next and ws.Jp. */
@@ -169,7 +180,15 @@ static void new_case(test_rng *rng, sr_model *m)
 {
     random_robot(rng, m);
     random_rows(rng, m, ws.x, ws.u, ws.a);
-    state_by_state(m, ws.x, ws.u, ws.ref);
+    state_by_state(m, ws.x, ws.u, ws.ref, ws.Fref);
+}
+
+/* F and the sensitivity on COLS of the workspace's N states in one sr_step_jacobian_param_cols_batch
+ * call, into ws.F and ws.Jp. */
+static int step_jacobian_batch(const sr_model *m, long *row)
+{
+    return sr_step_jacobian_param_cols_batch(m, SR_RKMK4, N, ws.x[0], ws.u[0], SR_C(0.01), NCOLS, COLS, ws.F[0],
+                                             ws.Jp[0], row);
 }
 
 #define SENSITIVITY_TOL (TEST_EPS > 1e-10 ? 1e-5 : 1e-13)
@@ -188,6 +207,33 @@ static void test_lockstep_sensitivity_equals_the_state_by_state_path(void)
         CHECK_STATUS(sr_step(&m, SR_RKMK4, ws.x[N - 1], ws.u[N - 1], SR_C(0.01), one_next), SR_OK);
         CHECK(relative_difference(ws.next[N - 1], one_next, SR_NX) <= (TEST_EPS > 1e-10 ? 1e-5 : 1e-12));
     }
+}
+
+static void test_lockstep_step_jacobian_and_sensitivity_equal_the_state_by_state_paths(void)
+{
+    test_rng rng = {47};
+    sr_model m;
+    long row = 5;
+    int r;
+    for (r = 0; r < NROBOTS; ++r) {
+        new_case(&rng, &m);
+        CHECK_STATUS(step_jacobian_batch(&m, &row), SR_OK);
+        CHECK(row == -1 && memcmp(ws.F, ws.Fref, sizeof ws.F) == 0 && batch_error(N) <= SENSITIVITY_TOL);
+    }
+}
+
+/* The F comparison sees one ulp of one entry of one state's F. */
+static void test_step_jacobian_comparison_sees_one_ulp(void)
+{
+    test_rng rng = {53};
+    sr_model m;
+    sr_real *e = &ws.F[N / 2][SR_NE * 3 + 4];
+    new_case(&rng, &m);
+    CHECK_STATUS(step_jacobian_batch(&m, NULL), SR_OK);
+    CHECK(memcmp(ws.F, ws.Fref, sizeof ws.F) == 0);
+    *e = sizeof(sr_real) == sizeof(float) ? (sr_real)nextafterf((float)*e, 2 * (float)*e + 1)
+                                          : (sr_real)nextafter((double)*e, 2 * (double)*e + 1);
+    CHECK(memcmp(ws.F, ws.Fref, sizeof ws.F) != 0);
 }
 
 /* The comparison above sees a change of 1e-12 of one entry of one state's sensitivity. */
@@ -221,5 +267,7 @@ void suite_param_lanes(void)
     RUN_TEST(test_kernel_comparison_sees_one_ulp_of_one_lane);
     RUN_TEST(test_lockstep_sensitivity_equals_the_state_by_state_path);
     RUN_TEST(test_sensitivity_comparison_sees_a_perturbed_state);
+    RUN_TEST(test_lockstep_step_jacobian_and_sensitivity_equal_the_state_by_state_paths);
+    RUN_TEST(test_step_jacobian_comparison_sees_one_ulp);
     RUN_TEST(test_a_bad_row_in_a_block_is_reported_at_its_row);
 }
