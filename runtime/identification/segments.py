@@ -173,9 +173,9 @@ def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True):
     r, Hx, Hn, Hb = (np.concatenate([p[i] for p in parts])[order] for i in range(4))
     r = r / sig
     # per row, as a segment alone forms them (the same products in the same order, bit for bit)
-    Phi_n, Sens_n = Gn[:, :, :NE], Gn[:, :, NE:]
-    th = -(np.einsum("rj,rjk->rk", Hx, Sens_n[node]) + np.einsum("rj,rjk->rk", Hn, Jpa[node])) / sig[:, None]
-    xs = -np.einsum("rj,rjk->rk", Hx, Phi_n[node]) / sig[:, None]
+    HG = np.einsum("rj,rjk->rk", Hx, Gn[node])         # [∂y/∂x Φ | ∂y/∂x S] of each row, one gather
+    th = -(HG[:, NE:] + np.einsum("rj,rjk->rk", Hn, Jpa[node])) / sig[:, None]
+    xs = -HG[:, :NE] / sig[:, None]
     Hb = -Hb / sig[:, None]
     bounds = lay["bounds"]
     if nxt is not None:
