@@ -7,7 +7,8 @@ integrators (∫e_y, ∫ of the rolling-rate error) advance by one period at any
 step would push a clipped torque further past its limit (conditional integration: the anti-windup),
 and ∫e_y only while the error is steady, |ė_y| ≤ `steady_rate_m_s` (a moving error is a transient).
 On a slope (the model's own, or one estimated online: `slope_estimate_s`) the torques gain the
-slope's feedforward (runtime/control/slope.py), the schedule being designed on the flat model.
+slope's feedforward (runtime/control/slope.py), the schedule being designed on the flat model, and
+with `pendulum_feedforward` the estimated pendulum's (its steady torques and lean).
 """
 import dataclasses
 import typing
