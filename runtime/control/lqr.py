@@ -7,7 +7,8 @@ integrators (∫e_y, ∫ of the rolling-rate error) advance by one period at any
 step would push a clipped torque further past its limit (conditional integration: the anti-windup),
 and ∫e_y only while the error is steady, |ė_y| ≤ `steady_rate_m_s` (a moving error is a transient).
 On a slope (the model's own, or one estimated online: `slope_estimate_s`) the torques gain the
-slope's feedforward (runtime/control/slope.py), the schedule being designed on the flat model.
+slope's feedforward (runtime/control/slope.py), the schedule being designed on the flat model, and
+with `pendulum_feedforward` the estimated pendulum's (its steady torques and lean).
 """
 import dataclasses
 import typing
@@ -53,6 +54,7 @@ class LqrGains:
     smoothing_m: float = 0.5          # ... along the path from the nearest point (0: the curvature there)
     steady_rate_m_s: float = 0.01    # ∫e_y advances only while |ė_y| ≤ this [m/s] (above the wander's rate)
     slope_estimate_s: float = 0.0     # the slope estimate's time constant [s] (0: the model's slope only)
+    pendulum_feedforward: float = 0.0  # the share of the estimated pendulum's operating-point move fed forward (needs the estimate)
     tight_cross_track_m: float = 0.03  # e_y of the tight path gains (the other sizes as above)
     tight_band_m: float = 0.1         # their weight is at most 1 − |e_y| / tight_band_m (0: no tight gains)
     tight_rise_s: float = 10.0        # ... and rises from 0 to 1 in no less than this [s]
@@ -71,6 +73,9 @@ class LqrGains:
             raise ValueError(f"v_max: must exceed v_min = {self.v_min!r} when n_speeds > 1, got {self.v_max!r}")
         if self.n_curvatures > 1 and not self.kappa_max > 0:
             raise ValueError(f"kappa_max: must be > 0 when n_curvatures > 1, got {self.kappa_max!r}")
+        if self.pendulum_feedforward > 0 and not self.slope_estimate_s > 0:
+            raise ValueError(f"pendulum_feedforward: feeds the slope estimate's pendulum forward, so needs "
+                             f"slope_estimate_s > 0, got {self.pendulum_feedforward!r} with slope_estimate_s = 0")
 
     def tight_weights(self, u_max):
         """The tight path gains' Riccati weights: these bounds with the cross-track error `tight_cross_track_m`."""
@@ -275,13 +280,25 @@ class Lqr(SlopeFeedforward, Controller):
         ff = self.slope_feedforward(target)
         if self._estimator is not None:
             ff = ff - self._estimator.torque_offset
+        if self._pendulum_schedule is not None:
+            ff = ff + self.gains.pendulum_feedforward * self.pendulum_feedforward(target)
         return self._raw + ff
 
-    def slope_feedforward(self, target):
-        """Δu* + K Δz* (2,) [N m]: the operating point's move on the slope `self.slope`, at the
+    def _moved(self, target, at):
+        """Δu* + K Δz* (2,) [N m] of the operating point's move (Δz*, Δu*) = at(v, κ), at the
         reference's speed and the operating curvature of the last sample."""
-        up, right = slope_components(self.slope, target.heading)
         kappa = float(self._memory.kappa) if target.cross_track is not None else 0.0
-        dz, du = self._slope_schedule.at(target.speed, kappa, up, right)
+        dz, du = at(target.speed, kappa)
         _, _, K_path, K_heading = self.schedule.at(target.speed, kappa)
         return du + (K_path if target.cross_track is not None else K_heading) @ dz
+
+    def slope_feedforward(self, target):
+        """Δu* + K Δz* (2,) [N m]: the operating point's move on the slope `self.slope`."""
+        up, right = slope_components(self.slope, target.heading)
+        return self._moved(target, lambda v, kappa: self._slope_schedule.at(v, kappa, up, right))
+
+    def pendulum_feedforward(self, target):
+        """Δu* + K Δz* (2,) [N m]: the operating point's move for the estimated pendulum's departure
+        from the model (Δm_P, Δc_P), fixed to the robot: the steady torques and lean it needs."""
+        pendulum = self._estimator.pendulum
+        return self._moved(target, lambda v, kappa: self._pendulum_schedule.at(v, kappa, pendulum))

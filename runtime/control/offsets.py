@@ -28,15 +28,22 @@ OFFSET_CONTROLLERS = ("lqr", "lqr-slope", "nmpc", "nmpc-slope", "nmpc-c", "nmpc-
 DEFAULT_OFFSET_CONTROLLERS = ("lqr", "lqr-slope", "nmpc", "nmpc-c", "nmpc-c-slope")
 #: The slope estimate's time constant [s] of the -slope runs.
 SLOPE_ESTIMATE_S = 5.0
+#: What lqr-slope sets besides the estimate: the estimated pendulum fed forward, and the cross-track
+#: integral loosened from 1 to 2 m s (the NMPC's): the estimate's feedforward carries the offsets the
+#: integral held, and the looser integral, wound up less by the line's approach, leaves less of it in
+#: the second half (docs/control.md, "Offset-free tracking").
+LQR_SLOPE_SETTINGS = {"pendulum_feedforward": 1.0, "cross_track_integral_m_s": 2.0}
 
 
 def with_controller(task, kind):
     """The task with only its controller of `kind`; nmpc-c takes the settings of the task's nmpc,
-    a kind ending in -slope those of its controller with `slope_estimate_s` = SLOPE_ESTIMATE_S."""
+    a kind ending in -slope those of its controller with `slope_estimate_s` = SLOPE_ESTIMATE_S (lqr-slope
+    with LQR_SLOPE_SETTINGS too)."""
     if kind.endswith("-slope"):
         task = with_controller(task, kind[:-len("-slope")])
         spec = task.controllers[0]
-        gains = dataclasses.replace(spec.gains, slope_estimate_s=SLOPE_ESTIMATE_S)
+        more = LQR_SLOPE_SETTINGS if kind == "lqr-slope" else {}
+        gains = dataclasses.replace(spec.gains, slope_estimate_s=SLOPE_ESTIMATE_S, **more)
         return dataclasses.replace(task, controllers=(dataclasses.replace(spec, gains=gains),))
     if kind != "nmpc-c" or "nmpc-c" in task.controller_kinds:
         return task.with_controller(kind)

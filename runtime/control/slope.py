@@ -30,8 +30,12 @@ pendulum's swing and lean, fixed to the robot, where a slope's pull turns with t
 to the fall line and acts on the whole robot.  So the estimate carries the pendulum's mass and
 centre of mass as well, their columns the model's one-period rates with each moved, less the flat
 ones (the identification's parameter sensitivities, here by differences); the slope fed forward is
-the part the pendulum does not explain.  The pendulum's part is not fed forward: the controllers'
-integrals and torque offset hold it as they do without an estimate.  Until the samples tell the
+the part the pendulum does not explain.  The LQR with `pendulum_feedforward` > 0 feeds the
+pendulum's part forward too, as the slope's: the operating point's derivatives with respect to m_P
+and c_P (`PendulumSchedule`), the steady torques and lean a pendulum unlike the model's needs; its
+estimate then carries the pendulum's damping k_P as well (`pendulum_damping`), whose pull while the
+pendulum swings was otherwise read as the pendulum.  Without it the controllers' integrals and
+torque offset hold the pendulum's part as they do without an estimate.  Until the samples tell the
 pendulum from the slope and d (rolling straight from the start, its columns lie nearly in their
 span), the slope and d are fitted alone with the pendulum held, so the slope is read as early as
 without it.
@@ -58,6 +62,9 @@ TORQUE_PROBE = 1e-3
 #: for the centre of mass) and the sizes their columns are scaled to (a tenth of the mass, 1 cm).
 MASS_PROBE, CENTRE_PROBE_M = 1e-3, 1e-4
 MASS_SCALE, CENTRE_SCALE_M = 0.1, 0.01
+#: The pendulum's damping k_P, estimated as well when the pendulum is fed forward: its relative step
+#: and the relative size its column is scaled to.
+DAMPING_PROBE, DAMPING_SCALE = 1e-3, 0.2
 
 
 class _Turned:
@@ -82,6 +89,12 @@ def turned_state(x, psi):
     return y
 
 
+def _interpolated(speeds, curvatures, a, b, v, kappa):
+    """(a, b) (each (nv, nk, ...)) interpolated bilinearly in (v, κ) as the LQR's schedule is."""
+    zero = np.zeros(a.shape[:2] + (2, design.NZ))
+    return Schedule(speeds, curvatures, a, b, zero, zero).at(v, kappa)[:2]
+
+
 @dataclasses.dataclass(frozen=True)
 class SlopeSchedule:
     """The operating point's derivatives per radian of slope on the LQR's grid: dz_up, dz_right
@@ -96,10 +109,25 @@ class SlopeSchedule:
     def at(self, v, kappa, up, right):
         """(Δz*, Δu*) for the slope components `up` (along the path) and `right` [rad], interpolated
         bilinearly in (v, κ) as the LQR's schedule is."""
-        zero = np.zeros(self.du_up.shape[:2] + (2, design.NZ))
-        a = Schedule(self.speeds, self.curvatures, self.dz_up, self.du_up, zero, zero).at(v, kappa)
-        b = Schedule(self.speeds, self.curvatures, self.dz_right, self.du_right, zero, zero).at(v, kappa)
+        a = _interpolated(self.speeds, self.curvatures, self.dz_up, self.du_up, v, kappa)
+        b = _interpolated(self.speeds, self.curvatures, self.dz_right, self.du_right, v, kappa)
         return up * a[0] + right * b[0], up * a[1] + right * b[1]
+
+
+@dataclasses.dataclass(frozen=True)
+class PendulumSchedule:
+    """The operating point's derivatives with respect to the pendulum's parameters on the LQR's grid,
+    in the units of `SlopeEstimator.pendulum` (Δm_P [kg], Δc_P (3,) [m]): dz (nv, nk, 4, NZ),
+    du (nv, nk, 4, 2)."""
+    speeds: np.ndarray
+    curvatures: np.ndarray
+    dz: np.ndarray
+    du: np.ndarray
+
+    def at(self, v, kappa, pendulum):
+        """(Δz*, Δu*) of the pendulum's departure `pendulum` (4,), interpolated bilinearly in (v, κ)."""
+        dz, du = _interpolated(self.speeds, self.curvatures, self.dz, self.du, v, kappa)
+        return np.asarray(pendulum) @ dz, np.asarray(pendulum) @ du
 
 
 def slope_components(slope_vector, psi):
@@ -135,33 +163,78 @@ def _design(params, schedule):
     return SlopeSchedule(schedule.speeds, schedule.curvatures, **out)
 
 
+def pendulum_probes(params):
+    """[(the model's parameters with one pendulum parameter moved, the step in the units of
+    `SlopeEstimator.pendulum`)] for Δm_P, Δc_P,x, Δc_P,y, Δc_P,z; the slope 0."""
+    flat = params.replace(slope=0.0)
+    c_P = np.asarray(params.c_P, dtype=float)
+    return [(flat.replace(m_P=params.m_P * (1 + MASS_PROBE)), MASS_PROBE * params.m_P)] + \
+        [(flat.replace(c_P=tuple(c_P + CENTRE_PROBE_M * e)), CENTRE_PROBE_M) for e in np.eye(3)]
+
+
+def design_pendulum_schedule(params, schedule):
+    """The PendulumSchedule of the flat LQR schedule `schedule` designed on `params` (slope 0):
+    Newton's operating point of the model with each pendulum parameter moved, less the flat one."""
+    key = (params.as_array().tobytes(), schedule.speeds.tobytes(), schedule.curvatures.tobytes())
+    if key not in _PENDULUM_SCHEDULES:
+        probes = pendulum_probes(params)
+        shape = schedule.z_star.shape[:2]
+        dz, du = np.zeros(shape + (len(probes), design.NZ)), np.zeros(shape + (len(probes), 2))
+        for k, (moved, step) in enumerate(probes):
+            model = Model(moved)
+            for i, v in enumerate(schedule.speeds):
+                for j, kappa in enumerate(schedule.curvatures):
+                    flat = (schedule.z_star[i, j], schedule.u_star[i, j])
+                    z, u = design.operating_point(model, v, kappa, start=flat)
+                    dz[i, j, k], du[i, j, k] = (z - flat[0]) / step, (u - flat[1]) / step
+        _PENDULUM_SCHEDULES[key] = PendulumSchedule(schedule.speeds, schedule.curvatures, dz, du)
+    return _PENDULUM_SCHEDULES[key]
+
+
+_PENDULUM_SCHEDULES = {}
+
+
 class SlopeEstimator:
     """The world's slope vector s [rad], a torque offset d [N m] (the plant moving as the model under
     u + d: a motor's bias) and the pendulum's departure from the model (`pendulum`: Δm_P [kg], Δc_P
     (3,) [m]) from the measured states and the torques held between them (see the module's
     docstring): least squares with exponential forgetting over `time_constant_s`.  What the torque
     offset or the pendulum explains is not read as a slope: they act on the rates along other
-    directions, fixed to the robot, where the slope's pull turns with the heading."""
+    directions, fixed to the robot, where the slope's pull turns with the heading.
+    `pendulum_damping`: the pendulum's damping k_P is a column too (`pendulum_damping`, Δk_P): a
+    damping unlike the model's pulls only while the pendulum swings, and unfitted, that pull was read
+    as a pendulum or a slope in the directions the samples hardly tell apart while rolling straight."""
 
-    def __init__(self, params, period, time_constant_s):
+    def __init__(self, params, period, time_constant_s, pendulum_damping=False):
         self.period, self.time_constant_s = float(period), float(time_constant_s)
         self._flat = Model(params.replace(slope=0.0))
         self._sloped = Model(params.replace(slope=PROBE_SLOPE))
-        c_P = np.asarray(params.c_P, dtype=float)
         # (the model with one pendulum parameter moved, the step, the column's scale)
-        self._pendulum = [(Model(params.replace(slope=0.0, m_P=params.m_P * (1 + MASS_PROBE))),
-                           MASS_PROBE * params.m_P, MASS_SCALE * params.m_P)]
-        self._pendulum += [(Model(params.replace(slope=0.0, c_P=tuple(c_P + CENTRE_PROBE_M * e))), CENTRE_PROBE_M,
-                            CENTRE_SCALE_M) for e in np.eye(3)]
+        self._pendulum = [(Model(moved), step, scale) for (moved, step), scale in
+                          zip(pendulum_probes(params), (MASS_SCALE * params.m_P,) + 3 * (CENTRE_SCALE_M,))]
+        if pendulum_damping:
+            self._pendulum.append((Model(params.replace(slope=0.0, k_P=params.k_P * (1 + DAMPING_PROBE))),
+                                   DAMPING_PROBE * params.k_P, DAMPING_SCALE * params.k_P))
         self._steps = max(1, math.ceil(self.period / PREDICT_DT - 1e-9))
         self._forget = math.exp(-self.period / self.time_constant_s)
         self.reset()
 
     def reset(self):
         """Forgets the samples and the estimate."""
-        self._normal, self._rhs = np.zeros((8, 8)), np.zeros(8)
+        n = 4 + len(self._pendulum)
+        self._normal, self._rhs = np.zeros((n, n)), np.zeros(n)
         self._last = None
-        self.slope, self.torque_offset, self.pendulum = np.zeros(2), np.zeros(2), np.zeros(4)
+        self.slope, self.torque_offset, self._moved = np.zeros(2), np.zeros(2), np.zeros(n - 4)
+
+    @property
+    def pendulum(self):
+        """The pendulum's departure from the model: (Δm_P [kg], Δc_P (3,) [m])."""
+        return self._moved[:4]
+
+    @property
+    def pendulum_damping(self):
+        """Δk_P [N m s/rad] when the estimate carries the pendulum's damping, else 0."""
+        return float(self._moved[4]) if len(self._moved) > 4 else 0.0
 
     def _rates(self, model, x, u):
         return model.simulate(x, self.period / self._steps, self._steps, np.tile(u, (self._steps, 1)),
@@ -185,12 +258,12 @@ class SlopeEstimator:
             scales = np.array([scale for _, _, scale in self._pendulum])
             if np.linalg.cond(self._normal) < 1e10:
                 theta = np.linalg.solve(self._normal, self._rhs)
-                self.slope, self.torque_offset, self.pendulum = theta[:2], theta[2:4], theta[4:] * scales
+                self.slope, self.torque_offset, self._moved = theta[:2], theta[2:4], theta[4:] * scales
             elif np.linalg.cond(self._normal[:4, :4]) < 1e10:
                 # Until the samples tell the pendulum from the slope and d (rolling straight at the
                 # start), the slope and d alone, the pendulum held: the slope's estimate arrives as
                 # soon as it would without the pendulum.
-                held = self._rhs[:4] - self._normal[:4, 4:] @ (self.pendulum / scales)
+                held = self._rhs[:4] - self._normal[:4, 4:] @ (self._moved / scales)
                 theta = np.linalg.solve(self._normal[:4, :4], held)
                 self.slope, self.torque_offset = theta[:2], theta[2:]
         self._last = np.array(x, dtype=float)
@@ -209,8 +282,10 @@ class SlopeFeedforward:
         self.model_slope = np.array([params.slope, 0.0])
         self._slope_schedule = design_slope_schedule(flat, schedule) \
             if params.slope != 0.0 or gains.slope_estimate_s > 0.0 else None
-        self._estimator = SlopeEstimator(flat, self.period, gains.slope_estimate_s) \
+        feeds_pendulum = gains.pendulum_feedforward > 0.0
+        self._estimator = SlopeEstimator(flat, self.period, gains.slope_estimate_s, pendulum_damping=feeds_pendulum) \
             if gains.slope_estimate_s > 0.0 else None
+        self._pendulum_schedule = design_pendulum_schedule(flat, schedule) if feeds_pendulum else None
         self._applied = np.zeros(2)
 
     def _reset_slope(self):
