@@ -25,12 +25,13 @@ flat one, per radian.  `SlopeEstimator` solves these with exponential forgetting
 A slope and a pendulum unlike the model's.  A pendulum heavier than the model's, or with its centre
 of mass moved, pulls on the rates too, and fitted with the slope and a torque offset alone it is read
 as a slope (in a transient, tens of times the slope the table's plants stand on) that the
-feedforward then acts on.  But it pulls as a change of the model's parameters does: through the
-pendulum's swing and lean, fixed to the robot, where a slope's pull turns with the heading relative
-to the fall line and acts on the whole robot.  So the estimate carries the pendulum's mass and
-centre of mass as well, their columns the model's one-period rates with each moved, less the flat
-ones (the identification's parameter sensitivities, here by differences); the slope fed forward is
-the part the pendulum does not explain.  The pendulum's part is not fed forward: the controllers'
+feedforward then acts on; so does a pendulum joint damped unlike the model's (k_P ∓20 %: 5 and 7
+times the table's slope on the circle).  But they pull as a change of the model's parameters does:
+through the pendulum's swing and lean, fixed to the robot, where a slope's pull turns with the
+heading relative to the fall line and acts on the whole robot.  So the estimate carries the
+pendulum's mass, centre of mass and joint damping as well, their columns the model's one-period
+rates with each moved, less the flat ones (the identification's parameter sensitivities, here by
+differences); the slope fed forward is the part the pendulum does not explain.  The pendulum's part is not fed forward: the controllers'
 integrals and torque offset hold it as they do without an estimate.  Until the samples tell the
 pendulum from the slope and d (rolling straight from the start, its columns lie nearly in their
 span), the slope and d are fitted alone with the pendulum held, so the slope is read as early as
@@ -58,6 +59,9 @@ TORQUE_PROBE = 1e-3
 #: for the centre of mass) and the sizes their columns are scaled to (a tenth of the mass, 1 cm).
 MASS_PROBE, CENTRE_PROBE_M = 1e-3, 1e-4
 MASS_SCALE, CENTRE_SCALE_M = 0.1, 0.01
+#: The pendulum joint's damping k_P, estimated with them: its step and its column's scale [N m s]
+#: (absolute: a robot may have no damping in its model).
+DAMPING_PROBE, DAMPING_SCALE = 1e-4, 0.01
 
 
 class _Turned:
@@ -138,7 +142,7 @@ def _design(params, schedule):
 class SlopeEstimator:
     """The world's slope vector s [rad], a torque offset d [N m] (the plant moving as the model under
     u + d: a motor's bias) and the pendulum's departure from the model (`pendulum`: Δm_P [kg], Δc_P
-    (3,) [m]) from the measured states and the torques held between them (see the module's
+    (3,) [m], Δk_P [N m s]) from the measured states and the torques held between them (see the module's
     docstring): least squares with exponential forgetting over `time_constant_s`.  What the torque
     offset or the pendulum explains is not read as a slope: they act on the rates along other
     directions, fixed to the robot, where the slope's pull turns with the heading."""
@@ -153,15 +157,18 @@ class SlopeEstimator:
                            MASS_PROBE * params.m_P, MASS_SCALE * params.m_P)]
         self._pendulum += [(Model(params.replace(slope=0.0, c_P=tuple(c_P + CENTRE_PROBE_M * e))), CENTRE_PROBE_M,
                             CENTRE_SCALE_M) for e in np.eye(3)]
+        self._pendulum.append((Model(params.replace(slope=0.0, k_P=params.k_P + DAMPING_PROBE)), DAMPING_PROBE,
+                               DAMPING_SCALE))
         self._steps = max(1, math.ceil(self.period / PREDICT_DT - 1e-9))
         self._forget = math.exp(-self.period / self.time_constant_s)
         self.reset()
 
     def reset(self):
         """Forgets the samples and the estimate."""
-        self._normal, self._rhs = np.zeros((8, 8)), np.zeros(8)
+        n = 4 + len(self._pendulum)
+        self._normal, self._rhs = np.zeros((n, n)), np.zeros(n)
         self._last = None
-        self.slope, self.torque_offset, self.pendulum = np.zeros(2), np.zeros(2), np.zeros(4)
+        self.slope, self.torque_offset, self.pendulum = np.zeros(2), np.zeros(2), np.zeros(len(self._pendulum))
 
     def _rates(self, model, x, u):
         return model.simulate(x, self.period / self._steps, self._steps, np.tile(u, (self._steps, 1)),
