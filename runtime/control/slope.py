@@ -25,17 +25,17 @@ flat one, per radian.  `SlopeEstimator` solves these with exponential forgetting
 A slope and a pendulum unlike the model's.  A pendulum heavier than the model's, or with its centre
 of mass moved, pulls on the rates too, and fitted with the slope and a torque offset alone it is read
 as a slope (in a transient, tens of times the slope the table's plants stand on) that the
-feedforward then acts on.  But it pulls as a change of the model's parameters does: through the
-pendulum's swing and lean, fixed to the robot, where a slope's pull turns with the heading relative
-to the fall line and acts on the whole robot.  So the estimate carries the pendulum's mass and
-centre of mass as well, their columns the model's one-period rates with each moved, less the flat
-ones (the identification's parameter sensitivities, here by differences); the slope fed forward is
-the part the pendulum does not explain.  The LQR with `pendulum_feedforward` > 0 feeds the
+feedforward then acts on; so does a pendulum joint damped unlike the model's (k_P ∓20 %: 5 and 7
+times the table's slope on the circle).  But they pull as a change of the model's parameters does:
+through the pendulum's swing and lean, fixed to the robot, where a slope's pull turns with the
+heading relative to the fall line and acts on the whole robot.  So the estimate carries the
+pendulum's mass, centre of mass and joint damping as well, their columns the model's one-period
+rates with each moved, less the flat ones (the identification's parameter sensitivities, here by
+differences); the slope fed forward is the part the pendulum does not explain.  The LQR with `pendulum_feedforward` > 0 feeds the
 pendulum's part forward too, as the slope's: the operating point's derivatives with respect to m_P
-and c_P (`PendulumSchedule`), the steady torques and lean a pendulum unlike the model's needs; its
-estimate then carries the pendulum's damping k_P as well (`pendulum_damping`), whose pull while the
-pendulum swings was otherwise read as the pendulum.  Without it the controllers' integrals and
-torque offset hold the pendulum's part as they do without an estimate.  Until the samples tell the
+and c_P (`PendulumSchedule`), the steady torques and lean a pendulum unlike the model's needs.
+Without it the controllers' integrals and torque offset hold the pendulum's part as they do without
+an estimate.  Until the samples tell the
 pendulum from the slope and d (rolling straight from the start, its columns lie nearly in their
 span), the slope and d are fitted alone with the pendulum held, so the slope is read as early as
 without it.
@@ -62,9 +62,9 @@ TORQUE_PROBE = 1e-3
 #: for the centre of mass) and the sizes their columns are scaled to (a tenth of the mass, 1 cm).
 MASS_PROBE, CENTRE_PROBE_M = 1e-3, 1e-4
 MASS_SCALE, CENTRE_SCALE_M = 0.1, 0.01
-#: The pendulum's damping k_P, estimated as well when the pendulum is fed forward: its relative step
-#: and the relative size its column is scaled to.
-DAMPING_PROBE, DAMPING_SCALE = 1e-3, 0.2
+#: The pendulum joint's damping k_P, estimated with them: its step and its column's scale [N m s]
+#: (absolute: a robot may have no damping in its model).
+DAMPING_PROBE, DAMPING_SCALE = 1e-4, 0.01
 
 
 class _Turned:
@@ -197,15 +197,16 @@ _PENDULUM_SCHEDULES = {}
 class SlopeEstimator:
     """The world's slope vector s [rad], a torque offset d [N m] (the plant moving as the model under
     u + d: a motor's bias) and the pendulum's departure from the model (`pendulum`: Δm_P [kg], Δc_P
-    (3,) [m]) from the measured states and the torques held between them (see the module's
+    (3,) [m], Δk_P [N m s]) from the measured states and the torques held between them (see the module's
     docstring): least squares with exponential forgetting over `time_constant_s`.  What the torque
     offset or the pendulum explains is not read as a slope: they act on the rates along other
     directions, fixed to the robot, where the slope's pull turns with the heading.
-    `pendulum_damping`: the pendulum's damping k_P is a column too (`pendulum_damping`, Δk_P): a
-    damping unlike the model's pulls only while the pendulum swings, and unfitted, that pull was read
-    as a pendulum or a slope in the directions the samples hardly tell apart while rolling straight."""
+    `pendulum_damping` (on by default; off only to show what it changes): the pendulum's damping k_P
+    is a column too (the property `pendulum_damping`, Δk_P): a damping unlike the model's pulls only
+    while the pendulum swings, and unfitted, that pull was read as a pendulum or a slope in the
+    directions the samples hardly tell apart while rolling straight."""
 
-    def __init__(self, params, period, time_constant_s, pendulum_damping=False):
+    def __init__(self, params, period, time_constant_s, pendulum_damping=True):
         self.period, self.time_constant_s = float(period), float(time_constant_s)
         self._flat = Model(params.replace(slope=0.0))
         self._sloped = Model(params.replace(slope=PROBE_SLOPE))
@@ -213,8 +214,8 @@ class SlopeEstimator:
         self._pendulum = [(Model(moved), step, scale) for (moved, step), scale in
                           zip(pendulum_probes(params), (MASS_SCALE * params.m_P,) + 3 * (CENTRE_SCALE_M,))]
         if pendulum_damping:
-            self._pendulum.append((Model(params.replace(slope=0.0, k_P=params.k_P * (1 + DAMPING_PROBE))),
-                                   DAMPING_PROBE * params.k_P, DAMPING_SCALE * params.k_P))
+            self._pendulum.append((Model(params.replace(slope=0.0, k_P=params.k_P + DAMPING_PROBE)), DAMPING_PROBE,
+                                   DAMPING_SCALE))
         self._steps = max(1, math.ceil(self.period / PREDICT_DT - 1e-9))
         self._forget = math.exp(-self.period / self.time_constant_s)
         self.reset()
@@ -283,7 +284,7 @@ class SlopeFeedforward:
         self._slope_schedule = design_slope_schedule(flat, schedule) \
             if params.slope != 0.0 or gains.slope_estimate_s > 0.0 else None
         feeds_pendulum = gains.pendulum_feedforward > 0.0
-        self._estimator = SlopeEstimator(flat, self.period, gains.slope_estimate_s, pendulum_damping=feeds_pendulum) \
+        self._estimator = SlopeEstimator(flat, self.period, gains.slope_estimate_s) \
             if gains.slope_estimate_s > 0.0 else None
         self._pendulum_schedule = design_pendulum_schedule(flat, schedule) if feeds_pendulum else None
         self._applied = np.zeros(2)

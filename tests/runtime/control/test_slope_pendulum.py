@@ -1,6 +1,6 @@
 """The slope estimate (runtime/control/slope.py) against a pendulum unlike the model's: the pendulum's
-mass and centre of mass are estimated with the slope, so what they pull is not read as a slope,
-and a real slope still is."""
+mass, centre of mass and joint damping are estimated with the slope, so what they pull is not read
+as a slope, and a real slope still is."""
 import math
 
 import numpy as np
@@ -28,7 +28,7 @@ READ_WITHIN_S = 0.5
 
 
 def _estimates_on_the_circle(plant, duration=20.0):
-    """The estimator's (slope (n, 2), pendulum (n, 4)) at every sample of the LQR (flat model, no
+    """The estimator's (slope (n, 2), pendulum (n, 5)) at every sample of the LQR (flat model, no
     estimate of its own) on the circle, reading the run's states and torques as the NMPC's would."""
     x0 = initial_state(R_S=so3.rot_z(-math.pi / 2), q=(0.0, 0.0, PARAMS.r), w_S=(-SPEED / PARAMS.r, 0.0, 0.0),
                        w_Y=SPEED / PARAMS.r, r=PARAMS.r)
@@ -39,7 +39,7 @@ def _estimates_on_the_circle(plant, duration=20.0):
     estimator, slopes, pendulums = SlopeEstimator(PARAMS, 1 / RATE, 5.0), [], []
     for k in range(0, len(result.time) - 1, per):
         slopes.append(estimator.update(result.trajectory[k], result.torques[k - 1] if k else np.zeros(2)).copy())
-        pendulums.append(estimator.pendulum.copy())
+        pendulums.append(np.append(estimator.pendulum, estimator.pendulum_damping))
     return np.array(slopes), np.array(pendulums)
 
 
@@ -58,10 +58,19 @@ def test_a_centre_of_mass_moved_is_read_as_the_pendulum_not_a_slope():
     assert pendulums[-1][1] == pytest.approx(-0.01, rel=0.05)
 
 
+@pytest.mark.parametrize("factor", [0.8, 1.2])
+def test_a_pendulum_joint_damped_unlike_the_model_is_read_as_the_pendulum_not_a_slope(factor):
+    # Without the damping's column: slopes of 5 (k_P -20 %) and 7 (+20 %) times this one after 2 s,
+    # which the NMPC's feedforward acted on (the circle's start 13 cm off the path).
+    slopes, pendulums = _estimates_on_the_circle(PARAMS.with_changes(k_P=factor * PARAMS.paper_params.k_P))
+    assert np.max(np.linalg.norm(slopes[int(2 * RATE):], axis=1)) < 0.1 * SLOPE
+    assert pendulums[-1][4] == pytest.approx((factor - 1) * PARAMS.k_P, rel=0.1)
+
+
 def test_a_slope_is_still_read_as_the_slope():
     slopes, pendulums = _estimates_on_the_circle(PARAMS.replace(slope=SLOPE))
     assert np.linalg.norm(slopes[-1] - (SLOPE, 0.0)) < 0.02 * SLOPE
-    assert np.all(np.abs(pendulums[-1]) < 1e-3 * np.array([PARAMS.m_P, 1, 1, 1]))
+    assert np.all(np.abs(pendulums[-1]) < 1e-3 * np.array([PARAMS.m_P, 1, 1, 1, PARAMS.k_P]))
 
 
 def test_rolling_straight_the_slope_is_read_before_the_pendulum_can_be():
