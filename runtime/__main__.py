@@ -20,6 +20,7 @@ COMMANDS = {
     "stability": ("runtime.stability", "eigenvalues and Floquet exponents; writes docs/figures/rolling-stability.png"),
     "envelope": ("runtime.control.envelope", "what the torque limits allow (make envelope)"),
     "noise-floor": ("runtime.control.noise_floor", "the LQR's steady wander under a sensor set's process noise, and its floor"),
+    "heading-seeds": ("runtime.control.heading_seeds", "the heading step on the robot's own filter over noise seeds: runs within the deadline, misses by class"),
     "climbing": ("runtime.control.climbing", "the climbing limit on a slope; writes docs/figures/climbing-limit.png"),
     "nmpc-c": ("runtime.control.nmpc_c", "the C NMPC: its design as C, its timing in a C loop, its QPs against DAQP"),
     "firmware-table": ("runtime.control.firmware", "the firmware examples' LQR gain table, generated/lqr_task.h, and the estimator example's vector (make generate)"),

@@ -66,6 +66,8 @@ OPTIONS = {
                 "--iterations": NOT_A_NUMBER + NOT_POSITIVE + NOT_AN_INTEGER,
                 "--seed": NOT_A_NUMBER + ["-1", "-5"] + NOT_AN_INTEGER, "--params": ["", ",", "k_X", "k_S,k_S"]}),
     "noise-floor": ([], {"--hold": NOT_A_NUMBER + NOT_POSITIVE + ["inf", "nan", "1e9"], "--sensors": ["no-such-set", ""]}),
+    "heading-seeds": ([], {"--seeds": ["3-1", "a-b", "-1-2", ""], "--kind": ["pid", ""],
+                           "--set": ["x", "heading_rad", "heading_rad=abc", "no_such_gain=1", "heading_rad=-1"]}),
     "sweep-bench": ([], {"--samples": NOT_A_NUMBER + NOT_POSITIVE, "--samples-per-task": NOT_A_NUMBER + NOT_POSITIVE,
                          "--noop-tasks": NOT_A_NUMBER + NOT_POSITIVE, "--rounds": NOT_A_NUMBER + NOT_POSITIVE}),
 }

@@ -1,0 +1,148 @@
+"""`python -m runtime heading-seeds`: the heading step on the robot's own filter over noise seeds.
+
+Each seed runs heading-step-sensors (the C EKF on the simulated sensors, the sensor simulation in C)
+with one controller; a run meets the target when the true heading's settle time (the metric's: the
+first time after which the error stays within ±3° to the end) is within the same controller's
+nominal heading-step settle time + 2 s (benchmark.SENSORS_SETTLE_MARGIN_S).  A miss is classed by
+how it misses: `late` (first inside the band after the deadline), `swing` (more than twice the
+band out after the deadline), `out at the deadline` (outside then, back later: the approach's
+overshoot), `later out` (inside at the deadline, out again later: the wander).  `--set key=value`
+changes a gain of both the nominal and the sensors task (docs/control.md, "The heading step over seeds").
+"""
+import argparse
+import dataclasses
+import json
+import time
+
+import numpy as np
+from scipy import stats
+
+from .benchmark import SENSORS_SETTLE_MARGIN_S, run_task
+from .closed_loop import simulate_on_sensors
+from .geometry import heading, wrap_angle
+from .metrics import HEADING_BAND_RAD, settle_time
+from .task import load_task
+
+#: The controllers measured here: the sensors task's kind and its nominal task's.
+KINDS = {"lqr": "lqr", "nmpc-c": "nmpc"}
+MISSES = ("late", "swing", "out at the deadline", "later out")
+
+
+def _with_gains(task, kind, changes):
+    base = task.controllers[0]
+    gains = dataclasses.replace(base.gains, **changes) if changes else base.gains
+    return dataclasses.replace(task, controllers=(dataclasses.replace(base, kind=kind, gains=gains),))
+
+
+def tasks(kind, changes=None):
+    """(nominal heading-step task, heading-step-sensors task) with controller `kind`, gains changed by `changes`."""
+    if kind not in KINDS:
+        raise ValueError(f"kind: expected one of {', '.join(KINDS)}, got {kind!r}")
+    sensors = load_task("heading-step-sensors").with_controller(kind)
+    names = {f.name for f in dataclasses.fields(sensors.controllers[0].gains)}
+    for key in changes or {}:
+        if key not in names:
+            raise ValueError(f"set: {key!r} is not a gain of the {kind} (one of {', '.join(sorted(names))})")
+    try:
+        nominal = _with_gains(load_task("heading-step").with_controller(KINDS[kind]), kind, changes or {})
+        return nominal, _with_gains(sensors, kind, changes or {})
+    except ValueError as exc:
+        raise ValueError(f"set: {exc}") from None
+
+
+def deadline(nominal):
+    """The nominal task's heading settle time + the margin [s] (ValueError when it never settles)."""
+    settle = run_task(nominal)[2]["heading_settle_s"]
+    if settle is None:
+        raise ValueError("nominal: the heading step does not settle without the sensors; no deadline")
+    return settle + SENSORS_SETTLE_MARGIN_S
+
+
+def classify(t, error, limit, band=HEADING_BAND_RAD):
+    """(settle time or None, met, miss class or None) of a heading error `error` [rad] at times `t` [s]
+    against the deadline `limit` [s]."""
+    out = np.abs(error) > band
+    settle = settle_time(t, error, band)
+    if settle is not None and settle <= limit:
+        return settle, True, None
+    after = t > limit
+    inside = np.flatnonzero(~out)
+    if not inside.size or t[inside[0]] > limit:
+        return settle, False, "late"
+    if np.abs(error[after]).max() > 2 * band:
+        return settle, False, "swing"
+    return settle, False, "out at the deadline" if out[np.searchsorted(t, limit, side="right") - 1] else "later out"
+
+
+def run_seed(task, seed, limit):
+    """One seed's record: settle time, met, miss class, largest error after the deadline [deg], clipped share."""
+    task = dataclasses.replace(task, noise=dataclasses.replace(task.noise, seed=seed))
+    reference = task.reference()
+    result = simulate_on_sensors(task.plant_params, task.controller(), reference, task.scenario.x0, task.duration,
+                                 task.scenario.dt, task.make_estimator(), task.sensors, task.scenario.method, seed,
+                                 engine="c", record_samples=False)
+    every = max(1, round(1 / (task.rate * task.scenario.dt)))
+    t = result.time[::every]
+    error = wrap_angle(reference.heading - heading(result.trajectory[::every]))
+    settle, met, miss = classify(t, error, limit)
+    return {"seed": seed, "settle_s": settle, "met": met, "miss": miss,
+            "worst_after_deg": float(np.degrees(np.abs(error[t > limit]).max())),
+            "saturated": float(result.saturated_fraction)}
+
+
+def summary(records, limit):
+    """The summary line: runs within the deadline, the 95 % Clopper–Pearson interval, the misses by class."""
+    n, k = len(records), sum(r["met"] for r in records)
+    ci = stats.binomtest(k, n).proportion_ci(0.95, method="exact")
+    misses = ", ".join(f"{name} {sum(r['miss'] == name for r in records)}" for name in MISSES)
+    clipped = float(np.median([r["saturated"] for r in records]))
+    return (f"{k}/{n} within {limit:.3f} s ({100 * k / n:.1f} %, 95 % CI {100 * ci.low:.1f}-{100 * ci.high:.1f} %); "
+            f"misses: {misses}; clipped p50 {100 * clipped:.1f} %")
+
+
+def _seeds(text):
+    try:
+        first, _, last = text.partition("-")
+        first, last = int(first), int(last or first)
+    except ValueError:
+        raise ValueError(f"seeds: expected FIRST-LAST (integers), got {text!r}") from None
+    if first < 0 or last < first:
+        raise ValueError(f"seeds: expected 0 <= FIRST <= LAST, got {text!r}")
+    return range(first, last + 1)
+
+
+def _changes(pairs):
+    changes = {}
+    for pair in pairs:
+        key, sep, value = pair.partition("=")
+        try:
+            changes[key] = float(value) if sep else None
+        except ValueError:
+            changes[key] = None
+        if changes[key] is None:
+            raise ValueError(f"set: expected KEY=NUMBER, got {pair!r}")
+    return changes
+
+
+def main(argv=()):
+    parser = argparse.ArgumentParser(prog="python -m runtime heading-seeds", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--kind", default="lqr", choices=sorted(KINDS), help="the controller")
+    parser.add_argument("--seeds", default="0-99", help="noise seeds FIRST-LAST (default 0-99)")
+    parser.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE", help="gains changed in both tasks")
+    parser.add_argument("--details", action="store_true", help="one JSON line per seed")
+    args = parser.parse_args(list(argv))
+    try:
+        seeds, changes = _seeds(args.seeds), _changes(args.set)
+        nominal, task = tasks(args.kind, changes)
+    except ValueError as exc:
+        parser.error(str(exc))
+    limit = deadline(nominal)
+    started = time.process_time()
+    records = []
+    for seed in seeds:
+        records.append(run_seed(task, seed, limit))
+        if args.details:
+            print(json.dumps(records[-1]), flush=True)
+    print(f"{args.kind} {changes or 'as the task files'}, seeds {seeds.start}-{seeds.stop - 1}: {summary(records, limit)}; "
+          f"CPU {time.process_time() - started:.1f} s")
+    return 0
