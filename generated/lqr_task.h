@@ -666,7 +666,8 @@ static const sr_lqr LQR_TASK_SCHEDULE = {
         SR_C(7.652271705692551), SR_C(0.9108076531296825), SR_C(0.07330786691645369), SR_C(0.0), SR_C(0.0), SR_C(-0.9797184750887343),
         SR_C(1.2225494551574334), SR_C(-8.117992361432545), SR_C(26.178670172117062), SR_C(2.1942974022676847), SR_C(8.770271277010833), SR_C(-4.24105389427879),
         SR_C(25.648982658863495), SR_C(0.8775909592425666), SR_C(0.5322609528125328), SR_C(0.0), SR_C(0.0), SR_C(-0.02731570264724147)}},
-    /* heading_band, heading_rise */ SR_C(0.15), SR_C(3.0)
+    /* heading_band, heading_rise */ SR_C(0.15), SR_C(3.0),
+    /* recovery_cross_track, recovery_heading, recovery_slow, recovery_rise */ SR_C(0.0), SR_C(0.0), SR_C(0.0), SR_C(1.0)
 };
 
 #endif /* LQR_TASK_H */

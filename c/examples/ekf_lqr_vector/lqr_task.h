@@ -666,7 +666,8 @@ static const sr_lqr LQR_TASK_SCHEDULE = {
         SR_C(7.506256300346263), SR_C(0.8940208253291311), SR_C(0.07206690896536075), SR_C(0.0), SR_C(0.0), SR_C(-0.9603027328734384),
         SR_C(1.1490792640001053), SR_C(-7.444697160614559), SR_C(23.6665957293686), SR_C(1.957595760210663), SR_C(7.97606562205805), SR_C(-3.9285689564913926),
         SR_C(23.26868248908386), SR_C(0.7943527966936511), SR_C(0.4834374877362595), SR_C(0.0), SR_C(0.0), SR_C(-0.024387066528291493)}},
-    /* heading_band, heading_rise */ SR_C(0.15), SR_C(3.0)
+    /* heading_band, heading_rise */ SR_C(0.15), SR_C(3.0),
+    /* recovery_cross_track, recovery_heading, recovery_slow, recovery_rise */ SR_C(0.0), SR_C(0.0), SR_C(0.0), SR_C(1.0)
 };
 
 #endif /* LQR_TASK_H */
