@@ -6,12 +6,11 @@ import dataclasses
 import numpy as np
 import pytest
 
-from runtime import so3
 from runtime.control import lqr
 from runtime.control.lqr_law import recovering_law
 from runtime.control.reference import Target
 from runtime.params import Params
-from runtime.state import initial_state
+from tests.runtime.control.test_lqr_heading_tight import rolling
 
 PARAMS = Params.paper_simulation()
 RATE, U_MAX = 50.0, 0.5
@@ -25,14 +24,6 @@ def controller(gains=GAINS):
     c = lqr.Lqr(PARAMS, RATE, U_MAX, gains=gains, schedule=lqr.design_schedule(PARAMS, RATE, U_MAX, gains))
     c.reset(None)
     return c
-
-
-def rolling(rng, heading_error=0.0, spread=1.0):
-    """A state rolling at 0.3 m/s along +x, turned by `heading_error` (left), with random departures."""
-    return initial_state(theta_P=spread * rng.normal(0, 0.05),
-                         R_S=so3.rot_z(heading_error - np.pi / 2) @ so3.exp(spread * rng.normal(0, 0.03, 3)),
-                         w_S=(-1.0 + spread * rng.normal(0, 0.05), *(spread * rng.normal(0, 0.05, 2))),
-                         w_Y=1.0 + spread * rng.normal(0, 0.05), w_P=spread * rng.normal(0, 0.1), r=PARAMS.r)
 
 
 def law(c, x, target, integrals, kappa, tight, clipped, recovery_before, recovery):
