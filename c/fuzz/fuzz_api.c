@@ -455,7 +455,7 @@ static void fuzz_model_validity(reader *r, const sr_model *valid, const sr_real 
                                                SR_C(0.03), SR_C(-0.1), SR_C(0.2), SR_C(0.01), SR_C(0.003)};
     static const sr_real nmpc_u[SR_NU] = {SR_C(0.1), SR_C(-0.05)};
     sr_real x2[2 * SR_NX];
-    const sr_lqr_memory fresh = {{0, 0}, 0, 0, 0, 0, {0, 0}};
+    const sr_lqr_memory fresh = {{0, 0}, 0, 0, 0, 0, {0, 0}, 0};
     sr_lqr_memory memory = fresh;
     sr_energy_guard guard = {SR_C(0.5), 0, 0, 0, 0};
     sr_adaptive_stats st;

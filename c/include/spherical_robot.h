@@ -728,7 +728,17 @@ int sr_regressor_batch(const sr_model *model, long n, const sr_real *x, const sr
  * (z[2], the yaw of the attitude error: the heading error), rising by at most
  * period / heading_rise per sample, after a clipped sample as above (tight_fall, tight_wait);
  * the integral columns stay K_heading's.  Stiffer heading gains hold the heading closer under
- * the process noise but, as a linear law on the saturating steering, lose a large step. */
+ * the process noise but, as a linear law on the saturating steering, lose a large step.
+ * Recovery at a large error (recovery_cross_track, recovery_heading > 0; 0: off, the law above):
+ * the law acts on the cross-track error e_y - e_y* clipped to +-recovery_cross_track and on the
+ * heading error z[2] - z*[2] clipped to +-recovery_heading, so that far from the path the
+ * steering asks for a bounded lean (a linear law asks for a lean that grows with the error, which
+ * on a robot off the model swings the pendulum past the horizontal, where the lean no longer
+ * steers).  While either error is beyond its bound the robot is recovering: the tight gains' weight
+ * is held at 0 or below (K_path's or K_heading's gain), neither integral advances, and with
+ * recovery_slow > 0 the speed reference is lowered by recovery_slow * r, the weight r rising by
+ * period / recovery_rise per sample while recovering and falling by as much otherwise (the
+ * operating point and the rolling-rate error taken at the lowered speed). */
 /** @{ */
 #define SR_LQR_NZ 12               /**< entries of the error coordinates z */
 #ifndef SR_LQR_MAX_SPEEDS
@@ -774,6 +784,10 @@ typedef struct sr_lqr {
     sr_real K_heading_tight[SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES][SR_NU * SR_LQR_NZ]; /**< stiffer heading gains for heading references, scheduled in near the heading (their integral columns are not read) */
     sr_real heading_band;                          /**< [rad], >= 0: K_heading_tight's weight is at most 1 - |heading error| / heading_band; 0: K_heading_tight unused */
     sr_real heading_rise;                          /**< [s], > 0 when heading_band > 0: K_heading_tight's weight rises from 0 to 1 in no less than this */
+    sr_real recovery_cross_track;                  /**< [m], >= 0: path references: the law acts on e_y - e_y* clipped to +-this, and beyond it recovers (see above); 0: neither */
+    sr_real recovery_heading;                      /**< [rad], >= 0: the law acts on the heading error z[2] - z*[2] clipped to +-this, and beyond it recovers; 0: neither */
+    sr_real recovery_slow;                         /**< in [0, 1): at full recovery the speed reference is lowered by this share; 0: not at all */
+    sr_real recovery_rise;                         /**< [s], > 0 when recovery_slow > 0: the recovery's weight moves from 0 to 1 (or back) in no less than this */
 } sr_lqr;
 
 /** What to track at this sample (from the reference). */
@@ -793,11 +807,13 @@ typedef struct sr_lqr_memory {
     int saturated;         /**< out: the last sample clipped a torque */
     sr_real tight;         /**< the tight gains' weight (K_tight's on a path, K_heading_tight's on a heading) at the last sample */
     sr_real world[2];      /**< the world part of the integral of e_y (x, y) [m s]: z[10] is integrals[0] plus its component along the path's left normal */
+    sr_real recovery;      /**< the recovery's weight in [0, 1] at the last sample (the share of recovery_slow applied) */
 } sr_lqr_memory;
 
 /** Checks a schedule: sizes in range, grids strictly increasing, every entry finite, period
  * and u_max > 0, kappa_rate, steady_rate, tight_band and tight_fall >= 0, tight_wait in [0, 1], tight_rise > 0 when tight_band > 0
- * (K_tight is read only then), heading_band >= 0, heading_rise > 0 when heading_band > 0 (K_heading_tight is read only then).  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
+ * (K_tight is read only then), heading_band >= 0, heading_rise > 0 when heading_band > 0 (K_heading_tight is read only then),
+ * recovery_cross_track and recovery_heading >= 0, recovery_slow in [0, 1), recovery_rise > 0 when recovery_slow > 0.  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
 int sr_lqr_check(const sr_lqr *lqr);
 
 /** Zeroes the memory.  Returns SR_OK or SR_ERR_NULL. */

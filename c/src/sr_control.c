@@ -20,7 +20,9 @@ static int valid_sizes(const sr_lqr *lqr)
         && lqr->kappa_rate >= 0 && lqr->steady_rate >= 0 && lqr->tight_band >= 0
         && (lqr->tight_band == 0 || lqr->tight_rise > 0) && lqr->world_share >= 0 && lqr->world_share <= 1
         && lqr->tight_fall >= 0 && lqr->tight_wait >= 0 && lqr->tight_wait <= 1 && lqr->heading_band >= 0
-        && (lqr->heading_band == 0 || lqr->heading_rise > 0);
+        && (lqr->heading_band == 0 || lqr->heading_rise > 0) && lqr->recovery_cross_track >= 0
+        && lqr->recovery_heading >= 0 && lqr->recovery_slow >= 0 && lqr->recovery_slow < 1
+        && (lqr->recovery_slow == 0 || lqr->recovery_rise > 0);
 }
 
 int sr_lqr_check(const sr_lqr *lqr)
@@ -30,7 +32,9 @@ int sr_lqr_check(const sr_lqr *lqr)
     if (!all_finite(&lqr->period, 1) || !all_finite(&lqr->u_max, 1) || !all_finite(&lqr->kappa_rate, 1)
         || !all_finite(&lqr->steady_rate, 1) || !all_finite(&lqr->tight_band, 1) || !all_finite(&lqr->tight_rise, 1)
         || !all_finite(&lqr->tight_fall, 1) || !all_finite(&lqr->tight_wait, 1)
-        || !all_finite(&lqr->world_share, 1) || !all_finite(&lqr->heading_band, 1) || !all_finite(&lqr->heading_rise, 1))
+        || !all_finite(&lqr->world_share, 1) || !all_finite(&lqr->heading_band, 1) || !all_finite(&lqr->heading_rise, 1)
+        || !all_finite(&lqr->recovery_cross_track, 1) || !all_finite(&lqr->recovery_heading, 1)
+        || !all_finite(&lqr->recovery_slow, 1) || !all_finite(&lqr->recovery_rise, 1))
         return SR_ERR_NONFINITE;
     if (!valid_sizes(lqr)) return SR_ERR_ARG;
     n = lqr->n_speeds * lqr->n_curvatures;
@@ -125,16 +129,22 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
                    sr_real u_raw[SR_NU])
 {
     sr_real z[SR_LQR_NZ], dz[SR_LQR_NZ], out[SR_NU], raw[SR_NU], kappa, step, wv, wk;
-    sr_real weight[4], k_int[SR_NU][2], step_int[2], tight = 0, normal[2], integrals[2], band;
-    int status = arg_model(model, READS(STATE)), i0, i1, j0, j1, k, j, n, point[4], clipped = 0;
+    sr_real weight[4], k_int[SR_NU][2], step_int[2], tight = 0, normal[2], integrals[2], band, recovery;
+    sr_lqr_target slowed;
+    int status = arg_model(model, READS(STATE)), i0, i1, j0, j1, k, j, n, point[4], clipped = 0, recovering = 0;
     if (status != SR_OK) return status;
     if (!lqr || !x || !target || !memory || !u) return SR_ERR_NULL;
     if (!valid_sizes(lqr)) return SR_ERR_ARG;
     status = sr_internal_check_state(model, x);
     if (status != SR_OK) return status;
     if (!valid_target(target) || !all_finite(memory->integrals, 2) || !all_finite(&memory->kappa, 1)
-        || !all_finite(&memory->tight, 1) || !all_finite(memory->world, 2))
+        || !all_finite(&memory->tight, 1) || !all_finite(memory->world, 2) || !all_finite(&memory->recovery, 1))
         return SR_ERR_NONFINITE;
+
+    /* Recovery: the speed reference lowered by the weight of the samples before (0 unless recovery_slow > 0). */
+    slowed = *target;
+    slowed.speed = target->speed * (1 - lqr->recovery_slow * memory->recovery);
+    target = &slowed;
 
     /* The operating point's curvature follows the reference's at a bounded rate. */
     kappa = target->path ? target->curvature : 0;
@@ -161,6 +171,16 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
     for (j = 0; j < SR_LQR_NZ; ++j)
         dz[j] = z[j] - (weight[0] * lqr->z_star[point[0]][j] + weight[1] * lqr->z_star[point[1]][j]
                         + weight[2] * lqr->z_star[point[2]][j] + weight[3] * lqr->z_star[point[3]][j]);
+    /* Recovery: the cross-track and heading errors the law acts on clipped to their bounds; beyond
+     * either the robot is recovering (below: no tight gains, no integration, the speed lowered). */
+    if (target->path && lqr->recovery_cross_track > 0 && SR_FABS(dz[9]) > lqr->recovery_cross_track) {
+        dz[9] = dz[9] > 0 ? lqr->recovery_cross_track : -lqr->recovery_cross_track;
+        recovering = 1;
+    }
+    if (lqr->recovery_heading > 0 && SR_FABS(dz[2]) > lqr->recovery_heading) {
+        dz[2] = dz[2] > 0 ? lqr->recovery_heading : -lqr->recovery_heading;
+        recovering = 1;
+    }
     /* The tight gains' weight: bounded by how near the path the robot is, rising slowly (a transient
      * must have died down) and falling after a clipped torque, below 0 (K_path's gain, a wait before
      * the tight gains return): held at the limits, they switch the steering torque between them. */
@@ -170,7 +190,7 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
         sr_real bound = 1 - SR_FABS(dz[target->path ? 9 : 2]) / band, prev = memory->tight;
         sr_real rise = !memory->saturated ? prev + lqr->period / (target->path ? lqr->tight_rise : lqr->heading_rise)
                      : (lqr->tight_fall > 0 ? prev - lqr->period / lqr->tight_fall : prev);
-        bound = bound < 0 ? 0 : bound;
+        bound = bound < 0 || recovering ? 0 : bound;
         tight = rise < bound ? rise : bound;
         tight = tight > 1 ? 1 : (tight < -lqr->tight_wait ? -lqr->tight_wait : tight);
     }
@@ -202,7 +222,7 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
     step_int[0] = target->path ? lqr->period * dz[9] : 0;
     step_int[1] = lqr->period * dz[4];
     for (j = 0; j < 2; ++j) {
-        int advance = j == 1 || SR_FABS(cross_track_rate(model, x, target->heading)) <= lqr->steady_rate;
+        int advance = !recovering && (j == 1 || SR_FABS(cross_track_rate(model, x, target->heading)) <= lqr->steady_rate);
         for (k = 0; k < SR_NU; ++k)
             if (out[k] != raw[k] && -k_int[k][j] * step_int[j] * (raw[k] - out[k]) > 0) advance = 0;
         if (!advance) continue;
@@ -214,6 +234,12 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
             memory->integrals[1] += step_int[1];
         }
     }
+    recovery = memory->recovery;
+    if (lqr->recovery_slow > 0) {
+        recovery += (recovering ? 1 : -1) * lqr->period / lqr->recovery_rise;
+        recovery = recovery > 1 ? 1 : (recovery < 0 ? 0 : recovery);
+    }
+    memory->recovery = recovery;
     memory->kappa = kappa;
     memory->started = 1;
     memory->saturated = clipped;

@@ -1,7 +1,8 @@
 /*
  * test_control.c -- the LQR controller (c/src/sr_control.c) on hand-made schedules: the error
  * coordinates at and near the reference, the law at a grid point and between points, clipping
- * with conditional integration at any offset, the curvature's rate limit, and status codes with untouched outputs.
+ * with conditional integration at any offset, the curvature's rate limit, the recovery at a large
+ * error, and status codes with untouched outputs.
  */
 #include "sr_test.h"
 
@@ -306,6 +307,69 @@ static void test_the_tight_gains_weight_falls_after_a_clipped_torque_to_minus_it
     CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_NONFINITE);
 }
 
+static void test_the_recovery_clips_the_errors_holds_the_integrals_and_lowers_the_speed(void)
+{
+    sr_model m;
+    sr_lqr lqr;
+    sr_lqr_memory mem;
+    sr_real x[SR_NX], u[SR_NU], raw[SR_NU];
+    const sr_lqr_target far = {SR_C(0.2), 0, 0, SR_C(0.3), 1}, near = {SR_C(0.2), 0, 0, SR_C(0.05), 1};
+    paper_simulation_model(&m);
+    empty_schedule(&lqr, 1);
+    lqr.steady_rate = SR_C(0.01);
+    lqr.K_path[0][9] = SR_C(-1.0);               /* u_Y = e_y (clipped) + I */
+    lqr.K_path[0][10] = SR_C(-1.0);
+    lqr.K_path[0][SR_LQR_NZ + 4] = SR_C(1.0);    /* u_P = -(z[4] - z*[4]): the rolling-rate error */
+    lqr.recovery_cross_track = SR_C(0.1);
+    lqr.recovery_slow = SR_C(0.5);
+    lqr.recovery_rise = SR_C(0.04);              /* two samples from 0 to 1 */
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_OK);
+    sr_lqr_reset(&mem);
+    reference_state(0.2, 0.0, 0.3, x);
+    /* 0.3 m off: the law acts on 0.1 m, neither integral advances, the weight rises by one half. */
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &far, &mem, u, raw), SR_OK);
+    CHECK_NEAR(raw[0], 0.1, 8 * TEST_EPS);
+    CHECK_NEAR(raw[1], 0.0, 8 * TEST_EPS);
+    CHECK(mem.integrals[0] == 0 && mem.integrals[1] == 0);
+    CHECK_NEAR(mem.recovery, 0.5, TEST_EPS);
+    /* The next sample tracks 0.2 (1 - 0.5 * 0.5) = 0.15 m/s: the robot at 0.2 m/s rolls 0.05 m/s too fast,
+     * z[4] - z*[4] = -0.05 / r, so u_P = 0.05 / r. */
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &far, &mem, u, raw), SR_OK);
+    CHECK_NEAR(raw[1], 0.05 / 0.3, 8 * TEST_EPS);
+    CHECK_NEAR(mem.recovery, 1.0, TEST_EPS);
+    /* Back within the bound: the law acts on the error itself, the integral advances, the weight falls. */
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &near, &mem, u, raw), SR_OK);
+    CHECK_NEAR(raw[0], 0.05, 8 * TEST_EPS);
+    CHECK_NEAR(mem.integrals[0], 0.02 * 0.05, 8 * TEST_EPS);
+    CHECK_NEAR(mem.recovery, 0.5, TEST_EPS);
+    /* The heading error too: a robot turned 0.3 rad off acts as if 0.2 rad off. */
+    lqr.K_path[0][2] = SR_C(-1.0);
+    lqr.K_path[0][9] = 0;
+    lqr.recovery_heading = SR_C(0.2);
+    sr_lqr_reset(&mem);
+    reference_state(0.2, 0.3, 0.3, x);
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &near, &mem, u, raw), SR_OK);
+    CHECK_NEAR(raw[0], 0.2, 8 * TEST_EPS);
+    CHECK(mem.integrals[0] == 0);
+    /* Refused: negative bounds, a slow-down of the whole speed or more, one with no rise time, NaN. */
+    lqr.recovery_cross_track = SR_C(-0.1);
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_ARG);
+    CHECK_STATUS(sr_lqr_control(&lqr, &m, x, &near, &mem, u, raw), SR_ERR_ARG);
+    lqr.recovery_cross_track = SR_C(0.1);
+    lqr.recovery_heading = SR_C(-0.2);
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_ARG);
+    lqr.recovery_heading = SR_C(0.2);
+    lqr.recovery_slow = SR_C(1.0);
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_ARG);
+    lqr.recovery_slow = SR_C(0.5);
+    lqr.recovery_rise = 0;
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_ARG);
+    lqr.recovery_rise = (sr_real)NAN;
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_ERR_NONFINITE);
+    lqr.recovery_rise = SR_C(0.04);
+    CHECK_STATUS(sr_lqr_check(&lqr), SR_OK);
+}
+
 static void test_bad_input_gives_status_and_leaves_outputs_untouched(void)
 {
     sr_model m;
@@ -364,5 +428,6 @@ void suite_control(void)
     RUN_TEST(test_the_operating_curvature_follows_a_jump_at_its_rate);
     RUN_TEST(test_the_tight_gains_weigh_in_as_the_error_allows_and_are_checked);
     RUN_TEST(test_the_tight_gains_weight_falls_after_a_clipped_torque_to_minus_its_wait);
+    RUN_TEST(test_the_recovery_clips_the_errors_holds_the_integrals_and_lowers_the_speed);
     RUN_TEST(test_bad_input_gives_status_and_leaves_outputs_untouched);
 }

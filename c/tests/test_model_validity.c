@@ -154,7 +154,7 @@ static int c_step_jacobian_batch(const sr_model *m, long n)
 static int c_lqr_error(const sr_model *m, long n) { (void)n; return sr_lqr_error(m, X, &TARGET, NULL, OUT); }
 static int c_lqr_control(const sr_model *m, long n)
 {
-    sr_lqr_memory memory = {{0, 0}, 0, 0, 0, 0, {0, 0}};
+    sr_lqr_memory memory = {{0, 0}, 0, 0, 0, 0, {0, 0}, 0};
     (void)n;
     return sr_lqr_control(&LQR, m, X, &TARGET, &memory, OUT, OUT2);
 }

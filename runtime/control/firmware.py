@@ -99,7 +99,10 @@ def header(task, controller):
         f"{_real(controller._c.tight_wait)},",
         "    /* K_heading_tight */ " + ("{" + ",\n     ".join(_array(s.K_heading_tight[i, j]) for i, j in points) + "}"
                                        if s.K_heading_tight is not None else "{{0}}") + ",",
-        f"    /* heading_band, heading_rise */ {_real(controller._c.heading_band)}, {_real(controller._c.heading_rise)}",
+        f"    /* heading_band, heading_rise */ {_real(controller._c.heading_band)}, {_real(controller._c.heading_rise)},",
+        f"    /* recovery_cross_track, recovery_heading, recovery_slow, recovery_rise */ "
+        f"{_real(controller._c.recovery_cross_track)}, {_real(controller._c.recovery_heading)}, "
+        f"{_real(controller._c.recovery_slow)}, {_real(controller._c.recovery_rise)}",
         "};",
         "",
         "#endif /* LQR_TASK_H */",

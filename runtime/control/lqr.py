@@ -64,6 +64,10 @@ class LqrGains:
     heading_band_rad: float = 0.0     # heading references: stiffer heading gains' weight ≤ 1 − |heading error| / this (0: none)
     tight_heading_rad: float = 0.03   # ... designed with this heading size (the other sizes as above)
     heading_rise_s: float = 2.0       # ... rising from 0 to 1 in no less than this [s] (after a clip as tight_fall_s, tight_wait)
+    recovery_cross_track_m: float = 0.0  # the law acts on e_y clipped to ± this; beyond it the robot recovers (0: neither)
+    recovery_heading_rad: float = 0.0    # ... on the heading error clipped to ± this, beyond it recovering (0: neither)
+    recovery_slow: float = 0.0        # recovering, the speed reference is lowered by this share at most (0: not at all) ...
+    recovery_rise_s: float = 1.0      # ... reached in no less than this [s] and left as fast
     #: The ranges of the settings (runtime/control/ranges.py: those of a task file's keys).
     RANGES: typing.ClassVar[dict] = LQR_RANGES
 
@@ -153,12 +157,14 @@ def tight_gain(K_path, K_riccati):
 
 
 def to_c(schedule, period, u_max, kappa_rate, steady_rate, tight_band=0.0, tight_rise=1.0, world_share=0.0, tight_fall=0.0,
-         tight_wait=0.0, heading_band=0.0, heading_rise=1.0):
+         tight_wait=0.0, heading_band=0.0, heading_rise=1.0, recovery=(0.0, 0.0, 0.0, 1.0)):
     """The schedule as the C struct `sr_lqr` (cffi), checked by `sr_lqr_check`; the tight gains are
     scheduled in within `tight_band` [m] of the path, over `tight_rise` [s] (and out by 1 per `tight_fall` [s]
     after a clipped torque, to a weight −`tight_wait`, below 0 K_path's; 0: held), when the schedule has them;
     `world_share` of the cross-track integral is held in the world frame; the stiffer heading gains, when
-    the schedule has them, within `heading_band` [rad] of a heading reference's heading over `heading_rise` [s]."""
+    the schedule has them, within `heading_band` [rad] of a heading reference's heading over `heading_rise` [s];
+    `recovery`: (recovery_cross_track [m], recovery_heading [rad], recovery_slow, recovery_rise [s]) of the
+    recovery at a large error (spherical_robot.h; zeros: off)."""
     nv, nk = len(schedule.speeds), len(schedule.curvatures)
     if nv > lib.SR_LQR_MAX_SPEEDS or nk > lib.SR_LQR_MAX_CURVATURES:
         raise ValueError(f"controller: the design grid has {nv} speeds and {nk} curvatures; the C controller "
@@ -186,11 +192,17 @@ def to_c(schedule, period, u_max, kappa_rate, steady_rate, tight_band=0.0, tight
     c.tight_wait = tight_wait
     c.heading_band = heading_band if schedule.K_heading_tight is not None else 0.0
     c.heading_rise = heading_rise
+    c.recovery_cross_track, c.recovery_heading, c.recovery_slow, c.recovery_rise = recovery
     status = lib.sr_lqr_check(c)
     if status != lib.SR_OK:
         raise ValueError(f"controller: the LQR schedule is not valid for the C controller "
                          f"({ffi.string(lib.sr_status_string(status)).decode()})")
     return c
+
+
+def recovery_settings(gains):
+    """The recovery's settings of `gains` as `to_c` takes them."""
+    return (gains.recovery_cross_track_m, gains.recovery_heading_rad, gains.recovery_slow, gains.recovery_rise_s)
 
 
 def c_target(target):
@@ -216,7 +228,7 @@ class Lqr(SlopeFeedforward, Controller):
         self.schedule = schedule if schedule is not None else design_schedule(flat, rate, u_max, gains)
         self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate, gains.steady_rate_m_s,
                        gains.tight_band_m, gains.tight_rise_s, gains.world_share, gains.tight_fall_s, gains.tight_wait,
-                       gains.heading_band_rad, gains.heading_rise_s)
+                       gains.heading_band_rad, gains.heading_rise_s, recovery_settings(gains))
         self._model = Model(flat)
         self._init_slope(params, flat, self.schedule, gains)
         self._memory = ffi.new("sr_lqr_memory *")

@@ -46,6 +46,10 @@ LQR_RANGES = {
     "heading_band_rad": Range(0, 3.2, "rad", "how near the heading the stiffer heading gains act (0: not at all)"),
     "tight_heading_rad": _ERROR_SIZE,
     "heading_rise_s": Range(1e-3, 1e4, "s", "how slowly the stiffer heading gains come in"),
+    "recovery_cross_track_m": Range(0, 100, "m", "the cross-track error the law acts on at most (0: unbounded)"),
+    "recovery_heading_rad": Range(0, 3.2, "rad", "the heading error the law acts on at most (0: unbounded)"),
+    "recovery_slow": Range(0, 0.9, "", "the share of the speed reference given up while recovering (below 1)"),
+    "recovery_rise_s": Range(1e-3, 1e4, "s", "how slowly the recovery's speed change comes in and goes"),
 }
 
 #: `NmpcGains`: the LQR's and the horizon's.
@@ -55,6 +59,8 @@ NMPC_RANGES = {
     "world_share": Range(0, 0, "", "the NMPC holds no world-frame integral (an LQR setting): 0 only"),
     "pendulum_feedforward": Range(0, 0, "", "the NMPC feeds no pendulum forward (an LQR setting): 0 only"),
     "heading_band_rad": Range(0, 0, "rad", "the NMPC has no scheduled heading gains (an LQR setting): 0 only"),
+    **{name: Range(0, 0, "", "the NMPC has no recovery mode (an LQR setting): 0 only")
+       for name in ("recovery_cross_track_m", "recovery_heading_rad", "recovery_slow")},
     "torque_step_n_m": Range(1e-6, 1e6, "N m", "a torque change worth the full cost"),
     "disturbance_gain": Range(0, 1, "", "the share of the torque offset's update taken per sample (0: no estimate)"),
     "horizon": Range(1, 200, "", "nodes of the horizon: the QP has 2N unknowns and a dense (2N)^2 Hessian",

@@ -225,6 +225,18 @@ def test_the_circle_lqr_holds_a_plant_that_left_the_path_with_the_steering_torqu
     assert row["success"][0] == 1 and row["cross_track_rms_m"][0] < 0.025
 
 
+
+def test_the_circle_lqr_holds_a_plant_that_swung_its_pendulum_past_the_horizontal_chasing_a_growing_error(tmp_path):
+    # Plant 398 of the shipped study: without the recovery the law's lean demand grows with the
+    # cross-track and heading errors, the pendulum's torque clips on about 77 % of the samples and the
+    # robot leaves the circle (about 1.5 m RMS, 0.57 of the path); the circle task's recovery (errors
+    # clipped to 0.15 m and 0.15 rad) holds it to about 18 mm (docs/control.md, "Robustness over many robots").
+    spec = load_sweep(str(_sweep(tmp_path, CIRCLE_PLANTS.replace("samples = 20", "samples = 400"))))
+    row = spec.run_chunk(398, 399)
+    assert row["plant"][0] == 398 and row["progress"][0] > 0.9 and row["saturated_fraction"][0] < 0.3
+    assert row["success"][0] == 1 and row["cross_track_rms_m"][0] < 0.025
+
+
 LINE_PLANTS = CIRCLE_PLANTS.replace("on the circle", "on the line").replace('tasks = ["circle"]', 'tasks = ["line"]')
 
 
