@@ -25,7 +25,7 @@ from ..ekf import RECOVER_AFTER, start_from_measurements
 from ..model import Model
 from ..state import IDX_E_NU, NE
 from ..verification.ekf_reference import NB, EkfReference
-from .consistency import COMPONENTS, NEES_TARGET, WITHIN_TARGET, consistency, run_once
+from .consistency import COMPONENTS, NEES_TARGET, WITHIN_TARGET, consistency, run_log, run_once
 
 
 class RecordingReference(EkfReference):
@@ -150,11 +150,12 @@ def _reference_start(model, **kwargs):
     return ReferenceFilter(start_from_measurements(model, recover_after=RECOVER_AFTER, **kwargs))
 
 
-def record_run(run, sensors, seed, duration=None, accel_noise="held"):
+def record_run(run, sensors, seed, duration=None, accel_noise="held", log=None):
     """One consistency run (`run_once`'s) with the NumPy reference as the filter: its result
     ({"t", "e", "P", ...}, the components from SETTLE_S on) and the recorded "ops", "P0" (18, 18),
     "T" (m, 18, 18: the filter's errors to the physical components at the scored samples),
-    "scored" (the indices of the scored samples among the "sample" ops), the start "x0", "b0"."""
+    "scored" (the indices of the scored samples among the "sample" ops), the start "x0", "b0".
+    `log`: the run's log already simulated (`run_log`; `run`, `sensors` and `duration` unused)."""
     recorded = {}
 
     def make_filter(model, **kwargs):
@@ -162,7 +163,10 @@ def record_run(run, sensors, seed, duration=None, accel_noise="held"):
         recorded["filter"] = f
         return f
 
-    result = run_once(run, sensors, seed, duration=duration, accel_noise=accel_noise, make_filter=make_filter)
+    if log is None:
+        result = run_once(run, sensors, seed, duration=duration, accel_noise=accel_noise, make_filter=make_filter)
+    else:
+        result = run_log(log, seed, accel_noise=accel_noise, make_filter=make_filter)
     f = recorded["filter"]
     result["ops"], result["P0"], result["x0"], result["b0"] = f.ref.ops, f.ekf.P, f.ekf.x, f.ekf.biases
     return result
@@ -192,20 +196,26 @@ def simulate(rec, runs, seed):
     return np.einsum("mij,rmj->rmi", rec["T"], d)
 
 
-def truth_draws(run, sensors, seed, duration=None):
-    """What the truth of `record_run`'s run drew, as the filter's linear model takes it: per sample
-    the measurement noise (reading less the noiseless reading of the truth, so the encoders'
-    quantisation too) by kind ("imu", "encoders", "position", "heading"), the torque disturbance's acceleration M⁻¹ w per step ("a"), the
-    biases per step ("b"), the step ("dt"), the truth's start ("x0"; "model" the truth's robot)."""
-    import math
-    from ..sensor_sim import random_streams
-    from .. import sensors as readings
+def simulated_log(run, sensors, seed, duration=None):
+    """The log (with its truth) of `record_run`'s run."""
     from .consistency import load_task
-    from .estimate import claimed_params
     from .sense import simulate_log
     from ..sensor_set import SensorSet, load_sensor_set
     sensors = sensors if sensors is None or isinstance(sensors, SensorSet) else load_sensor_set(sensors)
-    log = simulate_log(load_task(run, duration), sensors, seed=seed)
+    return simulate_log(load_task(run, duration), sensors, seed=seed)
+
+
+def truth_draws(run, sensors, seed, duration=None, log=None):
+    """What the truth of `record_run`'s run drew, as the filter's linear model takes it: per sample
+    the measurement noise (reading less the noiseless reading of the truth, so the encoders'
+    quantisation too) by kind ("imu", "encoders", "position", "heading"), the torque disturbance's acceleration M⁻¹ w per step ("a"), the
+    biases per step ("b"), the step ("dt"), the truth's start ("x0"; "model" the truth's robot).
+    `log`: the run's log (`simulated_log`) when already simulated."""
+    import math
+    from ..sensor_sim import random_streams
+    from .. import sensors as readings
+    from .estimate import claimed_params
+    log = simulated_log(run, sensors, seed, duration) if log is None else log
     model = Model(claimed_params(log))
     xs, bs, dt, spec = log.truth_states(), log.truth_biases(), float(log.meta["dt"]), log.sensors
     stream = random_streams(seed)["process"]
@@ -292,6 +302,16 @@ def sources(rec, draws, model_draws=0, seed=0):
     return np.einsum("mij,skmj->skmi", rec["T"], d)
 
 
+def redrawn_imu(log, draws, seed):
+    """`log` with its IMU's noise (`truth_draws`'s "imu") replaced by an independent draw of the
+    same σ, seeded `seed`: the same truth, torques and other sensors."""
+    import dataclasses
+    spec = log.sensors.imu
+    noise = np.random.default_rng(seed).standard_normal(draws["imu"].shape) * np.repeat(
+        [spec.gyro_noise, spec.accel_noise], 3)
+    return dataclasses.replace(log, imu=dataclasses.replace(log.imu, data=log.imu.data - draws["imu"] + noise))
+
+
 def driven(rec, draws):
     """The recorded linear system driven by the truth's own draws (`truth_draws`) from the run's
     start error: e ← T e at every map; at every noise the draw it stands for (an update's −K v, the
@@ -346,6 +366,8 @@ def build_parser():
                    "linear model driven source by source, by the truth's draw and by the filter's model of it (`trace`)")
     p.add_argument("--model-draws", type=whole(2), default=20, help="with --trace: draws of each source's model "
                    "per seed (default 20)")
+    p.add_argument("--redraw", action="store_true", help="with --trace: also each run's draws through the maps "
+                   "recorded with its IMU's noise redrawn")
     return p
 
 
@@ -408,26 +430,34 @@ def _main_driven(args):
     return 0
 
 
-def trace(run, sensors, seeds, model_draws=20, duration=None):
+def trace(run, sensors, seeds, model_draws=20, duration=None, redraw=False):
     """Per seed and component the mean error² / σ² of the run ("run"), of its linear model driven by
     its own draws ("linear") and by `model_draws` whole draws of the filter's model ("model", their
     mean; "rank", the share of them below "linear"), and per source (SOURCES, `sources`) of the
     linear model driven by that source alone: its own draw ("own"), its model's draws ("of_model",
     their mean) and the own draw's place among them ("source_rank").  A source whose truth is the
     filter's model has "own" spread as "of_model" over the seeds, and a "source_rank" of ½ on
-    average: a source that loads a component beyond its model shows as both above.  Arrays
-    (n, 18) and (n, S, 18) under those keys, with "seeds", "components", "sources"."""
-    keys = ("run", "linear", "model", "rank", "own", "of_model", "source_rank")
+    average: a source that loads a component beyond its model shows as both above.  `redraw`:
+    also "redrawn", the run's own draws through the maps the filter records on the same truth with
+    its IMU's noise redrawn (`redrawn_imu`): near "linear" when the maps do not depend on the
+    draws they propagate.  Arrays (n, 18) and (n, S, 18) under those keys, with "seeds",
+    "components", "sources"."""
+    keys = ("run", "linear", "model", "rank", "own", "of_model", "source_rank") + (("redrawn",) if redraw else ())
     out = {k: [] for k in keys}
     for seed in seeds:
-        rec = record_run(run, sensors, seed, duration=duration)
-        e = sources(rec, truth_draws(run, sensors, seed, duration=duration), model_draws, seed=[seed, 3])
+        log = simulated_log(run, sensors, seed, duration)
+        rec = record_run(run, sensors, seed, log=log)
+        draws = truth_draws(run, sensors, seed, log=log)
+        e = sources(rec, draws, model_draws, seed=[seed, 3])
         var = np.diagonal(rec["P"], axis1=1, axis2=2)
         per = np.mean(e ** 2 / var, axis=2)                        # (S, 1 + draws, 18)
         whole = np.mean(e.sum(axis=0) ** 2 / var, axis=1)          # (1 + draws, 18)
         values = (np.mean(rec["e"] ** 2 / var, axis=0), whole[0], whole[1:].mean(axis=0),
                   np.mean(whole[1:] < whole[0], axis=0), per[:, 0], per[:, 1:].mean(axis=1),
                   np.mean(per[:, 1:] < per[:, :1], axis=1))
+        if redraw:
+            other = record_run(run, sensors, seed, log=redrawn_imu(log, draws, [seed, 4]))
+            values += (np.mean(driven(other, draws) ** 2 / np.diagonal(other["P"], axis1=1, axis2=2), axis=0),)
         for k, v in zip(keys, values):
             out[k].append(v)
     return {"seeds": list(seeds), "components": list(COMPONENTS), "sources": list(SOURCES),
@@ -435,9 +465,10 @@ def trace(run, sensors, seeds, model_draws=20, duration=None):
 
 
 def _main_trace(args):
-    out = trace(args.run, args.sensors, range(args.seed, args.seed + args.trace), args.model_draws, args.duration)
+    out = trace(args.run, args.sensors, range(args.seed, args.seed + args.trace), args.model_draws, args.duration,
+                args.redraw)
     mean = {k: dict(zip(COMPONENTS, np.round(out[k].mean(axis=0), 4).tolist()))
-            for k in ("run", "linear", "model", "rank")}
+            for k in ("run", "linear", "model", "rank") + (("redrawn",) if args.redraw else ())}
     mean["sources"] = {name: {k: dict(zip(COMPONENTS, np.round(out[k][:, i].mean(axis=0), 4).tolist()))
                               for k in ("own", "of_model", "source_rank")} for i, name in enumerate(SOURCES)}
     if args.out:

@@ -5,7 +5,8 @@ check fails when one recorded noise or map is left out; blocks of draws are scor
 `consistency` scores runs; driven by the truth's own draws the recorded linear system tracks the
 run's own error, and does not without one of those draws; driven source by source, the draws of
 the sources' models together have the filter's covariance, and do not with one source left out;
-the command writes the blocks and the trace, and refuses a bad block size or number of draws."""
+a redrawn log's IMU noise is a new draw of the sensor's σ; the command writes the blocks and
+the trace, and refuses a bad block size or number of draws."""
 import json
 
 import numpy as np
@@ -13,7 +14,7 @@ import pytest
 
 from runtime.estimation.consistency import nees, nees_band, run_once
 from runtime.estimation.surrogate import (SOURCES, RecordingReference, block_statistics, driven, main, record_run,
-                                          simulate, sources, truth_draws)
+                                          redrawn_imu, simulate, simulated_log, sources, truth_draws)
 from runtime.verification.ekf_reference import NB
 
 from .test_tasks import short
@@ -164,9 +165,10 @@ def test_the_covariance_check_fails_with_one_source_left_out(recorded, draws, mo
 
 def test_the_command_traces_a_run_source_by_source(tmp_path):
     out = tmp_path / "trace.json"
-    assert main(["line", "--duration", "4", "--trace", "1", "--model-draws", "3", "--out", str(out)]) == 0
+    assert main(["line", "--duration", "4", "--trace", "1", "--model-draws", "3", "--redraw", "--out", str(out)]) == 0
     report = json.loads(out.read_text())
     assert report["sources"] == list(SOURCES)
+    assert np.shape(report["redrawn"]) == (1, 18)
     assert np.shape(report["own"]) == np.shape(report["of_model"]) == (1, len(SOURCES), 18)
     k = report["components"].index("tilt_x")
     assert report["mean"]["linear"]["tilt_x"] == pytest.approx(report["linear"][0][k], abs=1e-4)
@@ -177,3 +179,11 @@ def test_the_command_refuses_fewer_than_two_model_draws(capsys):
         main(["line", "--trace", "1", "--model-draws", "1"])
     assert exit_.value.code == 2
     assert "--model-draws" in capsys.readouterr().err
+
+
+def test_a_redrawn_logs_imu_noise_is_a_new_draw_of_the_sensors_sigma(draws):
+    log = simulated_log(short("line"), None, seed=0)
+    new = truth_draws(None, None, 0, log=redrawn_imu(log, draws, 5))["imu"]
+    sigma = np.repeat([log.sensors.imu.gyro_noise, log.sensors.imu.accel_noise], 3)
+    assert np.allclose(new.std(axis=0) / sigma, 1.0, atol=0.1)
+    assert max(abs(np.corrcoef(new[:, j], draws["imu"][:, j])[0, 1]) for j in range(6)) < 0.15
