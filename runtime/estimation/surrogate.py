@@ -440,9 +440,10 @@ def trace(run, sensors, seeds, model_draws=20, duration=None, redraw=False):
     average: a source that loads a component beyond its model shows as both above.  `redraw`:
     also "redrawn", the run's own draws through the maps the filter records on the same truth with
     its IMU's noise redrawn (`redrawn_imu`): near "linear" when the maps do not depend on the
-    draws they propagate.  Arrays (n, 18) and (n, S, 18) under those keys, with "seeds",
+    draws they propagate; "redrawn_sigma", that filter's σ over the run's, averaged over time.  Arrays (n, 18) and (n, S, 18) under those keys, with "seeds",
     "components", "sources"."""
-    keys = ("run", "linear", "model", "rank", "own", "of_model", "source_rank") + (("redrawn",) if redraw else ())
+    keys = ("run", "linear", "model", "rank", "own", "of_model", "source_rank") + (
+        ("redrawn", "redrawn_sigma") if redraw else ())
     out = {k: [] for k in keys}
     for seed in seeds:
         log = simulated_log(run, sensors, seed, duration)
@@ -457,7 +458,8 @@ def trace(run, sensors, seeds, model_draws=20, duration=None, redraw=False):
                   np.mean(per[:, 1:] < per[:, :1], axis=1))
         if redraw:
             other = record_run(run, sensors, seed, log=redrawn_imu(log, draws, [seed, 4]))
-            values += (np.mean(driven(other, draws) ** 2 / np.diagonal(other["P"], axis1=1, axis2=2), axis=0),)
+            other_var = np.diagonal(other["P"], axis1=1, axis2=2)
+            values += (np.mean(driven(other, draws) ** 2 / other_var, axis=0), np.mean(np.sqrt(other_var / var), axis=0))
         for k, v in zip(keys, values):
             out[k].append(v)
     return {"seeds": list(seeds), "components": list(COMPONENTS), "sources": list(SOURCES),
@@ -468,7 +470,7 @@ def _main_trace(args):
     out = trace(args.run, args.sensors, range(args.seed, args.seed + args.trace), args.model_draws, args.duration,
                 args.redraw)
     mean = {k: dict(zip(COMPONENTS, np.round(out[k].mean(axis=0), 4).tolist()))
-            for k in ("run", "linear", "model", "rank") + (("redrawn",) if args.redraw else ())}
+            for k in ("run", "linear", "model", "rank") + (("redrawn", "redrawn_sigma") if args.redraw else ())}
     mean["sources"] = {name: {k: dict(zip(COMPONENTS, np.round(out[k][:, i].mean(axis=0), 4).tolist()))
                               for k in ("own", "of_model", "source_rank")} for i, name in enumerate(SOURCES)}
     if args.out:

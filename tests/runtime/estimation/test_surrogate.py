@@ -168,7 +168,7 @@ def test_the_command_traces_a_run_source_by_source(tmp_path):
     assert main(["line", "--duration", "4", "--trace", "1", "--model-draws", "3", "--redraw", "--out", str(out)]) == 0
     report = json.loads(out.read_text())
     assert report["sources"] == list(SOURCES)
-    assert np.shape(report["redrawn"]) == (1, 18)
+    assert np.shape(report["redrawn"]) == np.shape(report["redrawn_sigma"]) == (1, 18)
     assert np.shape(report["own"]) == np.shape(report["of_model"]) == (1, len(SOURCES), 18)
     k = report["components"].index("tilt_x")
     assert report["mean"]["linear"]["tilt_x"] == pytest.approx(report["linear"][0][k], abs=1e-4)
