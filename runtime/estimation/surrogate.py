@@ -14,6 +14,10 @@ band per block is then the statistic's own spread for this filter's error correl
     rec = record_run("line", "default", seed=0)
     e = simulate(rec, runs=1000, seed=1)          # (1000, m, 18) physical components
     blocks = block_statistics(rec, e, block=50)   # per block of 50: share in band, ±3σ shares
+
+The same maps driven by the truth's own draws (`driven`), source by source and by the filter's
+model of each source (`sources`, `trace`: `python -m runtime surrogate line --trace 50`), say which
+of the truth's draws loads a component and whether it differs from what the filter assumes.
 """
 import argparse
 import json
