@@ -100,6 +100,11 @@ def run_once(run, sensors, seed, duration=None, plant_mismatch=False, every=EVER
     task = load_task(run, duration)
     sensors = sensors if sensors is None or isinstance(sensors, SensorSet) else load_sensor_set(sensors)
     log = simulate_log(task, sensors, seed=seed, plant_mismatch=plant_mismatch)
+    return run_log(log, seed, every=every, accel_noise=accel_noise, constrained=constrained, make_filter=make_filter)
+
+
+def run_log(log, seed, every=EVERY, accel_noise="held", constrained=None, make_filter=None):
+    """`run_once` over a log already simulated (with its truth) by the run seeded `seed`."""
     # The operator's heading at the start is the truth's off by a draw of the σ the start rule
     # assumes: started at the truth's, the filter would look conservative in heading by design.
     heading = start_heading(log) + np.random.default_rng([seed, 1]).normal(0.0, START_HEADING_SIGMA)

@@ -14,6 +14,10 @@ band per block is then the statistic's own spread for this filter's error correl
     rec = record_run("line", "default", seed=0)
     e = simulate(rec, runs=1000, seed=1)          # (1000, m, 18) physical components
     blocks = block_statistics(rec, e, block=50)   # per block of 50: share in band, ±3σ shares
+
+The same maps driven by the truth's own draws (`driven`), source by source and by the filter's
+model of each source (`sources`, `trace`: `python -m runtime surrogate line --trace 50`), say which
+of the truth's draws loads a component and whether it differs from what the filter assumes.
 """
 import argparse
 import json
@@ -25,7 +29,7 @@ from ..ekf import RECOVER_AFTER, start_from_measurements
 from ..model import Model
 from ..state import IDX_E_NU, NE
 from ..verification.ekf_reference import NB, EkfReference
-from .consistency import COMPONENTS, NEES_TARGET, WITHIN_TARGET, consistency, run_once
+from .consistency import COMPONENTS, NEES_TARGET, WITHIN_TARGET, consistency, run_log, run_once
 
 
 class RecordingReference(EkfReference):
@@ -70,11 +74,12 @@ class ReferenceFilter:
         self.t, self.count = 0.0, {}
         self.imu_sigma = np.array([n.gyro] * 3 + list(n.accel))
 
-    def _at(self, kind):
-        """Sets the reference's context: (kind, the sample's index among its kind's, time)."""
+    def _at(self, kind, sigma):
+        """Sets the reference's context: (kind, the sample's index among its kind's, time, the
+        standard deviations of its readings the filter assumes)."""
         i = self.count.get(kind, 0)
         self.count[kind] = i + 1
-        self.ref.context = (kind, i, self.t)
+        self.ref.context = (kind, i, self.t, np.asarray(sigma, dtype=float))
 
     def predict(self, u, dt):
         """`Ekf.predict`."""
@@ -87,19 +92,19 @@ class ReferenceFilter:
     def update_imu(self, y, u):
         """`Ekf.update_imu`: the held update when the noise holds the disturbance, else per axis."""
         n, gate = self.ekf.noise, self.ekf.gate["imu"]
-        self._at("imu")
+        self._at("imu", self.imu_sigma)
         if n.torque_hold > 0:
             return self.ref.update_imu_held(y, u, self.ekf.mount, self.imu_sigma, self.psd, n.torque_hold, gate)
         return self.ref.update_imu(y, u, self.ekf.mount, n.gyro, n.accel, gate)
 
     def update_encoders(self, y):
         """`Ekf.update_encoders`."""
-        self._at("encoders")
+        self._at("encoders", [self.ekf.noise.encoder] * 2)
         return self.ref.update_encoders(y, self.ekf.noise.encoder, self.ekf.gate["encoders"])
 
     def update_position(self, y):
         """`Ekf.update_position`."""
-        self._at("position")
+        self._at("position", [self.ekf.noise.position] * 2)
         return self.ref.update_position(y, self.ekf.noise.position, self.ekf.gate["position"])
 
     def mark_position(self, slot):
@@ -108,12 +113,12 @@ class ReferenceFilter:
 
     def update_position_delayed(self, slot, y):
         """`Ekf.update_position_delayed`."""
-        self._at("position")
+        self._at("position", [self.ekf.noise.position] * 2)
         return self.ref.update_position_delayed(slot, y, self.ekf.noise.position, self.ekf.gate["position"])
 
     def update_heading(self, y):
         """`Ekf.update_heading`."""
-        self._at("heading")
+        self._at("heading", [self.ekf.noise.heading])
         return self.ref.update_heading(y, self.ekf.heading_mount, self.ekf.noise.heading, self.ekf.gate["heading"])
 
     @property
@@ -149,11 +154,12 @@ def _reference_start(model, **kwargs):
     return ReferenceFilter(start_from_measurements(model, recover_after=RECOVER_AFTER, **kwargs))
 
 
-def record_run(run, sensors, seed, duration=None, accel_noise="held"):
+def record_run(run, sensors, seed, duration=None, accel_noise="held", log=None):
     """One consistency run (`run_once`'s) with the NumPy reference as the filter: its result
     ({"t", "e", "P", ...}, the components from SETTLE_S on) and the recorded "ops", "P0" (18, 18),
     "T" (m, 18, 18: the filter's errors to the physical components at the scored samples),
-    "scored" (the indices of the scored samples among the "sample" ops), the start "x0", "b0"."""
+    "scored" (the indices of the scored samples among the "sample" ops), the start "x0", "b0".
+    `log`: the run's log already simulated (`run_log`; `run`, `sensors` and `duration` unused)."""
     recorded = {}
 
     def make_filter(model, **kwargs):
@@ -161,7 +167,10 @@ def record_run(run, sensors, seed, duration=None, accel_noise="held"):
         recorded["filter"] = f
         return f
 
-    result = run_once(run, sensors, seed, duration=duration, accel_noise=accel_noise, make_filter=make_filter)
+    if log is None:
+        result = run_once(run, sensors, seed, duration=duration, accel_noise=accel_noise, make_filter=make_filter)
+    else:
+        result = run_log(log, seed, accel_noise=accel_noise, make_filter=make_filter)
     f = recorded["filter"]
     result["ops"], result["P0"], result["x0"], result["b0"] = f.ref.ops, f.ekf.P, f.ekf.x, f.ekf.biases
     return result
@@ -191,20 +200,26 @@ def simulate(rec, runs, seed):
     return np.einsum("mij,rmj->rmi", rec["T"], d)
 
 
-def truth_draws(run, sensors, seed, duration=None):
-    """What the truth of `record_run`'s run drew, as the filter's linear model takes it: per sample
-    the measurement noise (reading less the noiseless reading of the truth, so the encoders'
-    quantisation too) by kind, the torque disturbance's acceleration M⁻¹ w per step ("a"), the
-    biases per step ("b"), the step ("dt"), the truth's start ("x0"; "model" the truth's robot)."""
-    import math
-    from ..sensor_sim import random_streams
-    from .. import sensors as readings
+def simulated_log(run, sensors, seed, duration=None):
+    """The log (with its truth) of `record_run`'s run."""
     from .consistency import load_task
-    from .estimate import claimed_params
     from .sense import simulate_log
     from ..sensor_set import SensorSet, load_sensor_set
     sensors = sensors if sensors is None or isinstance(sensors, SensorSet) else load_sensor_set(sensors)
-    log = simulate_log(load_task(run, duration), sensors, seed=seed)
+    return simulate_log(load_task(run, duration), sensors, seed=seed)
+
+
+def truth_draws(run, sensors, seed, duration=None, log=None):
+    """What the truth of `record_run`'s run drew, as the filter's linear model takes it: per sample
+    the measurement noise (reading less the noiseless reading of the truth, so the encoders'
+    quantisation too) by kind ("imu", "encoders", "position", "heading"), the torque disturbance's acceleration M⁻¹ w per step ("a"), the
+    biases per step ("b"), the step ("dt"), the truth's start ("x0"; "model" the truth's robot).
+    `log`: the run's log (`simulated_log`) when already simulated."""
+    import math
+    from ..sensor_sim import random_streams
+    from .. import sensors as readings
+    from .estimate import claimed_params
+    log = simulated_log(run, sensors, seed, duration) if log is None else log
     model = Model(claimed_params(log))
     xs, bs, dt, spec = log.truth_states(), log.truth_biases(), float(log.meta["dt"]), log.sensors
     stream = random_streams(seed)["process"]
@@ -225,7 +240,80 @@ def truth_draws(run, sensors, seed, duration=None):
     if log.fixes is not None and len(log.fixes):
         out["position"] = np.array([log.fixes.select("x", "y")[i] - readings.position(model, xs[step(t)])
                                     for i, t in enumerate(log.fixes["t_measured"])])
+    if log.heading is not None and len(log.heading):
+        out["heading"] = np.array([[math.remainder(log.heading.data[i][0] - readings.heading(
+            model, xs[step(t)], spec.imu.mount), 2 * math.pi)] for i, t in enumerate(log.heading.t)])
     return out
+
+
+#: The truth's draws, source by source (`sources`): the start error, the gyroscope's noise, each
+#: accelerometer axis's noise, the encoders' quantisation, the fixes' and the heading's noise, the
+#: torque disturbance (M⁻¹ w: held over a step, and over the part of a step no held a covers), the
+#: biases' walk.
+SOURCES = ("start", "gyro", "accel_x", "accel_y", "accel_z", "encoders", "position", "heading", "torque", "bias")
+#: Each update kind's reading columns by source.
+_READINGS = {"imu": (("gyro", [0, 1, 2]), ("accel_x", [3]), ("accel_y", [4]), ("accel_z", [5])),
+             "encoders": (("encoders", [0, 1]),), "position": (("position", [0, 1]),), "heading": (("heading", [0]),)}
+
+
+def sources(rec, draws, model_draws=0, seed=0):
+    """The recorded linear system driven one source at a time (SOURCES): by the truth's own draw of
+    it (`truth_draws`) and by `model_draws` draws of the filter's model of it (the start from
+    N(0, P0), an update's noise −K v with v ~ N(0, λ diag(σ²)) of the σ the filter assumed, λ a
+    recovery's, the held disturbance's prior, the predicts' Q: its torque block and its biases'
+    block).  Returns (S, 1 + model_draws, m, 18), the own draw first, in the physical components at
+    the scored samples: the linear system is linear, so the sum over the sources of the own draws
+    is `driven`, and a source whose truth is the filter's model has its own draw's error² / σ²
+    spread as its model draws'."""
+    rng = np.random.default_rng(seed)
+    dt, model, k = draws["dt"], draws["model"], 1 + model_draws
+    at = {name: i for i, name in enumerate(SOURCES)}
+    e = np.zeros((len(SOURCES), k, NB))
+    e[at["start"], 0] = np.concatenate([model.local(rec["x0"], draws["x0"]), draws["b"][0] - rec["b0"]])
+    e[at["start"], 1:] = rng.standard_normal((model_draws, NB)) @ np.linalg.cholesky(rec["P0"]).T
+    nu, bias = np.r_[IDX_E_NU], np.r_[NE:NB]
+    samples = []
+    for op in rec["ops"]:
+        if op[0] == "map":
+            _, rows, cols, M = op
+            e[:, :, rows] = e[:, :, cols] @ M.T
+        elif op[0] == "resize":
+            e = np.where(op[1] >= 0, e[:, :, np.maximum(op[1], 0)], 0.0)
+        elif op[0] == "noise":
+            _, rows, L, context, gain = op
+            if context[0] == "predict":          # rows 0 … NB − 1: Q is block-diagonal, torque and biases
+                k0, k1 = int(round(context[1] / dt)), int(round(context[2] / dt))
+                z = rng.standard_normal((model_draws, L.shape[1])) @ L.T
+                e[at["bias"]][0, bias] += draws["b"][k1] - draws["b"][k0]
+                e[at["bias"]][1:, bias] += z[:, bias]
+                if k0 < len(draws["a"]):         # the part of the step no held disturbance covers
+                    e[at["torque"]][0, nu] += draws["a"][k0] * context[3]
+                e[at["torque"]][1:, nu] += z[:, nu]
+            elif gain is None:                   # the held disturbance's prior
+                i = int(round(context[2] / dt))
+                e[at["torque"]][0, rows] += draws["a"][i] if i < len(draws["a"]) else 0.0
+                e[at["torque"]][1:, rows] += rng.standard_normal((model_draws, L.shape[1])) @ L.T
+            else:
+                kind, sigma = context[0], context[3]
+                lam = np.sum(L * L) / np.sum((gain * sigma) ** 2)    # a recovery's λ R, else 1
+                v = rng.standard_normal((model_draws, len(sigma))) * sigma * np.sqrt(lam)
+                for name, cols in _READINGS[kind]:
+                    e[at[name]][0, rows] -= gain[:, cols] @ draws[kind][context[1]][cols]
+                    e[at[name]][1:, rows] -= v[:, cols] @ gain[:, cols].T
+        else:
+            samples.append(e[:, :, :NB].copy())
+    d = np.stack(samples, axis=2)[:, :, rec["scored"]]
+    return np.einsum("mij,skmj->skmi", rec["T"], d)
+
+
+def redrawn_imu(log, draws, seed):
+    """`log` with its IMU's noise (`truth_draws`'s "imu") replaced by an independent draw of the
+    same σ, seeded `seed`: the same truth, torques and other sensors."""
+    import dataclasses
+    spec = log.sensors.imu
+    noise = np.random.default_rng(seed).standard_normal(draws["imu"].shape) * np.repeat(
+        [spec.gyro_noise, spec.accel_noise], 3)
+    return dataclasses.replace(log, imu=dataclasses.replace(log.imu, data=log.imu.data - draws["imu"] + noise))
 
 
 def driven(rec, draws):
@@ -233,30 +321,7 @@ def driven(rec, draws):
     start error: e ← T e at every map; at every noise the draw it stands for (an update's −K v, the
     held disturbance's a, the biases' steps, M⁻¹ w over the part of a step no held a covers); the current error at the
     scored samples in the physical components (m, 18), to compare with the run's own ("e")."""
-    dt, model = draws["dt"], draws["model"]
-    e = np.concatenate([model.local(rec["x0"], draws["x0"]), draws["b"][0] - rec["b0"]])
-    samples = []
-    for op in rec["ops"]:
-        if op[0] == "map":
-            _, rows, cols, M = op
-            e[rows] = M @ e[cols]
-        elif op[0] == "resize":
-            e = np.where(op[1] >= 0, e[np.maximum(op[1], 0)], 0.0)
-        elif op[0] == "noise":
-            _, rows, L, context, gain = op
-            if context[0] == "predict":
-                k0, k1 = int(round(context[1] / dt)), int(round(context[2] / dt))
-                e[rows[NE:NB]] += draws["b"][k1] - draws["b"][k0]
-                if k0 < len(draws["a"]):         # the part of the step no held disturbance covers
-                    e[rows[IDX_E_NU]] += draws["a"][k0] * context[3]
-            elif gain is None:
-                k = int(round(context[2] / dt))
-                e[rows] += draws["a"][k] if k < len(draws["a"]) else 0.0
-            else:
-                e[rows] -= gain @ draws[context[0]][context[1]]
-        else:
-            samples.append(e[:NB].copy())
-    return np.einsum("mij,mj->mi", rec["T"], np.stack(samples)[rec["scored"]])
+    return sources(rec, draws)[:, 0].sum(axis=0)
 
 
 def block_statistics(rec, e, block=50):
@@ -301,6 +366,12 @@ def build_parser():
     p.add_argument("--out", metavar="FILE", help="a JSON file for the summary and every block")
     p.add_argument("--driven", type=whole(1), metavar="N", help="instead: seeds seed … seed + N − 1, each "
                    "run's error²/σ² and its linear model's driven by its own draws (`driven`)")
+    p.add_argument("--trace", type=whole(1), metavar="N", help="instead: seeds seed … seed + N − 1, each run's "
+                   "linear model driven source by source, by the truth's draw and by the filter's model of it (`trace`)")
+    p.add_argument("--model-draws", type=whole(2), default=20, help="with --trace: draws of each source's model "
+                   "per seed (default 20)")
+    p.add_argument("--redraw", action="store_true", help="with --trace: also each run's draws through the maps "
+                   "recorded with its IMU's noise redrawn")
     return p
 
 
@@ -321,6 +392,8 @@ def main(argv):
         return 2
     if args.driven:
         return _main_driven(args)
+    if args.trace:
+        return _main_trace(args)
     rec = record_run(args.run, args.sensors, args.seed, duration=args.duration)
     e = simulate(rec, args.draws, seed=[args.seed, 2])
     blocks = block_statistics(rec, e, args.block)
@@ -358,4 +431,55 @@ def _main_driven(args):
         with open(args.out, "w") as fh:
             fh.write(json.dumps(table, indent=1))
     print(json.dumps(table["mean"], indent=1))
+    return 0
+
+
+def trace(run, sensors, seeds, model_draws=20, duration=None, redraw=False):
+    """Per seed and component the mean error² / σ² of the run ("run"), of its linear model driven by
+    its own draws ("linear") and by `model_draws` whole draws of the filter's model ("model", their
+    mean; "rank", the share of them below "linear"), and per source (SOURCES, `sources`) of the
+    linear model driven by that source alone: its own draw ("own"), its model's draws ("of_model",
+    their mean) and the own draw's place among them ("source_rank").  A source whose truth is the
+    filter's model has "own" spread as "of_model" over the seeds, and a "source_rank" of ½ on
+    average: a source that loads a component beyond its model shows as both above.  `redraw`:
+    also "redrawn", the run's own draws through the maps the filter records on the same truth with
+    its IMU's noise redrawn (`redrawn_imu`): near "linear" when the maps do not depend on the
+    draws they propagate; "redrawn_sigma", that filter's σ over the run's, averaged over time.  Arrays (n, 18) and (n, S, 18) under those keys, with "seeds",
+    "components", "sources"."""
+    keys = ("run", "linear", "model", "rank", "own", "of_model", "source_rank") + (
+        ("redrawn", "redrawn_sigma") if redraw else ())
+    out = {k: [] for k in keys}
+    for seed in seeds:
+        log = simulated_log(run, sensors, seed, duration)
+        rec = record_run(run, sensors, seed, log=log)
+        draws = truth_draws(run, sensors, seed, log=log)
+        e = sources(rec, draws, model_draws, seed=[seed, 3])
+        var = np.diagonal(rec["P"], axis1=1, axis2=2)
+        per = np.mean(e ** 2 / var, axis=2)                        # (S, 1 + draws, 18)
+        whole = np.mean(e.sum(axis=0) ** 2 / var, axis=1)          # (1 + draws, 18)
+        values = (np.mean(rec["e"] ** 2 / var, axis=0), whole[0], whole[1:].mean(axis=0),
+                  np.mean(whole[1:] < whole[0], axis=0), per[:, 0], per[:, 1:].mean(axis=1),
+                  np.mean(per[:, 1:] < per[:, :1], axis=1))
+        if redraw:
+            other = record_run(run, sensors, seed, log=redrawn_imu(log, draws, [seed, 4]))
+            other_var = np.diagonal(other["P"], axis1=1, axis2=2)
+            values += (np.mean(driven(other, draws) ** 2 / other_var, axis=0), np.mean(np.sqrt(other_var / var), axis=0))
+        for k, v in zip(keys, values):
+            out[k].append(v)
+    return {"seeds": list(seeds), "components": list(COMPONENTS), "sources": list(SOURCES),
+            **{k: np.array(v) for k, v in out.items()}}
+
+
+def _main_trace(args):
+    out = trace(args.run, args.sensors, range(args.seed, args.seed + args.trace), args.model_draws, args.duration,
+                args.redraw)
+    mean = {k: dict(zip(COMPONENTS, np.round(out[k].mean(axis=0), 4).tolist()))
+            for k in ("run", "linear", "model", "rank") + (("redrawn", "redrawn_sigma") if args.redraw else ())}
+    mean["sources"] = {name: {k: dict(zip(COMPONENTS, np.round(out[k][:, i].mean(axis=0), 4).tolist()))
+                              for k in ("own", "of_model", "source_rank")} for i, name in enumerate(SOURCES)}
+    if args.out:
+        with open(args.out, "w") as fh:
+            fh.write(json.dumps({**{k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in out.items()},
+                                 "mean": mean}, indent=1))
+    print(json.dumps(mean, indent=1))
     return 0

@@ -51,7 +51,10 @@ OPTIONS = {
                                                              "--block": NOT_A_NUMBER + ["0", "1", "-1"] + NOT_AN_INTEGER,
                                                              "--seed": NOT_A_NUMBER + ["-1"] + NOT_AN_INTEGER,
                                                              "--duration": NOT_A_NUMBER + NOT_POSITIVE,
-                                                             "--driven": NOT_A_NUMBER + ["0", "-1"] + NOT_AN_INTEGER}),
+                                                             "--driven": NOT_A_NUMBER + ["0", "-1"] + NOT_AN_INTEGER,
+                                                             "--trace": NOT_A_NUMBER + ["0", "-1"] + NOT_AN_INTEGER,
+                                                             "--model-draws": NOT_A_NUMBER + ["0", "1", "-1"]
+                                                             + NOT_AN_INTEGER}),
     "consistency": (["circle", "--out", "{tmp}/c"], {"--runs": NOT_A_NUMBER + ["0", "1", "-1"] + NOT_AN_INTEGER,
                                                      "--first-seed": NOT_A_NUMBER + ["-1"] + NOT_AN_INTEGER,
                                                      "--workers": NOT_A_NUMBER + ["0", "-1"] + NOT_AN_INTEGER,

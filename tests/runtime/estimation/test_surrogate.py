@@ -3,16 +3,18 @@ reference is the C filter over a short line run; the draws of the recorded linea
 filter's covariance (their NEES averages to the dimension within its standard error), and that
 check fails when one recorded noise or map is left out; blocks of draws are scored as
 `consistency` scores runs; driven by the truth's own draws the recorded linear system tracks the
-run's own error, and does not without one of those draws; the command writes the blocks and
-refuses a bad block size."""
+run's own error, and does not without one of those draws; driven source by source, the draws of
+the sources' models together have the filter's covariance, and do not with one source left out;
+a redrawn log's IMU noise is a new draw of the sensor's σ; the command writes the blocks and
+the trace, and refuses a bad block size or number of draws."""
 import json
 
 import numpy as np
 import pytest
 
 from runtime.estimation.consistency import nees, nees_band, run_once
-from runtime.estimation.surrogate import (RecordingReference, block_statistics, driven, main, record_run, simulate,
-                                          truth_draws)
+from runtime.estimation.surrogate import (SOURCES, RecordingReference, block_statistics, driven, main, record_run,
+                                          redrawn_imu, simulate, simulated_log, sources, truth_draws)
 from runtime.verification.ekf_reference import NB
 
 from .test_tasks import short
@@ -141,3 +143,47 @@ def test_the_command_compares_a_run_with_its_driven_linear_model(tmp_path):
     assert report["seeds"] == [0]
     k = report["components"].index("tilt_x")
     assert report["mean"]["tilt_x"] == pytest.approx([report["run"][0][k], report["linear"][0][k]])
+
+
+def sources_nees_offset(rec, draws, model_draws=300):
+    """How far the NEES of the sources' model draws summed, averaged over the samples and the
+    draws, lies from 18, in standard errors of the draws' own averages."""
+    total = sources(rec, draws, model_draws, seed=1)[:, 1:].sum(axis=0)
+    per_draw = np.array([nees(draw, rec["P"]).mean() for draw in total])
+    return float((per_draw.mean() - 18.0) / (per_draw.std(ddof=1) / np.sqrt(len(per_draw))))
+
+
+def test_the_sources_models_together_have_the_filters_covariance(recorded, draws):
+    assert abs(sources_nees_offset(recorded, draws)) <= 4.0
+
+
+def test_the_covariance_check_fails_with_one_source_left_out(recorded, draws, monkeypatch):
+    from runtime.estimation import surrogate
+    monkeypatch.setitem(surrogate._READINGS, "imu", surrogate._READINGS["imu"][:3])   # no accel_z
+    assert sources_nees_offset(recorded, draws) < -10.0
+
+
+def test_the_command_traces_a_run_source_by_source(tmp_path):
+    out = tmp_path / "trace.json"
+    assert main(["line", "--duration", "4", "--trace", "1", "--model-draws", "3", "--redraw", "--out", str(out)]) == 0
+    report = json.loads(out.read_text())
+    assert report["sources"] == list(SOURCES)
+    assert np.shape(report["redrawn"]) == np.shape(report["redrawn_sigma"]) == (1, 18)
+    assert np.shape(report["own"]) == np.shape(report["of_model"]) == (1, len(SOURCES), 18)
+    k = report["components"].index("tilt_x")
+    assert report["mean"]["linear"]["tilt_x"] == pytest.approx(report["linear"][0][k], abs=1e-4)
+
+
+def test_the_command_refuses_fewer_than_two_model_draws(capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["line", "--trace", "1", "--model-draws", "1"])
+    assert exit_.value.code == 2
+    assert "--model-draws" in capsys.readouterr().err
+
+
+def test_a_redrawn_logs_imu_noise_is_a_new_draw_of_the_sensors_sigma(draws):
+    log = simulated_log(short("line"), None, seed=0)
+    new = truth_draws(None, None, 0, log=redrawn_imu(log, draws, 5))["imu"]
+    sigma = np.repeat([log.sensors.imu.gyro_noise, log.sensors.imu.accel_noise], 3)
+    assert np.allclose(new.std(axis=0) / sigma, 1.0, atol=0.1)
+    assert max(abs(np.corrcoef(new[:, j], draws["imu"][:, j])[0, 1]) for j in range(6)) < 0.15
