@@ -197,8 +197,8 @@ _PENDULUM_SCHEDULES = {}
 class SlopeEstimator:
     """The world's slope vector s [rad], a torque offset d [N m] (the plant moving as the model under
     u + d: a motor's bias) and the pendulum's departure from the model (`pendulum`: Δm_P [kg], Δc_P
-    (3,) [m], Δk_P [N m s]) from the measured states and the torques held between them (see the module's
-    docstring): least squares with exponential forgetting over `time_constant_s`.  What the torque
+    (3,) [m]; `pendulum_damping`: Δk_P [N m s]) from the measured states and the torques held
+    between them (see the module's docstring): least squares with exponential forgetting over `time_constant_s`.  What the torque
     offset or the pendulum explains is not read as a slope: they act on the rates along other
     directions, fixed to the robot, where the slope's pull turns with the heading.
     `pendulum_damping` (on by default; off only to show what it changes): the pendulum's damping k_P
@@ -283,10 +283,9 @@ class SlopeFeedforward:
         self.model_slope = np.array([params.slope, 0.0])
         self._slope_schedule = design_slope_schedule(flat, schedule) \
             if params.slope != 0.0 or gains.slope_estimate_s > 0.0 else None
-        feeds_pendulum = gains.pendulum_feedforward > 0.0
         self._estimator = SlopeEstimator(flat, self.period, gains.slope_estimate_s) \
             if gains.slope_estimate_s > 0.0 else None
-        self._pendulum_schedule = design_pendulum_schedule(flat, schedule) if feeds_pendulum else None
+        self._pendulum_schedule = design_pendulum_schedule(flat, schedule) if gains.pendulum_feedforward > 0.0 else None
         self._applied = np.zeros(2)
 
     def _reset_slope(self):
