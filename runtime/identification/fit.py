@@ -32,8 +32,8 @@ import scipy.linalg
 import scipy.optimize
 import scipy.sparse
 import scipy.stats
-import threadpoolctl
 
+from ..blas import one_thread
 from ..model import Model
 from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_parameters
 from ..params import SHAPES, Params, flat_names
@@ -770,16 +770,9 @@ def identify(log, params, names, segment=0.5, method="rkmk4", full_state=False, 
         raise IdentifyError(f"segment: expected a length > 0 in s, got {segment!r}")
     # The fit's products are small: one BLAS thread each (threads spinning for a busy core cost
     # far more than they gain on a shared 2-core machine).
-    with _blas_threads().limit(limits=1, user_api="blas"):
+    with one_thread():
         return _identify(log, params, free, segment, method, full_state, max_nfev, progress, x_guess, bias_guess,
                          jacobian, start)
-
-
-@functools.cache
-def _blas_threads():
-    """The process's thread pools (threadpoolctl), found once: finding them walks every loaded
-    library, 30 ms of CPU, a tenth of a full-state fit's."""
-    return threadpoolctl.ThreadpoolController()
 
 
 def _identify(log, params, free, segment, method, full_state, max_nfev, progress, x_guess, bias_guess, jacobian,

@@ -46,6 +46,7 @@ import math
 
 import numpy as np
 
+from ..blas import one_thread
 from ..control.metrics import second_half_stats
 from ..schema import Range, check_ranges, check_table
 from ..so3 import rot_z
@@ -192,13 +193,15 @@ class RobustnessSpec:
 
     def run_chunk(self, start, stop, nominal=()):
         """{column: array} of runs start..stop-1 (the sweep store's rows); `nominal`: groups of
-        perturbations (GROUPS) left out."""
+        perturbations (GROUPS) left out.  The runs use one BLAS thread (runtime/blas.py), as a
+        Dask worker's do: a row is the same in a worker, the serial mode and `--rerun`."""
         columns = {"sample": np.arange(start, stop, dtype=np.int64)}
         inputs = self.draw(start, stop)
         for group in nominal:
             inputs.update({k: np.full(stop - start, v) for k, v in with_nominal({}, [group]).items()})
         columns.update(inputs)
-        rows = [run_one(self, {k: v[j] for k, v in inputs.items()}) for j in range(stop - start)]
+        with one_thread():
+            rows = [run_one(self, {k: v[j] for k, v in inputs.items()}) for j in range(stop - start)]
         for name in OUTCOMES:
             dtype = np.int32 if name in ("status", "counted_apart", "success") else \
                 np.int64 if name == "steps_done" else np.float64

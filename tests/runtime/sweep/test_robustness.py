@@ -1,5 +1,8 @@
 """The robustness sweep: closed loops on the estimator over drawn plants, judged by the success rule."""
 import math
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pyarrow.parquet as pq
@@ -48,6 +51,27 @@ def test_a_handful_of_plants_run_through_the_sweep_command_into_a_table_a_summar
     printed = capsys.readouterr().out
     assert f"cross_track_rms_m = {rows['cross_track_rms_m'][2]!r}" in printed
 
+
+FIGURE8_SHORT = SMALL.replace("samples = 3", "samples = 1").replace('tasks = ["line"]', 'tasks = ["figure8"]') \
+    .replace("duration = 1.0", "duration = 2.0")
+
+
+@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="OpenBLAS runs one thread on one core")
+def test_a_row_a_dask_worker_wrote_equals_its_rerun_in_a_process_with_two_blas_threads(tmp_path):
+    # Dask's nannies start their workers on one BLAS thread; a shell's `--rerun` gets one per core.
+    # The figure eight's LQR gains differ at 1e-10 between one and two OpenBLAS threads (the 14 x 14
+    # expm of its discretisation), and the run with them (runtime/blas.py).  The rerun runs in a
+    # fresh process: this one's designs, cached by earlier tests, do not enter.
+    path, out = _sweep(tmp_path, FIGURE8_SHORT), tmp_path / "out"
+    assert main(["sweep", str(path), "--out", str(out), "--workers", "1", "--no-progress"]) == 0
+    row = pq.read_table(out / "results.parquet").to_pydict()
+    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")}
+    env.update(OPENBLAS_NUM_THREADS="2", OMP_NUM_THREADS="2")
+    printed = subprocess.run([sys.executable, "-m", "runtime", "sweep", str(path), "--out", str(out), "--rerun", "0"],
+                             env=env, capture_output=True, text=True, check=True).stdout
+    for name in ("cross_track_rms_m", "cross_track_max_m", "progress", "saturated_fraction",
+                 "estimate_position_rms_m"):
+        assert f"{name} = {row[name][0]!r}" in printed
 
 def test_every_run_of_a_plant_sees_the_same_robot_and_the_runs_cycle_through_tasks_and_controllers(tmp_path):
     spec = load_sweep("control-robustness")
