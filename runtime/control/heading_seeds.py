@@ -54,11 +54,16 @@ def tasks(kind, changes=None):
 
 
 def deadline(nominal):
-    """The nominal task's heading settle time + the margin [s] (ValueError when it never settles)."""
+    """The nominal task's heading settle time + the margin [s] (ValueError when it never settles, or
+    so late that no sample of the run is left after the deadline)."""
     settle = run_task(nominal)[2]["heading_settle_s"]
     if settle is None:
         raise ValueError("nominal: the heading step does not settle without the sensors; no deadline")
-    return settle + SENSORS_SETTLE_MARGIN_S
+    limit = settle + SENSORS_SETTLE_MARGIN_S
+    if limit >= nominal.duration:
+        raise ValueError(f"nominal: the heading step settles at {settle:g} s, so its deadline {limit:g} s "
+                         f"leaves nothing of the {nominal.duration:g} s run to score")
+    return limit
 
 
 def classify(t, error, limit, band=HEADING_BAND_RAD):
@@ -151,9 +156,9 @@ def main(argv=()):
     try:
         seeds, changes = _seeds(args.seeds), _changes(args.set)
         nominal, task = tasks(args.kind, changes)
+        limit = deadline(nominal)
     except ValueError as exc:
         parser.error(str(exc))
-    limit = deadline(nominal)
     started = time.process_time()
     records = []
     for seed in seeds:

@@ -53,7 +53,8 @@ def test_the_summary_gives_the_exact_interval_of_160_in_200():
 
 
 @pytest.mark.parametrize("argv, field", [(["--seeds", "3-1"], "seeds"), (["--seeds", "a-b"], "seeds"),
-                                         (["--set", "heading_rad"], "set"), (["--set", "no_such_gain=1"], "no_such_gain")])
+                                         (["--set", "heading_rad"], "set"), (["--set", "no_such_gain=1"], "no_such_gain"),
+                                         (["--set", "heading_rad=3"], "nominal: the heading step does not settle")])
 def test_bad_arguments_are_refused_by_name(argv, field, capsys):
     with pytest.raises(SystemExit):
         heading_seeds.main(argv)
@@ -113,3 +114,12 @@ def test_the_summary_gives_the_estimates_largest_error_in_the_misses_only():
 def test_the_command_says_when_the_controller_read_the_true_state(capsys):
     assert heading_seeds.main(["--seeds", "0-0", "--truth"]) == 0
     assert capsys.readouterr().out.startswith("lqr as the task files, on the true state, seeds 0-0: ")
+
+
+def test_a_nominal_step_settling_too_late_to_leave_a_deadline_in_the_run_is_refused(monkeypatch):
+    nominal, _ = heading_seeds.tasks("lqr")
+    monkeypatch.setattr(heading_seeds, "run_task", lambda task: (None, None, {"heading_settle_s": 28.5}))
+    with pytest.raises(ValueError, match="nominal: the heading step settles at 28.5 s"):
+        heading_seeds.deadline(nominal)
+    monkeypatch.setattr(heading_seeds, "run_task", lambda task: (None, None, {"heading_settle_s": 27.5}))
+    assert heading_seeds.deadline(nominal) == pytest.approx(29.5)
