@@ -95,12 +95,14 @@ ENGINES = ("python", "c", "c-loop")
 
 
 def simulate_on_sensors(plant_params, controller, reference, x0, duration, dt, estimator, sensors, method="rkmk4",
-                        seed=0, progress=False, engine="python", record_samples=True):
+                        seed=0, progress=False, engine="python", record_samples=True, read_truth=False):
     """Run `controller` on `reference` from x0 for `duration` s on the estimate of `estimator`
     (an `estimator.SensorEkf`) from the sensors `sensors` (a runtime.sensor_set.SensorSet) of the
     plant, seeded by `seed`; the plant steps by `dt`, the controller's period a whole number of steps.
     `engine`: one of ENGINES; `record_samples=False`: the result's `samples` is None (with the C
-    engine, building that list costs a tenth of the run)."""
+    engine, building that list costs a tenth of the run).  `read_truth`: the controller (and the reference's
+    target) reads the plant's state at its samples instead of the estimate, the filter running and
+    recorded as before on the same plant, process noise and readings (what the estimate costs the loop)."""
     if engine not in ENGINES:
         raise ValueError(f"engine: expected one of {', '.join(ENGINES)}, got {engine!r}")
     per = _period_steps(controller, dt)
@@ -110,18 +112,22 @@ def simulate_on_sensors(plant_params, controller, reference, x0, duration, dt, e
     steps = samples * per
     sim = SensorSimulation(Model(plant_params), sensors, dt, steps, method, seed)
     if engine == "c-loop":
+        if read_truth:
+            raise ValueError('read_truth: the C loop\'s controller reads the estimate only (engine "c" or "python")')
         from .loop_c import run
         return ClosedLoopResult(**run(sim, controller, reference, x0, estimator, per, samples, record_samples,
                                       progress))
     if engine == "c":
-        return _on_sensors_c(sim, controller, reference, x0, estimator, per, samples, progress, record_samples)
+        return _on_sensors_c(sim, controller, reference, x0, estimator, per, samples, progress, record_samples,
+                             read_truth)
     traj = np.empty((steps + 1, x0.size))
     torques = np.empty((steps + 1, NU))
     estimates = np.empty((samples, x0.size))
     applied, pending = [], []
     traj[0] = x = x0
     u = np.zeros(NU)
-    controller.reset(estimator.at(0.0, u))
+    start = estimator.at(0.0, u)
+    controller.reset(x0 if read_truth else start)
     if hasattr(reference, "reset"):
         reference.reset()
     started = time.perf_counter()
@@ -129,6 +135,8 @@ def simulate_on_sensors(plant_params, controller, reference, x0, duration, dt, e
         t = k * controller.period
         y = estimates[k] = estimator.at(t, u)
         applied.append((t, "tick", None))
+        if read_truth:
+            y = x.copy()
         u = controller.update(t, y, _target(reference, controller, t, y))
         torques[k * per:(k + 1) * per] = u
         for s in range(k * per, (k + 1) * per):
@@ -148,7 +156,7 @@ def simulate_on_sensors(plant_params, controller, reference, x0, duration, dt, e
                             estimates=estimates, samples=applied if record_samples else None)
 
 
-def _on_sensors_c(sim, controller, reference, x0, estimator, per, samples, progress, record_samples):
+def _on_sensors_c(sim, controller, reference, x0, estimator, per, samples, progress, record_samples, read_truth):
     from ..sensor_sim_c import SensorRunC
     steps = samples * per
     run = SensorRunC(sim, estimator, steps)
@@ -159,7 +167,8 @@ def _on_sensors_c(sim, controller, reference, x0, estimator, per, samples, progr
     traj[0] = x0
     x = np.array(x0, dtype=np.float64)
     u = np.zeros(NU)
-    controller.reset(estimator.at(0.0, u))
+    start = estimator.at(0.0, u)
+    controller.reset(x0 if read_truth else start)
     if hasattr(reference, "reset"):
         reference.reset()
     # A path's target and preview read in C, as the whole C loop reads them.
@@ -171,6 +180,8 @@ def _on_sensors_c(sim, controller, reference, x0, estimator, per, samples, progr
     for k in tqdm(range(samples), disable=not progress or None, unit="sample", leave=False):
         t = k * controller.period
         y = estimates[k] = estimator.at(t, u)
+        if read_truth:
+            y = x.copy()
         u = controller.update(t, y, target_of(t, y))
         torques[k * per:(k + 1) * per] = u
         before = run.applied

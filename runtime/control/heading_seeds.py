@@ -8,6 +8,9 @@ how it misses: `late` (first inside the band after the deadline), `swing` (more 
 band out after the deadline), `out at the deadline` (outside then, back later: the approach's
 overshoot), `later out` (inside at the deadline, out again later: the wander).  `--set key=value`
 changes a gain of both the nominal and the sensors task (docs/control.md, "The heading step over seeds").
+Each record gives the estimate's largest heading error after the deadline; `--truth` runs the same
+seeds with the controller reading the plant's state instead (the filter, the process noise and the
+readings unchanged): a miss that stays is the law's, not the estimate's.
 """
 import argparse
 import dataclasses
@@ -51,11 +54,16 @@ def tasks(kind, changes=None):
 
 
 def deadline(nominal):
-    """The nominal task's heading settle time + the margin [s] (ValueError when it never settles)."""
+    """The nominal task's heading settle time + the margin [s] (ValueError when it never settles, or
+    so late that no sample of the run is left after the deadline)."""
     settle = run_task(nominal)[2]["heading_settle_s"]
     if settle is None:
         raise ValueError("nominal: the heading step does not settle without the sensors; no deadline")
-    return settle + SENSORS_SETTLE_MARGIN_S
+    limit = settle + SENSORS_SETTLE_MARGIN_S
+    if limit >= nominal.duration:
+        raise ValueError(f"nominal: the heading step settles at {settle:g} s, so its deadline {limit:g} s "
+                         f"leaves nothing of the {nominal.duration:g} s run to score")
+    return limit
 
 
 def classify(t, error, limit, band=HEADING_BAND_RAD):
@@ -74,30 +82,39 @@ def classify(t, error, limit, band=HEADING_BAND_RAD):
     return settle, False, "out at the deadline" if out[np.searchsorted(t, limit, side="right") - 1] else "later out"
 
 
-def run_seed(task, seed, limit):
-    """One seed's record: settle time, met, miss class, largest error after the deadline [deg], clipped share."""
+def run_seed(task, seed, limit, truth=False):
+    """One seed's record: settle time, met, miss class, largest error after the deadline [deg], the
+    estimate's largest heading error after it [deg], clipped share; `truth`: the controller reads the
+    plant's state instead of the estimate."""
     task = dataclasses.replace(task, noise=dataclasses.replace(task.noise, seed=seed))
     reference = task.reference()
     result = simulate_on_sensors(task.plant_params, task.controller(), reference, task.scenario.x0, task.duration,
                                  task.scenario.dt, task.make_estimator(), task.sensors, task.scenario.method, seed,
-                                 engine="c", record_samples=False)
+                                 engine="c", record_samples=False, read_truth=truth)
     every = max(1, round(1 / (task.rate * task.scenario.dt)))
     t = result.time[::every]
-    error = wrap_angle(reference.heading - heading(result.trajectory[::every]))
+    true = heading(result.trajectory[::every])
+    error = wrap_angle(reference.heading - true)
     settle, met, miss = classify(t, error, limit)
+    # The estimate at sample k is the filter's at t[k], the rows of the trajectory one per sample.
+    estimate = wrap_angle(heading(result.estimates) - true[:len(result.estimates)])
     return {"seed": seed, "settle_s": settle, "met": met, "miss": miss,
             "worst_after_deg": float(np.degrees(np.abs(error[t > limit]).max())),
+            "estimate_after_deg": float(np.degrees(np.abs(estimate[t[:len(estimate)] > limit]).max())),
             "saturated": float(result.saturated_fraction)}
 
 
 def summary(records, limit):
-    """The summary line: runs within the deadline, the 95 % Clopper–Pearson interval, the misses by class."""
+    """The summary line: runs within the deadline, the 95 % Clopper–Pearson interval, the misses by class
+    (and, when the records give it, the estimate's largest heading error after the deadline in the misses)."""
     n, k = len(records), sum(r["met"] for r in records)
     ci = stats.binomtest(k, n).proportion_ci(0.95, method="exact")
     misses = ", ".join(f"{name} {sum(r['miss'] == name for r in records)}" for name in MISSES)
     clipped = float(np.median([r["saturated"] for r in records]))
+    missed = [r["estimate_after_deg"] for r in records if not r["met"] and "estimate_after_deg" in r]
+    estimate = f"; the estimate's heading error after the deadline in the misses ≤ {max(missed):.2f}°" if missed else ""
     return (f"{k}/{n} within {limit:.3f} s ({100 * k / n:.1f} %, 95 % CI {100 * ci.low:.1f}-{100 * ci.high:.1f} %); "
-            f"misses: {misses}; clipped p50 {100 * clipped:.1f} %")
+            f"misses: {misses}{estimate}; clipped p50 {100 * clipped:.1f} %")
 
 
 def _seeds(text):
@@ -133,19 +150,23 @@ def main(argv=()):
     parser.add_argument("--seeds", default="0-99", help="noise seeds FIRST-LAST (default 0-99)")
     parser.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE", help="gains changed in both tasks")
     parser.add_argument("--details", action="store_true", help="one JSON line per seed")
+    parser.add_argument("--truth", action="store_true",
+                        help="the controller reads the plant's state, not the estimate (the rest unchanged)")
     args = parser.parse_args(list(argv))
     try:
         seeds, changes = _seeds(args.seeds), _changes(args.set)
         nominal, task = tasks(args.kind, changes)
+        limit = deadline(nominal)
     except ValueError as exc:
         parser.error(str(exc))
-    limit = deadline(nominal)
     started = time.process_time()
     records = []
     for seed in seeds:
-        records.append(run_seed(task, seed, limit))
+        records.append(run_seed(task, seed, limit, args.truth))
         if args.details:
             print(json.dumps(records[-1]), flush=True)
-    print(f"{args.kind} {changes or 'as the task files'}, seeds {seeds.start}-{seeds.stop - 1}: {summary(records, limit)}; "
+    reads = ", on the true state" if args.truth else ""
+    print(f"{args.kind} {changes or 'as the task files'}{reads}, seeds {seeds.start}-{seeds.stop - 1}: "
+          f"{summary(records, limit)}; "
           f"CPU {time.process_time() - started:.1f} s")
     return 0

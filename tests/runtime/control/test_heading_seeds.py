@@ -53,7 +53,8 @@ def test_the_summary_gives_the_exact_interval_of_160_in_200():
 
 
 @pytest.mark.parametrize("argv, field", [(["--seeds", "3-1"], "seeds"), (["--seeds", "a-b"], "seeds"),
-                                         (["--set", "heading_rad"], "set"), (["--set", "no_such_gain=1"], "no_such_gain")])
+                                         (["--set", "heading_rad"], "set"), (["--set", "no_such_gain=1"], "no_such_gain"),
+                                         (["--set", "heading_rad=3"], "nominal: the heading step does not settle")])
 def test_bad_arguments_are_refused_by_name(argv, field, capsys):
     with pytest.raises(SystemExit):
         heading_seeds.main(argv)
@@ -80,3 +81,45 @@ def test_the_task_files_lqr_meets_the_deadline_on_seeds_its_former_setting_overs
     assert all(r["met"] == met for r in records)
     if not met:
         assert {r["miss"] for r in records} == {"out at the deadline"}
+
+
+@pytest.fixture(scope="module")
+def lqr_task_and_deadline():
+    nominal, task = heading_seeds.tasks("lqr")
+    return task, heading_seeds.deadline(nominal)
+
+
+def test_a_miss_of_the_law_stays_a_miss_with_the_controller_on_the_true_state(lqr_task_and_deadline):
+    # seed 11 leaves the band at 11.7-15.1 s by 3.4° while the estimate is within 0.4° of the truth
+    task, limit = lqr_task_and_deadline
+    on_estimate, on_truth = (heading_seeds.run_seed(task, 11, limit, truth) for truth in (False, True))
+    assert not on_estimate["met"] and not on_truth["met"]
+    assert on_estimate["estimate_after_deg"] < 0.4 < 3.0 < on_estimate["worst_after_deg"]
+
+
+def test_a_miss_by_the_estimate_meets_with_the_controller_on_the_true_state(lqr_task_and_deadline):
+    # seed 53 is out at the deadline on the estimate (0.36° off after it), inside on the truth
+    task, limit = lqr_task_and_deadline
+    assert not heading_seeds.run_seed(task, 53, limit)["met"]
+    assert heading_seeds.run_seed(task, 53, limit, truth=True)["met"]
+
+
+def test_the_summary_gives_the_estimates_largest_error_in_the_misses_only():
+    records = [{"met": True, "miss": None, "saturated": 0.1, "estimate_after_deg": 0.9},
+               {"met": False, "miss": "later out", "saturated": 0.1, "estimate_after_deg": 0.25},
+               {"met": False, "miss": "late", "saturated": 0.1, "estimate_after_deg": 0.125}]
+    assert "in the misses ≤ 0.25°" in heading_seeds.summary(records, 9.6)
+
+
+def test_the_command_says_when_the_controller_read_the_true_state(capsys):
+    assert heading_seeds.main(["--seeds", "0-0", "--truth"]) == 0
+    assert capsys.readouterr().out.startswith("lqr as the task files, on the true state, seeds 0-0: ")
+
+
+def test_a_nominal_step_settling_too_late_to_leave_a_deadline_in_the_run_is_refused(monkeypatch):
+    nominal, _ = heading_seeds.tasks("lqr")
+    monkeypatch.setattr(heading_seeds, "run_task", lambda task: (None, None, {"heading_settle_s": 28.5}))
+    with pytest.raises(ValueError, match="nominal: the heading step settles at 28.5 s"):
+        heading_seeds.deadline(nominal)
+    monkeypatch.setattr(heading_seeds, "run_task", lambda task: (None, None, {"heading_settle_s": 27.5}))
+    assert heading_seeds.deadline(nominal) == pytest.approx(29.5)

@@ -80,6 +80,38 @@ def test_the_filter_gets_every_sample_the_sensors_declare(on_sensors):
     assert arrivals == sorted(arrivals)
 
 
+def read_by_the_controller(engine, read_truth, duration=0.3):
+    """(the states the controller was given, the run) of a short circle on the default sensors."""
+    task = short("circle", SensorSet.default())
+    controller, seen = task.controller(), []
+    compute = controller.compute
+    controller.compute = lambda t, x, target: (seen.append(np.array(x)), compute(t, x, target))[1]
+    result = simulate_on_sensors(task.plant_params, controller, task.reference(), task.scenario.x0, duration,
+                                 task.scenario.dt, task.make_estimator(), task.sensors, task.scenario.method,
+                                 engine=engine, record_samples=False, read_truth=read_truth)
+    per = round(controller.period / task.scenario.dt)
+    return np.array(seen), result, result.trajectory[:-1:per]
+
+
+@pytest.mark.parametrize("engine", ["python", "c"])
+def test_with_read_truth_the_controller_reads_the_plants_state_and_the_filter_still_runs(engine):
+    seen, result, states = read_by_the_controller(engine, True)
+    np.testing.assert_array_equal(seen, states)
+    assert np.abs(result.estimates - states).max() > 0
+
+
+@pytest.mark.parametrize("engine", ["python", "c"])
+def test_without_it_the_controller_reads_the_estimate(engine):
+    seen, result, states = read_by_the_controller(engine, False)
+    np.testing.assert_array_equal(seen, result.estimates)
+    assert np.abs(seen - states).max() > 0
+
+
+def test_the_c_loop_refuses_to_read_the_truth():
+    with pytest.raises(ValueError, match="read_truth"):
+        read_by_the_controller("c-loop", True)
+
+
 def test_a_task_on_sensors_refuses_an_estimator_of_the_state():
     data = {"dt": 0.005, "duration": 1.0, "reference": {"kind": "speed", "speed": 0.3},
             "controller": {"kind": "pid", "rate": 50.0}, "sensors": {},
