@@ -41,7 +41,7 @@ from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_param
 from ..params import SHAPES, Params, flat_names
 from ..state import IDX_E_NU, IDX_E_XI_S, IDX_NU, IDX_RS, NE, NV
 from .first_guess import _dpi_of, regressor_guess
-from .segments import Rows, _ptr, dlocal_batch, dretract_batch, segment_blocks
+from .segments import Rows, _ptr, buffer, dlocal_batch, dretract_batch, segment_blocks
 from .sensitivity import JACOBIANS, step_and_sensitivity
 
 #: Where the fit starts the parameters: the regressor's linear least-squares first guess, or the nominal robot.
@@ -283,6 +283,7 @@ class _Problem:
         self.chol = None
         self._stacked = (None, None)       # (the whitenings, `stack_whitenings` of them)
         self._csr = (None, None)           # (the segments' widths, the Jacobian's CSR structure)
+        self.buffers = {}                   # an evaluation's large arrays, reused (segments.buffer)
         self._cache = (None, None)
         self.layouts = {}                   # where each set of segments' readings sit (segments._layout)
         self.nfev = 0
@@ -317,14 +318,15 @@ class _Problem:
     def segment_blocks(self, z):
         """Per segment: raw residuals r (noise-scaled readings, then the end-state difference), their
         Jacobian blocks (theta, bias, own start, next start), and what the whitening needs; all
-        segments evaluated together (runtime.identification.segments)."""
+        segments evaluated together (runtime.identification.segments).  The blocks' chains and
+        rows are views of arrays the problem reuses (`buffers`): valid until its next evaluation."""
         theta, b, Dz = self.split(z)
         model = self.model(theta)
         x0, D = dretract_batch(model, self.xref, Dz)
         has = np.arange(self.S) < self.S - 1
         nxt = (np.roll(x0, -1, axis=0), np.roll(D, -1, axis=0), has)
         return segment_blocks(self, model, np.arange(self.S), x0, D, b, nxt,
-                              sensitivities=not self.hold_parameters)
+                              sensitivities=not self.hold_parameters, buffers=self.buffers)
 
     def segment_block(self, model, s, start, nxt, b, sensitivities=True):
         """One segment's block: simulated from start = (x0, D) under the logged torques; the
@@ -525,16 +527,16 @@ class _Problem:
                                      for st, m in zip(steps, k)])}
 
     @staticmethod
-    def whiten_all(stacked, Ms):
+    def whiten_all(stacked, Ms, buffers=None):
         """[W_s M_s] for every segment s at once (`stack_whitenings`): `whiten`'s recursion in C
         (`sr_ident_whiten`), on the segments' rows as `segments.rows` stacks them (a `Rows`), or on
-        a list of arrays (stacked first)."""
+        a list of arrays (stacked first); the result in `buffers`' array "W" (`segments.buffer`)."""
         if not isinstance(Ms, Rows):
             Ms = [np.asarray(M, dtype=float) for M in Ms]
             Ms = Rows(np.concatenate([M.ravel() for M in Ms]), [M.shape for M in Ms])
         n_rows = np.array([m for m, _ in Ms.shapes], dtype=np.int64)
         width = np.array([w for _, w in Ms.shapes], dtype=np.int64)
-        out = np.empty_like(Ms.data)
+        out = buffer(buffers, "W", Ms.data.size)
         work = np.empty((NE + 1) * int(width.max()))
         status = _lib.sr_ident_whiten(len(n_rows), _ptr(n_rows, "long"), _ptr(width, "long"),
                                       _ptr(stacked["n_steps"], "long"), _ptr(stacked["step_rows"], "long"),
@@ -558,7 +560,7 @@ class _Problem:
         if self._stacked[0] is not self.chol:
             self._stacked = (self.chol, self.stack_whitenings(self.chol))
         rs, data = [], []
-        for M in self.whiten_all(self._stacked[1], blocks[0]["stack"]):
+        for M in self.whiten_all(self._stacked[1], blocks[0]["stack"], self.buffers):
             m = M.shape[1] - 1
             R = _upper_triangle(M, m + 1)
             r = R[:, m].copy()

@@ -74,20 +74,32 @@ def _check(field, status):
         raise KernelError(field, status)
 
 
-def chain(steps, nf, F, Jp=None):
+def buffer(buffers, name, size):
+    """A float array of `size` entries kept in the dict `buffers` under `name` and reused while the
+    size stays (an evaluation's large outputs: a fresh array of megabytes each evaluation costs
+    its page faults again); a new array without `buffers`."""
+    if buffers is None:
+        return np.empty(size)
+    if name not in buffers or buffers[name].size != size:
+        buffers[name] = np.empty(size)
+    return buffers[name]
+
+
+def chain(steps, nf, F, Jp=None, buffers=None):
     """The segments' sensitivity chains (C `sr_ident_chain`): for segment s of steps[s] steps,
     G_0 = [I | 0] and G_{k+1} = F_k G_k + [0 | Jp_k]; F (sum(steps), 12, 12) and Jp (sum(steps),
     12, nf) or None (zero) stacked segment after segment.  Returns G (sum(steps + 1), 12, 12 + nf)
-    stacked the same way."""
+    stacked the same way (in `buffers`' array "G", see `buffer`)."""
     steps = np.ascontiguousarray(steps, dtype=np.int64)
     F = np.ascontiguousarray(F, dtype=float)
-    G = np.empty((int(np.sum(steps + 1)), NE, NE + nf))
+    n = int(np.sum(steps + 1))
+    G = buffer(buffers, "G", n * NE * (NE + nf)).reshape(n, NE, NE + nf)
     jp = ffi.NULL if Jp is None else _ptr(np.ascontiguousarray(Jp, dtype=float))
     _check("chain", lib.sr_ident_chain(len(steps), _ptr(steps, "long"), nf, _ptr(F), jp, _ptr(G)))
     return G
 
 
-def _simulate(prob, model, segs, x0, sensitivities):
+def _simulate(prob, model, segs, x0, sensitivities, buffers=None):
     """Per segment of `segs`: its trajectory X (L + 1, 35) and its chain G (L + 1, 12, 12 + nf)
     = [Φ_k | S_k] (the state transition and the parameter sensitivity from its start; S zero
     without `sensitivities`), a view of the segments' chains stacked (`chain`, the third value).
@@ -104,7 +116,7 @@ def _simulate(prob, model, segs, x0, sensitivities):
         F, Jp = step_jacobians(model, xs, us, d.h, prob.method, prob.idx, prob.jacobian)
     else:
         F = step_state_jacobian(model, xs, us, d.h, prob.method, prob.jacobian)
-    stacked = chain(L, nf, F, Jp)
+    stacked = chain(L, nf, F, Jp, buffers)
     first = np.concatenate([[0], np.cumsum(L + 1)])
     return X, [stacked[first[i]:first[i + 1]] for i in range(len(segs))], stacked
 
@@ -150,17 +162,18 @@ def _layout(prob, segs):
     return lay
 
 
-def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True):
+def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True, buffers=None):
     """The blocks of the segments `segs` (indices into prob's segments, ascending) of the
     multiple-shooting problem `prob` (runtime.identification.fit._Problem) on the robot `model`:
     segment i simulated from x0[i] (its start, (S, 35)) whose offset Jacobian is D[i] (S, 12, 12);
     with the IMU's biases b.  `nxt`: (x (S, 35), D (S, 12, 12), has (S,) bool), the next segment's
     start for the end-state differences of the segments with `has`; None: no differences.  Without
     `sensitivities` the parameters' columns are zero.  Each block as `_Problem.segment_block`
-    describes it."""
+    describes it.  With `buffers` (a dict, `buffer`) the blocks' chains and rows are views of
+    arrays kept there: valid until the next call with the same dict."""
     d, nf = prob.data, prob.nf
     segs = np.asarray(segs)
-    X, G, stacked = _simulate(prob, model, segs, np.atleast_2d(x0), sensitivities)
+    X, G, stacked = _simulate(prob, model, segs, np.atleast_2d(x0), sensitivities, buffers)
     lay = _layout(prob, segs)
     counts, local, gnode, node, kinds, order, sig = (lay[k] for k in (
         "counts", "local", "gnode", "node", "kinds", "order", "sig"))
@@ -201,7 +214,7 @@ def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True):
         defects[w] = model.local(ends, nxt[0][w])
         Dn[w] = np.asarray(nxt[1])[w]
     M = rows(prob.ends[segs] - prob.starts[segs], nf, lay["n_read"], has, lay["at"], node, Hx, Hn, Hb, r, sig,
-             stacked, Jpa, np.ascontiguousarray(D, dtype=float), A, B, Dn, defects)
+             stacked, Jpa, np.ascontiguousarray(D, dtype=float), A, B, Dn, defects, buffers)
     out = []
     for i, s in enumerate(segs):
         sl = slice(lay["bounds"][i], lay["bounds"][i + 1])
@@ -226,16 +239,17 @@ class Rows(list):
         super().__init__(data[first[i]:first[i + 1]].reshape(shape) for i, shape in enumerate(shapes))
 
 
-def rows(steps, nf, n_read, has, at, node, Hx, Hn, Hb, r, sig, G, Jpa, D, A, B, Dn, defects):
+def rows(steps, nf, n_read, has, at, node, Hx, Hn, Hb, r, sig, G, Jpa, D, A, B, Dn, defects, buffers=None):
     """The segments' unwhitened rows (C `sr_ident_rows`, whose header gives the formulas): per
     segment its readings' rows (n_read[s] of them, stacked in the per-row arrays at, node, Hx (12),
     Hn (5), Hb (6), r, sig), through its chain (`chain`'s stacked G, the reading at node at[q] of
     its segment) and Jpa (nodes, 5, nf; None for zero), then with has[s] its end-state rows (A, B,
-    Dn (S, 12, 12), defects (S, 12)).  A `Rows` of the segments' [θ | b | x | next | r]."""
+    Dn (S, 12, 12), defects (S, 12)).  A `Rows` of the segments' [θ | b | x | next | r] (in
+    `buffers`' array "M", see `buffer`)."""
     steps = np.ascontiguousarray(steps, dtype=np.int64)
     has = np.ascontiguousarray(has, dtype=np.intc)
     shapes = [(int(m) + NE * int(h), nf + NB + NE + NE * int(h) + 1) for m, h in zip(n_read, has)]
-    out = np.empty(sum(m * w for m, w in shapes))
+    out = buffer(buffers, "M", sum(m * w for m, w in shapes))
     node = np.ascontiguousarray(node, dtype=np.int64)
     jpa = ffi.NULL if Jpa is None else _ptr(np.ascontiguousarray(Jpa, dtype=float))
     n_nodes = 0 if Jpa is None else len(Jpa)
