@@ -209,35 +209,37 @@ static void test_ident_rows_are_the_readings_through_the_chain_and_the_end_state
     }
 }
 
-static void test_ident_rows_refuse_bad_arguments(void)
+/* sr_ident_rows on one segment of one step and one reading row, no next start, with the
+ * arguments a refusal case varies. */
+static int one_row(long n_seg, const int *has, const long *at, const long *node, const sr_real *r,
+                   const sr_real *sig, const sr_real *D)
 {
-    const long steps[1] = {1}, n_read[1] = {1}, at[1] = {0}, far[1] = {2}, node[1] = {0}, off[1] = {1};
-    const int has[1] = {0}, two[1] = {2};
-    sr_real G[2 * NE * WG], Jpa[NV * NF], Hx[NE], Hn[NV], Hb[NB], r[1] = {1}, sig[1] = {1}, zero[1] = {0};
-    sr_real D[NE * NE], M[W1];
+    const long steps[1] = {1}, n_read[1] = {1};
+    sr_real G[2 * NE * WG], Jpa[NV * NF], Hx[NE], Hn[NV], Hb[NB], M[W1];
     fill(G, 2 * NE * WG, 15, 1.0);
     fill(Jpa, NV * NF, 16, 1.0);
     fill(Hx, NE, 17, 1.0);
     fill(Hn, NV, 18, 1.0);
     fill(Hb, NB, 19, 1.0);
+    return sr_ident_rows(n_seg, NF, steps, n_read, has, at, node, 1, Hx, Hn, Hb, r, sig, G, Jpa, D, NULL, NULL,
+                         NULL, NULL, M);
+}
+
+static void test_ident_rows_refuse_bad_arguments(void)
+{
+    const long at[1] = {0}, far[1] = {2}, node[1] = {0}, off[1] = {1};
+    const int has[1] = {0}, two[1] = {2};
+    sr_real r[1] = {1}, sig[1] = {1}, zero[1] = {0}, D[NE * NE];
     fill(D, NE * NE, 20, 1.0);
-    CHECK_STATUS(sr_ident_rows(1, NF, steps, n_read, has, at, node, 1, Hx, Hn, Hb, r, sig, G, Jpa, D, NULL, NULL,
-                               NULL, NULL, M), SR_OK);
-    CHECK_STATUS(sr_ident_rows(1, NF, steps, n_read, has, at, node, 1, Hx, Hn, Hb, r, sig, G, Jpa, NULL, NULL, NULL,
-                               NULL, NULL, M), SR_ERR_NULL);
-    CHECK_STATUS(sr_ident_rows(1, NF, steps, n_read, two, at, node, 1, Hx, Hn, Hb, r, sig, G, Jpa, D, NULL, NULL,
-                               NULL, NULL, M), SR_ERR_ARG);
-    CHECK_STATUS(sr_ident_rows(1, NF, steps, n_read, has, far, node, 1, Hx, Hn, Hb, r, sig, G, Jpa, D, NULL, NULL,
-                               NULL, NULL, M), SR_ERR_ARG);
-    CHECK_STATUS(sr_ident_rows(1, NF, steps, n_read, has, at, off, 1, Hx, Hn, Hb, r, sig, G, Jpa, D, NULL, NULL,
-                               NULL, NULL, M), SR_ERR_ARG);
-    CHECK_STATUS(sr_ident_rows(1, NF, steps, n_read, has, at, node, 1, Hx, Hn, Hb, r, zero, G, Jpa, D, NULL, NULL,
-                               NULL, NULL, M), SR_ERR_ARG);
-    CHECK_STATUS(sr_ident_rows(-1, NF, steps, n_read, has, at, node, 1, Hx, Hn, Hb, r, sig, G, Jpa, D, NULL, NULL,
-                               NULL, NULL, M), SR_ERR_ARG);
+    CHECK_STATUS(one_row(1, has, at, node, r, sig, D), SR_OK);
+    CHECK_STATUS(one_row(1, has, at, node, r, sig, NULL), SR_ERR_NULL);
+    CHECK_STATUS(one_row(1, two, at, node, r, sig, D), SR_ERR_ARG);        /* has_next not 0 or 1 */
+    CHECK_STATUS(one_row(1, has, far, node, r, sig, D), SR_ERR_ARG);       /* a node past the chain */
+    CHECK_STATUS(one_row(1, has, at, off, r, sig, D), SR_ERR_ARG);         /* a node past Jpa */
+    CHECK_STATUS(one_row(1, has, at, node, r, zero, D), SR_ERR_ARG);       /* sigma not > 0 */
+    CHECK_STATUS(one_row(-1, has, at, node, r, sig, D), SR_ERR_ARG);
     r[0] = (sr_real)INFINITY;
-    CHECK_STATUS(sr_ident_rows(1, NF, steps, n_read, has, at, node, 1, Hx, Hn, Hb, r, sig, G, Jpa, D, NULL, NULL,
-                               NULL, NULL, M), SR_ERR_NONFINITE);
+    CHECK_STATUS(one_row(1, has, at, node, r, sig, D), SR_ERR_NONFINITE);
 }
 
 /* One segment of three steps (2, 3 and 1 rows, the last divided by 0.5 first), width 4: column 1
