@@ -14,7 +14,7 @@ SOURCES = sorted(str(p.relative_to(ROOT)) for d in ("generated", "c/src") for p 
 INCLUDE_DIRS = ["generated", "c/include"]
 
 #: The public headers of c/include/ whose declarations the module exposes, in include order.
-HEADERS = ("spherical_robot.h", "sr_sensors.h", "sr_ekf.h", "sr_nmpc.h", "sr_sim.h", "sr_loop.h")
+HEADERS = ("spherical_robot.h", "sr_sensors.h", "sr_ekf.h", "sr_nmpc.h", "sr_sim.h", "sr_loop.h", "sr_ident.h")
 INCLUDES = "".join(f'#include "{name}"\n' for name in HEADERS)
 
 

@@ -59,6 +59,7 @@ int main(void)
     suite_param_jacobians();
     suite_nmpc();
     suite_sim();
+    suite_ident();
     return sr_test_summary();
 }
 

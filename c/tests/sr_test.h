@@ -78,6 +78,7 @@ void suite_step_batch(void);
 void suite_model_validity(void);
 void suite_sensors(void);
 void suite_ekf(void);
+void suite_ident(void);
 void suite_param_jacobians(void);
 void suite_nmpc(void);
 void suite_sim(void);

@@ -32,14 +32,16 @@ import scipy.linalg
 import scipy.optimize
 import scipy.sparse
 import scipy.stats
+from bindings._sr import lib as _lib
 
 from ..blas import one_thread
+from ..errors import KernelError
 from ..model import Model
 from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_parameters
 from ..params import SHAPES, Params, flat_names
 from ..state import IDX_E_NU, IDX_E_XI_S, IDX_NU, IDX_RS, NE, NV
 from .first_guess import _dpi_of, regressor_guess
-from .segments import dlocal_batch, dretract_batch, segment_blocks
+from .segments import Rows, _ptr, buffer, dlocal_batch, dretract_batch, segment_blocks
 from .sensitivity import JACOBIANS, step_and_sensitivity
 
 #: Where the fit starts the parameters: the regressor's linear least-squares first guess, or the nominal robot.
@@ -280,6 +282,8 @@ class _Problem:
         self.ncols = self.nf + 6 + NE * self.S
         self.chol = None
         self._stacked = (None, None)       # (the whitenings, `stack_whitenings` of them)
+        self._csr = (None, None)           # (the segments' widths, the Jacobian's CSR structure)
+        self.buffers = {}                   # an evaluation's large arrays, reused (segments.buffer)
         self._cache = (None, None)
         self.layouts = {}                   # where each set of segments' readings sit (segments._layout)
         self.nfev = 0
@@ -314,14 +318,15 @@ class _Problem:
     def segment_blocks(self, z):
         """Per segment: raw residuals r (noise-scaled readings, then the end-state difference), their
         Jacobian blocks (theta, bias, own start, next start), and what the whitening needs; all
-        segments evaluated together (runtime.identification.segments)."""
+        segments evaluated together (runtime.identification.segments).  The blocks' chains and
+        rows are views of arrays the problem reuses (`buffers`): valid until its next evaluation."""
         theta, b, Dz = self.split(z)
         model = self.model(theta)
         x0, D = dretract_batch(model, self.xref, Dz)
         has = np.arange(self.S) < self.S - 1
         nxt = (np.roll(x0, -1, axis=0), np.roll(D, -1, axis=0), has)
         return segment_blocks(self, model, np.arange(self.S), x0, D, b, nxt,
-                              sensitivities=not self.hold_parameters)
+                              sensitivities=not self.hold_parameters, buffers=self.buffers)
 
     def segment_block(self, model, s, start, nxt, b, sensitivities=True):
         """One segment's block: simulated from start = (x0, D) under the logged torques; the
@@ -506,55 +511,40 @@ class _Problem:
 
     @staticmethod
     def stack_whitenings(whites):
-        """The segments' whitenings (`covariances`) padded to one array each, for `whiten_all`:
-        (rows (S, K, R) the row of each step's place or -1, unit (S, K, R) what a row is divided
-        by first (the end-state difference's floor, else 1), H (S, K, R, 12), L⁻¹ (S, K, R, R),
-        gains (S, K, 12, R)), K the most steps of a segment, R the most rows of a step; padding
-        is zero, so it neither reads nor moves anything.  Then the places of the segments' rows
-        stacked one after the other (`whiten_all`'s one gather and one scatter): (offsets (S + 1,)
-        where each segment's rows start, at (S, K, R) the stacked row of each place, its last
-        row, a zero row, for the padding; back (rows,) the flat place of each stacked row)."""
-        S, K = len(whites), max(len(w) for w in whites)
-        R = max(st[0].stop - st[0].start for w in whites for st in w)
-        rows, unit = np.full((S, K, R), -1), np.ones((S, K, R))
-        H, Linv, gains = np.zeros((S, K, R, NE)), np.zeros((S, K, R, R)), np.zeros((S, K, NE, R))
-        for s, w in enumerate(whites):
-            for k, (sl, h, li, gain) in enumerate(w):
-                m = sl.stop - sl.start
-                rows[s, k, :m] = np.arange(sl.start, sl.stop)
-                H[s, k, :m], Linv[s, k, :m, :m] = h, li
-                if gain is None:        # the end-state difference, in units of its floor
-                    unit[s, k, :m] = DEFECT_FLOOR
-                else:
-                    gains[s, k, :, :m] = gain
-        sizes = np.array([max(st[0].stop for st in w) for w in whites])
-        offsets = np.concatenate([[0], np.cumsum(sizes)])
-        at = np.where(rows >= 0, rows + offsets[:S, None, None], offsets[S])
-        back = np.empty(offsets[S], dtype=int)
-        valid = rows >= 0
-        back[at[valid]] = np.flatnonzero(valid)
-        return rows, unit, H, Linv, gains, offsets, at, back
+        """The segments' whitenings (`covariances`) packed for `whiten_all` (C `sr_ident_whiten`):
+        {"n_steps" (S,) the steps of each segment, "step_rows" the rows of each step, "unit" what a
+        step's rows are divided by first (the end-state difference's floor, else 1), and the steps'
+        H (k, 12), L⁻¹ (k, k) and gains (12, k, zero for the end-state difference) flattened one
+        after the other}."""
+        steps = [st for w in whites for st in w]
+        k = [st[0].stop - st[0].start for st in steps]
+        return {"n_steps": np.array([len(w) for w in whites], dtype=np.int64),
+                "step_rows": np.array(k, dtype=np.int64),
+                "unit": np.array([1.0 if st[3] is not None else DEFECT_FLOOR for st in steps]),
+                "H": np.concatenate([np.ravel(st[1]) for st in steps]),
+                "L": np.concatenate([np.ravel(st[2]) for st in steps]),
+                "K": np.concatenate([np.ravel(st[3]) if st[3] is not None else np.zeros(NE * m)
+                                     for st, m in zip(steps, k)])}
 
     @staticmethod
-    def whiten_all(stacked, Ms):
-        """[W_s M_s] for every segment s at once (`stack_whitenings`): `whiten`'s recursion, one
-        step of all segments together."""
-        rows, unit, H, Linv, gains, offsets, at, back = stacked
-        S, K, R = rows.shape
-        m = max(M.shape[1] for M in Ms)
-        stacked_rows = np.zeros((offsets[S] + 1, m))        # the last row the padding's zeros
-        for s, M in enumerate(Ms):
-            stacked_rows[offsets[s]:offsets[s + 1], :M.shape[1]] = M
-        Y = stacked_rows[at]
-        Y /= unit[..., None]
-        out = np.empty_like(Y)
-        mean = np.zeros((S, NE, m))
-        for k in range(K):
-            innovation = Y[:, k] - H[:, k] @ mean
-            out[:, k] = Linv[:, k] @ innovation
-            mean += gains[:, k] @ innovation
-        W = out.reshape(-1, m)[back]
-        return [W[offsets[s]:offsets[s + 1], :M.shape[1]] for s, M in enumerate(Ms)]
+    def whiten_all(stacked, Ms, buffers=None):
+        """[W_s M_s] for every segment s at once (`stack_whitenings`): `whiten`'s recursion in C
+        (`sr_ident_whiten`), on the segments' rows as `segments.rows` stacks them (a `Rows`), or on
+        a list of arrays (stacked first); the result in `buffers`' array "W" (`segments.buffer`)."""
+        if not isinstance(Ms, Rows):
+            Ms = [np.asarray(M, dtype=float) for M in Ms]
+            Ms = Rows(np.concatenate([M.ravel() for M in Ms]), [M.shape for M in Ms])
+        n_rows = np.array([m for m, _ in Ms.shapes], dtype=np.int64)
+        width = np.array([w for _, w in Ms.shapes], dtype=np.int64)
+        out = buffer(buffers, "W", Ms.data.size)
+        work = np.empty((NE + 1) * int(width.max()))
+        status = _lib.sr_ident_whiten(len(n_rows), _ptr(n_rows, "long"), _ptr(width, "long"),
+                                      _ptr(stacked["n_steps"], "long"), _ptr(stacked["step_rows"], "long"),
+                                      _ptr(stacked["unit"]), _ptr(stacked["H"]), _ptr(stacked["L"]),
+                                      _ptr(stacked["K"]), _ptr(Ms.data), _ptr(out), _ptr(work))
+        if status != _lib.SR_OK:
+            raise KernelError("whitening", status)
+        return Rows(out, Ms.shapes)
 
     def assemble(self, z):
         """(residuals, sparse Jacobian, segment blocks) at z.  Each segment's whitened residuals r_s
@@ -569,45 +559,46 @@ class _Problem:
             self.chol = self.covariances(blocks)
         if self._stacked[0] is not self.chol:
             self._stacked = (self.chol, self.stack_whitenings(self.chol))
-        rs, data, ri, ci = [], [], [], []
-        row0 = 0
-        cols_g = np.arange(self.nf + 6)
-        Ms, colsets = [], []
-        for s, blk in enumerate(blocks):
-            parts = [np.hstack([blk["th"], blk["b"]]), blk["x"]]
-            cols = [cols_g, self.nf + 6 + NE * s + np.arange(NE)]
-            if blk["next"] is not None:
-                parts.append(blk["next"])
-                cols.append(self.nf + 6 + NE * (s + 1) + np.arange(NE))
-            Ms.append(np.hstack(parts + [blk["r"][:, None]]))
-            colsets.append(cols)
-        for M, cols in zip(self.whiten_all(self._stacked[1], Ms), colsets):
+        rs, data = [], []
+        for M in self.whiten_all(self._stacked[1], blocks[0]["stack"], self.buffers):
             m = M.shape[1] - 1
             R = _upper_triangle(M, m + 1)
             r = R[:, m].copy()
             r[m] = abs(r[m])
-            cols = np.concatenate(cols)
-            rr, cc = np.meshgrid(row0 + np.arange(m), cols, indexing="ij")
             data.append(R[:m, :m].ravel())
-            ri.append(rr.ravel())
-            ci.append(cc.ravel())
             rs.append(r)
-            row0 += m + 1
         # the weak prior on the first start state (the gauge no sensor fixes)
         _, _, Dz = self.split(z)
         rs.append(Dz[0] / GAUGE_SIGMA)
         data.append(np.full(NE, 1.0 / GAUGE_SIGMA))
-        ri.append(row0 + np.arange(NE))
-        ci.append(self.nf + 6 + np.arange(NE))
         r = np.concatenate(rs)
-        J = scipy.sparse.csr_matrix((np.concatenate(data), (np.concatenate(ri), np.concatenate(ci))),
-                                    shape=(len(r), self.ncols))
+        indices, indptr = self._pattern(blocks)
+        J = scipy.sparse.csr_matrix((np.concatenate(data), indices.copy(), indptr.copy()), shape=(len(r), self.ncols))
         self.n_residuals = sum(len(blk["r"]) for blk in blocks) + NE
         self._cache = (z.copy(), (r, J, blocks))
         self.nfev += 1
         if self.progress is not None:
             self.progress()
         return self._cache[1]
+
+    def _pattern(self, blocks):
+        """The CSR structure (indices, indptr) of `assemble`'s Jacobian, the same at every
+        evaluation: per segment its compressed rows R (m, m), m its columns (θ, b, its start and
+        the next's, ascending), then the row of its remaining residual, empty; then the gauge's
+        diagonal on the first start state."""
+        key = tuple(blk["M"].shape[1] for blk in blocks)
+        if self._csr[0] != key:
+            indices, counts = [], []
+            for s, blk in enumerate(blocks):
+                cols = np.concatenate([np.arange(self.nf + 6), self.nf + 6 + NE * s + np.arange(NE)]
+                                      + ([self.nf + 6 + NE * (s + 1) + np.arange(NE)] if blk["next"] is not None else []))
+                indices.append(np.tile(cols, len(cols)))
+                counts += [len(cols)] * len(cols) + [0]
+            indices.append(self.nf + 6 + np.arange(NE))
+            counts += [1] * NE
+            self._csr = (key, (np.concatenate(indices).astype(np.int32),
+                               np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)))
+        return self._csr[1]
 
     def align_headings(self, z):
         """Turn each segment's start about the vertical so that neighbouring segments agree in the

@@ -1,17 +1,25 @@
 """The multiple-shooting fit's segments evaluated together (runtime.identification.fit): each
 segment one C simulation; the step, parameter, acceleration and sensor Jacobians of all the
-segments' states in one C batch call each; the sensitivity chain one batched matrix product per
-step for all segments at once; the readings' rows of all segments formed together.  The Python
-work per evaluation is then a fixed number of array operations, not one per step of every
-segment; each block equals the one a segment alone would give, to rounding.
+segments' states in one C batch call each; the sensitivity chains of all segments in one C call
+(`chain`, c/include/sr_ident.h), and the readings' and end-state rows of all segments in another
+(`rows`), each segment's [θ | b | x | next | r] one block of a stacked array that the whitening
+(C `sr_ident_whiten`) reads as it is.  The Python work per evaluation is then a fixed number of
+array operations, not one per step of every segment; each block equals the one a segment alone
+would give, to rounding.
 
     x, D = dretract_batch(model, x_ref, offsets)
     out = segment_blocks(prob, model, np.arange(prob.S), x, D, b)
 """
 import numpy as np
 
+from bindings._sr import ffi, lib
+
+from ..errors import KernelError
 from ..sensors import encoders_jacobian_batch, imu_partials_batch, position_jacobian_batch
 from ..state import NE, NV, NX
+
+#: The IMU's biases.
+NB = 6
 from .sensitivity import accel_sensitivity, accel_state_jacobian, step_jacobians, step_state_jacobian
 
 #: The step of the group maps' central differences (error coordinates: rad, m, rad/s).
@@ -57,38 +65,60 @@ def dlocal_batch(model, a, b):
     return _differenced(da), _differenced(db)
 
 
-def _simulate(prob, model, segs, x0, sensitivities):
+def _ptr(arr, kind="double"):
+    return ffi.cast(f"{kind} *", ffi.from_buffer(arr))
+
+
+def _check(field, status):
+    if status != lib.SR_OK:
+        raise KernelError(field, status)
+
+
+def buffer(buffers, name, size):
+    """A float array of `size` entries kept in the dict `buffers` under `name` and reused while the
+    size stays (an evaluation's large outputs: a fresh array of megabytes each evaluation costs
+    its page faults again); a new array without `buffers`."""
+    if buffers is None:
+        return np.empty(size)
+    if name not in buffers or buffers[name].size != size:
+        buffers[name] = np.empty(size)
+    return buffers[name]
+
+
+def chain(steps, nf, F, Jp=None, buffers=None):
+    """The segments' sensitivity chains (C `sr_ident_chain`): for segment s of steps[s] steps,
+    G_0 = [I | 0] and G_{k+1} = F_k G_k + [0 | Jp_k]; F (sum(steps), 12, 12) and Jp (sum(steps),
+    12, nf) or None (zero) stacked segment after segment.  Returns G (sum(steps + 1), 12, 12 + nf)
+    stacked the same way (in `buffers`' array "G", see `buffer`)."""
+    steps = np.ascontiguousarray(steps, dtype=np.int64)
+    F = np.ascontiguousarray(F, dtype=float)
+    n = int(np.sum(steps + 1))
+    G = buffer(buffers, "G", n * NE * (NE + nf)).reshape(n, NE, NE + nf)
+    jp = ffi.NULL if Jp is None else _ptr(np.ascontiguousarray(Jp, dtype=float))
+    _check("chain", lib.sr_ident_chain(len(steps), _ptr(steps, "long"), nf, _ptr(F), jp, _ptr(G)))
+    return G
+
+
+def _simulate(prob, model, segs, x0, sensitivities, buffers=None):
     """Per segment of `segs`: its trajectory X (L + 1, 35) and its chain G (L + 1, 12, 12 + nf)
     = [Φ_k | S_k] (the state transition and the parameter sensitivity from its start; S zero
-    without `sensitivities`).  Each segment is one C simulation; the segments of one length share
-    one batch of step Jacobians and one batched product per step of the chain."""
+    without `sensitivities`), a view of the segments' chains stacked (`chain`, the third value).
+    Each segment is one C simulation; the steps of all segments one batch of step Jacobians."""
     d = prob.data
     k0, L = prob.starts[segs], prob.ends[segs] - prob.starts[segs]
     nf = prob.nf
     X = [model.simulate(x0[i], d.h, L[i], u=d.u[k0[i]:k0[i] + L[i]], method=prob.method, energy_tol=None)
          for i in range(len(segs))]
-    G = [None] * len(segs)
-    for length in np.unique(L):
-        g = np.flatnonzero(L == length)
-        rows = k0[g][:, None] + np.arange(length)              # (n_g, L) node of each step
-        xs = np.concatenate([X[i][:-1] for i in g])
-        us = d.u[rows.ravel()]
-        if sensitivities:
-            F, Jp = step_jacobians(model, xs, us, d.h, prob.method, prob.idx, prob.jacobian)
-            Jp = Jp.reshape(len(g), length, NE, nf)
-        else:
-            F = step_state_jacobian(model, xs, us, d.h, prob.method, prob.jacobian)
-        F = F.reshape(len(g), length, NE, NE)
-        Gg = np.empty((len(g), length + 1, NE, NE + nf))
-        Gg[:, 0] = 0.0
-        Gg[:, 0, :, :NE] = np.eye(NE)
-        for k in range(length):
-            np.matmul(F[:, k], Gg[:, k], out=Gg[:, k + 1])
-            if sensitivities:
-                Gg[:, k + 1, :, NE:] += Jp[:, k]
-        for i, c in enumerate(g):
-            G[c] = Gg[i]
-    return X, G
+    xs = np.concatenate([X[i][:-1] for i in range(len(segs))])
+    us = d.u[np.concatenate([k0[i] + np.arange(L[i]) for i in range(len(segs))])]
+    Jp = None
+    if sensitivities:
+        F, Jp = step_jacobians(model, xs, us, d.h, prob.method, prob.idx, prob.jacobian)
+    else:
+        F = step_state_jacobian(model, xs, us, d.h, prob.method, prob.jacobian)
+    stacked = chain(L, nf, F, Jp, buffers)
+    first = np.concatenate([[0], np.cumsum(L + 1)])
+    return X, [stacked[first[i]:first[i + 1]] for i in range(len(segs))], stacked
 
 
 def _layout(prob, segs):
@@ -126,30 +156,32 @@ def _layout(prob, segs):
     lay.update(order=order, node=node[order], kinds=kinds[order], sig=np.concatenate([p[2] for p in parts])[order],
                bounds=np.searchsorted(seg_of[node[order]], np.arange(len(segs) + 1)),
                nodes=[gnode[seg_of == i] for i in range(len(segs))])
+    lay["at"] = np.ascontiguousarray(local[lay["node"]], dtype=np.int64)
+    lay["n_read"] = np.diff(lay["bounds"]).astype(np.int64)
     prob.layouts[key] = lay
     return lay
 
 
-def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True):
+def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True, buffers=None):
     """The blocks of the segments `segs` (indices into prob's segments, ascending) of the
     multiple-shooting problem `prob` (runtime.identification.fit._Problem) on the robot `model`:
     segment i simulated from x0[i] (its start, (S, 35)) whose offset Jacobian is D[i] (S, 12, 12);
     with the IMU's biases b.  `nxt`: (x (S, 35), D (S, 12, 12), has (S,) bool), the next segment's
     start for the end-state differences of the segments with `has`; None: no differences.  Without
     `sensitivities` the parameters' columns are zero.  Each block as `_Problem.segment_block`
-    describes it."""
+    describes it.  With `buffers` (a dict, `buffer`) the blocks' chains and rows are views of
+    arrays kept there: valid until the next call with the same dict."""
     d, nf = prob.data, prob.nf
     segs = np.asarray(segs)
-    X, G = _simulate(prob, model, segs, np.atleast_2d(x0), sensitivities)
+    X, G, stacked = _simulate(prob, model, segs, np.atleast_2d(x0), sensitivities, buffers)
     lay = _layout(prob, segs)
-    counts, seg_of, local, gnode, node, kinds, order, sig = (lay[k] for k in (
-        "counts", "seg_of", "local", "gnode", "node", "kinds", "order", "sig"))
+    counts, local, gnode, node, kinds, order, sig = (lay[k] for k in (
+        "counts", "local", "gnode", "node", "kinds", "order", "sig"))
     Xn = np.concatenate([X[i][:c] for i, c in enumerate(counts)])
-    Gn = np.concatenate([G[i][:c] for i, c in enumerate(counts)])
     un = d.u[gnode]
     nudot = model.accel(Xn, un)
     Ja = accel_state_jacobian(model, Xn, un, prob.jacobian)
-    Jpa = np.zeros((len(Xn), NV, nf))          # ∂ν̇/∂θ where an IMU reads it
+    Jpa = np.zeros((len(Xn), NV, nf)) if sensitivities else None    # ∂ν̇/∂θ where an IMU reads it
     parts = []                  # (r, Hx, Hn, Hb) per kind, in the layout's order of kinds
     li = lay["li"]
     if li.size:
@@ -158,7 +190,7 @@ def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True):
         if sensitivities:
             Jpa[li] = accel_sensitivity(model, Xn[li], un[li], prob.idx, prob.jacobian)
         r = prob.log.imu.data[lay["imu_rows"]] - y
-        parts.append((r.ravel(), Hx.reshape(-1, NE), Hn.reshape(-1, NV), H[:, :, NE:].reshape(-1, 6)))
+        parts.append((r.ravel(), Hx.reshape(-1, NE), Hn.reshape(-1, NV), H[:, :, NE:].reshape(-1, NB)))
     for kind, batch in ((1, encoders_jacobian_batch), (2, position_jacobian_batch)):
         lk = lay["lk"][kind]
         if not lk.size:
@@ -169,34 +201,60 @@ def segment_blocks(prob, model, segs, x0, D, b, nxt=None, sensitivities=True):
         else:
             r = prob.fix_xy[lay["kind_rows"][kind]] - y
         Hx = H[:, :, :NE]
-        parts.append((r.ravel(), Hx.reshape(-1, NE), np.zeros((2 * lk.size, NV)), np.zeros((2 * lk.size, 6))))
-    r, Hx, Hn, Hb = (np.concatenate([p[i] for p in parts])[order] for i in range(4))
-    r = r / sig
-    # per row, as a segment alone forms them (the same products in the same order, bit for bit)
-    HG = np.einsum("rj,rjk->rk", Hx, Gn[node])         # [∂y/∂x Φ | ∂y/∂x S] of each row, one gather
-    th = -(HG[:, NE:] + np.einsum("rj,rjk->rk", Hn, Jpa[node])) / sig[:, None]
-    xs = -HG[:, :NE] / sig[:, None]
-    Hb = -Hb / sig[:, None]
-    bounds = lay["bounds"]
+        parts.append((r.ravel(), Hx.reshape(-1, NE), np.zeros((2 * lk.size, NV)), np.zeros((2 * lk.size, NB))))
+    r, Hx, Hn, Hb = (np.ascontiguousarray(np.concatenate([p[i] for p in parts])[order]) for i in range(4))
+    n = len(segs)
+    has = np.zeros(n, dtype=np.intc)
+    A, B, Dn, defects = (np.zeros((n, NE, NE)), np.zeros((n, NE, NE)), np.zeros((n, NE, NE)), np.zeros((n, NE)))
     if nxt is not None:
-        has = np.flatnonzero(nxt[2])
-        ends = np.array([X[i][-1] for i in has]).reshape(-1, NX)
-        A, B = dlocal_batch(model, ends, nxt[0][has])
-        defects = model.local(ends, nxt[0][has])
-        where = {int(i): j for j, i in enumerate(has)}
+        has[:] = np.asarray(nxt[2], dtype=bool)
+        w = np.flatnonzero(has)
+        ends = np.array([X[i][-1] for i in w]).reshape(-1, NX)
+        A[w], B[w] = dlocal_batch(model, ends, nxt[0][w])
+        defects[w] = model.local(ends, nxt[0][w])
+        Dn[w] = np.asarray(nxt[1])[w]
+    M = rows(prob.ends[segs] - prob.starts[segs], nf, lay["n_read"], has, lay["at"], node, Hx, Hn, Hb, r, sig,
+             stacked, Jpa, np.ascontiguousarray(D, dtype=float), A, B, Dn, defects, buffers)
     out = []
     for i, s in enumerate(segs):
-        sl = slice(bounds[i], bounds[i + 1])
-        Phi, Sens = G[i][:, :, :NE], G[i][:, :, NE:]
-        blk = {"r": r[sl], "th": th[sl], "b": Hb[sl], "x": xs[sl] @ D[i], "next": None,
+        sl = slice(lay["bounds"][i], lay["bounds"][i + 1])
+        Mi = M[i]
+        blk = {"M": Mi, "stack": M, "r": Mi[:, -1], "th": Mi[:, :nf], "b": Mi[:, nf:nf + NB],
+               "x": Mi[:, nf + NB:nf + NB + NE], "next": Mi[:, nf + NB + NE:-1] if has[i] else None,
                "rows": {"node": local[node[sl]], "kind": kinds[sl], "Hx": Hx[sl], "Hn": Hn[sl], "sig": sig[sl]},
-               "X": X[i], "Phi": Phi, "nodes": lay["nodes"][i], "model": model, "n_out": sl.stop - sl.start}
-        j = where.get(i) if nxt is not None else None
-        if j is not None:
-            blk["r"] = np.concatenate([blk["r"], defects[j]])
-            blk["th"] = np.vstack([blk["th"], A[j] @ Sens[-1]])
-            blk["b"] = np.vstack([blk["b"], np.zeros((NE, 6))])
-            blk["x"] = np.vstack([blk["x"], A[j] @ Phi[-1] @ D[i]])
-            blk["next"] = np.vstack([np.zeros((len(blk["r"]) - NE, NE)), B[j] @ nxt[1][i]])
+               "X": X[i], "Phi": G[i][:, :, :NE], "nodes": lay["nodes"][i], "model": model,
+               "n_out": sl.stop - sl.start}
         out.append(blk)
     return out
+
+
+class Rows(list):
+    """The segments' rows [θ | b | x | next | r] (`rows`): a list of each segment's (rows, width)
+    array, all views of one stacked array `data` (segment after segment, each row-major), which
+    C `sr_ident_whiten` reads as it is."""
+
+    def __init__(self, data, shapes):
+        self.data, self.shapes = data, shapes
+        first = np.concatenate([[0], np.cumsum([m * w for m, w in shapes])])
+        super().__init__(data[first[i]:first[i + 1]].reshape(shape) for i, shape in enumerate(shapes))
+
+
+def rows(steps, nf, n_read, has, at, node, Hx, Hn, Hb, r, sig, G, Jpa, D, A, B, Dn, defects, buffers=None):
+    """The segments' unwhitened rows (C `sr_ident_rows`, whose header gives the formulas): per
+    segment its readings' rows (n_read[s] of them, stacked in the per-row arrays at, node, Hx (12),
+    Hn (5), Hb (6), r, sig), through its chain (`chain`'s stacked G, the reading at node at[q] of
+    its segment) and Jpa (nodes, 5, nf; None for zero), then with has[s] its end-state rows (A, B,
+    Dn (S, 12, 12), defects (S, 12)).  A `Rows` of the segments' [θ | b | x | next | r] (in
+    `buffers`' array "M", see `buffer`)."""
+    steps = np.ascontiguousarray(steps, dtype=np.int64)
+    has = np.ascontiguousarray(has, dtype=np.intc)
+    shapes = [(int(m) + NE * int(h), nf + NB + NE + NE * int(h) + 1) for m, h in zip(n_read, has)]
+    out = buffer(buffers, "M", sum(m * w for m, w in shapes))
+    node = np.ascontiguousarray(node, dtype=np.int64)
+    jpa = ffi.NULL if Jpa is None else _ptr(np.ascontiguousarray(Jpa, dtype=float))
+    n_nodes = 0 if Jpa is None else len(Jpa)
+    _check("rows", lib.sr_ident_rows(len(steps), nf, _ptr(steps, "long"), _ptr(np.ascontiguousarray(n_read, dtype=np.int64), "long"),
+                                     _ptr(has, "int"), _ptr(at, "long"), _ptr(node, "long"), n_nodes, _ptr(Hx), _ptr(Hn),
+                                     _ptr(Hb), _ptr(r), _ptr(np.ascontiguousarray(sig, dtype=float)), _ptr(G), jpa, _ptr(D),
+                                     _ptr(A), _ptr(B), _ptr(Dn), _ptr(defects), _ptr(out)))
+    return Rows(out, shapes)

@@ -9,7 +9,7 @@ import pytest
 from runtime.estimation.sense import simulate_log
 from runtime.identification import fit as fitmod
 from runtime.identification.fit import free_parameters
-from runtime.identification.segments import _simulate, dlocal_batch, dretract_batch, segment_blocks
+from runtime.identification.segments import _simulate, chain, dlocal_batch, dretract_batch, rows, segment_blocks
 from runtime.model import Model
 from runtime.scenario import TorqueWindow, load_scenario
 from runtime.sensor_set import SensorSet
@@ -75,7 +75,7 @@ def test_a_segment_is_the_models_simulation_and_its_transition_the_product_of_it
 def test_the_chained_sensitivity_is_the_sum_of_each_steps_carried_to_the_end(problem):
     prob, model, x0, _, _ = problem
     segs = np.arange(prob.S)
-    X, G = _simulate(prob, model, segs, x0, sensitivities=True)
+    X, G, _ = _simulate(prob, model, segs, x0, sensitivities=True)
     for s in (0, prob.S - 1):                       # one of each length
         k0, k1 = prob.starts[s], prob.ends[s]
         u = prob.data.u[k0:k1]
@@ -85,7 +85,7 @@ def test_the_chained_sensitivity_is_the_sum_of_each_steps_carried_to_the_end(pro
         for k in range(k1 - k0):
             Sens = F[k] @ Sens + Jp[k]
         np.testing.assert_allclose(G[s][-1][:, NE:], Sens, rtol=1e-10, atol=1e-14)
-    _, held = _simulate(prob, model, segs[:1], x0[:1], sensitivities=False)
+    _, held, _ = _simulate(prob, model, segs[:1], x0[:1], sensitivities=False)
     assert held[0].shape == G[0].shape and not held[0][:, :, NE:].any()
 
 
@@ -131,3 +131,86 @@ def test_the_process_noise_reaches_the_end_state_through_the_transition_from_its
             entered += 1
         np.testing.assert_allclose(A[-NE:, 5 * c:5 * c + 5], expected, rtol=1e-10, atol=1e-12)
     assert entered >= 2
+
+
+def numpy_chain(steps, nf, F, Jp):
+    """The chain as the NumPy loop that C `sr_ident_chain` replaced: G_{k+1} = F_k G_k + [0 | Jp_k]."""
+    out, k = [], 0
+    for L in steps:
+        G = np.zeros((L + 1, NE, NE + nf))
+        G[0, :, :NE] = np.eye(NE)
+        for i in range(L):
+            G[i + 1] = F[k + i] @ G[i]
+            G[i + 1, :, NE:] += Jp[k + i]
+        out.append(G)
+        k += L
+    return np.concatenate(out)
+
+
+@pytest.fixture(scope="module")
+def steps_of(problem):
+    """The steps' Jacobians of every segment of the problem, segment after segment."""
+    prob, model, x0, _, _ = problem
+    X, _, _ = _simulate(prob, model, np.arange(prob.S), x0, sensitivities=True)
+    steps = prob.ends - prob.starts
+    xs = np.concatenate([X[s][:-1] for s in range(prob.S)])
+    us = np.concatenate([prob.data.u[k0:k0 + L] for k0, L in zip(prob.starts, steps)])
+    F, Jp = model.step_jacobians(xs, us, prob.data.h, "rkmk4", columns=prob.idx)
+    return steps, F, Jp
+
+
+def test_the_c_chain_is_the_numpy_recursion_it_replaced(steps_of, problem):
+    steps, F, Jp = steps_of
+    nf = problem[0].nf
+    expected = numpy_chain(steps, nf, F, Jp)
+    np.testing.assert_allclose(chain(steps, nf, F, Jp), expected, rtol=1e-12, atol=1e-12)
+    planted = F.copy()
+    planted[len(F) // 2, 3, 3] += 1e-9             # one entry of one step
+    assert not np.allclose(chain(steps, nf, planted, Jp), expected, rtol=1e-12, atol=1e-12)
+
+
+def numpy_rows(steps, nf, n_read, has, at, node, Hx, Hn, Hb, r, sig, G, Jpa, D, A, B, Dn, defects):
+    """The rows [θ | b | x | next | r] as the NumPy products that C `sr_ident_rows` replaced."""
+    first = np.concatenate([[0], np.cumsum(np.asarray(steps) + 1)])
+    bounds = np.concatenate([[0], np.cumsum(n_read)])
+    out = []
+    for s in range(len(steps)):
+        q = slice(bounds[s], bounds[s + 1])
+        Gs = G[first[s]:first[s + 1]]
+        HG = np.einsum("rj,rjk->rk", Hx[q], Gs[at[q]])
+        th = -(HG[:, NE:] + np.einsum("rj,rjk->rk", Hn[q], Jpa[node[q]])) / sig[q, None]
+        x = -HG[:, :NE] / sig[q, None] @ D[s]
+        rows = [th, -Hb[q] / sig[q, None], x]
+        if has[s]:
+            rows.append(np.zeros((len(x), NE)))
+        M = np.hstack(rows + [(r[q] / sig[q])[:, None]])
+        if has[s]:
+            end = np.hstack([A[s] @ Gs[-1, :, NE:], np.zeros((NE, 6)), A[s] @ Gs[-1, :, :NE] @ D[s], B[s] @ Dn[s],
+                             defects[s][:, None]])
+            M = np.vstack([M, end])
+        out.append(M)
+    return out
+
+
+def test_the_c_rows_are_the_numpy_products_they_replaced(problem):
+    prob = problem[0]
+    rng = np.random.default_rng(7)
+    steps, nf = np.array([5, 3, 4]), prob.nf
+    n_read, has = np.array([7, 4, 6]), np.array([1, 1, 0])
+    n, nodes = int(n_read.sum()), 15
+    at = np.concatenate([rng.integers(0, L + 1, m) for L, m in zip(steps, n_read)])
+    args = dict(steps=steps, nf=nf, n_read=n_read, has=has, at=at, node=rng.integers(0, nodes, n),
+                Hx=rng.standard_normal((n, NE)), Hn=rng.standard_normal((n, 5)), Hb=rng.standard_normal((n, 6)),
+                r=rng.standard_normal(n), sig=rng.uniform(0.1, 2.0, n),
+                G=rng.standard_normal((int(np.sum(steps + 1)), NE, NE + nf)), Jpa=rng.standard_normal((nodes, 5, nf)),
+                D=rng.standard_normal((3, NE, NE)), A=rng.standard_normal((3, NE, NE)),
+                B=rng.standard_normal((3, NE, NE)), Dn=rng.standard_normal((3, NE, NE)),
+                defects=rng.standard_normal((3, NE)))
+    expected = numpy_rows(**args)
+    got = rows(**args)
+    assert [M.shape for M in got] == [M.shape for M in expected]
+    for M, E in zip(got, expected):
+        np.testing.assert_allclose(M, E, rtol=1e-12, atol=1e-12)
+    args["Hx"] = args["Hx"].copy()
+    args["Hx"][9, 2] *= 1 + 1e-9                   # one reading's sensitivity to one coordinate
+    assert not all(np.allclose(M, E, rtol=1e-12, atol=1e-12) for M, E in zip(rows(**args), expected))
