@@ -42,21 +42,26 @@ int sr_internal_cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real
 
 /* B <- M^-1 B on the first n columns of B (SR_NV rows, row-major, ld entries per row), M = L L^T
  * from sr_internal_cholesky: forward then back substitution, all columns at once.  Inline, so each
- * caller's constant ld and n give it its own unrolled, vectorised copy. */
+ * caller's constant ld and n give it its own unrolled, vectorised copy.  Each entry is summed in a
+ * local, its terms in the order of k: the same arithmetic as updating B in place term by term, without
+ * a store and reload of the entry per term (B may alias nothing the compiler can prove, so it
+ * cannot keep the entry in a register itself). */
 static inline void sr_internal_cholesky_solve(const sr_real L[SR_NV * SR_NV], const sr_real inv[SR_NV], int ld, int n,
                                               sr_real *B)
 {
     int i, k, c;
-    for (i = 0; i < SR_NV; ++i) {
-        for (k = 0; k < i; ++k)
-            for (c = 0; c < n; ++c) B[ld * i + c] -= L[SR_NV * i + k] * B[ld * k + c];
-        for (c = 0; c < n; ++c) B[ld * i + c] *= inv[i];
-    }
-    for (i = SR_NV - 1; i >= 0; --i) {
-        for (k = i + 1; k < SR_NV; ++k)
-            for (c = 0; c < n; ++c) B[ld * i + c] -= L[SR_NV * k + i] * B[ld * k + c];
-        for (c = 0; c < n; ++c) B[ld * i + c] *= inv[i];
-    }
+    for (i = 0; i < SR_NV; ++i)
+        for (c = 0; c < n; ++c) {
+            sr_real t = B[ld * i + c];
+            for (k = 0; k < i; ++k) t -= L[SR_NV * i + k] * B[ld * k + c];
+            B[ld * i + c] = t * inv[i];
+        }
+    for (i = SR_NV - 1; i >= 0; --i)
+        for (c = 0; c < n; ++c) {
+            sr_real t = B[ld * i + c];
+            for (k = i + 1; k < SR_NV; ++k) t -= L[SR_NV * k + i] * B[ld * k + c];
+            B[ld * i + c] = t * inv[i];
+        }
 }
 
 #endif /* SR_KERNELS_H */

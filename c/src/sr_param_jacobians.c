@@ -248,10 +248,11 @@ static void stage_columns(const colset *cs, const sr_real df[SR_NV * SR_NE], con
         for (k = 0; k < SR_NE; ++k) g[i][k] = df[SR_NE * i + k];
         for (k = 0; k < 5; ++k)   /* the configuration directions d_xi_S, d_th_Y, d_th_P move M */
             for (j = 0; j < SR_NV; ++j) g[i][k] -= dM[15 * k + SR_UPPER[i][j]] * a[j];
-        for (k = 0; k < SR_NE; ++k) {
-            const sr_real m = g[i][k];
-            if (k == SR_E_q || k == SR_E_q + 1) continue;   /* nothing depends on q */
-            for (c = 0; c < nc; ++c) D[i][c] += m * dy[k][c];
+        for (c = 0; c < nc; ++c) {   /* summed in a local, in the order of k (see sr_internal_cholesky_solve) */
+            sr_real t = D[i][c];
+            for (k = 0; k < SR_NE; ++k)
+                if (k != SR_E_q && k != SR_E_q + 1) t += g[i][k] * dy[k][c];   /* nothing depends on q */
+            D[i][c] = t;
         }
     }
     sr_internal_cholesky_solve(L, inv, NW, nc, &D[0][0]);
@@ -394,9 +395,11 @@ static void field_columns(const sr_model *model, const colset *cs, const sr_real
         wxp[i][0] = w[1] * p[i][2] - w[2] * p[i][1];
         wxp[i][1] = w[2] * p[i][0] - w[0] * p[i][2];
         wxp[i][2] = w[0] * p[i][1] - w[1] * p[i][0];
-        for (j = 0; j < 3; ++j)
-            for (c = 0; c < nc; ++c)
-                df[SR_T_Q + i][c] += p[i][j] * dy[SR_E_nu + j][c] + wxp[i][j] * dy[SR_E_xi_S + j][c];
+        for (c = 0; c < nc; ++c) {   /* summed in a local, in the order of j (see sr_internal_cholesky_solve) */
+            sr_real t = df[SR_T_Q + i][c];
+            for (j = 0; j < 3; ++j) t += p[i][j] * dy[SR_E_nu + j][c] + wxp[i][j] * dy[SR_E_xi_S + j][c];
+            df[SR_T_Q + i][c] = t;
+        }
     }
 }
 
