@@ -437,9 +437,10 @@ static void stage_combine(int nc, const sr_real th[SR_NT], const tangent_p dth, 
     int i, j, c;
     dexpinv_and_derivatives(th, K_s, kS, P, Q);
     for (i = 0; i < 3; ++i)
-        for (c = 0; c < nc; ++c) {
-            dS[i][c] = 0;
-            for (j = 0; j < 3; ++j) dS[i][c] += P[3 * i + j] * dK[SR_T_S + j][c] + Q[3 * i + j] * dth[SR_T_S + j][c];
+        for (c = 0; c < nc; ++c) {   /* summed in a local (see sr_internal_cholesky_solve) */
+            sr_real t = 0;
+            for (j = 0; j < 3; ++j) t += P[3 * i + j] * dK[SR_T_S + j][c] + Q[3 * i + j] * dth[SR_T_S + j][c];
+            dS[i][c] = t;
         }
     for (i = 0; i < 3; ++i) {
         K_s[SR_T_S + i] = kS[i];
