@@ -187,14 +187,16 @@ static const sr_real *general_constants(const sr_model *model, sr_real cg[SR_GEN
 static void regressor_columns(const colset *cs, const sr_real Y[SR_NV * SR_NPI], sr_real D[SR_NV][NW])
 {
     int i, c, e;
-    for (i = 0; i < SR_NV; ++i) {
+    for (i = 0; i < SR_NV; ++i)
         for (c = 0; c < cs->ns; ++c) D[i][c] = 0;
-        for (c = cs->ns; c < cs->n; ++c) {
-            const pi_column *d = cs->pi + (c - cs->ns);
-            sr_real t = 0;
-            for (e = 0; e < d->n; ++e) t += Y[SR_NPI * i + d->k[e]] * d->v[e];
-            D[i][c] = -t;
+    for (c = cs->ns; c < cs->n; ++c) {   /* a column's five rows at once, each summed over e in order */
+        const pi_column *d = cs->pi + (c - cs->ns);
+        sr_real t[SR_NV] = {0, 0, 0, 0, 0};
+        for (e = 0; e < d->n; ++e) {
+            const sr_real *y = Y + d->k[e], v = d->v[e];
+            for (i = 0; i < SR_NV; ++i) t[i] += y[SR_NPI * i] * v;
         }
+        for (i = 0; i < SR_NV; ++i) D[i][c] = -t[i];
     }
 }
 
