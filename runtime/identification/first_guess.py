@@ -92,16 +92,15 @@ def regressor_guess(t, x, u, params, free, bounds, weights=None, window=WINDOW_S
         p[idx] = theta
         return _pi_of(p)
 
-    Y_kept = Y[:, :, kept]
+    rows = np.empty((Y.shape[0], NV, len(kept) + 1))     # [Y_kept | b], each equation's row
+    rows[..., :-1] = Y[:, :, kept]
+    rows[..., -1] = b
 
     def base_fit(w):
         """(β̂, R) of the rows weighed by w (5,).  Y π = Y_kept β with β = π_kept + C π_dep: β̂ is a
         full-rank linear least-squares problem, solved from one QR factorisation of [Y_kept | b]:
         R and Qᵀb at once."""
-        A = np.empty((Y.shape[0] * NV, len(kept) + 1))
-        A[:, :-1] = (Y_kept * w[None, :, None]).reshape(-1, len(kept))
-        A[:, -1] = (b * w).ravel()
-        Ra = np.linalg.qr(A, mode="r")
+        Ra = np.linalg.qr((rows * w[None, :, None]).reshape(-1, len(kept) + 1), mode="r")
         R = Ra[:-1, :-1]
         return scipy.linalg.solve_triangular(R, Ra[:-1, -1]), R
 
