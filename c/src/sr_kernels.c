@@ -20,19 +20,48 @@
 
 int sr_internal_cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real inv[SR_NV])
 {
-    int i, j, k;
-    memset(L, 0, sizeof(sr_real) * SR_NV * SR_NV);
-    for (j = 0; j < SR_NV; ++j) {
-        sr_real d = Mu[SR_UPPER[j][j]];
-        for (k = 0; k < j; ++k) d -= L[SR_NV * j + k] * L[SR_NV * j + k];
-        if (!(d > SR_GEN_PIVOT_TOL * Mu[SR_UPPER[j][j]])) return SR_ERR_SINGULAR;
-        L[SR_NV * j + j] = SR_SQRT(d);
-        inv[j] = 1 / L[SR_NV * j + j];
-        for (i = j + 1; i < SR_NV; ++i) {
-            sr_real s = Mu[SR_UPPER[i][j]];
-            for (k = 0; k < j; ++k) s -= L[SR_NV * i + k] * L[SR_NV * j + k];
-            L[SR_NV * i + j] = s * inv[j];
-        }
+    /* Column by column (j), as the loops L_jj = sqrt(M_jj - sum_(k<j) L_jk^2) and
+     * L_ij = (M_ij - sum_(k<j) L_ik L_jk) / L_jj, k ascending, written out for the five rows: the
+     * entries stay in locals (Mu's index of M_ij is SR_UPPER[i][j]). */
+    typedef char five_rows[SR_NV == 5 ? 1 : -1];
+    sr_real d, l00, l10, l20, l30, l40, l11, l21, l31, l41, l22, l32, l42, l33, l43, l44, i0, i1, i2, i3, i4;
+    (void)sizeof(five_rows);
+    d = Mu[0];
+    if (!(d > SR_GEN_PIVOT_TOL * Mu[0])) return SR_ERR_SINGULAR;
+    l00 = SR_SQRT(d);
+    i0 = 1 / l00;
+    l10 = Mu[1] * i0;
+    l20 = Mu[2] * i0;
+    l30 = Mu[3] * i0;
+    l40 = Mu[4] * i0;
+    d = Mu[5] - l10 * l10;
+    if (!(d > SR_GEN_PIVOT_TOL * Mu[5])) return SR_ERR_SINGULAR;
+    l11 = SR_SQRT(d);
+    i1 = 1 / l11;
+    l21 = (Mu[6] - l20 * l10) * i1;
+    l31 = (Mu[7] - l30 * l10) * i1;
+    l41 = (Mu[8] - l40 * l10) * i1;
+    d = Mu[9] - l20 * l20 - l21 * l21;
+    if (!(d > SR_GEN_PIVOT_TOL * Mu[9])) return SR_ERR_SINGULAR;
+    l22 = SR_SQRT(d);
+    i2 = 1 / l22;
+    l32 = (Mu[10] - l30 * l20 - l31 * l21) * i2;
+    l42 = (Mu[11] - l40 * l20 - l41 * l21) * i2;
+    d = Mu[12] - l30 * l30 - l31 * l31 - l32 * l32;
+    if (!(d > SR_GEN_PIVOT_TOL * Mu[12])) return SR_ERR_SINGULAR;
+    l33 = SR_SQRT(d);
+    i3 = 1 / l33;
+    l43 = (Mu[13] - l40 * l30 - l41 * l31 - l42 * l32) * i3;
+    d = Mu[14] - l40 * l40 - l41 * l41 - l42 * l42 - l43 * l43;
+    if (!(d > SR_GEN_PIVOT_TOL * Mu[14])) return SR_ERR_SINGULAR;
+    l44 = SR_SQRT(d);
+    i4 = 1 / l44;
+    {
+        const sr_real lower[SR_NV * SR_NV] = {l00, 0, 0, 0, 0, l10, l11, 0, 0, 0, l20, l21, l22, 0, 0,
+                                              l30, l31, l32, l33, 0, l40, l41, l42, l43, l44};
+        const sr_real r[SR_NV] = {i0, i1, i2, i3, i4};
+        memcpy(L, lower, sizeof lower);
+        memcpy(inv, r, sizeof r);
     }
     return SR_OK;
 }

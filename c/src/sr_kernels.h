@@ -41,21 +41,32 @@ static const unsigned char SR_UPPER[SR_NV][SR_NV] = {
 int sr_internal_cholesky(const sr_real Mu[15], sr_real L[SR_NV * SR_NV], sr_real inv[SR_NV]);
 
 /* B <- M^-1 B on the first n columns of B (SR_NV rows, row-major, ld entries per row), M = L L^T
- * from sr_internal_cholesky: forward then back substitution, all columns at once.  Inline, so each
- * caller's constant ld and n give it its own unrolled, vectorised copy. */
+ * from sr_internal_cholesky: forward then back substitution, column by column, each column's five
+ * entries held in locals through both sweeps (B may alias L for all the compiler can prove, so
+ * updated in place it would store and reload an entry per term).  Each entry's terms are taken in
+ * the order of the substitution loops, y_i = (b_i - sum_(k<i) L_ik y_k) / L_ii, then
+ * x_i = (y_i - sum_(k>i) L_ki x_k) / L_ii, k ascending. */
 static inline void sr_internal_cholesky_solve(const sr_real L[SR_NV * SR_NV], const sr_real inv[SR_NV], int ld, int n,
                                               sr_real *B)
 {
-    int i, k, c;
-    for (i = 0; i < SR_NV; ++i) {
-        for (k = 0; k < i; ++k)
-            for (c = 0; c < n; ++c) B[ld * i + c] -= L[SR_NV * i + k] * B[ld * k + c];
-        for (c = 0; c < n; ++c) B[ld * i + c] *= inv[i];
-    }
-    for (i = SR_NV - 1; i >= 0; --i) {
-        for (k = i + 1; k < SR_NV; ++k)
-            for (c = 0; c < n; ++c) B[ld * i + c] -= L[SR_NV * k + i] * B[ld * k + c];
-        for (c = 0; c < n; ++c) B[ld * i + c] *= inv[i];
+    typedef char five_rows[SR_NV == 5 ? 1 : -1];
+    int c;
+    (void)sizeof(five_rows);
+    for (c = 0; c < n; ++c) {
+        sr_real *b = B + c;
+        const sr_real y0 = b[0] * inv[0];
+        const sr_real y1 = (b[ld] - L[5] * y0) * inv[1];
+        const sr_real y2 = (b[2 * ld] - L[10] * y0 - L[11] * y1) * inv[2];
+        const sr_real y3 = (b[3 * ld] - L[15] * y0 - L[16] * y1 - L[17] * y2) * inv[3];
+        const sr_real x4 = (b[4 * ld] - L[20] * y0 - L[21] * y1 - L[22] * y2 - L[23] * y3) * inv[4] * inv[4];
+        const sr_real x3 = (y3 - L[23] * x4) * inv[3];
+        const sr_real x2 = (y2 - L[17] * x3 - L[22] * x4) * inv[2];
+        const sr_real x1 = (y1 - L[11] * x2 - L[16] * x3 - L[21] * x4) * inv[1];
+        b[0] = (y0 - L[5] * x1 - L[10] * x2 - L[15] * x3 - L[20] * x4) * inv[0];
+        b[ld] = x1;
+        b[2 * ld] = x2;
+        b[3 * ld] = x3;
+        b[4 * ld] = x4;
     }
 }
 

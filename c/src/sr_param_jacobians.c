@@ -187,14 +187,16 @@ static const sr_real *general_constants(const sr_model *model, sr_real cg[SR_GEN
 static void regressor_columns(const colset *cs, const sr_real Y[SR_NV * SR_NPI], sr_real D[SR_NV][NW])
 {
     int i, c, e;
-    for (i = 0; i < SR_NV; ++i) {
+    for (i = 0; i < SR_NV; ++i)
         for (c = 0; c < cs->ns; ++c) D[i][c] = 0;
-        for (c = cs->ns; c < cs->n; ++c) {
-            const pi_column *d = cs->pi + (c - cs->ns);
-            sr_real t = 0;
-            for (e = 0; e < d->n; ++e) t += Y[SR_NPI * i + d->k[e]] * d->v[e];
-            D[i][c] = -t;
+    for (c = cs->ns; c < cs->n; ++c) {   /* a column's five rows at once, each summed over e in order */
+        const pi_column *d = cs->pi + (c - cs->ns);
+        sr_real t[SR_NV] = {0, 0, 0, 0, 0};
+        for (e = 0; e < d->n; ++e) {
+            const sr_real *y = Y + d->k[e], v = d->v[e];
+            for (i = 0; i < SR_NV; ++i) t[i] += y[SR_NPI * i] * v;
         }
+        for (i = 0; i < SR_NV; ++i) D[i][c] = -t[i];
     }
 }
 
@@ -248,10 +250,11 @@ static void stage_columns(const colset *cs, const sr_real df[SR_NV * SR_NE], con
         for (k = 0; k < SR_NE; ++k) g[i][k] = df[SR_NE * i + k];
         for (k = 0; k < 5; ++k)   /* the configuration directions d_xi_S, d_th_Y, d_th_P move M */
             for (j = 0; j < SR_NV; ++j) g[i][k] -= dM[15 * k + SR_UPPER[i][j]] * a[j];
-        for (k = 0; k < SR_NE; ++k) {
-            const sr_real m = g[i][k];
-            if (k == SR_E_q || k == SR_E_q + 1) continue;   /* nothing depends on q */
-            for (c = 0; c < nc; ++c) D[i][c] += m * dy[k][c];
+        for (c = 0; c < nc; ++c) {   /* summed in a local, in the order of k (see sr_internal_cholesky_solve) */
+            sr_real t = D[i][c];
+            for (k = 0; k < SR_NE; ++k)
+                if (k != SR_E_q && k != SR_E_q + 1) t += g[i][k] * dy[k][c];   /* nothing depends on q */
+            D[i][c] = t;
         }
     }
     sr_internal_cholesky_solve(L, inv, NW, nc, &D[0][0]);
@@ -394,9 +397,11 @@ static void field_columns(const sr_model *model, const colset *cs, const sr_real
         wxp[i][0] = w[1] * p[i][2] - w[2] * p[i][1];
         wxp[i][1] = w[2] * p[i][0] - w[0] * p[i][2];
         wxp[i][2] = w[0] * p[i][1] - w[1] * p[i][0];
-        for (j = 0; j < 3; ++j)
-            for (c = 0; c < nc; ++c)
-                df[SR_T_Q + i][c] += p[i][j] * dy[SR_E_nu + j][c] + wxp[i][j] * dy[SR_E_xi_S + j][c];
+        for (c = 0; c < nc; ++c) {   /* summed in a local, in the order of j (see sr_internal_cholesky_solve) */
+            sr_real t = df[SR_T_Q + i][c];
+            for (j = 0; j < 3; ++j) t += p[i][j] * dy[SR_E_nu + j][c] + wxp[i][j] * dy[SR_E_xi_S + j][c];
+            df[SR_T_Q + i][c] = t;
+        }
     }
 }
 
@@ -434,9 +439,10 @@ static void stage_combine(int nc, const sr_real th[SR_NT], const tangent_p dth, 
     int i, j, c;
     dexpinv_and_derivatives(th, K_s, kS, P, Q);
     for (i = 0; i < 3; ++i)
-        for (c = 0; c < nc; ++c) {
-            dS[i][c] = 0;
-            for (j = 0; j < 3; ++j) dS[i][c] += P[3 * i + j] * dK[SR_T_S + j][c] + Q[3 * i + j] * dth[SR_T_S + j][c];
+        for (c = 0; c < nc; ++c) {   /* summed in a local (see sr_internal_cholesky_solve) */
+            sr_real t = 0;
+            for (j = 0; j < 3; ++j) t += P[3 * i + j] * dK[SR_T_S + j][c] + Q[3 * i + j] * dth[SR_T_S + j][c];
+            dS[i][c] = t;
         }
     for (i = 0; i < 3; ++i) {
         K_s[SR_T_S + i] = kS[i];

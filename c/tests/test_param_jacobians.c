@@ -2,7 +2,8 @@
  * test_param_jacobians.c -- the derivatives in the parameters (c/src/sr_param_jacobians.c): the
  * columns of sr_accel_param_jacobian are central differences of sr_accel over perturbed models; a
  * Lie-Euler step's sensitivity is dt times it in the nu rows; the regressor times the robot's
- * inertial parameters is M nu' - f; the method and bad input are refused with outputs untouched.
+ * inertial parameters is M nu' - f; an RKMK4 step's sensitivity on columns that move pi alone is
+ * the batched central differences; the method and bad input are refused with outputs untouched.
  */
 #include "sr_test.h"
 
@@ -112,6 +113,47 @@ static void test_the_regressor_times_pi_is_m_nudot_minus_f(void)
     }
 }
 
+/* An RKMK4 step's sensitivity on columns that move pi alone (a fit's free entries: the lockstep
+ * blocks and the regressor's bracket) is the batched central differences of the step over
+ * perturbed models (sr_step_param_jacobian_fd_batch, its own path through sr_step_batch), from both
+ * entry points that take it: with the end states (a full-state fit's) and with F (a sensor fit's). */
+static void test_an_rkmk4_steps_pi_columns_are_the_batched_central_differences(void)
+{
+    enum { N = 11, NC = 7 };
+    static const int cols[NC] = {SR_P_k_S, SR_P_k_Y, SR_P_k_P, SR_P_m_P, SR_P_J_P_yy, SR_P_c_P_x, SR_P_j_mY};
+    static sr_real x[N][SR_NX], u[N][SR_NU], next[N][SR_NX], F[N][SR_NE * SR_NE], Jp[N][SR_NE * NC],
+        Jf[N][SR_NE * NC], Jw[N][SR_NE * NC], work[N * SR_PARAM_FD_WORK];
+    const sr_real dt = SR_C(0.01);
+    sr_real p[SR_NPARAM];
+    test_rng rng = {42};
+    sr_model m;
+    long row = 5;
+    int i, k, c;
+    if (TEST_EPS > 1e-10) return;   /* double only: float rounding swamps the differences */
+    general_robot_params(p);
+    CHECK_STATUS(sr_model_init(&m, p), SR_OK);
+    for (i = 0; i < N; ++i) {
+        random_state(&rng, p[SR_P_r], 2.0, x[i]);
+        u[i][0] = (sr_real)rng_uniform(&rng, -0.15, 0.15);
+        u[i][1] = (sr_real)rng_uniform(&rng, -0.15, 0.15);
+    }
+    CHECK_STATUS(sr_step_param_jacobian_fd_batch(&m, SR_RKMK4, N, x[0], u[0], dt, NC, cols, Jf[0], work, &row), SR_OK);
+    CHECK_STATUS(sr_step_and_param_jacobian_cols_batch(&m, SR_RKMK4, N, x[0], u[0], dt, NC, cols, next[0], Jp[0], &row),
+                 SR_OK);
+    CHECK_STATUS(sr_step_jacobian_param_cols_batch(&m, SR_RKMK4, N, x[0], u[0], dt, NC, cols, F[0], Jw[0], &row), SR_OK);
+    CHECK(row == -1);
+    for (c = 0; c < NC; ++c) {   /* each column against its own size: the differences' error is ~1e-10 of it */
+        double scale = 0;
+        for (i = 0; i < N; ++i)
+            for (k = 0; k < SR_NE; ++k) scale = fmax(scale, fabs((double)Jf[i][NC * k + c]));
+        for (i = 0; i < N; ++i)
+            for (k = 0; k < SR_NE; ++k) {
+                CHECK_NEAR(Jp[i][NC * k + c], Jf[i][NC * k + c], 1e-7 * scale);
+                CHECK_NEAR(Jw[i][NC * k + c], Jf[i][NC * k + c], 1e-7 * scale);
+            }
+    }
+}
+
 static void test_parameter_jacobians_refuse_a_method_and_bad_input_leaving_outputs_untouched(void)
 {
     sr_real p[SR_NPARAM], x[SR_NX], a[SR_NV] = {0}, Jp[SR_NE * SR_NPARAM], Y[SR_NV * SR_NPI];
@@ -138,5 +180,6 @@ void suite_param_jacobians(void)
     RUN_TEST(test_accel_param_jacobian_columns_are_central_differences_over_perturbed_models);
     RUN_TEST(test_a_lie_euler_steps_sensitivity_is_dt_times_the_accelerations_in_the_nu_rows);
     RUN_TEST(test_the_regressor_times_pi_is_m_nudot_minus_f);
+    RUN_TEST(test_an_rkmk4_steps_pi_columns_are_the_batched_central_differences);
     RUN_TEST(test_parameter_jacobians_refuse_a_method_and_bad_input_leaving_outputs_untouched);
 }

@@ -92,16 +92,22 @@ def regressor_guess(t, x, u, params, free, bounds, weights=None, window=WINDOW_S
         p[idx] = theta
         return _pi_of(p)
 
-    def solve(w, prior):
-        """β̂ of the rows weighed by w (5,), and θ nearest it with the pull `prior` (per entry, on
-        the relative change)."""
-        Yw = (Y * w[None, :, None]).reshape(-1, NPI)
-        # Y π = Y_kept β with β = π_kept + C π_dep: β̂ is a full-rank linear least-squares
-        # problem, solved from one QR factorisation of [Y_kept | b]: R and Qᵀb at once
-        Ra = np.linalg.qr(np.column_stack([Yw[:, kept], (b * w).ravel()]), mode="r")
-        R = Ra[:-1, :-1]
-        beta = scipy.linalg.solve_triangular(R, Ra[:-1, -1])
+    rows = np.empty((Y.shape[0], NV, len(kept) + 1))     # [Y_kept | b], each equation's row
+    rows[..., :-1] = Y[:, :, kept]
+    rows[..., -1] = b
 
+    def base_fit(w):
+        """(β̂, R) of the rows weighed by w (5,).  Y π = Y_kept β with β = π_kept + C π_dep: β̂ is a
+        full-rank linear least-squares problem, solved from one QR factorisation of [Y_kept | b]:
+        R and Qᵀb at once."""
+        Ra = np.linalg.qr((rows * w[None, :, None]).reshape(-1, len(kept) + 1), mode="r")
+        R = Ra[:-1, :-1]
+        return scipy.linalg.solve_triangular(R, Ra[:-1, -1]), R
+
+    def solve(fitted, prior):
+        """θ nearest β̂ of `fitted` (`base_fit`'s) with the pull `prior` (per entry, on the relative
+        change), and β̂."""
+        beta, R = fitted
         RB = R @ B
 
         def residual(theta):
@@ -114,21 +120,21 @@ def regressor_guess(t, x, u, params, free, bounds, weights=None, window=WINDOW_S
 
         sol = scipy.optimize.least_squares(residual, np.clip(theta0, lo, hi), jac=jacobian, bounds=(lo, hi),
                                            x_scale=scale, method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12)
-        return sol.x, beta, R
+        return sol.x, beta
 
     w = np.ones(NV) if weights is None else np.asarray(weights, dtype=float)
     # first the rows alone (a pull of PRIOR_WEIGHT of what the rows say about each entry alone, which
     # only settles what they leave undetermined) ...
-    _, _, R = solve(w, 0.0)
-    alone = np.linalg.norm(R @ B @ _dpi_of(p0, idx), axis=0) * scale
-    theta, beta, _ = solve(w, PRIOR_WEIGHT * np.where(alone > 0, alone, alone.max(initial=0.0) or 1.0))
+    fitted = base_fit(w)
+    alone = np.linalg.norm(fitted[1] @ B @ _dpi_of(p0, idx), axis=0) * scale
+    theta, beta = solve(fitted, PRIOR_WEIGHT * np.where(alone > 0, alone, alone.max(initial=0.0) or 1.0))
     # ... then weighed by what they leave: each equation by its residuals' RMS, the rows counted
     # once per smoothing window (the filter correlates its neighbours), against the nominal values
     # known within NOMINAL_SPREAD (one σ).  An entry the rows see poorly stays near its nominal value.
     e = np.einsum("nij,j->ni", Y, pi_of(theta)) - b
     sigma = np.sqrt(np.mean(e ** 2, axis=0))
     w = 1.0 / (np.where(sigma > 0, sigma, sigma.max(initial=0.0) or 1.0) * np.sqrt(n_win))
-    theta, beta, _ = solve(w, np.full(len(idx), 1.0 / NOMINAL_SPREAD))
+    theta, beta = solve(base_fit(w), np.full(len(idx), 1.0 / NOMINAL_SPREAD))
     theta = _physical(params, idx, theta, theta0, lo, hi)
     return FirstGuess(names=tuple(free), nominal=theta0, theta=theta, base_names=tuple(base.names(4)),
                       base=beta, base_at_theta=base.values(pi_of(theta)), rows=int(Y.size // NPI))

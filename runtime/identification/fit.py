@@ -948,9 +948,9 @@ def first_guess(log, params, free, prob, full_state, x_guess):
 
 
 def _report(prob, sol, free, params, full_state):
-    r, J, _ = prob.assemble(sol.x)
+    r, J, _ = prob.assemble(sol.x, sparse=False) if full_state else prob.assemble(sol.x)   # full state: dense
     nf = len(free)
-    I = (J.T @ J).toarray()
+    I = J.T @ J if full_state else (J.T @ J).toarray()
     if full_state:
         info = I
     else:                           # eliminate the start states and the biases

@@ -51,6 +51,14 @@ def test_the_bench_keeps_both_fits_their_ratio_and_the_optima_distance(tmp_path,
     assert "analytic faster by" in capsys.readouterr().out
 
 
+def test_the_bench_keeps_every_rounds_cpu_time_and_ratio(state_log):
+    log, nominal, _ = state_log
+    result = bench.compare(log, nominal, "k_P", rounds=2, full_state=True)
+    a, f = result["analytic"]["cpu_s_rounds"], result["fd"]["cpu_s_rounds"]
+    assert len(a) == len(f) == 2 and result["analytic"]["cpu_s"] == min(a) and result["fd"]["cpu_s"] == min(f)
+    assert result["speedup_cpu_rounds"] == [f[0] / a[0], f[1] / a[1]]
+
+
 @pytest.mark.parametrize("k_Y", [0.04, 0.0], ids=["central", "one-sided at the bound"])
 def test_the_finite_difference_acceleration_sensitivity_is_the_analytic_one(state_log, k_Y):
     from runtime.identification.sensitivity import accel_sensitivity
