@@ -892,6 +892,76 @@ int sr_lqr_control_offsets(const sr_lqr *lqr, const sr_model *model, const sr_re
                            sr_real u[SR_NU], sr_real u_raw[SR_NU]);
 /** @} */
 
+/** @name Slope estimate (c/src/sr_slope.c)
+ * The world's slope vector s, a torque offset d and the pendulum's departure from the model (dm_P,
+ * dc_P, and its joint damping dk_P) from the measured states and the torques held between them,
+ * for the LQR's feedforward (sr_lqr_control_offsets); runtime/control/slope.py's SlopeEstimator
+ * (its reference: the same arithmetic) and docs/control.md describe it.  At each sample after the
+ * first, the rates nu one period after the last state x0 under the torques u held are predicted by
+ * the flat model (slope 0) in RKMK4 steps of at most 5 ms (sr_simulate), and the measured rates'
+ * departure from that prediction is fitted as G theta, theta = (s_x, s_y, d_1, d_2, the pendulum's
+ * m_P, c_P x, y, z and k_P scaled to a tenth of m_P, 1 cm, 1 cm, 1 cm and 0.01 N m s): G's columns
+ * the predictions of the model on a slope of 1e-3 rad (along x; along y with x0 turned by -pi/2
+ * about the vertical), under u + 1e-3 N m on each motor and with each pendulum parameter moved
+ * (m_P by 0.1 %, c_P by 0.1 mm, k_P by 1e-4 N m s), less the flat one, per unit of each entry.
+ * Normal equations with exponential forgetting, N = f N + G^T G, b = f b + G^T (nu - nu_flat),
+ * f = exp(-period / time_constant); theta = N^-1 b (Gaussian elimination with partial pivoting)
+ * when N's 2-norm condition number (for the symmetric N: the ratio of its eigenvalues' magnitudes,
+ * by Jacobi rotations) is below SR_SLOPE_COND_LIMIT; else, while the leading 4 x 4 block (slope and
+ * d) is below it, those four alone with the pendulum's entries held at their last estimate (rolling
+ * straight at the start the samples do not yet tell them apart); else the estimate is held.  The
+ * estimator's state, its moved models included, lives in the caller's struct: no allocation. */
+/** @{ */
+#define SR_SLOPE_NTHETA 9          /**< the fitted entries: slope (2), torque offset (2), pendulum (4), its damping */
+#define SR_SLOPE_NMOVED 5          /**< the pendulum's parameters moved: m_P, c_P x, y, z, k_P */
+#define SR_SLOPE_MAX_STEPS 16      /**< the prediction's RKMK4 steps per period at most (period <= 80 ms) */
+#define SR_SLOPE_COND_LIMIT 1e10   /**< the condition number below which the normal equations are solved */
+
+#ifdef SR_USE_FLOAT
+#define sr_slope_estimator sr_slope_estimator_f
+#define sr_slope_init sr_slope_init_f
+#define sr_slope_reset sr_slope_reset_f
+#define sr_slope_update sr_slope_update_f
+#endif
+
+/** The estimator's state (fill with sr_slope_init).  Read offsets and pendulum_damping; the rest is
+ * its working state. */
+typedef struct sr_slope_estimator {
+    sr_model flat;                          /**< the robot with slope 0 */
+    sr_model sloped;                        /**< ... on the probe slope */
+    sr_model moved[SR_SLOPE_NMOVED];        /**< ... with one pendulum parameter moved each */
+    sr_real factor[SR_SLOPE_NMOVED];        /**< each pendulum column's scale over its probe's step */
+    sr_real scale[SR_SLOPE_NMOVED];         /**< each pendulum column's scale (theta's unit) */
+    sr_real period;                         /**< the sampling period [s] */
+    sr_real forget;                         /**< exp(-period / time_constant) */
+    int steps;                              /**< RKMK4 steps per period */
+    int started;                            /**< nonzero once a state is held */
+    sr_real normal[SR_SLOPE_NTHETA * SR_SLOPE_NTHETA]; /**< the normal equations' matrix N (row-major) */
+    sr_real rhs[SR_SLOPE_NTHETA];           /**< ... and right-hand side b */
+    sr_real last[SR_NX];                    /**< the last state */
+    sr_lqr_offsets offsets;                 /**< out: the slope vector [rad], torque offset [N m] and pendulum (dm_P [kg], dc_P [m]) */
+    sr_real pendulum_damping;               /**< out: dk_P [N m s/rad] */
+    sr_real work[(SR_SLOPE_MAX_STEPS + 1) * SR_NX]; /**< the predictions' trajectory (scratch) */
+} sr_slope_estimator;
+
+/** Fills the estimator for the robot params (its slope ignored: the model is the flat one) at the
+ * sampling period [s] with the forgetting time constant [s], and resets it.  Returns SR_OK,
+ * SR_ERR_NULL, SR_ERR_NONFINITE, SR_ERR_ARG (period or time_constant not > 0, period above
+ * SR_SLOPE_MAX_STEPS * 5 ms), or sr_model_init's status for params or a moved copy; *est is written
+ * only on SR_OK. */
+int sr_slope_init(sr_slope_estimator *est, const sr_real params[SR_NPARAM], sr_real period, sr_real time_constant);
+
+/** Forgets the samples and the estimate (zeros).  Returns SR_OK or SR_ERR_NULL. */
+int sr_slope_reset(sr_slope_estimator *est);
+
+/** One sample: the measured (or estimated) state x and the torques u held since the last sample
+ * (ignored at the first).  Updates est->offsets and est->pendulum_damping as described above.
+ * Checks x in full (sr_check_state) and u for finiteness; returns SR_OK, SR_ERR_NULL,
+ * SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT or a prediction's sr_simulate status (the
+ * estimator then unchanged). */
+int sr_slope_update(sr_slope_estimator *est, const sr_real x[SR_NX], const sr_real u[SR_NU]);
+/** @} */
+
 #ifdef __cplusplus
 }
 #endif

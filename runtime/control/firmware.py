@@ -48,6 +48,9 @@ def header(task, controller):
     if not isinstance(reference, SpeedHeading):
         raise ValueError(f"{task.source}: reference.kind: the firmware example tracks a speed or a heading "
                          f"(a constant target); got {task.reference_spec['kind']!r}")
+    if controller._slope_schedule is not None:
+        raise ValueError(f"{task.source}: controller: the firmware example has no slope feedforward or estimate "
+                         f"(slope_estimate_s = 0 and a level model needed)")
     s = controller.schedule
     nv, nk = len(s.speeds), len(s.curvatures)
     if nv > lib.SR_LQR_MAX_SPEEDS or nk > lib.SR_LQR_MAX_CURVATURES:
@@ -102,7 +105,8 @@ def header(task, controller):
         f"    /* heading_band, heading_rise */ {_real(controller._c.heading_band)}, {_real(controller._c.heading_rise)},",
         f"    /* recovery_cross_track, recovery_heading, recovery_slow, recovery_rise */ "
         f"{_real(controller._c.recovery_cross_track)}, {_real(controller._c.recovery_heading)}, "
-        f"{_real(controller._c.recovery_slow)}, {_real(controller._c.recovery_rise)}",
+        f"{_real(controller._c.recovery_slow)}, {_real(controller._c.recovery_rise)},",
+        "    /* slope, pendulum, pendulum_share: no feedforward tables */ NULL, NULL, SR_C(0.0)",
         "};",
         "",
         "#endif /* LQR_TASK_H */",
