@@ -24,7 +24,7 @@ from .controller import DEFAULT_U_MAX, Controller
 from .ranges import LQR_RANGES
 from . import lqr_design as design
 from .lqr_design import Schedule
-from .slope import SlopeFeedforward, slope_components
+from .slope import SlopeEstimatorC, SlopeFeedforward, slope_components
 
 
 @dataclasses.dataclass(frozen=True)
@@ -257,7 +257,9 @@ class Lqr(SlopeFeedforward, Controller):
         # the flat one, and the slope's direction (the model's +x) is a world vector.
         flat = params.replace(slope=0.0)
         self.schedule = schedule if schedule is not None else design_schedule(flat, rate, u_max, gains)
-        self._init_slope(params, flat, self.schedule, gains)
+        # the slope estimate in C (sr_slope_update): what the C loop updates (runtime/control/slope.py's
+        # SlopeEstimator, its NumPy reference, gives the same to rounding)
+        self._init_slope(params, flat, self.schedule, gains, SlopeEstimatorC)
         # the feedforward's tables, which the C struct points to (kept here as long as it)
         self._tables = feedforward_tables(self._slope_schedule, self._pendulum_schedule)
         self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate, gains.steady_rate_m_s,

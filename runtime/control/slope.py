@@ -332,13 +332,14 @@ class SlopeFeedforward:
     estimates one, the online estimate (`slope_estimate_s` > 0) and the torques held since the last
     sample, which the estimate's next prediction needs.  A mixin before `Controller`."""
 
-    def _init_slope(self, params, flat, schedule, gains):
+    def _init_slope(self, params, flat, schedule, gains, estimator=None):
         """Sets the slope's parts from the robot `params`, its `flat` copy, the flat design's
-        `schedule` and the controller's `gains`; after `Controller.__init__` (it reads the period)."""
+        `schedule` and the controller's `gains`; after `Controller.__init__` (it reads the period).
+        `estimator`: the estimate's class (`SlopeEstimator`, or `SlopeEstimatorC`; None: the first)."""
         self.model_slope = np.array([params.slope, 0.0])
         self._slope_schedule = design_slope_schedule(flat, schedule) \
             if params.slope != 0.0 or gains.slope_estimate_s > 0.0 else None
-        self._estimator = SlopeEstimator(flat, self.period, gains.slope_estimate_s) \
+        self._estimator = (estimator or SlopeEstimator)(flat, self.period, gains.slope_estimate_s) \
             if gains.slope_estimate_s > 0.0 else None
         self._pendulum_schedule = design_pendulum_schedule(flat, schedule) if gains.pendulum_feedforward > 0.0 else None
         self._applied = np.zeros(2)

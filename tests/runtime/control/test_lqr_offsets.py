@@ -25,10 +25,10 @@ def _ptr(a):
 
 def _random_offsets(controller, rng):
     """Random slope, torque offset and pendulum in the controller's estimate (what `offsets` reads)."""
-    est = controller._estimator
-    est.slope = rng.normal(0, 0.05, 2)
-    est.torque_offset = rng.normal(0, 0.02, 2)
-    est._moved = np.concatenate([[rng.normal(0, 0.05)], rng.normal(0, 0.005, 3), [rng.normal(0, 0.01)]])
+    est = controller._estimator._c
+    est.offsets.slope[0:2] = rng.normal(0, 0.05, 2).tolist()
+    est.offsets.torque_offset[0:2] = rng.normal(0, 0.02, 2).tolist()
+    est.offsets.pendulum[0:4] = np.concatenate([[rng.normal(0, 0.05)], rng.normal(0, 0.005, 3)]).tolist()
 
 
 def _mismatch(controller, samples=40, seed=3, offsets=None):
