@@ -14,7 +14,7 @@
 /* The probes and scales of runtime/control/slope.py (PROBE_SLOPE, PREDICT_DT, TORQUE_PROBE, MASS_PROBE,
  * CENTRE_PROBE_M, MASS_SCALE, CENTRE_SCALE_M, DAMPING_PROBE, DAMPING_SCALE). */
 #define PROBE_SLOPE SR_C(1e-3)
-#define PREDICT_DT 0.005
+#define PREDICT_DT SR_C(0.005)
 #define TORQUE_PROBE SR_C(1e-3)
 #define MASS_PROBE SR_C(1e-3)
 #define CENTRE_PROBE SR_C(1e-4)
@@ -22,24 +22,33 @@
 #define CENTRE_SCALE SR_C(0.01)
 #define DAMPING_PROBE SR_C(1e-4)
 #define DAMPING_SCALE SR_C(0.01)
-#define PI_HALF 1.57079632679489661923
+/* cos and sin of -pi/2 as libm gives them for the double nearest -pi/2 (Python's math.cos, math.sin) */
+#define COS_MINUS_PI_HALF SR_C(6.123233995736766e-17)
+#define SIN_MINUS_PI_HALF SR_C(-1.0)
+#ifdef SR_USE_FLOAT
+#define SLOPE_CEIL ceilf
+#define SLOPE_EXP expf
+#else
+#define SLOPE_CEIL ceil
+#define SLOPE_EXP exp
+#endif
 
 int sr_slope_init(sr_slope_estimator *est, const sr_real params[SR_NPARAM], sr_real period, sr_real time_constant)
 {
     sr_real p[SR_NPARAM], moved[SR_NPARAM];
     sr_slope_estimator e;
-    double steps;
+    sr_real steps;
     int k, status;
     if (!est || !params) return SR_ERR_NULL;
     if (!all_finite(params, SR_NPARAM) || !all_finite(&period, 1) || !all_finite(&time_constant, 1))
         return SR_ERR_NONFINITE;
     if (!(period > 0) || !(time_constant > 0)) return SR_ERR_ARG;
-    steps = ceil((double)period / PREDICT_DT - 1e-9);
+    steps = SLOPE_CEIL(period / PREDICT_DT - SR_C(1e-9));
     if (steps > SR_SLOPE_MAX_STEPS) return SR_ERR_ARG;
     memset(&e, 0, sizeof e);
     e.steps = steps < 1 ? 1 : (int)steps;
     e.period = period;
-    e.forget = (sr_real)exp(-(double)period / (double)time_constant);
+    e.forget = SLOPE_EXP(-period / time_constant);
     memcpy(p, params, sizeof p);
     p[SR_P_slope] = 0;
     status = sr_model_init(&e.flat, p);
@@ -202,7 +211,7 @@ int sr_slope_update(sr_slope_estimator *est, const sr_real x[SR_NX], const sr_re
     if (status == SR_OK) status = rates(est, &est->sloped, est->last, u, nu);
     for (i = 0; i < SR_NV && status == SR_OK; ++i) G[i][0] = (nu[i] - flat[i]) / PROBE_SLOPE;
     if (status == SR_OK) {
-        const sr_real c = (sr_real)cos(-PI_HALF), s = (sr_real)sin(-PI_HALF);
+        const sr_real c = COS_MINUS_PI_HALF, s = SIN_MINUS_PI_HALF;
         const sr_real turn[9] = {c, -s, 0, s, c, 0, 0, 0, 1};
         memcpy(turned, est->last, sizeof turned);
         for (i = 0; i < 3; ++i)
@@ -241,7 +250,7 @@ int sr_slope_update(sr_slope_estimator *est, const sr_real x[SR_NX], const sr_re
     memcpy(est->normal, normal, sizeof normal);
     memcpy(est->rhs, rhs, sizeof rhs);
     memcpy(est->last, x, sizeof est->last);
-    if (condition(normal, NT) < SR_SLOPE_COND_LIMIT) {
+    if (condition(normal, NT) < (sr_real)SR_SLOPE_COND_LIMIT) {
         solve(normal, rhs, NT, theta);
         if (!all_finite(theta, NT)) return SR_OK;
         for (k = 0; k < 2; ++k) {
@@ -250,7 +259,7 @@ int sr_slope_update(sr_slope_estimator *est, const sr_real x[SR_NX], const sr_re
         }
         for (k = 0; k < SR_LQR_NPENDULUM; ++k) est->offsets.pendulum[k] = theta[4 + k] * est->scale[k];
         est->pendulum_damping = theta[8] * est->scale[4];
-    } else if (condition(normal, 4) < SR_SLOPE_COND_LIMIT) {
+    } else if (condition(normal, 4) < (sr_real)SR_SLOPE_COND_LIMIT) {
         /* Until the samples tell the pendulum from the slope and d: those alone, the pendulum held. */
         sr_real held[4];
         for (j = 0; j < 4; ++j) {
