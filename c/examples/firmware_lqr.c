@@ -22,6 +22,7 @@
  * Exit status 0 on success; on an error, a message on stderr and 1.
  */
 #include <stdio.h>
+#include <stdlib.h>
 
 /* -DLQR_TASK_FROM_INCLUDE_PATH -I<dir>: another task's header from <dir> (the tests do this, through
  * c/Makefile's CPPFLAGS, which come before the library's include directories). */
@@ -59,6 +60,10 @@ static void print_row(long n, const sr_real x[SR_NX], const sr_real u[SR_NU])
 #ifdef LQR_TASK_SLOPE_ESTIMATE_S
 /* The slope estimate's state (the seven moved models in it: static storage, not the stack). */
 static sr_slope_estimator estimate;
+#include "systick.h"
+#ifdef HAVE_SYSTICK   /* on a Cortex-M: the instructions of each sample's estimate and law (stderr) */
+static uint32_t sample_ticks[LQR_TASK_SAMPLES];
+#endif
 #endif
 
 int main(void)
@@ -100,12 +105,23 @@ int main(void)
     for (i = 0; i < SR_NX; ++i) x[i] = LQR_TASK_X0[i];
 
     print_header();
+#if defined(LQR_TASK_SLOPE_ESTIMATE_S) && defined(HAVE_SYSTICK)
+    systick_start();
+#endif
     for (k = 0; k < LQR_TASK_SAMPLES; ++k) {
         wait_for_tick();
 #ifdef LQR_TASK_SLOPE_ESTIMATE_S
-        if (LQR_TASK_SLOPE_ESTIMATE_S > 0) status = sr_slope_update(&estimate, x, u);
-        if (status == SR_OK)
-            status = sr_lqr_control_offsets(&LQR_TASK_SCHEDULE, &model, x, &target, offsets, &memory, u, NULL);
+        {
+#ifdef HAVE_SYSTICK
+            const uint32_t start = SYST_CVR;
+#endif
+            if (LQR_TASK_SLOPE_ESTIMATE_S > 0) status = sr_slope_update(&estimate, x, u);
+            if (status == SR_OK)
+                status = sr_lqr_control_offsets(&LQR_TASK_SCHEDULE, &model, x, &target, offsets, &memory, u, NULL);
+#ifdef HAVE_SYSTICK
+            sample_ticks[k] = ticks_since(start);
+#endif
+        }
 #else
         status = sr_lqr_control(&LQR_TASK_SCHEDULE, &model, x, &target, &memory, u, NULL);
 #endif
@@ -126,5 +142,14 @@ int main(void)
         for (i = 0; i < SR_NX; ++i) x[i] = traj[PER][i];
     }
     print_row(LQR_TASK_SAMPLES * PER, x, u);
+#if defined(LQR_TASK_SLOPE_ESTIMATE_S) && defined(HAVE_SYSTICK)
+    {
+        const double per_tick = instructions_per_tick();
+        qsort(sample_ticks + 1, LQR_TASK_SAMPLES - 1, sizeof sample_ticks[0], by_ticks);
+        fprintf(stderr, "instructions per sample (the slope estimate and the law): first %.0f; the other %ld: "
+                "p50 %.0f, max %.0f\n", per_tick * (double)sample_ticks[0], LQR_TASK_SAMPLES - 1,
+                per_tick * (double)sample_ticks[LQR_TASK_SAMPLES / 2], per_tick * (double)sample_ticks[LQR_TASK_SAMPLES - 1]);
+    }
+#endif
     return 0;
 }
