@@ -33,11 +33,33 @@
 #define SLOPE_EXP exp
 #endif
 
+/* The model's parameters p (slope 0) with the estimate's model k moved: -1 the probe slope, 0 m_P
+ * (relative step), 1..3 c_P x, y, z (metres), 4 k_P (absolute); *step and *scale of its column. */
+static void moved_params(const sr_real p[SR_NPARAM], int k, sr_real moved[SR_NPARAM], sr_real *step, sr_real *scale)
+{
+    memcpy(moved, p, SR_NPARAM * sizeof *p);
+    *step = *scale = 1;
+    if (k < 0) {
+        moved[SR_P_slope] = PROBE_SLOPE;
+    } else if (k == 0) {
+        moved[SR_P_m_P] = p[SR_P_m_P] * (1 + MASS_PROBE);
+        *step = MASS_PROBE * p[SR_P_m_P];
+        *scale = MASS_SCALE * p[SR_P_m_P];
+    } else if (k < 4) {
+        moved[SR_P_c_P_x + k - 1] = p[SR_P_c_P_x + k - 1] + CENTRE_PROBE;
+        *step = CENTRE_PROBE;
+        *scale = CENTRE_SCALE;
+    } else {
+        moved[SR_P_k_P] = p[SR_P_k_P] + DAMPING_PROBE;
+        *step = DAMPING_PROBE;
+        *scale = DAMPING_SCALE;
+    }
+}
+
 int sr_slope_init(sr_slope_estimator *est, const sr_real params[SR_NPARAM], sr_real period, sr_real time_constant)
 {
-    sr_real p[SR_NPARAM], moved[SR_NPARAM];
-    sr_slope_estimator e;
-    sr_real steps;
+    sr_real p[SR_NPARAM], moved[SR_NPARAM], steps, step, scale;
+    sr_model probe;     /* each model tried here first: *est is written only when all of them are valid */
     int k, status;
     if (!est || !params) return SR_ERR_NULL;
     if (!all_finite(params, SR_NPARAM) || !all_finite(&period, 1) || !all_finite(&time_constant, 1))
@@ -45,40 +67,27 @@ int sr_slope_init(sr_slope_estimator *est, const sr_real params[SR_NPARAM], sr_r
     if (!(period > 0) || !(time_constant > 0)) return SR_ERR_ARG;
     steps = SLOPE_CEIL(period / PREDICT_DT - SR_C(1e-9));
     if (steps > SR_SLOPE_MAX_STEPS) return SR_ERR_ARG;
-    memset(&e, 0, sizeof e);
-    e.steps = steps < 1 ? 1 : (int)steps;
-    e.period = period;
-    e.forget = SLOPE_EXP(-period / time_constant);
     memcpy(p, params, sizeof p);
     p[SR_P_slope] = 0;
-    status = sr_model_init(&e.flat, p);
-    if (status != SR_OK) return status;
-    memcpy(moved, p, sizeof moved);
-    moved[SR_P_slope] = PROBE_SLOPE;
-    status = sr_model_init(&e.sloped, moved);
-    /* the pendulum's columns: m_P (relative step), c_P x, y, z (metres), k_P (absolute) */
-    for (k = 0; k < NM && status == SR_OK; ++k) {
-        sr_real step, scale;
-        memcpy(moved, p, sizeof moved);
-        if (k == 0) {
-            moved[SR_P_m_P] = p[SR_P_m_P] * (1 + MASS_PROBE);
-            step = MASS_PROBE * p[SR_P_m_P];
-            scale = MASS_SCALE * p[SR_P_m_P];
-        } else if (k < 4) {
-            moved[SR_P_c_P_x + k - 1] = p[SR_P_c_P_x + k - 1] + CENTRE_PROBE;
-            step = CENTRE_PROBE;
-            scale = CENTRE_SCALE;
-        } else {
-            moved[SR_P_k_P] = p[SR_P_k_P] + DAMPING_PROBE;
-            step = DAMPING_PROBE;
-            scale = DAMPING_SCALE;
-        }
-        e.factor[k] = scale / step;
-        e.scale[k] = scale;
-        status = sr_model_init(&e.moved[k], moved);
+    status = sr_model_init(&probe, p);
+    for (k = -1; k < NM && status == SR_OK; ++k) {
+        moved_params(p, k, moved, &step, &scale);
+        status = sr_model_init(&probe, moved);
     }
     if (status != SR_OK) return status;
-    *est = e;
+    memset(est, 0, sizeof *est);
+    est->steps = steps < 1 ? 1 : (int)steps;
+    est->period = period;
+    est->forget = SLOPE_EXP(-period / time_constant);
+    sr_model_init(&est->flat, p);
+    moved_params(p, -1, moved, &step, &scale);
+    sr_model_init(&est->sloped, moved);
+    for (k = 0; k < NM; ++k) {
+        moved_params(p, k, moved, &step, &scale);
+        est->factor[k] = scale / step;
+        est->scale[k] = scale;
+        sr_model_init(&est->moved[k], moved);
+    }
     return SR_OK;
 }
 
