@@ -667,7 +667,8 @@ static const sr_lqr LQR_TASK_SCHEDULE = {
         SR_C(1.1567168863062747), SR_C(-8.354557957332002), SR_C(24.32791200641743), SR_C(2.254399833111082), SR_C(9.343750967565683), SR_C(-4.054330109316419),
         SR_C(27.027910818503866), SR_C(0.9334892661244617), SR_C(0.5514031867805806), SR_C(0.0), SR_C(0.0), SR_C(-0.0334283436675469)}},
     /* heading_band, heading_rise */ SR_C(0.2), SR_C(3.0),
-    /* recovery_cross_track, recovery_heading, recovery_slow, recovery_rise */ SR_C(0.0), SR_C(0.0), SR_C(0.0), SR_C(1.0)
+    /* recovery_cross_track, recovery_heading, recovery_slow, recovery_rise */ SR_C(0.0), SR_C(0.0), SR_C(0.0), SR_C(1.0),
+    /* slope, pendulum, pendulum_share: no feedforward tables */ NULL, NULL, SR_C(0.0)
 };
 
 #endif /* LQR_TASK_H */

@@ -118,6 +118,10 @@ static int parse(const char *line, int *kind, double *t, sr_real v[SR_NIMU])
     return 1;
 }
 
+#ifdef LQR_TASK_SLOPE_ESTIMATE_S
+#error "firmware_ekf_lqr: the task's LQR has a slope feedforward or estimate, which this example does not run (c/examples/firmware_lqr.c does)"
+#endif
+
 int main(void)
 {
     static const sr_real zero_bias[SR_NBIAS] = {0};

@@ -15,9 +15,14 @@
  * the rows equal, bit for bit, the Python closed loop of the same task
  * (runtime.control.closed_loop.simulate_closed_loop with the C controller,
  * tests/runtime/control/test_firmware.py).  Build: `make example` in c/.
+ * With the slope's feedforward in the task's LQR (the header then defines LQR_TASK_SLOPE_ESTIMATE_S:
+ * `slope_estimate_s` > 0, or a slope in the controller's model), every sample first updates the slope
+ * estimate (sr_slope_update: the state and the torques held since the last sample) and the law feeds
+ * its offsets forward (sr_lqr_control_offsets); without an estimate, the model's slope.
  * Exit status 0 on success; on an error, a message on stderr and 1.
  */
 #include <stdio.h>
+#include <stdlib.h>
 
 /* -DLQR_TASK_FROM_INCLUDE_PATH -I<dir>: another task's header from <dir> (the tests do this, through
  * c/Makefile's CPPFLAGS, which come before the library's include directories). */
@@ -52,19 +57,47 @@ static void print_row(long n, const sr_real x[SR_NX], const sr_real u[SR_NU])
     printf(",%.17g,%.17g\n", (double)u[0], (double)u[1]);
 }
 
+#ifdef LQR_TASK_SLOPE_ESTIMATE_S
+/* The slope estimate's state (the seven moved models in it: static storage, not the stack). */
+static sr_slope_estimator estimate;
+#include "systick.h"
+#ifdef HAVE_SYSTICK   /* on a Cortex-M: the instructions of each sample's estimate and law (stderr) */
+static uint32_t sample_ticks[LQR_TASK_SAMPLES];
+#endif
+#endif
+
 int main(void)
 {
-    sr_model model;
+    sr_model model, plant;
     sr_lqr_memory memory;
     const sr_lqr_target target = {LQR_TASK_SPEED, LQR_TASK_HEADING, 0, 0, 0};
-    sr_real x[SR_NX], traj[PER + 1][SR_NX], u[SR_NU], u_hold[PER][SR_NU];
+    sr_real x[SR_NX], traj[PER + 1][SR_NX], u[SR_NU] = {0, 0}, u_hold[PER][SR_NU];   /* u: held before the first sample */
     long k, done;
     int i, status;
+#ifdef LQR_TASK_SLOPE_ESTIMATE_S
+    sr_lqr_offsets known = {{0, 0}, {0, 0}, {0, 0, 0, 0}};
+    const sr_lqr_offsets *offsets = &estimate.offsets;
+#endif
 
     status = sr_model_init(&model, LQR_TASK_PARAMS);
+#ifdef LQR_TASK_HAS_PLANT   /* a robot unlike the controller's model */
+    if (status == SR_OK) status = sr_model_init(&plant, LQR_TASK_PLANT_PARAMS);
+#else
+    plant = model;
+#endif
     if (status == SR_OK) status = sr_lqr_check(&LQR_TASK_SCHEDULE);
     if (status == SR_OK) status = sr_check_state(&model, LQR_TASK_X0);
     if (status == SR_OK) status = sr_lqr_reset(&memory);
+#ifdef LQR_TASK_SLOPE_ESTIMATE_S
+    /* the estimate's offsets, or (no estimate) the model's slope */
+    known.slope[0] = LQR_TASK_MODEL_SLOPE[0];
+    known.slope[1] = LQR_TASK_MODEL_SLOPE[1];
+    if (LQR_TASK_SLOPE_ESTIMATE_S > 0) {
+        if (status == SR_OK) status = sr_slope_init(&estimate, LQR_TASK_PARAMS, LQR_TASK_SCHEDULE.period, LQR_TASK_SLOPE_ESTIMATE_S);
+    } else {
+        offsets = &known;
+    }
+#endif
     if (status != SR_OK) {
         fprintf(stderr, "firmware_lqr: setup failed: %s\n", sr_status_string(status));
         return 1;
@@ -72,9 +105,26 @@ int main(void)
     for (i = 0; i < SR_NX; ++i) x[i] = LQR_TASK_X0[i];
 
     print_header();
+#if defined(LQR_TASK_SLOPE_ESTIMATE_S) && defined(HAVE_SYSTICK)
+    systick_start();
+#endif
     for (k = 0; k < LQR_TASK_SAMPLES; ++k) {
         wait_for_tick();
+#ifdef LQR_TASK_SLOPE_ESTIMATE_S
+        {
+#ifdef HAVE_SYSTICK
+            const uint32_t start = SYST_CVR;
+#endif
+            if (LQR_TASK_SLOPE_ESTIMATE_S > 0) status = sr_slope_update(&estimate, x, u);
+            if (status == SR_OK)
+                status = sr_lqr_control_offsets(&LQR_TASK_SCHEDULE, &model, x, &target, offsets, &memory, u, NULL);
+#ifdef HAVE_SYSTICK
+            sample_ticks[k] = ticks_since(start);
+#endif
+        }
+#else
         status = sr_lqr_control(&LQR_TASK_SCHEDULE, &model, x, &target, &memory, u, NULL);
+#endif
         if (status != SR_OK) {
             fprintf(stderr, "firmware_lqr: controller sample %ld failed: %s\n", k, sr_status_string(status));
             return 1;
@@ -83,7 +133,7 @@ int main(void)
             u_hold[i][0] = u[0];
             u_hold[i][1] = u[1];
         }
-        status = sr_simulate(&model, LQR_TASK_METHOD, x, LQR_TASK_DT, PER, &u_hold[0][0], &traj[0][0], &done);
+        status = sr_simulate(&plant, LQR_TASK_METHOD, x, LQR_TASK_DT, PER, &u_hold[0][0], &traj[0][0], &done);
         if (status != SR_OK) {
             fprintf(stderr, "firmware_lqr: plant step %ld failed: %s\n", k * PER + done + 1, sr_status_string(status));
             return 1;
@@ -92,5 +142,14 @@ int main(void)
         for (i = 0; i < SR_NX; ++i) x[i] = traj[PER][i];
     }
     print_row(LQR_TASK_SAMPLES * PER, x, u);
+#if defined(LQR_TASK_SLOPE_ESTIMATE_S) && defined(HAVE_SYSTICK)
+    {
+        const double per_tick = instructions_per_tick();
+        qsort(sample_ticks + 1, LQR_TASK_SAMPLES - 1, sizeof sample_ticks[0], by_ticks);
+        fprintf(stderr, "instructions per sample (the slope estimate and the law): first %.0f; the other %ld: "
+                "p50 %.0f, max %.0f\n", per_tick * (double)sample_ticks[0], LQR_TASK_SAMPLES - 1,
+                per_tick * (double)sample_ticks[LQR_TASK_SAMPLES / 2], per_tick * (double)sample_ticks[LQR_TASK_SAMPLES - 1]);
+    }
+#endif
     return 0;
 }

@@ -756,7 +756,33 @@ int sr_regressor_batch(const sr_model *model, long n, const sr_real *x, const sr
 #define sr_lqr_reset sr_lqr_reset_f
 #define sr_lqr_error sr_lqr_error_f
 #define sr_lqr_control sr_lqr_control_f
+#define sr_lqr_control_offsets sr_lqr_control_offsets_f
+#define sr_lqr_slope_table sr_lqr_slope_table_f
+#define sr_lqr_pendulum_table sr_lqr_pendulum_table_f
+#define sr_lqr_offsets sr_lqr_offsets_f
 #endif
+
+#define SR_LQR_NPOINTS (SR_LQR_MAX_SPEEDS * SR_LQR_MAX_CURVATURES) /**< capacity of a schedule's grid points */
+#define SR_LQR_NPENDULUM 4         /**< the pendulum's departure fed forward: (dm_P [kg], dc_P x, y, z [m]) */
+
+/** The operating point's derivatives per radian of slope at each grid point (entry i * n_curvatures
+ * + j, as sr_lqr's tables): the slope along the path (uphill ahead) and across it (uphill on the
+ * robot's right), each the change of z* and u* that Newton's operating point of the flat design
+ * makes on that slope, to first order (runtime/control/slope.py, SlopeSchedule). */
+typedef struct sr_lqr_slope_table {
+    sr_real dz_up[SR_LQR_NPOINTS][SR_LQR_NZ];    /**< dz* / d(slope along the path) [per rad] */
+    sr_real du_up[SR_LQR_NPOINTS][SR_NU];        /**< du* / d(slope along the path) [N m per rad] */
+    sr_real dz_right[SR_LQR_NPOINTS][SR_LQR_NZ]; /**< dz* / d(slope across, uphill on the right) */
+    sr_real du_right[SR_LQR_NPOINTS][SR_NU];     /**< du* / d(slope across) */
+} sr_lqr_slope_table;
+
+/** The operating point's derivatives with respect to the pendulum's parameters at each grid point
+ * (runtime/control/slope.py, PendulumSchedule): row k of dz[i] and du[i] per unit of entry k of
+ * sr_lqr_offsets.pendulum (dm_P [kg], dc_P x, y, z [m]). */
+typedef struct sr_lqr_pendulum_table {
+    sr_real dz[SR_LQR_NPOINTS][SR_LQR_NPENDULUM][SR_LQR_NZ]; /**< dz* per unit of each pendulum entry */
+    sr_real du[SR_LQR_NPOINTS][SR_LQR_NPENDULUM][SR_NU];     /**< du* [N m] per unit of each pendulum entry */
+} sr_lqr_pendulum_table;
 
 /** A gain schedule (read-only during control; fill it from the design, such as the header that
  * `python -m runtime.control.lqr --emit-c` writes).  Point (i, j) of the grid, speed i and
@@ -788,7 +814,18 @@ typedef struct sr_lqr {
     sr_real recovery_heading;                      /**< [rad], >= 0: the law acts on the heading error z[2] - z*[2] clipped to +-this, and beyond it recovers; 0: neither */
     sr_real recovery_slow;                         /**< in [0, 1): at full recovery the speed reference is lowered by this share; 0: not at all */
     sr_real recovery_rise;                         /**< [s], > 0 when recovery_slow > 0: the recovery's weight moves from 0 to 1 (or back) in no less than this */
+    const sr_lqr_slope_table *slope;               /**< the slope's feedforward table (read by sr_lqr_control_offsets); NULL: none */
+    const sr_lqr_pendulum_table *pendulum;         /**< the pendulum's feedforward table (read by sr_lqr_control_offsets); NULL: none */
+    sr_real pendulum_share;                        /**< in [0, 1]: the share of the pendulum's feedforward applied */
 } sr_lqr;
+
+/** What sr_lqr_control_offsets feeds forward at one sample: a slope, a torque offset and the
+ * pendulum's departure from the model (from an estimate, sr_slope_update, or known). */
+typedef struct sr_lqr_offsets {
+    sr_real slope[2];                      /**< the world's slope vector alpha (cos beta, sin beta) [rad]: inclination alpha, uphill towards beta */
+    sr_real torque_offset[2];              /**< d [N m]: the plant moves as the model under u + d; the law subtracts it */
+    sr_real pendulum[SR_LQR_NPENDULUM];    /**< the pendulum's departure from the model: dm_P [kg], dc_P (x, y, z) [m] */
+} sr_lqr_offsets;
 
 /** What to track at this sample (from the reference). */
 typedef struct sr_lqr_target {
@@ -813,7 +850,8 @@ typedef struct sr_lqr_memory {
 /** Checks a schedule: sizes in range, grids strictly increasing, every entry finite, period
  * and u_max > 0, kappa_rate, steady_rate, tight_band and tight_fall >= 0, tight_wait in [0, 1], tight_rise > 0 when tight_band > 0
  * (K_tight is read only then), heading_band >= 0, heading_rise > 0 when heading_band > 0 (K_heading_tight is read only then),
- * recovery_cross_track and recovery_heading >= 0, recovery_slow in [0, 1), recovery_rise > 0 when recovery_slow > 0.  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
+ * recovery_cross_track and recovery_heading >= 0, recovery_slow in [0, 1), recovery_rise > 0 when recovery_slow > 0,
+ * pendulum_share in [0, 1], the feedforward tables (when not NULL) finite at every grid point.  Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG. */
 int sr_lqr_check(const sr_lqr *lqr);
 
 /** Zeroes the memory.  Returns SR_OK or SR_ERR_NULL. */
@@ -835,6 +873,93 @@ int sr_lqr_error(const sr_model *model, const sr_real x[SR_NX], const sr_lqr_tar
 int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_NX],
                    const sr_lqr_target *target, sr_lqr_memory *memory, sr_real u[SR_NU],
                    sr_real u_raw[SR_NU]);
+
+/** sr_lqr_control with the offsets fed forward (offsets NULL: exactly sr_lqr_control).  At the
+ * reference's speed v_ref (before any recovery slowing) and the operating curvature kappa of this
+ * sample (0 on a heading reference), with the gain K (K_path on a path, K_heading otherwise, without
+ * the tight gains) and the tables interpolated bilinearly as the schedule is:
+ *     u_raw = (the law's torques) + du_s + K dz_s - d + pendulum_share (du_p + K dz_p),
+ * (dz_s, du_s) = up (dz_up, du_up) + right (dz_right, du_right), up = s_x cos psi + s_y sin psi and
+ * right = s_x sin psi - s_y cos psi the slope vector's components along the reference's heading psi
+ * and to its right, (dz_p, du_p) = sum_k pendulum[k] (dz[k], du[k]), d the torque offset; a table
+ * that is NULL adds nothing.  u is u_raw clipped to +-u_max.  The feedforward is added after the
+ * law's own limits: the conditional integration and the tight weight's clip (memory->saturated) see
+ * the law's torques without it, as runtime/control/lqr.py's controller has it.  Checks as
+ * sr_lqr_control, and the offsets for finiteness (SR_ERR_NONFINITE); u, u_raw and the memory are
+ * written only on SR_OK. */
+int sr_lqr_control_offsets(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_NX],
+                           const sr_lqr_target *target, const sr_lqr_offsets *offsets, sr_lqr_memory *memory,
+                           sr_real u[SR_NU], sr_real u_raw[SR_NU]);
+/** @} */
+
+/** @name Slope estimate (c/src/sr_slope.c)
+ * The world's slope vector s, a torque offset d and the pendulum's departure from the model (dm_P,
+ * dc_P, and its joint damping dk_P) from the measured states and the torques held between them,
+ * for the LQR's feedforward (sr_lqr_control_offsets); runtime/control/slope.py's SlopeEstimator
+ * (its reference: the same arithmetic) and docs/control.md describe it.  At each sample after the
+ * first, the rates nu one period after the last state x0 under the torques u held are predicted by
+ * the flat model (slope 0) in RKMK4 steps of at most 5 ms (sr_simulate), and the measured rates'
+ * departure from that prediction is fitted as G theta, theta = (s_x, s_y, d_1, d_2, the pendulum's
+ * m_P, c_P x, y, z and k_P scaled to a tenth of m_P, 1 cm, 1 cm, 1 cm and 0.01 N m s): G's columns
+ * the predictions of the model on a slope of 1e-3 rad (along x; along y with x0 turned by -pi/2
+ * about the vertical), under u + 1e-3 N m on each motor and with each pendulum parameter moved
+ * (m_P by 0.1 %, c_P by 0.1 mm, k_P by 1e-4 N m s), less the flat one, per unit of each entry.
+ * Normal equations with exponential forgetting, N = f N + G^T G, b = f b + G^T (nu - nu_flat),
+ * f = exp(-period / time_constant); theta = N^-1 b (Gaussian elimination with partial pivoting)
+ * when N's 2-norm condition number (for the symmetric N: the ratio of its eigenvalues' magnitudes,
+ * by Jacobi rotations) is below SR_SLOPE_COND_LIMIT; else, while the leading 4 x 4 block (slope and
+ * d) is below it, those four alone with the pendulum's entries held at their last estimate (rolling
+ * straight at the start the samples do not yet tell them apart); else the estimate is held.  The
+ * estimator's state, its moved models included, lives in the caller's struct: no allocation. */
+/** @{ */
+#define SR_SLOPE_NTHETA 9          /**< the fitted entries: slope (2), torque offset (2), pendulum (4), its damping */
+#define SR_SLOPE_NMOVED 5          /**< the pendulum's parameters moved: m_P, c_P x, y, z, k_P */
+#define SR_SLOPE_MAX_STEPS 16      /**< the prediction's RKMK4 steps per period at most (period <= 80 ms) */
+#define SR_SLOPE_COND_LIMIT 1e10   /**< the condition number below which the normal equations are solved */
+
+#ifdef SR_USE_FLOAT
+#define sr_slope_estimator sr_slope_estimator_f
+#define sr_slope_init sr_slope_init_f
+#define sr_slope_reset sr_slope_reset_f
+#define sr_slope_update sr_slope_update_f
+#endif
+
+/** The estimator's state (fill with sr_slope_init).  Read offsets and pendulum_damping; the rest is
+ * its working state. */
+typedef struct sr_slope_estimator {
+    sr_model flat;                          /**< the robot with slope 0 */
+    sr_model sloped;                        /**< ... on the probe slope */
+    sr_model moved[SR_SLOPE_NMOVED];        /**< ... with one pendulum parameter moved each */
+    sr_real factor[SR_SLOPE_NMOVED];        /**< each pendulum column's scale over its probe's step */
+    sr_real scale[SR_SLOPE_NMOVED];         /**< each pendulum column's scale (theta's unit) */
+    sr_real period;                         /**< the sampling period [s] */
+    sr_real forget;                         /**< exp(-period / time_constant) */
+    int steps;                              /**< RKMK4 steps per period */
+    int started;                            /**< nonzero once a state is held */
+    sr_real normal[SR_SLOPE_NTHETA * SR_SLOPE_NTHETA]; /**< the normal equations' matrix N (row-major) */
+    sr_real rhs[SR_SLOPE_NTHETA];           /**< ... and right-hand side b */
+    sr_real last[SR_NX];                    /**< the last state */
+    sr_lqr_offsets offsets;                 /**< out: the slope vector [rad], torque offset [N m] and pendulum (dm_P [kg], dc_P [m]) */
+    sr_real pendulum_damping;               /**< out: dk_P [N m s/rad] */
+    sr_real work[(SR_SLOPE_MAX_STEPS + 1) * SR_NX]; /**< the predictions' trajectory (scratch) */
+} sr_slope_estimator;
+
+/** Fills the estimator for the robot params (its slope ignored: the model is the flat one) at the
+ * sampling period [s] with the forgetting time constant [s], and resets it.  Returns SR_OK,
+ * SR_ERR_NULL, SR_ERR_NONFINITE, SR_ERR_ARG (period or time_constant not > 0, period above
+ * SR_SLOPE_MAX_STEPS * 5 ms), or sr_model_init's status for params or a moved copy; *est is written
+ * only on SR_OK. */
+int sr_slope_init(sr_slope_estimator *est, const sr_real params[SR_NPARAM], sr_real period, sr_real time_constant);
+
+/** Forgets the samples and the estimate (zeros).  Returns SR_OK or SR_ERR_NULL. */
+int sr_slope_reset(sr_slope_estimator *est);
+
+/** One sample: the measured (or estimated) state x and the torques u held since the last sample
+ * (ignored at the first).  Updates est->offsets and est->pendulum_damping as described above.
+ * Checks x in full (sr_check_state) and u for finiteness; returns SR_OK, SR_ERR_NULL,
+ * SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT or a prediction's sr_simulate status (the
+ * estimator then unchanged). */
+int sr_slope_update(sr_slope_estimator *est, const sr_real x[SR_NX], const sr_real u[SR_NU]);
 /** @} */
 
 #ifdef __cplusplus

@@ -15,7 +15,9 @@
  * One controller sample k of sr_loop_lqr, at t = k period: the filter is predicted to t under the
  * torques held since the last sample (when t is past its time), the target is read at the estimate's
  * position, the operating curvature is the mean of the path's curvature at the preview distances
- * (or the nearest sample's when there are none), sr_lqr_control gives the torques, and the run
+ * (or the nearest sample's when there are none), the slope estimate (when given) takes the estimate
+ * and the torques held since the last sample (sr_slope_update), sr_lqr_control_offsets gives the
+ * torques (with the estimate's offsets, or the fixed ones, or none: sr_lqr_control), and the run
  * advances the controller's period (sr_sim_advance) under them.  This is the order of
  * runtime/control/closed_loop.py's Python loop, which stays the reference.
  *
@@ -92,11 +94,15 @@ int sr_path_cross_track(sr_path *path, const sr_real *positions, long n, long st
  * each step), torques count x SR_NU, estimates count x SR_NX (what the controller read), applied count
  * (the run's samples applied by the end of each controller sample).  saturated (may be NULL) is
  * increased by the samples at which a torque reached u_max within a relative 1e-9.  done: the
- * samples completed; failed_in: where an error stopped the run (SR_LOOP_*).  Returns SR_OK,
+ * samples completed; failed_in: where an error stopped the run (SR_LOOP_*; the slope estimate's
+ * errors are SR_LOOP_CONTROL's).  estimate (may be NULL): the slope estimate, updated at every
+ * sample before the law, whose offsets the law feeds forward; without it, offsets (may be NULL: the
+ * plain law) are fed forward at every sample (a known slope).  Returns SR_OK,
  * SR_ERR_NULL, SR_ERR_ARG (per < 1, count < 0, n_preview < 0, steps beyond the run, an invalid
  * schedule's sizes), sr_sim_check's or sr_path_check's status, or the first failing call's. */
 int sr_loop_lqr(sr_sim *sim, const sr_model *plant, sr_ekf *ekf, const sr_model *model, const sr_lqr *lqr,
-                sr_lqr_memory *memory, sr_path *path, const sr_real *preview, int n_preview, long per, long first,
+                sr_lqr_memory *memory, sr_slope_estimator *estimate, const sr_lqr_offsets *offsets,
+                sr_path *path, const sr_real *preview, int n_preview, long per, long first,
                 long count, sr_real x[SR_NX], sr_real u[SR_NU], sr_real *traj, sr_real *torques,
                 sr_real *estimates, long *applied, long *saturated, long *done, int *failed_in);
 

@@ -22,7 +22,7 @@ static int valid_sizes(const sr_lqr *lqr)
         && lqr->tight_fall >= 0 && lqr->tight_wait >= 0 && lqr->tight_wait <= 1 && lqr->heading_band >= 0
         && (lqr->heading_band == 0 || lqr->heading_rise > 0) && lqr->recovery_cross_track >= 0
         && lqr->recovery_heading >= 0 && lqr->recovery_slow >= 0 && lqr->recovery_slow < 1
-        && (lqr->recovery_slow == 0 || lqr->recovery_rise > 0);
+        && (lqr->recovery_slow == 0 || lqr->recovery_rise > 0) && lqr->pendulum_share >= 0 && lqr->pendulum_share <= 1;
 }
 
 int sr_lqr_check(const sr_lqr *lqr)
@@ -34,7 +34,8 @@ int sr_lqr_check(const sr_lqr *lqr)
         || !all_finite(&lqr->tight_fall, 1) || !all_finite(&lqr->tight_wait, 1)
         || !all_finite(&lqr->world_share, 1) || !all_finite(&lqr->heading_band, 1) || !all_finite(&lqr->heading_rise, 1)
         || !all_finite(&lqr->recovery_cross_track, 1) || !all_finite(&lqr->recovery_heading, 1)
-        || !all_finite(&lqr->recovery_slow, 1) || !all_finite(&lqr->recovery_rise, 1))
+        || !all_finite(&lqr->recovery_slow, 1) || !all_finite(&lqr->recovery_rise, 1)
+        || !all_finite(&lqr->pendulum_share, 1))
         return SR_ERR_NONFINITE;
     if (!valid_sizes(lqr)) return SR_ERR_ARG;
     n = lqr->n_speeds * lqr->n_curvatures;
@@ -44,7 +45,12 @@ int sr_lqr_check(const sr_lqr *lqr)
         if (!all_finite(lqr->z_star[i], SR_LQR_NZ) || !all_finite(lqr->u_star[i], SR_NU)
             || !all_finite(lqr->K_path[i], SR_NU * SR_LQR_NZ) || !all_finite(lqr->K_heading[i], SR_NU * SR_LQR_NZ)
             || (lqr->tight_band > 0 && !all_finite(lqr->K_tight[i], SR_NU * SR_LQR_NZ))
-            || (lqr->heading_band > 0 && !all_finite(lqr->K_heading_tight[i], SR_NU * SR_LQR_NZ)))
+            || (lqr->heading_band > 0 && !all_finite(lqr->K_heading_tight[i], SR_NU * SR_LQR_NZ))
+            || (lqr->slope && (!all_finite(lqr->slope->dz_up[i], SR_LQR_NZ) || !all_finite(lqr->slope->du_up[i], SR_NU)
+                               || !all_finite(lqr->slope->dz_right[i], SR_LQR_NZ)
+                               || !all_finite(lqr->slope->du_right[i], SR_NU)))
+            || (lqr->pendulum && (!all_finite(lqr->pendulum->dz[i][0], SR_LQR_NPENDULUM * SR_LQR_NZ)
+                                  || !all_finite(lqr->pendulum->du[i][0], SR_LQR_NPENDULUM * SR_NU))))
             return SR_ERR_NONFINITE;
     for (i = 1; i < lqr->n_speeds; ++i)
         if (!(lqr->speeds[i] > lqr->speeds[i - 1])) return SR_ERR_ARG;
@@ -124,21 +130,88 @@ static void bracket(const sr_real *grid, int n, sr_real value, int *lo, int *hi,
     *w = *w < 0 ? 0 : (*w > 1 ? 1 : *w);
 }
 
+/* The grid's four points around (v, kappa) and their weights, in the order of the law. */
+static void grid_points(const sr_lqr *lqr, sr_real v, sr_real kappa, int point[4], sr_real weight[4])
+{
+    int i0, i1, j0, j1, n = lqr->n_curvatures;
+    sr_real wv, wk;
+    bracket(lqr->speeds, lqr->n_speeds, v, &i0, &i1, &wv);
+    bracket(lqr->curvatures, lqr->n_curvatures, kappa, &j0, &j1, &wk);
+    point[0] = i0 * n + j0; weight[0] = (1 - wv) * (1 - wk);
+    point[1] = i0 * n + j1; weight[1] = (1 - wv) * wk;
+    point[2] = i1 * n + j0; weight[2] = wv * (1 - wk);
+    point[3] = i1 * n + j1; weight[3] = wv * wk;
+}
+
+/* The feedforward of the offsets (see sr_lqr_control_offsets) at speed v and operating curvature
+ * kappa: du + K dz of the slope's and the pendulum's moves of the operating point, less d. */
+static void feedforward(const sr_lqr *lqr, const sr_lqr_offsets *offsets, const sr_lqr_target *target, sr_real v,
+                        sr_real kappa, sr_real ff[SR_NU])
+{
+    sr_real weight[4], dz[SR_LQR_NZ], du[SR_NU], K[SR_NU][SR_LQR_NZ];
+    const sr_real s = SR_SIN(target->heading), c = SR_COS(target->heading);
+    const sr_real up = offsets->slope[0] * c + offsets->slope[1] * s, right = offsets->slope[0] * s - offsets->slope[1] * c;
+    int point[4], i, j, k, part;
+    grid_points(lqr, v, kappa, point, weight);
+    for (k = 0; k < SR_NU; ++k)
+        for (j = 0; j < SR_LQR_NZ; ++j) {
+            K[k][j] = 0;
+            for (i = 0; i < 4; ++i) K[k][j] += weight[i] * (target->path ? lqr->K_path : lqr->K_heading)[point[i]][k * SR_LQR_NZ + j];
+        }
+    for (k = 0; k < SR_NU; ++k) ff[k] = -offsets->torque_offset[k];
+    for (part = 0; part < 2; ++part) {
+        sr_real share = part == 0 ? 1 : lqr->pendulum_share;
+        if (part == 0 ? !lqr->slope : !lqr->pendulum) continue;
+        memset(dz, 0, sizeof dz);
+        memset(du, 0, sizeof du);
+        for (i = 0; i < 4; ++i) {
+            const int p = point[i];
+            if (part == 0) {
+                for (j = 0; j < SR_LQR_NZ; ++j)
+                    dz[j] += weight[i] * (up * lqr->slope->dz_up[p][j] + right * lqr->slope->dz_right[p][j]);
+                for (k = 0; k < SR_NU; ++k)
+                    du[k] += weight[i] * (up * lqr->slope->du_up[p][k] + right * lqr->slope->du_right[p][k]);
+            } else {
+                int e;
+                for (e = 0; e < SR_LQR_NPENDULUM; ++e) {
+                    for (j = 0; j < SR_LQR_NZ; ++j) dz[j] += weight[i] * offsets->pendulum[e] * lqr->pendulum->dz[p][e][j];
+                    for (k = 0; k < SR_NU; ++k) du[k] += weight[i] * offsets->pendulum[e] * lqr->pendulum->du[p][e][k];
+                }
+            }
+        }
+        for (k = 0; k < SR_NU; ++k) {
+            sr_real kdz = 0;
+            for (j = 0; j < SR_LQR_NZ; ++j) kdz += K[k][j] * dz[j];
+            ff[k] += share * (du[k] + kdz);
+        }
+    }
+}
+
 int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_NX],
                    const sr_lqr_target *target, sr_lqr_memory *memory, sr_real u[SR_NU],
                    sr_real u_raw[SR_NU])
 {
-    sr_real z[SR_LQR_NZ], dz[SR_LQR_NZ], out[SR_NU], raw[SR_NU], kappa, step, wv, wk;
+    return sr_lqr_control_offsets(lqr, model, x, target, NULL, memory, u, u_raw);
+}
+
+int sr_lqr_control_offsets(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_NX],
+                           const sr_lqr_target *target, const sr_lqr_offsets *offsets, sr_lqr_memory *memory,
+                           sr_real u[SR_NU], sr_real u_raw[SR_NU])
+{
+    const sr_lqr_target *reference = target;
+    sr_real z[SR_LQR_NZ], dz[SR_LQR_NZ], out[SR_NU], raw[SR_NU], ff[SR_NU], ff_out[SR_NU], kappa, step;
     sr_real weight[4], k_int[SR_NU][2], step_int[2], tight = 0, normal[2], integrals[2], band, recovery;
     sr_lqr_target slowed;
-    int status = arg_model(model, READS(STATE)), i0, i1, j0, j1, k, j, n, point[4], clipped = 0, recovering = 0;
+    int status = arg_model(model, READS(STATE)), i0, k, j, point[4], clipped = 0, recovering = 0;
     if (status != SR_OK) return status;
     if (!lqr || !x || !target || !memory || !u) return SR_ERR_NULL;
     if (!valid_sizes(lqr)) return SR_ERR_ARG;
     status = sr_internal_check_state(model, x);
     if (status != SR_OK) return status;
     if (!valid_target(target) || !all_finite(memory->integrals, 2) || !all_finite(&memory->kappa, 1)
-        || !all_finite(&memory->tight, 1) || !all_finite(memory->world, 2) || !all_finite(&memory->recovery, 1))
+        || !all_finite(&memory->tight, 1) || !all_finite(memory->world, 2) || !all_finite(&memory->recovery, 1)
+        || (offsets && (!all_finite(offsets->slope, 2) || !all_finite(offsets->torque_offset, 2)
+                        || !all_finite(offsets->pendulum, SR_LQR_NPENDULUM))))
         return SR_ERR_NONFINITE;
 
     /* Recovery: the speed reference lowered by the weight of the samples before (0 unless recovery_slow > 0). */
@@ -153,13 +226,7 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
         kappa = kappa - memory->kappa > step ? memory->kappa + step
               : (kappa - memory->kappa < -step ? memory->kappa - step : kappa);
     }
-    bracket(lqr->speeds, lqr->n_speeds, target->speed, &i0, &i1, &wv);
-    bracket(lqr->curvatures, lqr->n_curvatures, kappa, &j0, &j1, &wk);
-    n = lqr->n_curvatures;
-    point[0] = i0 * n + j0; weight[0] = (1 - wv) * (1 - wk);
-    point[1] = i0 * n + j1; weight[1] = (1 - wv) * wk;
-    point[2] = i1 * n + j0; weight[2] = wv * (1 - wk);
-    point[3] = i1 * n + j1; weight[3] = wv * wk;
+    grid_points(lqr, target->speed, kappa, point, weight);
 
     /* z[10] reads the world part along the path's left normal (-sin psi, cos psi): a pull fixed in
      * the world (a slope) turns against a turning path, and only a world vector can hold it. */
@@ -212,6 +279,14 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
         out[k] = acc > lqr->u_max ? lqr->u_max : (acc < -lqr->u_max ? -lqr->u_max : acc);
         clipped |= out[k] != acc;
     }
+    if (offsets) {      /* the feedforward, after the law's limits (see spherical_robot.h) */
+        feedforward(lqr, offsets, reference, reference->speed, target->path ? kappa : 0, ff);
+        for (k = 0; k < SR_NU; ++k) {
+            ff[k] += raw[k];
+            ff_out[k] = ff[k] > lqr->u_max ? lqr->u_max : (ff[k] < -lqr->u_max ? -lqr->u_max : ff[k]);
+        }
+        if (!all_finite(ff, SR_NU)) return SR_ERR_NONFINITE;
+    }
     if (!all_finite(raw, SR_NU)) return SR_ERR_NONFINITE;
 
     /* Conditional integration: an integrator advances at any error unless its step would push a
@@ -244,7 +319,7 @@ int sr_lqr_control(const sr_lqr *lqr, const sr_model *model, const sr_real x[SR_
     memory->started = 1;
     memory->saturated = clipped;
     memory->tight = tight;
-    memcpy(u, out, sizeof out);
-    if (u_raw) memcpy(u_raw, raw, sizeof raw);
+    memcpy(u, offsets ? ff_out : out, sizeof out);
+    if (u_raw) memcpy(u_raw, offsets ? ff : raw, sizeof raw);
     return SR_OK;
 }

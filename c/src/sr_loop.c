@@ -121,7 +121,8 @@ static int sample_target(sr_path *path, const sr_real *preview, int n_preview, c
 }
 
 int sr_loop_lqr(sr_sim *sim, const sr_model *plant, sr_ekf *ekf, const sr_model *model, const sr_lqr *lqr,
-                sr_lqr_memory *memory, sr_path *path, const sr_real *preview, int n_preview, long per, long first,
+                sr_lqr_memory *memory, sr_slope_estimator *estimate, const sr_lqr_offsets *offsets,
+                sr_path *path, const sr_real *preview, int n_preview, long per, long first,
                 long count, sr_real x[SR_NX], sr_real u[SR_NU], sr_real *traj, sr_real *torques,
                 sr_real *estimates, long *applied, long *saturated, long *done, int *failed_in)
 {
@@ -155,7 +156,10 @@ int sr_loop_lqr(sr_sim *sim, const sr_model *plant, sr_ekf *ekf, const sr_model 
         }
         if (estimates) memcpy(estimates + k * SR_NX, ekf->x, sizeof ekf->x);
         status = sample_target(path, preview, n_preview, ekf->x, &target);
-        if (status == SR_OK) status = sr_lqr_control(lqr, model, ekf->x, &target, memory, out, NULL);
+        if (status == SR_OK && estimate) status = sr_slope_update(estimate, ekf->x, u);
+        if (status == SR_OK)
+            status = sr_lqr_control_offsets(lqr, model, ekf->x, &target, estimate ? &estimate->offsets : offsets, memory,
+                                            out, NULL);
         if (status != SR_OK) {
             *failed_in = SR_LOOP_CONTROL;
             return status;

@@ -49,6 +49,7 @@ int main(void)
     suite_general();
     suite_jacobians();
     suite_control();
+    suite_slope();
     suite_trig();
     suite_accel_batch();
     suite_param_lanes();

@@ -71,6 +71,7 @@ void suite_group(void);
 void suite_general(void);
 void suite_jacobians(void);
 void suite_control(void);
+void suite_slope(void);
 void suite_trig(void);
 void suite_accel_batch(void);
 void suite_param_lanes(void);

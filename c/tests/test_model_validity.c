@@ -158,6 +158,13 @@ static int c_lqr_control(const sr_model *m, long n)
     (void)n;
     return sr_lqr_control(&LQR, m, X, &TARGET, &memory, OUT, OUT2);
 }
+static int c_lqr_control_offsets(const sr_model *m, long n)
+{
+    sr_lqr_memory memory = {{0, 0}, 0, 0, 0, 0, {0, 0}, 0};
+    const sr_lqr_offsets offsets = {{SR_C(0.01), 0}, {SR_C(0.001), 0}, {0, 0, 0, 0}};
+    (void)n;
+    return sr_lqr_control_offsets(&LQR, m, X, &TARGET, &offsets, &memory, OUT, OUT2);
+}
 static int c_imu_measure(const sr_model *m, long n)
 {
     (void)n;
@@ -240,6 +247,7 @@ static const model_fn TAKES_MODEL[] = {
     {"sr_step_jacobian_batch", c_step_jacobian_batch, R_JACOBIAN | R_STATE},
     {"sr_lqr_error", c_lqr_error, R_STATE},
     {"sr_lqr_control", c_lqr_control, R_STATE},
+    {"sr_lqr_control_offsets", c_lqr_control_offsets, R_STATE},
     {"sr_imu_measure", c_imu_measure, R_STATE | R_SENSORS},
     {"sr_imu_measure_u", c_imu_measure_u, R_STATE | R_SENSORS | R_ACCEL},
     {"sr_imu_partials", c_imu_partials, R_STATE | R_SENSORS},

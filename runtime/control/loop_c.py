@@ -7,8 +7,8 @@ target and the LQR, one C call per chunk of controller samples.
 It does what runtime/control/closed_loop.py's Python loop does with the LQR (runtime/control/lqr.py)
 on a path reference, sample for sample: the filter predicted to the sample, the target at the
 estimate's position, the operating curvature the mean over the controller's preview, the C law,
-the run advanced one period.  That loop stays the reference it is tested against.  Controllers
-with Python of their own per sample (the slope's feedforward or estimate) are not supported.
+the run advanced one period; with a slope's feedforward, the C slope estimate updated before the law
+(or the model's slope fed forward).  That loop stays the reference it is tested against.
 """
 import dataclasses
 import time
@@ -22,15 +22,16 @@ from ..sensor_sim_c import SensorRunC
 from ..state import IDX_Q, NU
 from .lqr import Lqr
 from .reference import SEARCH_AHEAD_M, SEARCH_BACK_M, Path, Target
+from .slope import SlopeEstimatorC
 
 #: Controller samples per C call (a progress bar moves between calls).
 CHUNK = 500
 
 
 def supports(controller, reference):
-    """True when the C loop runs this pair: the LQR exactly (not a subclass with its own Python)
-    without slope feedforward or estimate, on a path reference."""
-    return (type(controller) is Lqr and controller._slope_schedule is None and controller._estimator is None
+    """True when the C loop runs this pair: the LQR exactly (not a subclass with its own Python), its
+    slope estimate, if any, the C one (`SlopeEstimatorC`: the loop updates it), on a path reference."""
+    return (type(controller) is Lqr and (controller._estimator is None or type(controller._estimator) is SlopeEstimatorC)
             and type(reference) is Path)
 
 
@@ -113,7 +114,7 @@ def run(sim, controller, reference, x0, estimator, per, samples, record_samples,
     apart from the plant in C)."""
     from tqdm.auto import tqdm
     if not supports(controller, reference):
-        raise ValueError(f"engine: the C loop runs the LQR on a path reference without slope feedforward, "
+        raise ValueError(f"engine: the C loop runs the LQR (its slope estimate the C one) on a path reference, "
                          f"got {controller.kind} on {type(reference).__name__}")
     steps = samples * per
     sim_c = SensorRunC(sim, estimator, steps)
@@ -130,13 +131,16 @@ def run(sim, controller, reference, x0, estimator, per, samples, record_samples,
     path = c_path(reference, keep)
     preview = np.ascontiguousarray(controller.preview_distances(None), dtype=np.float64)
     saturated, done, failed_in = ffi.new("long *"), ffi.new("long *"), ffi.new("int *")
+    # the slope estimate's struct, updated in C; else the model's slope fed forward (or nothing)
+    estimate = ffi.NULL if controller._estimator is None else controller._estimator._c
+    offsets = controller.offsets()
     sim_c._c.filter_time = estimator.t
     started = time.perf_counter()
     for first in tqdm(range(0, samples, CHUNK), disable=not progress or None, unit="chunk", leave=False):
         count = min(CHUNK, samples - first)
         status = lib.sr_loop_lqr(sim_c._c, sim.plant._model, estimator.filter._ekf, controller._model._model,
-                                 controller._c, controller._memory, path, _ptr(preview), len(preview), per, first,
-                                 count, _ptr(x), _ptr(u), _ptr(traj[first * per + 1:]), _ptr(torques[first:]),
+                                 controller._c, controller._memory, estimate, offsets, path, _ptr(preview), len(preview),
+                                 per, first, count, _ptr(x), _ptr(u), _ptr(traj[first * per + 1:]), _ptr(torques[first:]),
                                  _ptr(estimates[first:]), ffi.cast("long *", ffi.from_buffer(applied[first:])),
                                  saturated, done, failed_in)
         estimator.t = float(sim_c._c.filter_time)

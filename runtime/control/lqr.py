@@ -24,7 +24,7 @@ from .controller import DEFAULT_U_MAX, Controller
 from .ranges import LQR_RANGES
 from . import lqr_design as design
 from .lqr_design import Schedule
-from .slope import SlopeFeedforward, slope_components
+from .slope import SlopeEstimatorC, SlopeFeedforward, slope_components
 
 
 @dataclasses.dataclass(frozen=True)
@@ -156,9 +156,37 @@ def tight_gain(K_path, K_riccati):
     return K
 
 
+def feedforward_tables(slope_schedule=None, pendulum_schedule=None):
+    """(sr_lqr_slope_table *, sr_lqr_pendulum_table *) (cffi; None for a schedule that is None) of a
+    SlopeSchedule and a PendulumSchedule (runtime/control/slope.py), grid point (i, j) at entry
+    i * n_curvatures + j as `to_c` lays out the LQR's: what `to_c`'s `feedforward` points to (the
+    caller keeps them alive as long as the struct)."""
+    slope = pendulum = None
+    if slope_schedule is not None:
+        slope = ffi.new("sr_lqr_slope_table *")
+        nv, nk = slope_schedule.dz_up.shape[:2]
+        for name in ("dz_up", "du_up", "dz_right", "du_right"):
+            table, values = getattr(slope, name), getattr(slope_schedule, name)
+            for n in range(nv * nk):
+                table[n][0:values.shape[-1]] = values[n // nk, n % nk].tolist()
+    if pendulum_schedule is not None:
+        pendulum = ffi.new("sr_lqr_pendulum_table *")
+        nv, nk, n_entries = pendulum_schedule.dz.shape[:3]
+        if n_entries != lib.SR_LQR_NPENDULUM:
+            raise ValueError(f"controller: the pendulum's schedule has {n_entries} entries; the C controller "
+                             f"feeds forward {lib.SR_LQR_NPENDULUM}")
+        for n in range(nv * nk):
+            for e in range(n_entries):
+                pendulum.dz[n][e][0:design.NZ] = pendulum_schedule.dz[n // nk, n % nk, e].tolist()
+                pendulum.du[n][e][0:2] = pendulum_schedule.du[n // nk, n % nk, e].tolist()
+    return slope, pendulum
+
+
 def to_c(schedule, period, u_max, kappa_rate, steady_rate, tight_band=0.0, tight_rise=1.0, world_share=0.0, tight_fall=0.0,
-         tight_wait=0.0, heading_band=0.0, heading_rise=1.0, recovery=(0.0, 0.0, 0.0, 1.0)):
-    """The schedule as the C struct `sr_lqr` (cffi), checked by `sr_lqr_check`; the tight gains are
+         tight_wait=0.0, heading_band=0.0, heading_rise=1.0, recovery=(0.0, 0.0, 0.0, 1.0), feedforward=(None, None, 0.0)):
+    """The schedule as the C struct `sr_lqr` (cffi), checked by `sr_lqr_check`; `feedforward`: (the
+    slope's table, the pendulum's, the pendulum's share) as `feedforward_tables` makes them (None:
+    none), which the caller keeps alive as long as the struct; the tight gains are
     scheduled in within `tight_band` [m] of the path, over `tight_rise` [s] (and out by 1 per `tight_fall` [s]
     after a clipped torque, to a weight −`tight_wait`, below 0 K_path's; 0: held), when the schedule has them;
     `world_share` of the cross-track integral is held in the world frame; the stiffer heading gains, when
@@ -193,6 +221,9 @@ def to_c(schedule, period, u_max, kappa_rate, steady_rate, tight_band=0.0, tight
     c.heading_band = heading_band if schedule.K_heading_tight is not None else 0.0
     c.heading_rise = heading_rise
     c.recovery_cross_track, c.recovery_heading, c.recovery_slow, c.recovery_rise = recovery
+    slope, pendulum, c.pendulum_share = feedforward
+    c.slope = ffi.NULL if slope is None else slope
+    c.pendulum = ffi.NULL if pendulum is None else pendulum
     status = lib.sr_lqr_check(c)
     if status != lib.SR_OK:
         raise ValueError(f"controller: the LQR schedule is not valid for the C controller "
@@ -226,11 +257,17 @@ class Lqr(SlopeFeedforward, Controller):
         # the flat one, and the slope's direction (the model's +x) is a world vector.
         flat = params.replace(slope=0.0)
         self.schedule = schedule if schedule is not None else design_schedule(flat, rate, u_max, gains)
+        # the slope estimate in C (sr_slope_update): what the C loop updates (runtime/control/slope.py's
+        # SlopeEstimator, its NumPy reference, gives the same to rounding)
+        self._init_slope(params, flat, self.schedule, gains, SlopeEstimatorC)
+        # the feedforward's tables, which the C struct points to (kept here as long as it)
+        self._tables = feedforward_tables(self._slope_schedule, self._pendulum_schedule)
         self._c = to_c(self.schedule, self.period, self.u_max, gains.kappa_rate, gains.steady_rate_m_s,
                        gains.tight_band_m, gains.tight_rise_s, gains.world_share, gains.tight_fall_s, gains.tight_wait,
-                       gains.heading_band_rad, gains.heading_rise_s, recovery_settings(gains))
+                       gains.heading_band_rad, gains.heading_rise_s, recovery_settings(gains),
+                       self._tables + (gains.pendulum_feedforward,))
         self._model = Model(flat)
-        self._init_slope(params, flat, self.schedule, gains)
+        self._offsets = ffi.new("sr_lqr_offsets *")
         self._memory = ffi.new("sr_lqr_memory *")
         self._u, self._raw = np.zeros(2), np.zeros(2)
 
@@ -279,22 +316,43 @@ class Lqr(SlopeFeedforward, Controller):
             self._estimator.update(x, self._applied)
         if target.cross_track is not None:
             target = dataclasses.replace(target, curvature=self.operating_curvature(target))
-        status = lib.sr_lqr_control(self._c, self._model._model, ffi.cast("double *", ffi.from_buffer(x)),
-                                    c_target(target), self._memory, ffi.cast("double *", ffi.from_buffer(self._u)),
-                                    ffi.cast("double *", ffi.from_buffer(self._raw)))
+        status = lib.sr_lqr_control_offsets(self._c, self._model._model, ffi.cast("double *", ffi.from_buffer(x)),
+                                            c_target(target), self.offsets(), self._memory,
+                                            ffi.cast("double *", ffi.from_buffer(self._u)),
+                                            ffi.cast("double *", ffi.from_buffer(self._raw)))
         if status == lib.SR_ERR_MODEL:
             raise KernelError("model", status, f" (controller lqr at t = {t:g} s)")
         if status != lib.SR_OK:
             raise ValueError(f"controller lqr: {ffi.string(lib.sr_status_string(status)).decode()} "
                              f"at t = {t:g} s")
+        return self._raw.copy()
+
+    def offsets(self):
+        """The sr_lqr_offsets * (cffi) the C law feeds forward at this sample (`sr_lqr_control_offsets`:
+        the slope `self.slope`, the estimate's torque offset and pendulum), or NULL without a slope's
+        feedforward (the plain law)."""
         if self._slope_schedule is None:
-            return self._raw.copy()
+            return ffi.NULL
+        c = self._offsets
+        c.slope[0:2] = [float(s) for s in self.slope]
+        if self._estimator is not None:
+            c.torque_offset[0:2] = [float(d) for d in self._estimator.torque_offset]
+            c.pendulum[0:lib.SR_LQR_NPENDULUM] = [float(p) for p in self._estimator.pendulum]
+        return c
+
+    def numpy_feedforward(self, target):
+        """What the C law adds for the offsets (`offsets`) at this sample, written out in NumPy (the
+        tests' reference): the slope's feedforward, less the estimated torque offset, plus the share
+        `pendulum_feedforward` of the pendulum's; zeros without a slope's feedforward.  Read after
+        `compute` (the operating curvature of its sample)."""
+        if self._slope_schedule is None:
+            return np.zeros(2)
         ff = self.slope_feedforward(target)
         if self._estimator is not None:
             ff = ff - self._estimator.torque_offset
         if self._pendulum_schedule is not None:
             ff = ff + self.gains.pendulum_feedforward * self.pendulum_feedforward(target)
-        return self._raw + ff
+        return ff
 
     def _moved(self, target, at):
         """Δu* + K Δz* (2,) [N m] of the operating point's move (Δz*, Δu*) = at(v, κ), at the

@@ -45,6 +45,8 @@ import math
 
 import numpy as np
 
+from bindings._sr import ffi, lib
+
 from ..model import Model
 from ..so3 import rot_z
 from ..state import IDX_NU, IDX_Q, IDX_RS
@@ -271,19 +273,73 @@ class SlopeEstimator:
         return self.slope
 
 
+class SlopeEstimatorC:
+    """`SlopeEstimator` (with its damping column) in C: `sr_slope_update` (c/src/sr_slope.c) on a
+    caller-held `sr_slope_estimator`, the same arithmetic to rounding (its condition number by Jacobi
+    rotations, its solve by Gaussian elimination with partial pivoting); what the C closed loop runs."""
+
+    def __init__(self, params, period, time_constant_s):
+        self.period, self.time_constant_s = float(period), float(time_constant_s)
+        self._c = ffi.new("sr_slope_estimator *")
+        p = np.ascontiguousarray(params.replace(slope=0.0).as_array(), dtype=np.float64)
+        status = lib.sr_slope_init(self._c, ffi.cast("double *", ffi.from_buffer(p)), self.period, self.time_constant_s)
+        if status != lib.SR_OK:
+            raise ValueError(f"slope_estimate_s: the C slope estimate refuses period {self.period!r} s and time "
+                             f"constant {self.time_constant_s!r} s ({ffi.string(lib.sr_status_string(status)).decode()})")
+
+    def reset(self):
+        """Forgets the samples and the estimate."""
+        lib.sr_slope_reset(self._c)
+
+    @property
+    def slope(self):
+        """The world's slope vector [rad]."""
+        return np.array(list(self._c.offsets.slope))
+
+    @property
+    def torque_offset(self):
+        """The torque offset d [N m]."""
+        return np.array(list(self._c.offsets.torque_offset))
+
+    @property
+    def pendulum(self):
+        """The pendulum's departure from the model: (Δm_P [kg], Δc_P (3,) [m])."""
+        return np.array(list(self._c.offsets.pendulum))
+
+    @property
+    def pendulum_damping(self):
+        """Δk_P [N m s/rad]."""
+        return float(self._c.pendulum_damping)
+
+    def update(self, x, u_applied_before):
+        """As `SlopeEstimator.update`: the slope estimate after the measured state x, the torques
+        `u_applied_before` held since the last one."""
+        x = np.ascontiguousarray(x, dtype=np.float64)
+        u = np.ascontiguousarray(u_applied_before, dtype=np.float64)
+        if u.shape != (2,) or not np.all(np.isfinite(u)):
+            raise ValueError(f"u_applied_before: expected 2 finite torques, got {u_applied_before!r}")
+        status = lib.sr_slope_update(self._c, ffi.cast("double *", ffi.from_buffer(x)),
+                                     ffi.cast("double *", ffi.from_buffer(u)))
+        if status != lib.SR_OK:
+            raise ValueError(f"x: the C slope estimate refuses the sample "
+                             f"({ffi.string(lib.sr_status_string(status)).decode()})")
+        return self.slope
+
+
 class SlopeFeedforward:
     """What a controller on the flat model carries for a slope (the LQR's and the NMPC's): the
     model's slope vector, the feedforward's schedule when the model has a slope or the controller
     estimates one, the online estimate (`slope_estimate_s` > 0) and the torques held since the last
     sample, which the estimate's next prediction needs.  A mixin before `Controller`."""
 
-    def _init_slope(self, params, flat, schedule, gains):
+    def _init_slope(self, params, flat, schedule, gains, estimator=None):
         """Sets the slope's parts from the robot `params`, its `flat` copy, the flat design's
-        `schedule` and the controller's `gains`; after `Controller.__init__` (it reads the period)."""
+        `schedule` and the controller's `gains`; after `Controller.__init__` (it reads the period).
+        `estimator`: the estimate's class (`SlopeEstimator`, or `SlopeEstimatorC`; None: the first)."""
         self.model_slope = np.array([params.slope, 0.0])
         self._slope_schedule = design_slope_schedule(flat, schedule) \
             if params.slope != 0.0 or gains.slope_estimate_s > 0.0 else None
-        self._estimator = SlopeEstimator(flat, self.period, gains.slope_estimate_s) \
+        self._estimator = (estimator or SlopeEstimator)(flat, self.period, gains.slope_estimate_s) \
             if gains.slope_estimate_s > 0.0 else None
         self._pendulum_schedule = design_pendulum_schedule(flat, schedule) if gains.pendulum_feedforward > 0.0 else None
         self._applied = np.zeros(2)

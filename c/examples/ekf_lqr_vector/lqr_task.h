@@ -667,7 +667,8 @@ static const sr_lqr LQR_TASK_SCHEDULE = {
         SR_C(1.0876515305282997), SR_C(-7.651346304338515), SR_C(21.91704711840285), SR_C(2.0095295477347106), SR_C(8.479718873663483), SR_C(-3.762155827437976),
         SR_C(24.46717750842318), SR_C(0.8419503500301488), SR_C(0.5002398708376599), SR_C(0.0), SR_C(0.0), SR_C(-0.029922998877083672)}},
     /* heading_band, heading_rise */ SR_C(0.2), SR_C(3.0),
-    /* recovery_cross_track, recovery_heading, recovery_slow, recovery_rise */ SR_C(0.0), SR_C(0.0), SR_C(0.0), SR_C(1.0)
+    /* recovery_cross_track, recovery_heading, recovery_slow, recovery_rise */ SR_C(0.0), SR_C(0.0), SR_C(0.0), SR_C(1.0),
+    /* slope, pendulum, pendulum_share: no feedforward tables */ NULL, NULL, SR_C(0.0)
 };
 
 #endif /* LQR_TASK_H */

@@ -1,6 +1,7 @@
 """The closed-loop firmware example (c/examples/firmware_lqr.c) equals the Python closed loop of the
 same task bit for bit (double build, host), and its gain table, generated/lqr_task.h (written by
 `make generate`), is the current design within the spread of LAPACK builds."""
+import dataclasses
 import re
 import shutil
 import subprocess
@@ -109,3 +110,51 @@ def test_the_dispatcher_command_writes_the_table(fresh_table, tmp_path, capsys):
     out = tmp_path / "lqr_task.h"
     assert main(["firmware-table", "--out", str(out)]) == 0
     assert out.read_text() == fresh_table
+
+
+def _estimating_task():
+    """The firmware task with lqr-slope's settings (the estimate 5 s, the pendulum fed forward), on a
+    plant unlike the model (the pendulum 10 % heavier, its centre of mass 5 mm along the hinge), 10 s."""
+    from runtime.control.offsets import LQR_SLOPE_SETTINGS, SLOPE_ESTIMATE_S
+    task = firmware_task()
+    spec = task.controllers[0]
+    gains = dataclasses.replace(spec.gains, slope_estimate_s=SLOPE_ESTIMATE_S, **LQR_SLOPE_SETTINGS)
+    plant = task.plant_params
+    plant = plant.replace(m_P=plant.m_P * 1.1, c_P=(plant.c_P[0] + 0.005, plant.c_P[1], plant.c_P[2]))
+    task = dataclasses.replace(task, controllers=(dataclasses.replace(spec, gains=gains),), plant_params=plant)
+    return dataclasses.replace(task, scenario=dataclasses.replace(task.scenario, steps=2000))
+
+
+@pytest.fixture(scope="module")
+def estimating_runs(tmp_path_factory):
+    """(firmware rows, Python closed-loop result, header text, build dir, controller) of `_estimating_task`."""
+    tmp = tmp_path_factory.mktemp("firmware-estimate")
+    task = _estimating_task()
+    controller = task.controller()
+    text = header(task, controller)
+    (tmp / "lqr_task.h").write_text(text)
+    rows = build_and_run(tmp, tmp / "build")
+    result = simulate_closed_loop(task.plant_params, controller, task.reference(), task.scenario.x0,
+                                  task.duration, task.scenario.dt, task.scenario.method)
+    return rows, result, text, tmp, controller
+
+
+def test_the_firmware_with_the_slope_estimate_equals_the_python_closed_loop_bit_for_bit(estimating_runs):
+    rows, result, text, _, controller = estimating_runs
+    assert "LQR_TASK_SLOPE_ESTIMATE_S SR_C(5.0)" in text and "&LQR_TASK_PENDULUM_TABLE" in text
+    # the estimate is at work: it reads the heavier pendulum
+    assert controller._estimator.pendulum[0] > 0.05 * controller.params.m_P
+    assert rows.shape == (len(result.time), 38)
+    assert np.array_equal(rows[:, 1:36], result.trajectory)
+    assert np.array_equal(rows[:, 36:38], result.torques)
+
+
+def test_the_estimating_firmwares_check_fails_for_the_time_constant_changed_in_its_7th_digit(estimating_runs):
+    rows, _, text, tmp, _ = estimating_runs
+    changed = text.replace("LQR_TASK_SLOPE_ESTIMATE_S SR_C(5.0)", "LQR_TASK_SLOPE_ESTIMATE_S SR_C(5.000001)")
+    assert changed != text
+    other = tmp / "perturbed"
+    other.mkdir()
+    (other / "lqr_task.h").write_text(changed)
+    perturbed = build_and_run(other, tmp / "build-perturbed")
+    assert not np.array_equal(perturbed[:, 1:36], rows[:, 1:36])

@@ -12,7 +12,9 @@ from runtime.control.estimator import SensorEkf
 from runtime.control.geometry import heading
 from runtime.control.lqr import Lqr
 from runtime.control.loop_c import c_path, supports, track
+from runtime.control.offsets import LQR_SLOPE_SETTINGS, SLOPE_ESTIMATE_S
 from runtime.control.reference import Path
+from runtime.control.slope import SlopeEstimator
 from runtime.state import IDX_Q
 from runtime.sweep.robustness import _task
 from tests.runtime.test_sensor_sim_c import RTOL, _sensors, assert_same_run
@@ -113,15 +115,74 @@ def test_a_path_that_is_not_one_is_refused_with_a_status():
 
 
 def test_a_controller_with_python_of_its_own_is_not_run_in_c():
+    # the slope estimate in NumPy (runtime/control/slope.py's SlopeEstimator) has no C struct to update
     task = _task("circle", "lqr", "default")
     s = task.scenario
-    sloped = Lqr(s.params.replace(slope=0.01), task.rate, task.u_max)
-    assert supports(task.controller(), task.reference())
-    assert not supports(sloped, task.reference())
-    with pytest.raises(ValueError, match="engine: the C loop runs the LQR on a path"):
-        simulate_on_sensors(s.params, sloped, task.reference(), s.x0, 0.1, s.dt,
+    estimating = _slope_controller()
+    assert supports(task.controller(), task.reference()) and supports(estimating, task.reference())
+    estimating._estimator = SlopeEstimator(s.params, estimating.period, SLOPE_ESTIMATE_S)
+    assert not supports(estimating, task.reference())
+    with pytest.raises(ValueError, match="engine: the C loop runs the LQR .its slope estimate the C one. on a path"):
+        simulate_on_sensors(s.params, estimating, task.reference(), s.x0, 0.1, s.dt,
                             SensorEkf(s.params, task.sensors, s.x0, s.method), task.sensors, s.method, 1,
                             engine="c-loop")
+
+
+#: How far the C loop with the slope estimate may stray from the Python loop over its 0.3 s (relative,
+#: against |value| + 1e-3): not bit for bit, as the filter's first samples already differ by 1e-17
+#: between the loops and the estimate's first solves, on normal equations of condition up to 1e10,
+#: magnify that (this start, off the winding path at the torque limit, magnifies any difference five
+#: times per 10 samples even without the estimate).  Measured: 3e-8 (the C estimate in both loops),
+#: 1.2e-7 (the Python loop on the NumPy estimate).
+SLOPE_LOOP_RTOL = 1e-6
+
+
+def _slope_controller():
+    """lqr-slope's LQR (the offset table's settings) on the loop test's task, its estimate the C one."""
+    task = _task("circle", "lqr", "default")
+    gains = dataclasses.replace(task.controllers[0].gains, slope_estimate_s=SLOPE_ESTIMATE_S, **LQR_SLOPE_SETTINGS)
+    return Lqr(task.scenario.params, task.rate, U_MAX, gains)
+
+
+def _relative(a, b):
+    return max(float((np.abs(getattr(a, n) - getattr(b, n)) / (np.abs(getattr(a, n)) + 1e-3)).max())
+               for n in ("trajectory", "estimates", "torques"))
+
+
+@pytest.fixture(scope="module")
+def slope_runs():
+    numpy_estimate = _slope_controller()
+    numpy_estimate._estimator = SlopeEstimator(numpy_estimate.params.replace(slope=0.0), numpy_estimate.period,
+                                               SLOPE_ESTIMATE_S)
+    return _run("python", controller=_slope_controller()), _run("c-loop", controller=_slope_controller()), \
+        _run("python", controller=numpy_estimate)
+
+
+def test_the_c_loop_with_the_slope_estimate_equals_the_python_loop(slope_runs):
+    (python, lqr_python), (c, lqr_c), (numpy_run, lqr_numpy) = slope_runs
+    # the estimate is at work: a slope, a heavier pendulum (the plant's m_P is 10 % up) and a torque offset
+    assert np.abs(lqr_c._estimator.slope).max() > 1e-3 and lqr_c._estimator.pendulum[0] > 0.1
+    assert np.abs(lqr_c._estimator.torque_offset).max() > 0.1
+    assert _relative(python, c) <= SLOPE_LOOP_RTOL
+    assert _relative(numpy_run, c) <= SLOPE_LOOP_RTOL
+    for name in ("slope", "torque_offset", "pendulum"):     # each against its largest entry
+        a, b = getattr(lqr_c._estimator, name), getattr(lqr_numpy._estimator, name)
+        assert np.abs(a - b).max() <= SLOPE_LOOP_RTOL * np.abs(b).max()
+
+
+@pytest.mark.parametrize("plant", ["share", "column", "table"])
+def test_the_slope_loops_comparison_fails_for_a_planted_error(slope_runs, plant):
+    (python, _), _, _ = slope_runs
+    controller = _slope_controller()
+    if plant == "share":                        # the pendulum's feedforward at 99.99 %
+        controller._c.pendulum_share = 0.9999
+    elif plant == "column":                     # the estimate's c_P,z column off by a part in 10^4
+        controller._estimator._c.factor[3] *= 1 + 1e-4
+    else:                                       # the slope's table: dz*/d(up) of every point off by 10^-4
+        for n in range(len(controller._c.slope.dz_up)):
+            controller._c.slope.dz_up[n][3] *= 1 + 1e-4
+    c, _ = _run("c-loop", controller=controller)
+    assert _relative(python, c) > 10 * SLOPE_LOOP_RTOL
 
 
 def test_a_track_of_positions_equals_the_paths_own_matching():
