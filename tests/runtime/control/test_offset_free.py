@@ -162,3 +162,31 @@ def test_with_the_slope_estimate_and_the_offset_estimate_off_a_heavier_yoke_leav
     rms, _ = _shipped_offset_rms("circle m_h +20 %", kind="nmpc-c-slope")
     rms_off, _ = _shipped_offset_rms("circle m_h +20 %", disturbance_gain=0.0, kind="nmpc-c-slope")
     assert rms_off > 5 * rms
+
+
+def _raw_noise_speed_settle(disturbance_gain=None):
+    """(the C NMPC's speed settle time [s] on circle-mismatch, raw noisy rates; the same on the nominal
+    circle), circle-mismatch at its own offset gain or at `disturbance_gain`."""
+    from runtime.control.benchmark import run_task
+    from runtime.control.offsets import with_controller
+    from runtime.control.task import load_task
+
+    task = with_controller(load_task("circle-mismatch"), "nmpc-c")
+    if disturbance_gain is not None:
+        spec = task.controllers[0]
+        spec = dataclasses.replace(spec, gains=dataclasses.replace(spec.gains, disturbance_gain=disturbance_gain))
+        task = dataclasses.replace(task, controllers=(spec,))
+    nominal = run_task(with_controller(load_task("circle"), "nmpc-c"))[2]["speed_settle_s"]
+    return run_task(task)[2]["speed_settle_s"], nominal
+
+
+def test_on_raw_noisy_rates_the_c_nmpcs_speed_settles_within_twice_the_nominal_circles():
+    # The mismatch target's "≤ 2× nominal": 9.8 s against 2 × 5.35 s (AMD EPYC), circle-mismatch's
+    # offset gain 0.01; the next test: at the default 0.05 the speed wanders outside ±5 % till 49.75 s.
+    settle, nominal = _raw_noise_speed_settle()
+    assert settle is not None and settle <= 2 * nominal
+
+
+def test_at_the_default_offset_gain_the_shell_acceleration_chases_the_rate_noise_and_the_speed_does_not_settle():
+    settle, nominal = _raw_noise_speed_settle(disturbance_gain=nmpc.NmpcGains().disturbance_gain)
+    assert settle is None or settle > 2 * nominal
