@@ -53,6 +53,16 @@ def _replayed(recorded, plant=lambda c: None):
     return np.array([p for p, _ in out]), np.array([q for _, q in out])
 
 
+def _conditions(recorded):
+    """Per sample: the 2-norm condition of NumPy's normal equations after the update (1 before the first)."""
+    params, period, samples = recorded
+    python, out = SlopeEstimator(params, period, 5.0), []
+    for x, u in samples:
+        python.update(x, u)
+        out.append(np.linalg.cond(python._normal) if np.any(python._normal) else 1.0)
+    return np.array(out)
+
+
 def _mismatch(recorded, python, c):
     """Per sample: |θ_NumPy − θ_C| / |θ_NumPy| in the estimate's own scaled units (the columns' scales:
     1 rad, 1 N m, a tenth of m_P, 1 cm, 0.01 N m s), 0 before the first estimate."""
@@ -66,7 +76,11 @@ def _mismatch(recorded, python, c):
 def test_the_c_estimate_is_numpys_over_a_whole_closed_loop_run(recorded):
     python, c = _replayed(recorded)
     assert np.abs(python).max(axis=0)[[0, 4, 8]].min() > 0            # slope, pendulum and damping estimated
-    assert _mismatch(recorded, python, c).max() <= 1e-9
+    # Two solves of the same normal equations may differ by up to their condition times the rounding:
+    # the first samples' systems are near 1e10 (the first estimate 1.8e-9 apart on one machine), from
+    # the first second on near 1e7 (1e-9); each sample held to that.
+    bound = np.maximum(1e-12, np.finfo(float).eps * _conditions(recorded))
+    assert np.all(_mismatch(recorded, python, c) <= bound)
     # each quantity after the first second (the normal equations well conditioned) against its largest
     later = np.abs(python[50:] - c[50:]).max(axis=0) / np.abs(python).max(axis=0)
     assert later.max() <= 1e-8
