@@ -35,60 +35,61 @@ static void run_on_slope(double slope, int samples, sr_slope_estimator *est)
     }
 }
 
+/* 16 KB each: static, not on the stack, and shared by the tests (the Cortex-M7 test image holds
+ * every suite's statics and its stack in 4 MB of RAM). */
+static sr_slope_estimator slope_est, slope_kept;
+
 static void test_a_robot_rolling_on_a_slope_reads_as_that_slope_and_no_other_offset(void)
 {
-    static sr_slope_estimator est;   /* 16 KB: static, not on the stack */
     int k;
-    run_on_slope(SLOPE, 100, &est);
+    run_on_slope(SLOPE, 100, &slope_est);
 #ifdef SR_USE_FLOAT
     /* float: the one-period differences of 1e-3 probes keep about three digits */
-    CHECK_NEAR(est.offsets.slope[0], SLOPE, 0.1 * SLOPE);
-    CHECK_NEAR(est.offsets.slope[1], 0.0, 0.1 * SLOPE);
+    CHECK_NEAR(slope_est.offsets.slope[0], SLOPE, 0.1 * SLOPE);
+    CHECK_NEAR(slope_est.offsets.slope[1], 0.0, 0.1 * SLOPE);
 #else
-    CHECK_NEAR(est.offsets.slope[0], SLOPE, 1e-3 * SLOPE);
-    CHECK_NEAR(est.offsets.slope[1], 0.0, 1e-3 * SLOPE);
-    for (k = 0; k < 2; ++k) CHECK_NEAR(est.offsets.torque_offset[k], 0.0, 1e-5);
-    for (k = 0; k < SR_LQR_NPENDULUM; ++k) CHECK_NEAR(est.offsets.pendulum[k], 0.0, 1e-4);   /* 0.1 g, 0.1 mm */
+    CHECK_NEAR(slope_est.offsets.slope[0], SLOPE, 1e-3 * SLOPE);
+    CHECK_NEAR(slope_est.offsets.slope[1], 0.0, 1e-3 * SLOPE);
+    for (k = 0; k < 2; ++k) CHECK_NEAR(slope_est.offsets.torque_offset[k], 0.0, 1e-5);
+    for (k = 0; k < SR_LQR_NPENDULUM; ++k) CHECK_NEAR(slope_est.offsets.pendulum[k], 0.0, 1e-4);   /* 0.1 g, 0.1 mm */
 #endif
     (void)k;
 }
 
 static void test_on_level_ground_the_estimate_is_zero_and_the_slope_is_not_invented(void)
 {
-    static sr_slope_estimator est;
-    run_on_slope(0.0, 50, &est);
-    CHECK_NEAR(est.offsets.slope[0], 0.0, 1e-9);
-    CHECK_NEAR(est.offsets.slope[1], 0.0, 1e-9);
+    run_on_slope(0.0, 50, &slope_est);
+    CHECK_NEAR(slope_est.offsets.slope[0], 0.0, 1e-9);
+    CHECK_NEAR(slope_est.offsets.slope[1], 0.0, 1e-9);
 }
 
 static void test_bad_input_gives_status_and_leaves_the_estimator_untouched(void)
 {
-    static sr_slope_estimator est, kept;
     sr_real p[SR_NPARAM], x[SR_NX];
     sr_real u[SR_NU] = {0, 0};
     paper_simulation_params(p);
     CHECK_STATUS(sr_slope_init(NULL, p, SR_C(0.02), SR_C(5.0)), SR_ERR_NULL);
-    CHECK_STATUS(sr_slope_init(&est, NULL, SR_C(0.02), SR_C(5.0)), SR_ERR_NULL);
-    CHECK_STATUS(sr_slope_init(&est, p, 0, SR_C(5.0)), SR_ERR_ARG);
-    CHECK_STATUS(sr_slope_init(&est, p, SR_C(0.02), 0), SR_ERR_ARG);
-    CHECK_STATUS(sr_slope_init(&est, p, SR_C(0.1), SR_C(5.0)), SR_ERR_ARG);   /* 20 steps of 5 ms > 16 */
-    CHECK_STATUS(sr_slope_init(&est, p, (sr_real)NAN, SR_C(5.0)), SR_ERR_NONFINITE);
+    CHECK_STATUS(sr_slope_init(&slope_est, NULL, SR_C(0.02), SR_C(5.0)), SR_ERR_NULL);
+    CHECK_STATUS(sr_slope_init(&slope_est, p, 0, SR_C(5.0)), SR_ERR_ARG);
+    CHECK_STATUS(sr_slope_init(&slope_est, p, SR_C(0.02), 0), SR_ERR_ARG);
+    CHECK_STATUS(sr_slope_init(&slope_est, p, SR_C(0.1), SR_C(5.0)), SR_ERR_ARG);   /* 20 steps of 5 ms > 16 */
+    CHECK_STATUS(sr_slope_init(&slope_est, p, (sr_real)NAN, SR_C(5.0)), SR_ERR_NONFINITE);
     p[SR_P_m_P] = -1;
-    CHECK_STATUS(sr_slope_init(&est, p, SR_C(0.02), SR_C(5.0)), SR_ERR_PARAM);
+    CHECK_STATUS(sr_slope_init(&slope_est, p, SR_C(0.02), SR_C(5.0)), SR_ERR_PARAM);
     paper_simulation_params(p);
-    CHECK_STATUS(sr_slope_init(&est, p, SR_C(0.02), SR_C(5.0)), SR_OK);
+    CHECK_STATUS(sr_slope_init(&slope_est, p, SR_C(0.02), SR_C(5.0)), SR_OK);
     CHECK_STATUS(sr_slope_reset(NULL), SR_ERR_NULL);
     make_state(x, 0.0, 0.0, (double)p[SR_P_r]);
-    CHECK_STATUS(sr_slope_update(&est, x, u), SR_OK);
-    kept = est;
+    CHECK_STATUS(sr_slope_update(&slope_est, x, u), SR_OK);
+    slope_kept = slope_est;
     CHECK_STATUS(sr_slope_update(NULL, x, u), SR_ERR_NULL);
-    CHECK_STATUS(sr_slope_update(&est, NULL, u), SR_ERR_NULL);
+    CHECK_STATUS(sr_slope_update(&slope_est, NULL, u), SR_ERR_NULL);
     u[1] = (sr_real)INFINITY;
-    CHECK_STATUS(sr_slope_update(&est, x, u), SR_ERR_NONFINITE);
+    CHECK_STATUS(sr_slope_update(&slope_est, x, u), SR_ERR_NONFINITE);
     u[1] = 0;
     x[SR_X_R_S] += SR_C(0.1);
-    CHECK_STATUS(sr_slope_update(&est, x, u), SR_ERR_NOT_ROTATION);
-    CHECK(memcmp(&est, &kept, sizeof est) == 0);
+    CHECK_STATUS(sr_slope_update(&slope_est, x, u), SR_ERR_NOT_ROTATION);
+    CHECK(memcmp(&slope_est, &slope_kept, sizeof slope_est) == 0);
 }
 
 void suite_slope(void)
