@@ -14,7 +14,7 @@
 /* The robot of the paper's simulation, rolling at 0.3 m/s along the world's y axis (across the
  * slope), on the slope `slope` along x: the estimator (flat model, 20 ms, 5 s) after `samples`
  * periods of zero torque. */
-static void run_on_slope(double slope, int samples, sr_slope_estimator *est)
+static void run_on_slope(double slope, int samples, sr_slope_estimator *est, double prior_scale)
 {
     sr_model plant;
     sr_real p[SR_NPARAM], x[SR_NX], traj[5 * SR_NX];
@@ -23,6 +23,7 @@ static void run_on_slope(double slope, int samples, sr_slope_estimator *est)
     int k;
     paper_simulation_params(p);
     CHECK_STATUS(sr_slope_init(est, p, SR_C(0.02), SR_C(5.0)), SR_OK);
+    CHECK_STATUS(sr_slope_weigh(est, (sr_real)prior_scale), SR_OK);
     p[SR_P_slope] = (sr_real)slope;
     CHECK_STATUS(sr_model_init(&plant, p), SR_OK);
     make_state(x, 0.0, 0.0, (double)p[SR_P_r]);
@@ -39,7 +40,7 @@ static void test_a_robot_rolling_on_a_slope_reads_as_that_slope_and_no_other_off
 {
     static sr_slope_estimator est;   /* 16 KB: static, not on the stack */
     int k;
-    run_on_slope(SLOPE, 100, &est);
+    run_on_slope(SLOPE, 100, &est, 0.0);
 #ifdef SR_USE_FLOAT
     /* float: the one-period differences of 1e-3 probes keep about three digits */
     CHECK_NEAR(est.offsets.slope[0], SLOPE, 0.1 * SLOPE);
@@ -56,9 +57,44 @@ static void test_a_robot_rolling_on_a_slope_reads_as_that_slope_and_no_other_off
 static void test_on_level_ground_the_estimate_is_zero_and_the_slope_is_not_invented(void)
 {
     static sr_slope_estimator est;
-    run_on_slope(0.0, 50, &est);
+    run_on_slope(0.0, 50, &est, 0.0);
     CHECK_NEAR(est.offsets.slope[0], 0.0, 1e-9);
     CHECK_NEAR(est.offsets.slope[1], 0.0, 1e-9);
+}
+
+static void test_weighted_a_robot_rolling_on_a_slope_still_reads_as_that_slope(void)
+{
+    /* no process noise: after the first samples (whose errors, the slope not yet read, stay in the
+     * forgotten variances) the residuals are small, their weights large, and the prior (5 mrad) light:
+     * 4.993 mrad after 2 s */
+    static sr_slope_estimator est;
+    run_on_slope(SLOPE, 100, &est, 1.0);
+    CHECK(est.prior_precision[0] > 0);
+#ifdef SR_USE_FLOAT
+    CHECK_NEAR(est.offsets.slope[0], SLOPE, 0.1 * SLOPE);
+    CHECK_NEAR(est.offsets.slope[1], 0.0, 0.1 * SLOPE);
+#else
+    CHECK_NEAR(est.offsets.slope[0], SLOPE, 1e-2 * SLOPE);
+    CHECK_NEAR(est.offsets.slope[1], 0.0, 1e-2 * SLOPE);
+#endif
+}
+
+static void test_weigh_refuses_a_bad_prior_scale_and_leaves_the_estimator_untouched(void)
+{
+    static sr_slope_estimator est, kept;
+    sr_real p[SR_NPARAM];
+    paper_simulation_params(p);
+    CHECK_STATUS(sr_slope_init(&est, p, SR_C(0.02), SR_C(5.0)), SR_OK);
+    kept = est;
+    CHECK_STATUS(sr_slope_weigh(NULL, 1), SR_ERR_NULL);
+    CHECK_STATUS(sr_slope_weigh(&est, -1), SR_ERR_ARG);
+    CHECK_STATUS(sr_slope_weigh(&est, (sr_real)NAN), SR_ERR_NONFINITE);
+    CHECK_STATUS(sr_slope_weigh(&est, (sr_real)INFINITY), SR_ERR_NONFINITE);
+    CHECK(memcmp(&est, &kept, sizeof est) == 0);
+    CHECK_STATUS(sr_slope_weigh(&est, 2), SR_OK);
+    CHECK_NEAR(est.prior_precision[0], 1 / (0.01 * 0.01), 1e-3);      /* 1 / (2 x 5 mrad)^2 */
+    CHECK_STATUS(sr_slope_weigh(&est, 0), SR_OK);
+    CHECK(memcmp(&est, &kept, sizeof est) == 0);                      /* 0: unweighted, as init left it */
 }
 
 static void test_bad_input_gives_status_and_leaves_the_estimator_untouched(void)
@@ -96,4 +132,6 @@ void suite_slope(void)
     RUN_TEST(test_a_robot_rolling_on_a_slope_reads_as_that_slope_and_no_other_offset);
     RUN_TEST(test_on_level_ground_the_estimate_is_zero_and_the_slope_is_not_invented);
     RUN_TEST(test_bad_input_gives_status_and_leaves_the_estimator_untouched);
+    RUN_TEST(test_weighted_a_robot_rolling_on_a_slope_still_reads_as_that_slope);
+    RUN_TEST(test_weigh_refuses_a_bad_prior_scale_and_leaves_the_estimator_untouched);
 }
