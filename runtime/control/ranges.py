@@ -59,6 +59,7 @@ NMPC_RANGES = {
     "tight_band_m": Range(0, 0, "m", "the NMPC has no tight gains (an LQR setting): 0 only"),
     "world_share": Range(0, 0, "", "the NMPC holds no world-frame integral (an LQR setting): 0 only"),
     "pendulum_feedforward": Range(0, 0, "", "the NMPC feeds no pendulum forward (an LQR setting): 0 only"),
+    "slope_prior": Range(0, 0, "", "the NMPC's slope estimate is unweighted (an LQR setting): 0 only"),
     "heading_band_rad": Range(0, 0, "rad", "the NMPC has no scheduled heading gains (an LQR setting): 0 only"),
     **{name: Range(0, 0, "", "the NMPC has no recovery mode (an LQR setting): 0 only")
        for name in ("recovery_cross_track_m", "recovery_heading_rad", "recovery_slow")},

@@ -40,6 +40,12 @@ def test_the_lqr_refuses_a_bad_slope_prior_by_name():
             lqr.LqrGains(**gains)
 
 
+def test_the_nmpc_refuses_the_weighted_estimate_by_name():
+    from runtime.control.nmpc import NmpcGains
+    with pytest.raises(ValueError, match="slope_prior"):
+        NmpcGains(slope_estimate_s=5.0, slope_prior=1.0)
+
+
 def test_the_numpy_estimate_refuses_a_bad_prior_scale_by_name():
     for bad in (-1.0, float("inf")):
         with pytest.raises(ValueError, match="slope_prior"):
