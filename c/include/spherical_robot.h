@@ -909,19 +909,28 @@ int sr_lqr_control_offsets(const sr_lqr *lqr, const sr_model *model, const sr_re
  * when N's 2-norm condition number (for the symmetric N: the ratio of its eigenvalues' magnitudes,
  * by Jacobi rotations) is below SR_SLOPE_COND_LIMIT; else, while the leading 4 x 4 block (slope and
  * d) is below it, those four alone with the pendulum's entries held at their last estimate (rolling
- * straight at the start the samples do not yet tell them apart); else the estimate is held.  The
- * estimator's state, its moved models included, lives in the caller's struct: no allocation. */
+ * straight at the start the samples do not yet tell them apart); else the estimate is held.
+ * Weighted (opt-in, sr_slope_weigh with a prior scale a > 0): each rate's row of G and of the
+ * residual is divided by the root of that rate's one-period prediction error's variance, estimated
+ * with the same forgetting (v = (f v_num + e^2) / (f v_den + 1), e = nu - nu_flat - G theta_last, at
+ * least SR_SLOPE_VARIANCE_FLOOR), so a rate the process noise moves much (the pendulum's) does not
+ * decide the fit; and theta = (N + P)^-1 b always, P = diag(1 / (a sigma)^2) a Gaussian prior of
+ * standard deviations sigma = (5 mrad, 5 mrad, 0.05 N m, 0.05 N m, 20 % of m_P, 1 cm, 1 cm, 1 cm,
+ * 0.01 N m s) in theta's units.  The estimator's state, its moved models included, lives in the
+ * caller's struct: no allocation. */
 /** @{ */
 #define SR_SLOPE_NTHETA 9          /**< the fitted entries: slope (2), torque offset (2), pendulum (4), its damping */
 #define SR_SLOPE_NMOVED 5          /**< the pendulum's parameters moved: m_P, c_P x, y, z, k_P */
 #define SR_SLOPE_MAX_STEPS 16      /**< the prediction's RKMK4 steps per period at most (period <= 80 ms) */
 #define SR_SLOPE_COND_LIMIT 1e10   /**< the condition number below which the normal equations are solved */
+#define SR_SLOPE_VARIANCE_FLOOR 1e-10 /**< the weighted fit's least variance of a rate's prediction error [(rad/s)^2] */
 
 #ifdef SR_USE_FLOAT
 #define sr_slope_estimator sr_slope_estimator_f
 #define sr_slope_init sr_slope_init_f
 #define sr_slope_reset sr_slope_reset_f
 #define sr_slope_update sr_slope_update_f
+#define sr_slope_weigh sr_slope_weigh_f
 #endif
 
 /** The estimator's state (fill with sr_slope_init).  Read offsets and pendulum_damping; the rest is
@@ -942,6 +951,10 @@ typedef struct sr_slope_estimator {
     sr_lqr_offsets offsets;                 /**< out: the slope vector [rad], torque offset [N m] and pendulum (dm_P [kg], dc_P [m]) */
     sr_real pendulum_damping;               /**< out: dk_P [N m s/rad] */
     sr_real work[(SR_SLOPE_MAX_STEPS + 1) * SR_NX]; /**< the predictions' trajectory (scratch) */
+    sr_real prior_precision[SR_SLOPE_NTHETA]; /**< the weighted fit's prior P's diagonal (all 0: unweighted; sr_slope_weigh) */
+    sr_real variance_sum[SR_NV];            /**< the weighted fit's forgotten sums of each rate's squared error ... */
+    sr_real variance_count;                 /**< ... and of the samples */
+    sr_real theta[SR_SLOPE_NTHETA];         /**< the weighted fit's last theta (scaled units) */
 } sr_slope_estimator;
 
 /** Fills the estimator for the robot params (its slope ignored: the model is the flat one) at the
@@ -960,6 +973,12 @@ int sr_slope_reset(sr_slope_estimator *est);
  * SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT or a prediction's sr_simulate status (the
  * estimator then unchanged). */
 int sr_slope_update(sr_slope_estimator *est, const sr_real x[SR_NX], const sr_real u[SR_NU]);
+
+/** Makes the fit weighted with a prior of prior_scale times the standard deviations above (0: the
+ * unweighted fit, as sr_slope_init leaves it); call after sr_slope_init, before the first sample.
+ * Returns SR_OK, SR_ERR_NULL, SR_ERR_NONFINITE or SR_ERR_ARG (prior_scale < 0); *est unchanged
+ * unless SR_OK. */
+int sr_slope_weigh(sr_slope_estimator *est, sr_real prior_scale);
 /** @} */
 
 #ifdef __cplusplus

@@ -99,6 +99,25 @@ int sr_slope_reset(sr_slope_estimator *est)
     memset(&est->offsets, 0, sizeof est->offsets);
     est->pendulum_damping = 0;
     est->started = 0;
+    memset(est->variance_sum, 0, sizeof est->variance_sum);
+    est->variance_count = 0;
+    memset(est->theta, 0, sizeof est->theta);
+    return SR_OK;
+}
+
+int sr_slope_weigh(sr_slope_estimator *est, sr_real prior_scale)
+{
+    /* the prior's standard deviations in theta's units (runtime/control/slope.py's PRIOR_SD): 5 mrad,
+     * 0.05 N m, 20 % of m_P (2 tenths), 1 cm (CENTRE_SCALE), 0.01 N m s (DAMPING_SCALE) */
+    const sr_real sd[NT] = {SR_C(5e-3), SR_C(5e-3), SR_C(0.05), SR_C(0.05), 2, 1, 1, 1, 1};
+    int k;
+    if (!est) return SR_ERR_NULL;
+    if (!all_finite(&prior_scale, 1)) return SR_ERR_NONFINITE;
+    if (!(prior_scale >= 0)) return SR_ERR_ARG;
+    for (k = 0; k < NT; ++k) {
+        const sr_real s = prior_scale * sd[k];
+        est->prior_precision[k] = prior_scale > 0 ? 1 / (s * s) : 0;
+    }
     return SR_OK;
 }
 
@@ -202,10 +221,23 @@ static void solve(const sr_real *a, const sr_real *b, int n, sr_real *x)
     }
 }
 
+/* The outputs from theta (scaled units). */
+static void set_estimate(sr_slope_estimator *est, const sr_real theta[NT])
+{
+    int k;
+    for (k = 0; k < 2; ++k) {
+        est->offsets.slope[k] = theta[k];
+        est->offsets.torque_offset[k] = theta[2 + k];
+    }
+    for (k = 0; k < SR_LQR_NPENDULUM; ++k) est->offsets.pendulum[k] = theta[4 + k] * est->scale[k];
+    est->pendulum_damping = theta[8] * est->scale[4];
+}
+
 int sr_slope_update(sr_slope_estimator *est, const sr_real x[SR_NX], const sr_real u[SR_NU])
 {
     sr_real G[SR_NV][NT], flat[SR_NV], nu[SR_NV], turned[SR_NX], normal[NT * NT], rhs[NT], theta[NT], probe[SR_NU];
-    int i, j, k, status;
+    sr_real residual[SR_NV], variance_sum[SR_NV], variance_count = 0;
+    int i, j, k, status, weighted = 0;
     if (!est || !x || !u) return SR_ERR_NULL;
     if (!all_finite(u, SR_NU)) return SR_ERR_NONFINITE;
     status = sr_check_state(&est->flat, x);
@@ -244,6 +276,21 @@ int sr_slope_update(sr_slope_estimator *est, const sr_real x[SR_NX], const sr_re
         for (i = 0; i < SR_NV && status == SR_OK; ++i) G[i][4 + k] = (nu[i] - flat[i]) * est->factor[k];
     }
     if (status != SR_OK) return status;
+    for (i = 0; i < SR_NV; ++i) residual[i] = x[SR_X_w_S + i] - flat[i];
+    for (k = 0; k < NT; ++k) weighted |= est->prior_precision[k] > 0;
+    if (weighted) {
+        /* each rate's row over the root of its prediction error's forgotten variance */
+        variance_count = est->forget * est->variance_count + 1;
+        for (i = 0; i < SR_NV; ++i) {
+            sr_real e = residual[i], w;
+            for (k = 0; k < NT; ++k) e -= G[i][k] * est->theta[k];
+            variance_sum[i] = est->forget * est->variance_sum[i] + e * e;
+            w = variance_sum[i] / variance_count;
+            w = 1 / SR_SQRT(w > (sr_real)SR_SLOPE_VARIANCE_FLOOR ? w : (sr_real)SR_SLOPE_VARIANCE_FLOOR);
+            for (k = 0; k < NT; ++k) G[i][k] *= w;
+            residual[i] *= w;
+        }
+    }
     /* the normal equations, forgetting the old samples */
     for (j = 0; j < NT; ++j) {
         sr_real acc = 0;
@@ -252,22 +299,28 @@ int sr_slope_update(sr_slope_estimator *est, const sr_real x[SR_NX], const sr_re
             for (i = 0; i < SR_NV; ++i) gg += G[i][j] * G[i][k];
             normal[j * NT + k] = est->forget * est->normal[j * NT + k] + gg;
         }
-        for (i = 0; i < SR_NV; ++i) acc += G[i][j] * (x[SR_X_w_S + i] - flat[i]);
+        for (i = 0; i < SR_NV; ++i) acc += G[i][j] * residual[i];
         rhs[j] = est->forget * est->rhs[j] + acc;
     }
     if (!all_finite(normal, NT * NT) || !all_finite(rhs, NT)) return SR_ERR_NONFINITE;
     memcpy(est->normal, normal, sizeof normal);
     memcpy(est->rhs, rhs, sizeof rhs);
     memcpy(est->last, x, sizeof est->last);
-    if (condition(normal, NT) < (sr_real)SR_SLOPE_COND_LIMIT) {
+    if (weighted) {
+        /* the prior makes N + P positive definite: solved at every sample */
+        sr_real posterior[NT * NT];
+        memcpy(est->variance_sum, variance_sum, sizeof variance_sum);
+        est->variance_count = variance_count;
+        memcpy(posterior, normal, sizeof posterior);
+        for (k = 0; k < NT; ++k) posterior[k * NT + k] += est->prior_precision[k];
+        solve(posterior, rhs, NT, theta);
+        if (!all_finite(theta, NT)) return SR_OK;
+        memcpy(est->theta, theta, sizeof theta);
+        set_estimate(est, theta);
+    } else if (condition(normal, NT) < (sr_real)SR_SLOPE_COND_LIMIT) {
         solve(normal, rhs, NT, theta);
         if (!all_finite(theta, NT)) return SR_OK;
-        for (k = 0; k < 2; ++k) {
-            est->offsets.slope[k] = theta[k];
-            est->offsets.torque_offset[k] = theta[2 + k];
-        }
-        for (k = 0; k < SR_LQR_NPENDULUM; ++k) est->offsets.pendulum[k] = theta[4 + k] * est->scale[k];
-        est->pendulum_damping = theta[8] * est->scale[4];
+        set_estimate(est, theta);
     } else if (condition(normal, 4) < (sr_real)SR_SLOPE_COND_LIMIT) {
         /* Until the samples tell the pendulum from the slope and d: those alone, the pendulum held. */
         sr_real held[4];

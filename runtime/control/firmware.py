@@ -48,6 +48,9 @@ def header(task, controller):
     if not isinstance(reference, SpeedHeading):
         raise ValueError(f"{task.source}: reference.kind: the firmware example tracks a speed or a heading "
                          f"(a constant target); got {task.reference_spec['kind']!r}")
+    if controller.gains.slope_prior > 0:
+        raise ValueError(f"{task.source}: slope_prior: the firmware example runs the unweighted slope estimate "
+                         f"(sr_slope_weigh is not wired into it); got {controller.gains.slope_prior!r}")
     s = controller.schedule
     nv, nk = len(s.speeds), len(s.curvatures)
     if nv > lib.SR_LQR_MAX_SPEEDS or nk > lib.SR_LQR_MAX_CURVATURES:

@@ -55,6 +55,7 @@ class LqrGains:
     steady_rate_m_s: float = 0.01    # ∫e_y advances only while |ė_y| ≤ this [m/s] (above the wander's rate)
     slope_estimate_s: float = 0.0     # the slope estimate's time constant [s] (0: the model's slope only)
     pendulum_feedforward: float = 0.0  # the share of the estimated pendulum's operating-point move fed forward (needs the estimate)
+    slope_prior: float = 0.0          # > 0: the slope estimate weighted by its rates' noise, with a prior this times slope.PRIOR_SD (0: unweighted)
     tight_cross_track_m: float = 0.03  # e_y of the tight path gains (the other sizes as above)
     tight_band_m: float = 0.1         # their weight is at most 1 − |e_y| / tight_band_m (0: no tight gains)
     tight_rise_s: float = 10.0        # ... and rises from 0 to 1 in no less than this [s]
@@ -80,6 +81,9 @@ class LqrGains:
         if self.pendulum_feedforward > 0 and not self.slope_estimate_s > 0:
             raise ValueError(f"pendulum_feedforward: feeds the slope estimate's pendulum forward, so needs "
                              f"slope_estimate_s > 0, got {self.pendulum_feedforward!r} with slope_estimate_s = 0")
+        if self.slope_prior > 0 and not self.slope_estimate_s > 0:
+            raise ValueError(f"slope_prior: weights the slope estimate, so needs slope_estimate_s > 0, "
+                             f"got {self.slope_prior!r} with slope_estimate_s = 0")
 
     def tight_weights(self, u_max):
         """The tight path gains' Riccati weights: these bounds with the cross-track error `tight_cross_track_m`."""

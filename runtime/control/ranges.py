@@ -38,6 +38,7 @@ LQR_RANGES = {
     "steady_rate_m_s": Range(0, 10, "m/s", "a rate of the cross-track error"),
     "slope_estimate_s": Range(0, 1e4, "s", "the slope estimate's time constant (0: no estimate)"),
     "pendulum_feedforward": Range(0, 1, "", "the share of the estimated pendulum's steady torques fed forward"),
+    "slope_prior": Range(0, 1e3, "", "the slope estimate's prior, times its standard deviations (0: unweighted)"),
     "tight_band_m": Range(0, 100, "m", "how near the path the tight gains act (0: not at all)"),
     "tight_rise_s": Range(1e-3, 1e4, "s", "how slowly the tight gains come in"),
     "world_share": Range(0, 1, "", "the share of the cross-track integral held in the world frame"),
@@ -58,6 +59,7 @@ NMPC_RANGES = {
     "tight_band_m": Range(0, 0, "m", "the NMPC has no tight gains (an LQR setting): 0 only"),
     "world_share": Range(0, 0, "", "the NMPC holds no world-frame integral (an LQR setting): 0 only"),
     "pendulum_feedforward": Range(0, 0, "", "the NMPC feeds no pendulum forward (an LQR setting): 0 only"),
+    "slope_prior": Range(0, 0, "", "the NMPC's slope estimate is unweighted (an LQR setting): 0 only"),
     "heading_band_rad": Range(0, 0, "rad", "the NMPC has no scheduled heading gains (an LQR setting): 0 only"),
     **{name: Range(0, 0, "", "the NMPC has no recovery mode (an LQR setting): 0 only")
        for name in ("recovery_cross_track_m", "recovery_heading_rad", "recovery_slow")},

@@ -49,7 +49,7 @@ from bindings._sr import ffi, lib
 
 from ..model import Model
 from ..so3 import rot_z
-from ..state import IDX_NU, IDX_Q, IDX_RS
+from ..state import IDX_NU, IDX_Q, IDX_RS, NV
 from . import lqr_design as design
 from .lqr_design import Schedule
 
@@ -67,6 +67,12 @@ MASS_SCALE, CENTRE_SCALE_M = 0.1, 0.01
 #: The pendulum joint's damping k_P, estimated with them: its step and its column's scale [N m s]
 #: (absolute: a robot may have no damping in its model).
 DAMPING_PROBE, DAMPING_SCALE = 1e-4, 0.01
+#: The weighted fit's (`prior_scale` > 0) prior: the standard deviations of θ = (s_x, s_y [rad], d_1,
+#: d_2 [N m], the pendulum's Δm_P, Δc_P x, y, z and Δk_P in their columns' scales: 20 % of m_P, 1 cm,
+#: 1 cm, 1 cm, 0.01 N m s), each times `prior_scale`; and the least variance of a rate's prediction
+#: error [(rad/s)²] its weights divide by.
+PRIOR_SD = (5e-3, 5e-3, 0.05, 0.05, 2.0, 1.0, 1.0, 1.0, 1.0)
+VARIANCE_FLOOR = 1e-10
 
 
 class _Turned:
@@ -206,10 +212,19 @@ class SlopeEstimator:
     `pendulum_damping` (on by default; off only to show what it changes): the pendulum's damping k_P
     is a column too (the property `pendulum_damping`, Δk_P): a damping unlike the model's pulls only
     while the pendulum swings, and unfitted, that pull was read as a pendulum or a slope in the
-    directions the samples hardly tell apart while rolling straight."""
+    directions the samples hardly tell apart while rolling straight.
 
-    def __init__(self, params, period, time_constant_s, pendulum_damping=True):
+    `prior_scale` > 0 (opt-in; 0: the unweighted fit above): each rate's row is divided by the root of
+    the variance of its one-period prediction error (against the last θ), estimated with the same
+    forgetting, so that the rate the plant's process noise moves most (the pendulum's) does not decide
+    the fit; and θ is the posterior's mode under a Gaussian prior of `PRIOR_SD` times `prior_scale`,
+    solved at every sample (the prior keeps the system regular)."""
+
+    def __init__(self, params, period, time_constant_s, pendulum_damping=True, prior_scale=0.0):
         self.period, self.time_constant_s = float(period), float(time_constant_s)
+        self.prior_scale = float(prior_scale)
+        if not (math.isfinite(self.prior_scale) and self.prior_scale >= 0):
+            raise ValueError(f"slope_prior: must be a finite number >= 0 (0: the unweighted fit), got {prior_scale!r}")
         self._flat = Model(params.replace(slope=0.0))
         self._sloped = Model(params.replace(slope=PROBE_SLOPE))
         # (the model with one pendulum parameter moved, the step, the column's scale)
@@ -228,6 +243,7 @@ class SlopeEstimator:
         self._normal, self._rhs = np.zeros((n, n)), np.zeros(n)
         self._last = None
         self.slope, self.torque_offset, self._moved = np.zeros(2), np.zeros(2), np.zeros(n - 4)
+        self._variance_sum, self._variance_count, self._theta = np.zeros(NV), 0.0, np.zeros(n)
 
     @property
     def pendulum(self):
@@ -256,10 +272,21 @@ class SlopeEstimator:
             columns += [(self._rates(model, x0, u) - flat) * (scale / step) for model, step, scale in self._pendulum]
             G = np.stack(columns, axis=1)
             residual = np.asarray(x)[IDX_NU] - flat
+            if self.prior_scale > 0:
+                error = residual - G @ self._theta
+                self._variance_sum = self._forget * self._variance_sum + error * error
+                self._variance_count = self._forget * self._variance_count + 1
+                weight = 1 / np.sqrt(np.maximum(self._variance_sum / self._variance_count, VARIANCE_FLOOR))
+                G, residual = G * weight[:, None], residual * weight
             self._normal = self._forget * self._normal + G.T @ G
             self._rhs = self._forget * self._rhs + G.T @ residual
             scales = np.array([scale for _, _, scale in self._pendulum])
-            if np.linalg.cond(self._normal) < 1e10:
+            if self.prior_scale > 0:
+                sd = self.prior_scale * np.array(PRIOR_SD[:len(self._theta)])
+                theta = np.linalg.solve(self._normal + np.diag(1 / (sd * sd)), self._rhs)
+                self._theta = theta
+                self.slope, self.torque_offset, self._moved = theta[:2], theta[2:4], theta[4:] * scales
+            elif np.linalg.cond(self._normal) < 1e10:
                 theta = np.linalg.solve(self._normal, self._rhs)
                 self.slope, self.torque_offset, self._moved = theta[:2], theta[2:4], theta[4:] * scales
             elif np.linalg.cond(self._normal[:4, :4]) < 1e10:
@@ -278,14 +305,21 @@ class SlopeEstimatorC:
     caller-held `sr_slope_estimator`, the same arithmetic to rounding (its condition number by Jacobi
     rotations, its solve by Gaussian elimination with partial pivoting); what the C closed loop runs."""
 
-    def __init__(self, params, period, time_constant_s):
+    def __init__(self, params, period, time_constant_s, prior_scale=0.0):
         self.period, self.time_constant_s = float(period), float(time_constant_s)
+        self.prior_scale = float(prior_scale)
+        if not (math.isfinite(self.prior_scale) and self.prior_scale >= 0):
+            raise ValueError(f"slope_prior: must be a finite number >= 0 (0: the unweighted fit), got {prior_scale!r}")
         self._c = ffi.new("sr_slope_estimator *")
         p = np.ascontiguousarray(params.replace(slope=0.0).as_array(), dtype=np.float64)
         status = lib.sr_slope_init(self._c, ffi.cast("double *", ffi.from_buffer(p)), self.period, self.time_constant_s)
         if status != lib.SR_OK:
             raise ValueError(f"slope_estimate_s: the C slope estimate refuses period {self.period!r} s and time "
                              f"constant {self.time_constant_s!r} s ({ffi.string(lib.sr_status_string(status)).decode()})")
+        status = lib.sr_slope_weigh(self._c, self.prior_scale)
+        if status != lib.SR_OK:
+            raise ValueError(f"slope_prior: the C slope estimate refuses {self.prior_scale!r} "
+                             f"({ffi.string(lib.sr_status_string(status)).decode()})")
 
     def reset(self):
         """Forgets the samples and the estimate."""
@@ -339,7 +373,8 @@ class SlopeFeedforward:
         self.model_slope = np.array([params.slope, 0.0])
         self._slope_schedule = design_slope_schedule(flat, schedule) \
             if params.slope != 0.0 or gains.slope_estimate_s > 0.0 else None
-        self._estimator = (estimator or SlopeEstimator)(flat, self.period, gains.slope_estimate_s) \
+        self._estimator = (estimator or SlopeEstimator)(flat, self.period, gains.slope_estimate_s,
+                                                        prior_scale=gains.slope_prior) \
             if gains.slope_estimate_s > 0.0 else None
         self._pendulum_schedule = design_pendulum_schedule(flat, schedule) if gains.pendulum_feedforward > 0.0 else None
         self._applied = np.zeros(2)

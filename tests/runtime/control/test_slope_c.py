@@ -6,7 +6,8 @@ import pytest
 from bindings._sr import ffi, lib
 from runtime.control.closed_loop import simulate_closed_loop
 from runtime.control.offsets import offset_cases, with_controller
-from runtime.control.slope import CENTRE_SCALE_M, DAMPING_SCALE, MASS_SCALE, SlopeEstimator, SlopeEstimatorC
+from runtime.control.slope import (CENTRE_SCALE_M, DAMPING_SCALE, MASS_SCALE, PRIOR_SD, SlopeEstimator,
+                                   SlopeEstimatorC)
 from runtime.control.task import load_task
 
 #: The table's circle cases the runs come from: the slope (pendulum near the model's) and a pendulum
@@ -40,10 +41,12 @@ def _estimates(estimator):
     return np.concatenate([estimator.slope, estimator.torque_offset, estimator.pendulum, [estimator.pendulum_damping]])
 
 
-def _replayed(recorded, plant=lambda c: None):
-    """(NumPy's, C's) estimates (samples, 9) over the recorded run; `plant(c_struct)` plants an error in C's."""
+def _replayed(recorded, plant=lambda c: None, prior_scale=0.0):
+    """(NumPy's, C's) estimates (samples, 9) over the recorded run; `plant(c_struct)` plants an error in C's;
+    `prior_scale` > 0: the weighted fit."""
     params, period, samples = recorded
-    python, c = SlopeEstimator(params, period, 5.0), SlopeEstimatorC(params, period, 5.0)
+    python = SlopeEstimator(params, period, 5.0, prior_scale=prior_scale)
+    c = SlopeEstimatorC(params, period, 5.0, prior_scale=prior_scale)
     plant(c._c)
     out = []
     for x, u in samples:
@@ -53,13 +56,15 @@ def _replayed(recorded, plant=lambda c: None):
     return np.array([p for p, _ in out]), np.array([q for _, q in out])
 
 
-def _conditions(recorded):
-    """Per sample: the 2-norm condition of NumPy's normal equations after the update (1 before the first)."""
+def _conditions(recorded, prior_scale=0.0):
+    """Per sample: the 2-norm condition of the system NumPy's update solved (the normal equations, plus the
+    prior's precision when weighted; 1 before the first)."""
     params, period, samples = recorded
-    python, out = SlopeEstimator(params, period, 5.0), []
+    python, out = SlopeEstimator(params, period, 5.0, prior_scale=prior_scale), []
+    prior = np.diag(1 / (prior_scale * np.array(PRIOR_SD)) ** 2) if prior_scale > 0 else 0.0
     for x, u in samples:
         python.update(x, u)
-        out.append(np.linalg.cond(python._normal) if np.any(python._normal) else 1.0)
+        out.append(np.linalg.cond(python._normal + prior) if np.any(python._normal) else 1.0)
     return np.array(out)
 
 
@@ -84,6 +89,39 @@ def test_the_c_estimate_is_numpys_over_a_whole_closed_loop_run(recorded):
     # each quantity after the first second (the normal equations well conditioned) against its largest
     later = np.abs(python[50:] - c[50:]).max(axis=0) / np.abs(python).max(axis=0)
     assert later.max() <= 1e-8
+
+
+def test_the_weighted_c_estimate_is_numpys_over_a_whole_closed_loop_run(recorded):
+    python, c = _replayed(recorded, prior_scale=1.0)
+    unweighted, _ = _replayed(recorded)
+    assert np.abs(python - unweighted).max() > 1e-4                   # the weighting changes the estimate
+    bound = np.maximum(1e-12, np.finfo(float).eps * _conditions(recorded, 1.0))
+    assert np.all(_mismatch(recorded, python, c) <= bound)
+
+
+def test_the_weighted_comparison_fails_for_the_prior_or_the_variance_changed(recorded):
+    def prior(c):
+        c.prior_precision[4] = c.prior_precision[4] * (1 + 1e-6)
+    python, c = _replayed(recorded, prior, prior_scale=1.0)
+    assert _mismatch(recorded, python, c).max() > 1e-8
+
+    def variance(c):
+        c.variance_sum[3] = 1e-6                                      # one rate's first weight moved
+    python, c = _replayed(recorded, variance, prior_scale=1.0)
+    assert _mismatch(recorded, python, c).max() > 1e-8
+
+
+def test_weigh_refuses_a_negative_or_non_finite_prior_scale():
+    from runtime.params import Params
+    est = ffi.new("sr_slope_estimator *")
+    assert lib.sr_slope_weigh(ffi.NULL, 1.0) == lib.SR_ERR_NULL
+    assert lib.sr_slope_weigh(est, -1.0) == lib.SR_ERR_ARG
+    assert lib.sr_slope_weigh(est, float("inf")) == lib.SR_ERR_NONFINITE
+    assert lib.sr_slope_weigh(est, float("nan")) == lib.SR_ERR_NONFINITE
+    assert not any(est.prior_precision)                               # unchanged by the refusals
+    for bad in (-1.0, float("nan")):
+        with pytest.raises(ValueError, match="slope_prior"):
+            SlopeEstimatorC(Params.paper_simulation(), 0.02, 5.0, prior_scale=bad)
 
 
 def test_the_comparison_fails_for_a_dropped_column(recorded):
