@@ -49,7 +49,7 @@ from bindings._sr import ffi, lib
 
 from ..model import Model
 from ..so3 import rot_z
-from ..state import IDX_NU, IDX_Q, IDX_RS, NV
+from ..state import IDX_NU, IDX_Q, IDX_RS, NV, NX
 from . import lqr_design as design
 from .lqr_design import Schedule
 
@@ -202,6 +202,14 @@ def design_pendulum_schedule(params, schedule):
 _PENDULUM_SCHEDULES = {}
 
 
+def _prior_scale(value):
+    """`prior_scale` (the LQR's `slope_prior`) as a float, refused by name unless finite and >= 0."""
+    scale = float(value)
+    if not (math.isfinite(scale) and scale >= 0):
+        raise ValueError(f"slope_prior: must be a finite number >= 0 (0: the unweighted fit), got {value!r}")
+    return scale
+
+
 class SlopeEstimator:
     """The world's slope vector s [rad], a torque offset d [N m] (the plant moving as the model under
     u + d: a motor's bias) and the pendulum's departure from the model (`pendulum`: Δm_P [kg], Δc_P
@@ -222,9 +230,7 @@ class SlopeEstimator:
 
     def __init__(self, params, period, time_constant_s, pendulum_damping=True, prior_scale=0.0):
         self.period, self.time_constant_s = float(period), float(time_constant_s)
-        self.prior_scale = float(prior_scale)
-        if not (math.isfinite(self.prior_scale) and self.prior_scale >= 0):
-            raise ValueError(f"slope_prior: must be a finite number >= 0 (0: the unweighted fit), got {prior_scale!r}")
+        self.prior_scale = _prior_scale(prior_scale)
         self._flat = Model(params.replace(slope=0.0))
         self._sloped = Model(params.replace(slope=PROBE_SLOPE))
         # (the model with one pendulum parameter moved, the step, the column's scale)
@@ -307,9 +313,7 @@ class SlopeEstimatorC:
 
     def __init__(self, params, period, time_constant_s, prior_scale=0.0):
         self.period, self.time_constant_s = float(period), float(time_constant_s)
-        self.prior_scale = float(prior_scale)
-        if not (math.isfinite(self.prior_scale) and self.prior_scale >= 0):
-            raise ValueError(f"slope_prior: must be a finite number >= 0 (0: the unweighted fit), got {prior_scale!r}")
+        self.prior_scale = _prior_scale(prior_scale)
         self._c = ffi.new("sr_slope_estimator *")
         p = np.ascontiguousarray(params.replace(slope=0.0).as_array(), dtype=np.float64)
         status = lib.sr_slope_init(self._c, ffi.cast("double *", ffi.from_buffer(p)), self.period, self.time_constant_s)
@@ -349,6 +353,8 @@ class SlopeEstimatorC:
         """As `SlopeEstimator.update`: the slope estimate after the measured state x, the torques
         `u_applied_before` held since the last one."""
         x = np.ascontiguousarray(x, dtype=np.float64)
+        if x.shape != (NX,):
+            raise ValueError(f"x: expected a state of {NX} entries, got shape {x.shape}")
         u = np.ascontiguousarray(u_applied_before, dtype=np.float64)
         if u.shape != (2,) or not np.all(np.isfinite(u)):
             raise ValueError(f"u_applied_before: expected 2 finite torques, got {u_applied_before!r}")

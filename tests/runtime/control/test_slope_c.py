@@ -167,3 +167,12 @@ def test_update_refuses_a_non_finite_torque_and_keeps_its_state(recorded):
     assert bytes(ffi.buffer(c._c)) == before
     with pytest.raises(ValueError, match="u_applied_before"):
         c.update(x, u)
+
+
+def test_update_refuses_a_state_of_the_wrong_size_before_c_reads_it(recorded):
+    params, period, samples = recorded
+    c = SlopeEstimatorC(params, period, 5.0)
+    before = bytes(ffi.buffer(c._c))
+    with pytest.raises(ValueError, match="x: expected a state of"):
+        c.update(samples[0][0][:-1], samples[0][1])
+    assert bytes(ffi.buffer(c._c)) == before
