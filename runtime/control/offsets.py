@@ -18,14 +18,18 @@ import numpy as np
 from ..so3 import rot_z
 from ..state import IDX_RS
 from .climbing import climbing_limit
+from .lqr import LqrGains
 
 #: The controllers the offset table runs (the PID has no integral on the path); nmpc-c is the NMPC's
 #: formulation in C (runtime/control/nmpc.py's NmpcC), which runs the table many times faster;
-#: a kind ending in -slope is that controller with its online slope estimate on (runtime/control/slope.py).
-OFFSET_CONTROLLERS = ("lqr", "lqr-slope", "nmpc", "nmpc-slope", "nmpc-c", "nmpc-c-slope")
-#: Those the table runs by default: the Python NMPC's estimate is the C NMPC's formulation (its tests
-#: hold them equal), so only the C one runs it.
-DEFAULT_OFFSET_CONTROLLERS = ("lqr", "lqr-slope", "nmpc", "nmpc-c", "nmpc-c-slope")
+#: a kind ending in -slope is that controller with its online slope estimate on (runtime/control/slope.py);
+#: lqr-plain is the task's LQR with its offset-free settings off (no estimate, no feedforward of it, the
+#: cross-track integral at its default), the law the shipped path tasks ran before they carried them.
+OFFSET_CONTROLLERS = ("lqr", "lqr-plain", "lqr-slope", "nmpc", "nmpc-slope", "nmpc-c", "nmpc-c-slope")
+#: Those the table runs by default: the shipped circle's and line's LQR carries its estimate already
+#: (so lqr-slope is the same law there), and the Python NMPC's estimate is the C NMPC's formulation
+#: (its tests hold them equal), so only the C one runs it.
+DEFAULT_OFFSET_CONTROLLERS = ("lqr", "lqr-plain", "nmpc", "nmpc-c", "nmpc-c-slope")
 #: The slope estimate's time constant [s] of the -slope runs.
 SLOPE_ESTIMATE_S = 5.0
 #: What lqr-slope sets besides the estimate: the estimated pendulum fed forward, and the cross-track
@@ -33,12 +37,21 @@ SLOPE_ESTIMATE_S = 5.0
 #: integral held, and the looser integral, wound up less by the line's approach, leaves less of it in
 #: the second half (docs/control.md, "Offset-free tracking").
 LQR_SLOPE_SETTINGS = {"pendulum_feedforward": 1.0, "cross_track_integral_m_s": 2.0}
+#: What lqr-plain sets: the offset-free settings back to LqrGains' defaults (off, the integral at 1 m s).
+LQR_PLAIN_SETTINGS = {field.name: field.default for field in dataclasses.fields(LqrGains)
+                      if field.name in ("slope_estimate_s", "slope_prior", "pendulum_feedforward",
+                                        "cross_track_integral_m_s")}
 
 
 def with_controller(task, kind):
     """The task with only its controller of `kind`; nmpc-c takes the settings of the task's nmpc,
     a kind ending in -slope those of its controller with `slope_estimate_s` = SLOPE_ESTIMATE_S (lqr-slope
-    with LQR_SLOPE_SETTINGS too)."""
+    with LQR_SLOPE_SETTINGS too), lqr-plain those of its LQR with LQR_PLAIN_SETTINGS."""
+    if kind == "lqr-plain":
+        task = task.with_controller("lqr")
+        spec = task.controllers[0]
+        gains = dataclasses.replace(spec.gains, **LQR_PLAIN_SETTINGS)
+        return dataclasses.replace(task, controllers=(dataclasses.replace(spec, gains=gains),))
     if kind.endswith("-slope"):
         task = with_controller(task, kind[:-len("-slope")])
         spec = task.controllers[0]
