@@ -9,7 +9,7 @@ from runtime.control import lqr, lqr_design as design
 from runtime.control.benchmark import run_task
 from runtime.control.closed_loop import simulate_closed_loop
 from runtime.control.nmpc import NmpcGains
-from runtime.control.offsets import offset_cases, with_controller
+from runtime.control.offsets import LQR_PLAIN_SETTINGS, offset_cases, with_controller
 from runtime.control.slope import SlopeEstimator, design_pendulum_schedule
 from runtime.control.task import load_task
 from runtime.model import Model
@@ -20,21 +20,22 @@ TARGET_M = 0.005
 
 
 def _line_case(change, pendulum_feedforward):
-    """The offset table's line case `change` for lqr-slope, its pendulum fed forward by this share, with
-    the shipped line's cross-track integral (1 m s: lqr-slope's looser one alone brings this case to
-    4.8 mm, so only there does the feedforward alone decide the target)."""
+    """The offset table's line case `change` for the shipped line's LQR (its weighted estimate), its
+    pendulum fed forward by this share, with the cross-track integral at its default (1 m s, lqr-plain's:
+    the shipped looser one alone brings this case to 4.8 mm, so only there does the feedforward alone
+    decide the target)."""
     circle, line = (with_controller(load_task(name), "lqr-slope") for name in ("circle", "line"))
     case = next(c for c in offset_cases(circle, line) if c.name == "line" and c.change == change)
     spec = case.task.controllers[0]
     gains = dataclasses.replace(spec.gains, pendulum_feedforward=pendulum_feedforward,
-                                cross_track_integral_m_s=load_task("line").with_controller("lqr").controllers[0]
-                                .gains.cross_track_integral_m_s)
+                                cross_track_integral_m_s=LQR_PLAIN_SETTINGS["cross_track_integral_m_s"])
     return dataclasses.replace(case.task, controllers=(dataclasses.replace(spec, gains=gains),))
 
 
 def test_feeding_the_estimated_pendulum_forward_holds_the_line_with_c_p_moved_1_cm():
     # The estimate finds the centre of mass moved along the hinge; without its feedforward (share 0)
     # the torque offset and the integral hold it, and the line misses (6.0 mm against 4.0 mm).
+    assert _line_case("c_P x-1 cm", 1.0).controllers[0].gains.slope_prior > 0
     _, _, fed = run_task(_line_case("c_P x-1 cm", 1.0))
     _, _, not_fed = run_task(_line_case("c_P x-1 cm", 0.0))
     assert fed["cross_track_rms_m"] < TARGET_M < not_fed["cross_track_rms_m"]
