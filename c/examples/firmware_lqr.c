@@ -18,7 +18,8 @@
  * With the slope's feedforward in the task's LQR (the header then defines LQR_TASK_SLOPE_ESTIMATE_S:
  * `slope_estimate_s` > 0, or a slope in the controller's model), every sample first updates the slope
  * estimate (sr_slope_update: the state and the torques held since the last sample) and the law feeds
- * its offsets forward (sr_lqr_control_offsets); without an estimate, the model's slope.
+ * its offsets forward (sr_lqr_control_offsets); without an estimate, the model's slope.  With
+ * LQR_TASK_SLOPE_PRIOR > 0 (`slope_prior`), the estimate is the weighted fit (sr_slope_weigh).
  * Exit status 0 on success; on an error, a message on stderr and 1.
  */
 #include <stdio.h>
@@ -94,6 +95,7 @@ int main(void)
     known.slope[1] = LQR_TASK_MODEL_SLOPE[1];
     if (LQR_TASK_SLOPE_ESTIMATE_S > 0) {
         if (status == SR_OK) status = sr_slope_init(&estimate, LQR_TASK_PARAMS, LQR_TASK_SCHEDULE.period, LQR_TASK_SLOPE_ESTIMATE_S);
+        if (status == SR_OK && LQR_TASK_SLOPE_PRIOR > 0) status = sr_slope_weigh(&estimate, LQR_TASK_SLOPE_PRIOR);
     } else {
         offsets = &known;
     }

@@ -48,9 +48,6 @@ def header(task, controller):
     if not isinstance(reference, SpeedHeading):
         raise ValueError(f"{task.source}: reference.kind: the firmware example tracks a speed or a heading "
                          f"(a constant target); got {task.reference_spec['kind']!r}")
-    if controller.gains.slope_prior > 0:
-        raise ValueError(f"{task.source}: slope_prior: the firmware example runs the unweighted slope estimate "
-                         f"(sr_slope_weigh is not wired into it); got {controller.gains.slope_prior!r}")
     s = controller.schedule
     nv, nk = len(s.speeds), len(s.curvatures)
     if nv > lib.SR_LQR_MAX_SPEEDS or nk > lib.SR_LQR_MAX_CURVATURES:
@@ -134,6 +131,7 @@ def _feedforward_tables(controller, points):
     feedforward: without one, no lines and NULL tables; with one, the tables (sr_lqr_slope_table,
     sr_lqr_pendulum_table when the pendulum is fed forward), the model's slope vector
     (LQR_TASK_MODEL_SLOPE) and, with the online estimate, its time constant LQR_TASK_SLOPE_ESTIMATE_S
+    and its prior scale LQR_TASK_SLOPE_PRIOR (> 0: the weighted fit, sr_slope_weigh; 0: unweighted)
     (c/examples/firmware_lqr.c then runs sr_slope_update and sr_lqr_control_offsets)."""
     slope, pendulum = controller._slope_schedule, controller._pendulum_schedule
     if slope is None:
@@ -152,11 +150,13 @@ def _feedforward_tables(controller, points):
             for name in ("dz", "du")]
         lines += ["};", ""]
     estimate = controller.gains.slope_estimate_s if controller._estimator is not None else 0.0
-    lines += ["/* The model's slope vector [rad] (fed forward without an estimate) and the estimate's time constant [s]",
-              " * (0: no estimate). */",
+    prior = controller.gains.slope_prior if controller._estimator is not None else 0.0
+    lines += ["/* The model's slope vector [rad] (fed forward without an estimate), the estimate's time constant [s]",
+              " * (0: no estimate) and its prior scale (> 0: the weighted fit, sr_slope_weigh; 0: unweighted). */",
               f"static const sr_real LQR_TASK_MODEL_SLOPE[2] = {{{_real(controller.model_slope[0])}, "
               f"{_real(controller.model_slope[1])}}};",
-              f"#define LQR_TASK_SLOPE_ESTIMATE_S {_real(estimate)}", ""]
+              f"#define LQR_TASK_SLOPE_ESTIMATE_S {_real(estimate)}",
+              f"#define LQR_TASK_SLOPE_PRIOR {_real(prior)}", ""]
     share = controller.gains.pendulum_feedforward if pendulum is not None else 0.0
     return lines, (f"    /* slope, pendulum, pendulum_share */ &LQR_TASK_SLOPE_TABLE, "
                    f"{'&LQR_TASK_PENDULUM_TABLE' if pendulum is not None else 'NULL'}, {_real(share)}")
