@@ -241,10 +241,10 @@ def ekf_header(task, estimator):
     return "\n".join(out)
 
 
-def write_ekf_headers(folder, name=EKF_TASK):
-    """Write lqr_task.h and ekf_task.h of the task `name` (on sensors, with an LQR; its own rate)
-    into `folder`; returns the task with its LQR alone."""
-    task = load_task(name).with_controller("lqr")
+def write_ekf_headers(folder, name=EKF_TASK, task=None):
+    """Write lqr_task.h and ekf_task.h of the task `name` (on sensors, with an LQR; its own rate), or
+    of `task` when given (its first controller an LQR), into `folder`; returns the task with its LQR alone."""
+    task = load_task(name).with_controller("lqr") if task is None else task
     if task.sensors is None:
         raise ValueError(f"{task.source}: sensors: the example runs on sensors; the task has no [sensors]")
     folder = pathlib.Path(folder)
