@@ -148,6 +148,14 @@ def _rebuilt_with(text, old, new, tmp):
     return build_and_run(other, other / "build")
 
 
+def _assert_estimating_and_equal(rows, result, controller):
+    """The estimate at work (it reads the heavier pendulum), and the firmware's rows the Python loop's bit for bit."""
+    assert controller._estimator.pendulum[0] > 0.05 * controller.params.m_P
+    assert rows.shape == (len(result.time), 38)
+    assert np.array_equal(rows[:, 1:36], result.trajectory)
+    assert np.array_equal(rows[:, 36:38], result.torques)
+
+
 @pytest.fixture(scope="module")
 def estimating_runs(tmp_path_factory):
     """`_firmware_and_python` of `_estimating_task`."""
@@ -158,11 +166,7 @@ def test_the_firmware_with_the_slope_estimate_equals_the_python_closed_loop_bit_
     rows, result, text, _, controller = estimating_runs
     assert "LQR_TASK_SLOPE_ESTIMATE_S SR_C(5.0)" in text and "&LQR_TASK_PENDULUM_TABLE" in text
     assert "LQR_TASK_SLOPE_PRIOR SR_C(0.0)" in text
-    # the estimate is at work: it reads the heavier pendulum
-    assert controller._estimator.pendulum[0] > 0.05 * controller.params.m_P
-    assert rows.shape == (len(result.time), 38)
-    assert np.array_equal(rows[:, 1:36], result.trajectory)
-    assert np.array_equal(rows[:, 36:38], result.torques)
+    _assert_estimating_and_equal(rows, result, controller)
 
 
 def test_the_estimating_firmwares_check_fails_for_the_time_constant_changed_in_its_7th_digit(estimating_runs):
@@ -182,12 +186,8 @@ def weighted_runs(tmp_path_factory):
 def test_the_firmware_with_the_weighted_slope_estimate_equals_the_python_closed_loop_bit_for_bit(weighted_runs):
     rows, result, text, _, controller = weighted_runs
     assert "LQR_TASK_SLOPE_PRIOR SR_C(1.0)" in text
-    # the Python loop runs the weighted fit, and it reads the heavier pendulum
-    assert controller._estimator.prior_scale == 1.0
-    assert controller._estimator.pendulum[0] > 0.05 * controller.params.m_P
-    assert rows.shape == (len(result.time), 38)
-    assert np.array_equal(rows[:, 1:36], result.trajectory)
-    assert np.array_equal(rows[:, 36:38], result.torques)
+    assert controller._estimator.prior_scale == 1.0      # the Python loop runs the weighted fit
+    _assert_estimating_and_equal(rows, result, controller)
 
 
 def test_the_weighted_firmwares_check_fails_when_the_firmware_runs_the_unweighted_estimate(weighted_runs):
