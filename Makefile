@@ -36,6 +36,7 @@ generate:
 	$(MAKE) install
 	$(PY) -m runtime firmware-table --out generated/lqr_task.h
 	$(PY) -m runtime firmware-table --ekf-vector c/examples/ekf_lqr_vector
+	$(PY) -m runtime firmware-table --slope-vector c/examples/slope_vector
 	$(PY) -m runtime nmpc-c --header generated/nmpc_task.h --horizon 20 --node-periods 3
 
 verify: $(STAMP)

@@ -107,17 +107,38 @@ def test_api_contract_holds_under_libfuzzer(fuzz_build, tmp_path):
     assert runs and int(runs.group(1)) > 1000, result.stderr[-2000:]
 
 
-def test_driver_finds_a_contract_violation(fuzz_build, tmp_path):
-    """The harness can fail: a target that breaks the contract (a non-finite output with SR_OK) aborts."""
+#: Targets that break the contract, each by wrapping one function: (the wrapper, the function the
+#: harness must name).
+BROKEN = {
+    # success with a NaN
+    "energy-nan": ('static int bad_energy(const sr_model *m, const sr_real *x, sr_real *e)\n'
+                   '{ (void)m; (void)x; *e = (sr_real)NAN; return SR_OK; }\n'
+                   '#define sr_energy bad_energy', "sr_energy"),
+    # an error that forgets the estimator's last state
+    "slope-update-writes-on-error": (
+        'static int bad_slope_update(sr_slope_estimator *e, const sr_real *x, const sr_real *u)\n'
+        '{ const int s = sr_slope_update(e, x, u); if (s != SR_OK && e) e->started = 0; return s; }\n'
+        '#define sr_slope_update bad_slope_update', "sr_slope_update"),
+    # a torque beyond u_max with SR_OK
+    "control-offsets-beyond-u-max": (
+        'static int bad_control_offsets(const sr_lqr *l, const sr_model *m, const sr_real *x, const sr_lqr_target *t,\n'
+        '    const sr_lqr_offsets *o, sr_lqr_memory *mem, sr_real *u, sr_real *raw)\n'
+        '{ const int s = sr_lqr_control_offsets(l, m, x, t, o, mem, u, raw); if (s == SR_OK) u[0] = l->u_max * 1.5f;'
+        ' return s; }\n'
+        '#define sr_lqr_control_offsets bad_control_offsets', "sr_lqr_control_offsets"),
+}
+
+
+@pytest.mark.parametrize("broken", list(BROKEN))
+def test_driver_finds_a_contract_violation(fuzz_build, tmp_path, broken):
+    """The harness can fail: a target that breaks the contract (a non-finite output with SR_OK, the
+    estimator changed on an error, a torque beyond the limit) aborts."""
     build, _ = fuzz_build
+    wrapper, function = BROKEN[broken]
     bad = tmp_path / "bad_target.c"
-    # Wrap sr_energy so that it reports success with a NaN: the harness must notice.
+    # Wrap the function after the header declares it: the harness must notice.
     bad.write_text((C_DIR / "fuzz" / "fuzz_api.c").read_text().replace(
-        '#include "spherical_robot.h"',
-        '#include "spherical_robot.h"\n#include <math.h>\n'
-        'static int bad_energy(const sr_model *m, const sr_real *x, sr_real *e)\n'
-        '{ (void)m; (void)x; *e = (sr_real)NAN; return SR_OK; }\n'
-        '#define sr_energy bad_energy', 1))
+        '#include "spherical_robot.h"', '#include "spherical_robot.h"\n#include <math.h>\n' + wrapper, 1))
     exe = tmp_path / "bad_driver"
     compile_ = subprocess.run([CC, "-std=c99", "-O1", "-I", str(C_DIR / "include"), "-I", str(ROOT / "generated"), str(bad),
                                str(C_DIR / "fuzz" / "driver.c"), str(build / "libsphericalrobot_asan.a"),
@@ -125,4 +146,4 @@ def test_driver_finds_a_contract_violation(fuzz_build, tmp_path):
     assert compile_.returncode == 0, compile_.stderr
     result = subprocess.run([exe, "-n", "100"], capture_output=True, text=True, env=ENV)
     assert result.returncode != 0
-    assert "contract violated by sr_energy" in result.stderr and "failing input: seed" in result.stderr
+    assert f"contract violated by {function}" in result.stderr and "failing input: seed" in result.stderr

@@ -19,7 +19,10 @@
 #     the loop on the estimator (c/examples/firmware_ekf_lqr.c on the recorded samples of
 #     examples/ekf_lqr_vector) against the host build of its precision, run with -icount shift=0:
 #     the filter's instructions per 200 Hz sample are printed, the M4F's median held to
-#     EKF_INSTRUCTION_BUDGET;
+#     EKF_INSTRUCTION_BUDGET; the LQR's closed loop with the weighted slope estimate
+#     (c/examples/firmware_lqr.c on examples/slope_vector) on the Cortex-M4F against the host float
+#     build, run with -icount shift=0: its instructions per sample printed, the median held to
+#     SLOPE_INSTRUCTION_BUDGET;
 #  7. the CMake toolchain file (c/cmake/arm-none-eabi.cmake): both libraries configured and built
 #     for the two CPUs, and checked like the Makefile's;
 #  8. the M4 sizes and stacks (tools/m4_report.py): a Lie-Euler-only firmware linked and run under QEMU,
@@ -41,6 +44,9 @@ NMPC_INSTRUCTION_BUDGET=${NMPC_INSTRUCTION_BUDGET:-5000000}
 # Instructions of the median 200 Hz sample of the filter on the Cortex-M4F (float): a prediction
 # (RKMK4 step and its Jacobian), an IMU and an encoder update.
 EKF_INSTRUCTION_BUDGET=${EKF_INSTRUCTION_BUDGET:-300000}
+# Instructions of the median 100 Hz sample of the weighted slope estimate and the law on the
+# Cortex-M4F (float): ten one-period predictions of two RKMK4 steps, the fit, the law.
+SLOPE_INSTRUCTION_BUDGET=${SLOPE_INSTRUCTION_BUDGET:-300000}
 
 failures=0
 step() { printf '\n== %s\n' "$*"; }
@@ -160,6 +166,25 @@ run_qemu mps2-an386 "$M4_DIR/firmware_lqr_f" "$OUT/lqr_f.m4.csv" || fail "Cortex
 python3 ../tools/compare_runs.py double "$OUT/lqr.host.csv" "$OUT/lqr.m7.csv" || fail "Cortex-M7 closed loop"
 python3 ../tools/compare_runs.py float "$OUT/lqr_f.host.csv" "$OUT/lqr_f.m4.csv" "$OUT/lqr.host.csv" ||
     fail "Cortex-M4F closed loop"
+
+step "closed-loop firmware example with the weighted slope estimate (examples/slope_vector, 10 s) on the Cortex-M4F"
+$MAKE -j"$JOBS" --no-print-directory BUILD="$HOST_DIR" "$HOST_DIR/firmware_lqr_slope" "$HOST_DIR/firmware_lqr_slope_f" ||
+    fail "host build of the example with the slope estimate"
+cross_make "$M4_DIR" "$M4_CPU_FLAGS" mps2-an386.ld "$M4_DIR/firmware_lqr_slope_f" ||
+    fail "Cortex-M4F build of the example with the slope estimate"
+"$HOST_DIR/firmware_lqr_slope" >"$OUT/slope.host.csv" || fail "host double, with the slope estimate"
+"$HOST_DIR/firmware_lqr_slope_f" >"$OUT/slope_f.host.csv" || fail "host float, with the slope estimate"
+# Under -icount shift=0 the firmware prints the instructions of each sample's estimate and law
+# (SysTick, calibrated); the median is held to SLOPE_INSTRUCTION_BUDGET.
+run_qemu mps2-an386 "$M4_DIR/firmware_lqr_slope_f" "$OUT/slope_f.m4.csv" -icount shift=0 2>"$OUT/slope_f.m4.txt" ||
+    fail "Cortex-M4F example with the slope estimate exited with $?"
+counts=$(grep '^instructions per sample' "$OUT/slope_f.m4.txt")
+echo "  Cortex-M4F float: ${counts:-no instruction counts: $(cat "$OUT/slope_f.m4.txt")}"
+median=$(echo "$counts" | sed -n 's/.* p50 \([0-9]*\),.*/\1/p')
+[ -n "$median" ] && [ "$median" -le "$SLOPE_INSTRUCTION_BUDGET" ] ||
+    fail "Cortex-M4F slope estimate: the median sample beyond $SLOPE_INSTRUCTION_BUDGET instructions (${median:-none counted})"
+python3 ../tools/compare_runs.py float "$OUT/slope_f.host.csv" "$OUT/slope_f.m4.csv" "$OUT/slope.host.csv" ||
+    fail "Cortex-M4F closed loop with the slope estimate"
 
 step "firmware example on the estimator (sensor samples in, EKF, LQR; examples/ekf_lqr_vector, 1 s) under QEMU"
 EKF_VECTOR=examples/ekf_lqr_vector

@@ -17,10 +17,15 @@
  *
  * Every event first predicts the filter from its last time to t under the torques held since the
  * last tick; a tick then runs the LQR on the estimate and holds its torques until the next tick.
+ * With the slope's feedforward in the task's LQR (lqr_task.h defines LQR_TASK_SLOPE_ESTIMATE_S), a
+ * tick first updates the slope estimate on the filter's estimate and the torques held since the last
+ * tick (sr_slope_update; weighted, sr_slope_weigh, when LQR_TASK_SLOPE_PRIOR > 0), then runs the law
+ * with its offsets (sr_lqr_control_offsets), as the Python closed loop on sensors does
+ * (lqr_task_law.h).
  * Output (stdout): CSV, a header line (as firmware_lqr.c's) then one row per tick: t, the 35 estimated state entries (spherical_robot.h's
  * order) and the torques u_Y, u_P, %.17g.  In the double build the rows equal, bit for bit, the
  * Python closed loop on the estimator of the same task fed the same samples
- * (runtime.control.closed_loop.simulate_on_sensors, tests/runtime/control/test_firmware.py).
+ * (runtime.control.closed_loop.simulate_on_sensors, tests/runtime/control/test_firmware_ekf.py).
  * Exit status 0 on success; on an error, a message on stderr and 1.
  * On an Armv7-M part (SysTick) also one line on stderr: the instructions of the filter's 200 Hz
  * samples (the prediction to the sample's time, the IMU and the encoder update; not the LQR, nor
@@ -35,6 +40,7 @@
 #include <lqr_task.h>
 #include "sr_ekf.h"
 #include "spherical_robot.h"
+#include "lqr_task_law.h"
 
 #define MAX_LINE 1024
 
@@ -75,6 +81,25 @@ static void report(sample_count *c, double per_tick)
 }
 
 static sample_count counts; /* 1 kB, not on the stack */
+
+#ifdef LQR_TASK_SLOPE_ESTIMATE_S
+/* The ticks of each controller tick's slope estimate and law (the first MAX_SAMPLES). */
+typedef struct tick_count {
+    uint32_t ticks[MAX_SAMPLES];
+    int n;
+} tick_count;
+
+static void report_ticks(tick_count *c, double per_tick)
+{
+    if (c->n < 2) return;
+    qsort(c->ticks + 1, (size_t)(c->n - 1), sizeof c->ticks[0], by_ticks);
+    fprintf(stderr, "instructions per tick (the slope estimate and the law): first %.0f; the other %d: p50 %.0f, "
+            "max %.0f\n", per_tick * (double)c->ticks[0], c->n - 1, per_tick * (double)c->ticks[c->n / 2],
+            per_tick * (double)c->ticks[c->n - 1]);
+}
+
+static tick_count law_counts;
+#endif
 #endif
 
 /* The numbers after the kind and the time on a line of each kind. */
@@ -118,18 +143,15 @@ static int parse(const char *line, int *kind, double *t, sr_real v[SR_NIMU])
     return 1;
 }
 
-#ifdef LQR_TASK_SLOPE_ESTIMATE_S
-#error "firmware_ekf_lqr: the task's LQR has a slope feedforward or estimate, which this example does not run (c/examples/firmware_lqr.c does)"
-#endif
-
 int main(void)
 {
     static const sr_real zero_bias[SR_NBIAS] = {0};
     const sr_lqr_target target = {LQR_TASK_SPEED, LQR_TASK_HEADING, 0, 0, 0};
     const sr_ekf_process process = {{EKF_TASK_TORQUE_PSD, EKF_TASK_TORQUE_PSD, EKF_TASK_TORQUE_PSD},
                                     EKF_TASK_GYRO_BIAS_RW, EKF_TASK_ACCEL_BIAS_RW};
+    /* the law's memory and, with the slope's feedforward, its estimate (16 KB in double: static storage) */
+    static lqr_task_law law;
     sr_model model;
-    sr_lqr_memory memory;
     sr_ekf ekf;
     sr_real u[SR_NU] = {0, 0}, v[SR_NIMU];
     double t_now = 0.0, t;
@@ -149,8 +171,7 @@ int main(void)
 #endif
 
     status = sr_model_init(&model, LQR_TASK_PARAMS);
-    if (status == SR_OK) status = sr_lqr_check(&LQR_TASK_SCHEDULE);
-    if (status == SR_OK) status = sr_lqr_reset(&memory);
+    if (status == SR_OK) status = lqr_task_law_init(&law);
     if (status == SR_OK) status = sr_ekf_init_diagonal(&ekf, &model, LQR_TASK_X0, zero_bias, EKF_TASK_SIGMA);
     for (kind = 0; kind < SR_EKF_NKINDS && status == SR_OK; ++kind)
         status = sr_ekf_set_recovery(&ekf, kind, EKF_TASK_RECOVER_AFTER[kind]);
@@ -176,10 +197,17 @@ int main(void)
             t_now = t;
         }
         if (status == SR_OK) switch (kind) {
-        case 0:
-            status = sr_lqr_control(&LQR_TASK_SCHEDULE, &model, ekf.x, &target, &memory, u, NULL);
+        case 0: {
+#if defined(HAVE_SYSTICK) && defined(LQR_TASK_SLOPE_ESTIMATE_S)
+            const uint32_t law_start = SYST_CVR;
+#endif
+            status = lqr_task_law_sample(&law, &model, ekf.x, &target, u);
+#if defined(HAVE_SYSTICK) && defined(LQR_TASK_SLOPE_ESTIMATE_S)
+            if (law_counts.n < MAX_SAMPLES) law_counts.ticks[law_counts.n++] = ticks_since(law_start);
+#endif
             if (status == SR_OK) print_row(t, ekf.x, u);
             break;
+        }
         case 1:
             COUNT_FROM();
             /* The torque disturbance held over EKF_TASK_TORQUE_HOLD (> 0) read by the accelerometer, as the
@@ -211,6 +239,9 @@ int main(void)
     }
 #ifdef HAVE_SYSTICK
     report(&counts, per_tick);
+#ifdef LQR_TASK_SLOPE_ESTIMATE_S
+    report_ticks(&law_counts, per_tick);
+#endif
 #endif
     return 0;
 }

@@ -18,7 +18,9 @@
  * With the slope's feedforward in the task's LQR (the header then defines LQR_TASK_SLOPE_ESTIMATE_S:
  * `slope_estimate_s` > 0, or a slope in the controller's model), every sample first updates the slope
  * estimate (sr_slope_update: the state and the torques held since the last sample) and the law feeds
- * its offsets forward (sr_lqr_control_offsets); without an estimate, the model's slope.
+ * its offsets forward (sr_lqr_control_offsets); without an estimate, the model's slope.  With
+ * LQR_TASK_SLOPE_PRIOR > 0 (`slope_prior`), the estimate is the weighted fit (sr_slope_weigh).
+ * The sample's calls are lqr_task_law.h's, which firmware_ekf_lqr.c shares.
  * Exit status 0 on success; on an error, a message on stderr and 1.
  */
 #include <stdio.h>
@@ -32,6 +34,8 @@
 #include "lqr_task.h"
 #endif
 #include "spherical_robot.h"
+#include "lqr_task_law.h"
+#include "systick.h"
 
 #define PER LQR_TASK_STEPS_PER_SAMPLE
 
@@ -57,27 +61,20 @@ static void print_row(long n, const sr_real x[SR_NX], const sr_real u[SR_NU])
     printf(",%.17g,%.17g\n", (double)u[0], (double)u[1]);
 }
 
-#ifdef LQR_TASK_SLOPE_ESTIMATE_S
-/* The slope estimate's state (the seven moved models in it: static storage, not the stack). */
-static sr_slope_estimator estimate;
-#include "systick.h"
-#ifdef HAVE_SYSTICK   /* on a Cortex-M: the instructions of each sample's estimate and law (stderr) */
+#if defined(LQR_TASK_SLOPE_ESTIMATE_S) && defined(HAVE_SYSTICK)
+/* on a Cortex-M: the instructions of each sample's estimate and law (stderr) */
 static uint32_t sample_ticks[LQR_TASK_SAMPLES];
-#endif
 #endif
 
 int main(void)
 {
+    /* the law's memory and the slope estimate (the seven moved models in it: static storage, not the stack) */
+    static lqr_task_law law;
     sr_model model, plant;
-    sr_lqr_memory memory;
     const sr_lqr_target target = {LQR_TASK_SPEED, LQR_TASK_HEADING, 0, 0, 0};
     sr_real x[SR_NX], traj[PER + 1][SR_NX], u[SR_NU] = {0, 0}, u_hold[PER][SR_NU];   /* u: held before the first sample */
     long k, done;
     int i, status;
-#ifdef LQR_TASK_SLOPE_ESTIMATE_S
-    sr_lqr_offsets known = {{0, 0}, {0, 0}, {0, 0, 0, 0}};
-    const sr_lqr_offsets *offsets = &estimate.offsets;
-#endif
 
     status = sr_model_init(&model, LQR_TASK_PARAMS);
 #ifdef LQR_TASK_HAS_PLANT   /* a robot unlike the controller's model */
@@ -85,19 +82,8 @@ int main(void)
 #else
     plant = model;
 #endif
-    if (status == SR_OK) status = sr_lqr_check(&LQR_TASK_SCHEDULE);
     if (status == SR_OK) status = sr_check_state(&model, LQR_TASK_X0);
-    if (status == SR_OK) status = sr_lqr_reset(&memory);
-#ifdef LQR_TASK_SLOPE_ESTIMATE_S
-    /* the estimate's offsets, or (no estimate) the model's slope */
-    known.slope[0] = LQR_TASK_MODEL_SLOPE[0];
-    known.slope[1] = LQR_TASK_MODEL_SLOPE[1];
-    if (LQR_TASK_SLOPE_ESTIMATE_S > 0) {
-        if (status == SR_OK) status = sr_slope_init(&estimate, LQR_TASK_PARAMS, LQR_TASK_SCHEDULE.period, LQR_TASK_SLOPE_ESTIMATE_S);
-    } else {
-        offsets = &known;
-    }
-#endif
+    if (status == SR_OK) status = lqr_task_law_init(&law);
     if (status != SR_OK) {
         fprintf(stderr, "firmware_lqr: setup failed: %s\n", sr_status_string(status));
         return 1;
@@ -110,21 +96,15 @@ int main(void)
 #endif
     for (k = 0; k < LQR_TASK_SAMPLES; ++k) {
         wait_for_tick();
-#ifdef LQR_TASK_SLOPE_ESTIMATE_S
         {
-#ifdef HAVE_SYSTICK
+#if defined(LQR_TASK_SLOPE_ESTIMATE_S) && defined(HAVE_SYSTICK)
             const uint32_t start = SYST_CVR;
 #endif
-            if (LQR_TASK_SLOPE_ESTIMATE_S > 0) status = sr_slope_update(&estimate, x, u);
-            if (status == SR_OK)
-                status = sr_lqr_control_offsets(&LQR_TASK_SCHEDULE, &model, x, &target, offsets, &memory, u, NULL);
-#ifdef HAVE_SYSTICK
+            status = lqr_task_law_sample(&law, &model, x, &target, u);
+#if defined(LQR_TASK_SLOPE_ESTIMATE_S) && defined(HAVE_SYSTICK)
             sample_ticks[k] = ticks_since(start);
 #endif
         }
-#else
-        status = sr_lqr_control(&LQR_TASK_SCHEDULE, &model, x, &target, &memory, u, NULL);
-#endif
         if (status != SR_OK) {
             fprintf(stderr, "firmware_lqr: controller sample %ld failed: %s\n", k, sr_status_string(status));
             return 1;

@@ -8,7 +8,9 @@
  * samples, noise levels, one per reading for sr_ekf_update_imu_axes and sr_ekf_update_imu_held, holds,
  * gates and delayed-fix slots)
  * and of sr_nmpc.h (a fuzzed box QP; a fuzzed NMPC design of a short horizon, target and
- * curvatures ahead) and checks their
+ * curvatures ahead), the slope estimate (sr_slope_*: fuzzed period, time constant, prior scale,
+ * samples) and the law with offsets (sr_lqr_control_offsets: fuzzed feedforward tables and
+ * offsets), and checks their
  * contract (abort() on a violation, so libFuzzer and the plain driver both report it with the
  * input that caused it):
  *
@@ -751,6 +753,147 @@ static void fuzz_ekf(reader *r, const sr_model *model, const sr_real x[SR_NX], c
     check_ekf("sr_ekf_update_imu_held(NULL)", status, &ekf, &before);
 }
 
+/* ---- the slope estimate and the law with offsets: sr_slope_init, sr_slope_weigh, sr_slope_reset,
+ * sr_slope_update, sr_lqr_control_offsets ------------------------------------------------------
+ * The estimator for the model's parameters with one of them picked, a fuzzed period (mostly one
+ * 5 ms prediction step, for speed) and time constant, a fuzzed prior scale, sometimes a reset, then
+ * two samples (x, then x with one entry picked, under fuzzed torques).  Contract: documented status;
+ * the estimator byte for byte as it was on every error (its scratch trajectory aside) and never
+ * written by a failed sr_slope_init; on SR_OK its offsets and pendulum damping finite.  Then
+ * sr_lqr_control_offsets on a 1 x 1 schedule of fuzzed gains, operating point and feedforward
+ * tables (the pendulum's sometimes NULL, its share picked), with the estimate's offsets, fuzzed
+ * ones or NULL: documented status, u and u_raw finite with |u| <= u_max on SR_OK and untouched
+ * otherwise, the memory untouched on error. */
+static void check_slope(const char *fn, int status, const sr_slope_estimator *est, const sr_slope_estimator *before)
+{
+    int k;
+    if (status != SR_OK) {
+        static sr_slope_estimator same;   /* 16 KB: not on the stack */
+        same = *est;
+        memcpy(same.work, before->work, sizeof same.work);
+        if (memcmp(&same, before, sizeof same) != 0) fail(fn, status, "changed the estimator on error");
+        return;
+    }
+    for (k = 0; k < 2; ++k)
+        if (!isfinite(est->offsets.slope[k]) || !isfinite(est->offsets.torque_offset[k]))
+            fail(fn, status, "a non-finite slope or torque offset with SR_OK");
+    for (k = 0; k < SR_LQR_NPENDULUM; ++k)
+        if (!isfinite(est->offsets.pendulum[k])) fail(fn, status, "a non-finite pendulum offset with SR_OK");
+    if (!isfinite(est->pendulum_damping)) fail(fn, status, "a non-finite pendulum damping with SR_OK");
+}
+
+static void fuzz_slope(reader *r, const sr_model *model, const sr_real x[SR_NX], const sr_real *u)
+{
+    static sr_slope_estimator est, before;
+    static sr_lqr lqr;
+    static sr_lqr_slope_table slope;
+    static sr_lqr_pendulum_table pendulum;
+    static guarded gu, gr;
+    const sr_lqr_target target = {SR_C(0.3), SR_C(0.5), SR_C(0.2), SR_C(0.05), 1};
+    sr_real p[SR_NPARAM], x1[SR_NX], u1[SR_NU], period, time_constant, prior;
+    sr_lqr_offsets fuzzed;
+    const sr_lqr_offsets *offsets;
+    sr_lqr_memory memory, kept;
+    int i, j, k, status, sample;
+
+    memcpy(p, model->p, sizeof p);
+    i = (int)(read_u8(r) % SR_NPARAM);
+    p[i] = pick(r, (double)p[i]);
+    period = pick(r, read_u8(r) % 8 == 7 ? 0.02 : 0.005);
+    time_constant = pick(r, 5.0);
+    prior = pick(r, read_u8(r) % 2 ? 1.0 : 0.0);
+    memset(&est, CANARY, sizeof est);
+    before = est;
+    status = sr_slope_init(&est, p, period, time_constant);
+    EXPECT_STATUS("sr_slope_init", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_ARG, SR_ERR_PARAM, SR_ERR_SINGULAR);
+    if (status != SR_OK && memcmp(&est, &before, sizeof est) != 0) fail("sr_slope_init", status, "wrote the estimator on error");
+    if (status != SR_OK && sr_slope_init(&est, model->p, SR_C(0.005), SR_C(5.0)) != SR_OK) return; /* a model at a rule's edge */
+    EXPECT_STATUS("sr_slope_init(NULL)", sr_slope_init(NULL, p, period, time_constant), SR_ERR_NULL);
+    before = est;
+    status = sr_slope_init(&est, NULL, period, time_constant);
+    EXPECT_STATUS("sr_slope_init(NULL params)", status, SR_ERR_NULL);
+    if (memcmp(&est, &before, sizeof est) != 0) fail("sr_slope_init(NULL params)", status, "wrote the estimator on error");
+
+    status = sr_slope_weigh(&est, prior);
+    EXPECT_STATUS("sr_slope_weigh", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_ARG);
+    check_slope("sr_slope_weigh", status, &est, &before);
+    EXPECT_STATUS("sr_slope_weigh(NULL)", sr_slope_weigh(NULL, SR_C(1.0)), SR_ERR_NULL);
+    if (read_u8(r) % 4 == 3) {
+        EXPECT_STATUS("sr_slope_reset", sr_slope_reset(&est), SR_OK);
+        if (est.started || est.offsets.slope[0] != 0 || est.offsets.torque_offset[1] != 0 || est.pendulum_damping != 0)
+            fail("sr_slope_reset", SR_OK, "left the estimate unzeroed");
+    }
+    EXPECT_STATUS("sr_slope_reset(NULL)", sr_slope_reset(NULL), SR_ERR_NULL);
+
+    memcpy(x1, x, sizeof x1);
+    i = (int)(read_u8(r) % SR_NX);
+    x1[i] = pick(r, (double)x1[i]);
+    for (sample = 0; sample < 2; ++sample) {   /* the first stores the state, the second predicts from it */
+        for (k = 0; k < SR_NU; ++k) u1[k] = u ? pick(r, (double)u[k]) : 0;
+        before = est;
+        status = sr_slope_update(&est, sample ? x1 : x, u1);
+        EXPECT_STATUS("sr_slope_update", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION, SR_ERR_CONSTRAINT,
+                      SR_ERR_SINGULAR, SR_ERR_ARG);
+        check_slope("sr_slope_update", status, &est, &before);
+    }
+    before = est;
+    EXPECT_STATUS("sr_slope_update(NULL)", sr_slope_update(NULL, x, u1), SR_ERR_NULL);
+    EXPECT_STATUS("sr_slope_update(NULL x)", sr_slope_update(&est, NULL, u1), SR_ERR_NULL);
+    EXPECT_STATUS("sr_slope_update(NULL u)", sr_slope_update(&est, x, NULL), SR_ERR_NULL);
+    check_slope("sr_slope_update(NULL)", SR_ERR_NULL, &est, &before);
+
+    /* the law with offsets on a 1 x 1 schedule */
+    memset(&lqr, 0, sizeof lqr);
+    lqr.n_speeds = lqr.n_curvatures = 1;
+    lqr.period = SR_C(0.01);
+    lqr.u_max = pick(r, 0.5);
+    lqr.steady_rate = SR_C(0.005);
+    lqr.slope = &slope;
+    lqr.pendulum = read_u8(r) % 4 == 3 ? NULL : &pendulum;
+    lqr.pendulum_share = pick(r, 1.0);
+    for (j = 0; j < SR_LQR_NZ; ++j) lqr.z_star[0][j] = pick(r, 0.1 * unit(r));
+    for (j = 0; j < SR_NU; ++j) lqr.u_star[0][j] = pick(r, 0.1 * unit(r));
+    for (j = 0; j < SR_NU * SR_LQR_NZ; ++j) lqr.K_path[0][j] = pick(r, 2.0 * unit(r));
+    for (j = 0; j < SR_NU * SR_LQR_NZ; ++j) lqr.K_heading[0][j] = pick(r, 2.0 * unit(r));
+    for (j = 0; j < SR_LQR_NZ; ++j) {
+        slope.dz_up[0][j] = pick(r, unit(r));
+        slope.dz_right[0][j] = pick(r, unit(r));
+        for (k = 0; k < SR_LQR_NPENDULUM; ++k) pendulum.dz[0][k][j] = pick(r, unit(r));
+    }
+    for (j = 0; j < SR_NU; ++j) {
+        slope.du_up[0][j] = pick(r, unit(r));
+        slope.du_right[0][j] = pick(r, unit(r));
+        for (k = 0; k < SR_LQR_NPENDULUM; ++k) pendulum.du[0][k][j] = pick(r, unit(r));
+    }
+    fuzzed = est.offsets;
+    for (k = 0; k < 2; ++k) {
+        fuzzed.slope[k] = pick(r, (double)fuzzed.slope[k]);
+        fuzzed.torque_offset[k] = pick(r, (double)fuzzed.torque_offset[k]);
+    }
+    for (k = 0; k < SR_LQR_NPENDULUM; ++k) fuzzed.pendulum[k] = pick(r, (double)fuzzed.pendulum[k]);
+    k = (int)(read_u8(r) % 4);
+    offsets = k == 3 ? NULL : k == 2 ? &fuzzed : &est.offsets;
+    EXPECT_STATUS("sr_lqr_reset", sr_lqr_reset(&memory), SR_OK);
+    for (sample = 0; sample < 2; ++sample) {
+        kept = memory;
+        status = sr_lqr_control_offsets(&lqr, model, sample ? x1 : x, &target, offsets, &memory, arm(&gu, SR_NU),
+                                        arm(&gr, SR_NU));
+        EXPECT_STATUS("sr_lqr_control_offsets", status, SR_OK, SR_ERR_NONFINITE, SR_ERR_NOT_ROTATION,
+                      SR_ERR_CONSTRAINT, SR_ERR_ARG);
+        expect("sr_lqr_control_offsets", status, &gu, status == SR_OK ? SR_NU : 0, 1);
+        expect("sr_lqr_control_offsets", status, &gr, status == SR_OK ? SR_NU : 0, 1);
+        if (status == SR_OK) {
+            for (j = 0; j < SR_NU; ++j)
+                if (!(fabs((double)gu.buf[GUARD + j]) <= (double)lqr.u_max))
+                    fail("sr_lqr_control_offsets", status, "torque beyond u_max");
+        } else if (memcmp(&kept, &memory, sizeof memory) != 0) {
+            fail("sr_lqr_control_offsets", status, "changed the memory on error");
+        }
+    }
+    EXPECT_STATUS("sr_lqr_control_offsets(NULL)",
+                  sr_lqr_control_offsets(&lqr, model, x, &target, offsets, NULL, arm(&gu, SR_NU), NULL), SR_ERR_NULL);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -1085,5 +1228,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     /* The validity stamp (read last, for the same reason). */
     fuzz_model_validity(&rd, &model, x, u_or_null, dt, method);
+
+    /* The slope estimate and the law with offsets: their own reader over the input from its start
+     * (the parts above exhaust most inputs), after everything else (the kept inputs decode as before). */
+    {
+        reader again = {data, size};
+        fuzz_slope(&again, &model, x, u_or_null);
+    }
     return 0;
 }

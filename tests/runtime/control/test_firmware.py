@@ -2,9 +2,11 @@
 same task bit for bit (double build, host), and its gain table, generated/lqr_task.h (written by
 `make generate`), is the current design within the spread of LAPACK builds."""
 import dataclasses
+import pathlib
 import re
 import shutil
 import subprocess
+import tempfile
 
 import numpy as np
 import pytest
@@ -12,7 +14,7 @@ import pytest
 from conftest import ROOT
 from runtime.control.closed_loop import simulate_closed_loop
 from runtime.control.firmware import header, write_header
-from runtime.control.firmware import firmware_task
+from runtime.control.firmware import firmware_task, slope_task, write_slope_vector
 
 C_DIR = ROOT / "c"
 SHIPPED = ROOT / "generated" / "lqr_task.h"
@@ -112,24 +114,8 @@ def test_the_dispatcher_command_writes_the_table(fresh_table, tmp_path, capsys):
     assert out.read_text() == fresh_table
 
 
-def _estimating_task():
-    """The firmware task with lqr-slope's settings (the estimate 5 s, the pendulum fed forward), on a
-    plant unlike the model (the pendulum 10 % heavier, its centre of mass 5 mm along the hinge), 10 s."""
-    from runtime.control.offsets import LQR_SLOPE_SETTINGS, SLOPE_ESTIMATE_S
-    task = firmware_task()
-    spec = task.controllers[0]
-    gains = dataclasses.replace(spec.gains, slope_estimate_s=SLOPE_ESTIMATE_S, **LQR_SLOPE_SETTINGS)
-    plant = task.plant_params
-    plant = plant.replace(m_P=plant.m_P * 1.1, c_P=(plant.c_P[0] + 0.005, plant.c_P[1], plant.c_P[2]))
-    task = dataclasses.replace(task, controllers=(dataclasses.replace(spec, gains=gains),), plant_params=plant)
-    return dataclasses.replace(task, scenario=dataclasses.replace(task.scenario, steps=2000))
-
-
-@pytest.fixture(scope="module")
-def estimating_runs(tmp_path_factory):
-    """(firmware rows, Python closed-loop result, header text, build dir, controller) of `_estimating_task`."""
-    tmp = tmp_path_factory.mktemp("firmware-estimate")
-    task = _estimating_task()
+def _firmware_and_python(tmp, task):
+    """(firmware rows, Python closed-loop result, header text, build dir, controller) of `task`."""
     controller = task.controller()
     text = header(task, controller)
     (tmp / "lqr_task.h").write_text(text)
@@ -139,22 +125,76 @@ def estimating_runs(tmp_path_factory):
     return rows, result, text, tmp, controller
 
 
-def test_the_firmware_with_the_slope_estimate_equals_the_python_closed_loop_bit_for_bit(estimating_runs):
-    rows, result, text, _, controller = estimating_runs
-    assert "LQR_TASK_SLOPE_ESTIMATE_S SR_C(5.0)" in text and "&LQR_TASK_PENDULUM_TABLE" in text
-    # the estimate is at work: it reads the heavier pendulum
+def _rebuilt_with(text, old, new, tmp):
+    """The firmware's rows with `old` in the header text replaced by `new`."""
+    changed = text.replace(old, new)
+    assert changed != text
+    other = pathlib.Path(tempfile.mkdtemp(prefix="perturbed", dir=tmp))
+    (other / "lqr_task.h").write_text(changed)
+    return build_and_run(other, other / "build")
+
+
+def _assert_estimating_and_equal(rows, result, controller):
+    """The estimate at work (it reads the heavier pendulum), and the firmware's rows the Python loop's bit for bit."""
     assert controller._estimator.pendulum[0] > 0.05 * controller.params.m_P
     assert rows.shape == (len(result.time), 38)
     assert np.array_equal(rows[:, 1:36], result.trajectory)
     assert np.array_equal(rows[:, 36:38], result.torques)
 
 
+@pytest.fixture(scope="module")
+def estimating_runs(tmp_path_factory):
+    """`_firmware_and_python` of the slope task (firmware.slope_task) with the unweighted estimate."""
+    return _firmware_and_python(tmp_path_factory.mktemp("firmware-estimate"), slope_task(slope_prior=0.0))
+
+
+def test_the_firmware_with_the_slope_estimate_equals_the_python_closed_loop_bit_for_bit(estimating_runs):
+    rows, result, text, _, controller = estimating_runs
+    assert "LQR_TASK_SLOPE_ESTIMATE_S SR_C(5.0)" in text and "&LQR_TASK_PENDULUM_TABLE" in text
+    assert "LQR_TASK_SLOPE_PRIOR SR_C(0.0)" in text
+    _assert_estimating_and_equal(rows, result, controller)
+
+
 def test_the_estimating_firmwares_check_fails_for_the_time_constant_changed_in_its_7th_digit(estimating_runs):
     rows, _, text, tmp, _ = estimating_runs
-    changed = text.replace("LQR_TASK_SLOPE_ESTIMATE_S SR_C(5.0)", "LQR_TASK_SLOPE_ESTIMATE_S SR_C(5.000001)")
-    assert changed != text
-    other = tmp / "perturbed"
-    other.mkdir()
-    (other / "lqr_task.h").write_text(changed)
-    perturbed = build_and_run(other, tmp / "build-perturbed")
+    perturbed = _rebuilt_with(text, "LQR_TASK_SLOPE_ESTIMATE_S SR_C(5.0)", "LQR_TASK_SLOPE_ESTIMATE_S SR_C(5.000001)",
+                              tmp)
     assert not np.array_equal(perturbed[:, 1:36], rows[:, 1:36])
+
+
+@pytest.fixture(scope="module")
+def weighted_runs(tmp_path_factory):
+    """`_firmware_and_python` of the slope task with the weighted estimate (slope_prior 1, as the
+    path tasks ship it)."""
+    return _firmware_and_python(tmp_path_factory.mktemp("firmware-weighted"), slope_task(slope_prior=1.0))
+
+
+def test_the_firmware_with_the_weighted_slope_estimate_equals_the_python_closed_loop_bit_for_bit(weighted_runs):
+    rows, result, text, _, controller = weighted_runs
+    assert "LQR_TASK_SLOPE_PRIOR SR_C(1.0)" in text
+    assert controller._estimator.prior_scale == 1.0      # the Python loop runs the weighted fit
+    _assert_estimating_and_equal(rows, result, controller)
+
+
+def test_the_weighted_firmwares_check_fails_when_the_firmware_runs_the_unweighted_estimate(weighted_runs):
+    rows, _, text, tmp, _ = weighted_runs
+    perturbed = _rebuilt_with(text, "LQR_TASK_SLOPE_PRIOR SR_C(1.0)", "LQR_TASK_SLOPE_PRIOR SR_C(0.0)", tmp)
+    assert not np.array_equal(perturbed[:, 1:36], rows[:, 1:36])
+
+
+def test_the_weighted_firmwares_check_fails_for_the_prior_scale_changed_in_its_7th_digit(weighted_runs):
+    rows, _, text, tmp, _ = weighted_runs
+    perturbed = _rebuilt_with(text, "LQR_TASK_SLOPE_PRIOR SR_C(1.0)", "LQR_TASK_SLOPE_PRIOR SR_C(1.000001)", tmp)
+    assert not np.array_equal(perturbed[:, 1:36], rows[:, 1:36])
+
+
+SLOPE_VECTOR = C_DIR / "examples" / "slope_vector" / "lqr_task.h"
+
+
+def test_the_checked_in_slope_vector_is_what_make_generate_writes_now(tmp_path):
+    """c/examples/slope_vector/lqr_task.h (the cross-test's weighted slope estimate on the Cortex-M4F)
+    is the current design of the slope task, within the spread of LAPACK builds."""
+    write_slope_vector(tmp_path)
+    fresh = (tmp_path / "lqr_task.h").read_text()
+    assert "LQR_TASK_SLOPE_PRIOR SR_C(1.0)" in fresh
+    assert same_table(SLOPE_VECTOR.read_text(), fresh)

@@ -5,7 +5,7 @@ import dataclasses
 
 import pytest
 
-from runtime.control import closed_loop as cl, firmware, lqr
+from runtime.control import closed_loop as cl, lqr
 from runtime.control.metrics import tracking_metrics
 from runtime.control.offsets import with_controller
 from runtime.control.slope import SlopeEstimator
@@ -51,11 +51,3 @@ def test_the_numpy_estimate_refuses_a_bad_prior_scale_by_name():
         with pytest.raises(ValueError, match="slope_prior"):
             SlopeEstimator(Params.paper_simulation(), 0.02, 5.0, prior_scale=bad)
 
-
-def test_the_firmware_header_refuses_the_weighted_estimate_it_does_not_run():
-    task = firmware.firmware_task()
-    spec = task.controllers[0]
-    gains = dataclasses.replace(spec.gains, slope_estimate_s=5.0, slope_prior=1.0)
-    task = dataclasses.replace(task, controllers=(dataclasses.replace(spec, gains=gains),))
-    with pytest.raises(ValueError, match="slope_prior"):
-        firmware.header(task, task.controller())
