@@ -16,6 +16,7 @@ import dataclasses
 import numpy as np
 
 from bindings._sr import ffi, lib
+from bindings.buffers import pointer
 
 from . import memory
 from . import model as _model
@@ -117,10 +118,10 @@ def simulate_many(params, x0, dt, steps, u=None, method="lie-euler", energy_tol=
     traj = np.full((n, steps + 1, NX), np.nan) if trajectories else None
     work = None if trajectories else np.empty((_model.CHUNK_STEPS + 1, NX))
     rc = lib.sr_simulate_batch(
-        code, n, _model._ptr(p), stride["params"], _model._ptr(x), stride["x0"], dt, steps,
-        ffi.NULL if u is None else _model._ptr(u), stride.get("u", 0), tol, _model.CHUNK_STEPS,
-        ffi.NULL if work is None else _model._ptr(work), ffi.NULL if traj is None else _model._ptr(traj),
-        _model._ptr(final), _model._ptr(metrics), ffi.cast("int *", ffi.from_buffer(status)),
+        code, n, pointer(p), stride["params"], pointer(x), stride["x0"], dt, steps,
+        ffi.NULL if u is None else pointer(u), stride.get("u", 0), tol, _model.CHUNK_STEPS,
+        ffi.NULL if work is None else pointer(work), ffi.NULL if traj is None else pointer(traj),
+        pointer(final), pointer(metrics), ffi.cast("int *", ffi.from_buffer(status)),
         ffi.cast("long *", ffi.from_buffer(steps_done)))
     if rc != lib.SR_OK:   # every argument was checked above: a failure here is a bug, not bad input
         raise RuntimeError(f"sr_simulate_batch: {ffi.string(lib.sr_status_string(rc)).decode()}")

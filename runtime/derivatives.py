@@ -7,12 +7,10 @@ group, whose derivatives are short enough to write here in closed form.
 import numpy as np
 
 from bindings._sr import ffi, lib
+from bindings.buffers import pointer
 
 from .state import IDX_E_NU, IDX_E_Q, IDX_E_TH_P, IDX_E_TH_Y, IDX_E_XI_S, IDX_WS, NE, NU, NV, rotations
 
-
-def _ptr(arr):
-    return ffi.cast("double *", ffi.from_buffer(arr))
 
 
 class DerivativeMethods:
@@ -27,10 +25,10 @@ class DerivativeMethods:
         lead = x.shape[:-1]
         Ja, Jb = np.empty(lead + (NV, NE)), np.empty(lead + (NV, NU))
         if x.ndim == 1:
-            self._check("x", lib.sr_accel_jacobian(self._model, _ptr(x), _ptr(u), _ptr(Ja), _ptr(Jb)))
+            self._check("x", lib.sr_accel_jacobian(self._model, pointer(x), pointer(u), pointer(Ja), pointer(Jb)))
             return Ja, Jb
         failed = ffi.new("long *")
-        status = lib.sr_accel_jacobian_batch(self._model, x.shape[0], _ptr(x), _ptr(u), _ptr(Ja), _ptr(Jb), failed)
+        status = lib.sr_accel_jacobian_batch(self._model, x.shape[0], pointer(x), pointer(u), pointer(Ja), pointer(Jb), failed)
         self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
         return Ja, Jb
 

@@ -27,6 +27,7 @@ import numpy as np
 from scipy.stats import chi2
 
 from bindings._sr import ffi, lib
+from bindings.buffers import pointer
 
 from .errors import KernelError
 from .model import Model
@@ -50,9 +51,6 @@ RECOVER_AFTER = {"imu": 10, "encoders": 10, "position": 4, "heading": 4}
 IDX_EB_BG = slice(lib.SR_EB_b_g, lib.SR_EB_b_g + 3)
 IDX_EB_BA = slice(lib.SR_EB_b_a, lib.SR_EB_b_a + 3)
 
-
-def _ptr(arr):
-    return ffi.cast("double *", ffi.from_buffer(arr))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -148,13 +146,13 @@ class Ekf:
         if P0 is not None:
             P = real_array(P0, "P0", (NEB, NEB), batch=False)
             check_finite(P, "P0")
-            status = lib.sr_ekf_init(self._ekf, model._model, _ptr(x), _ptr(b), _ptr(P))
+            status = lib.sr_ekf_init(self._ekf, model._model, pointer(x), pointer(b), pointer(P))
             what = "P0"
         else:
             s = _vector(sigma, "sigma", NEB)
             if not (s > 0).all():
                 raise ValueError(f"sigma: every standard deviation must be > 0, got {s.min()!r}")
-            status = lib.sr_ekf_init_diagonal(self._ekf, model._model, _ptr(x), _ptr(b), _ptr(s))
+            status = lib.sr_ekf_init_diagonal(self._ekf, model._model, pointer(x), pointer(b), pointer(s))
             what = "sigma"
         if status == lib.SR_ERR_ARG:
             raise ValueError("P0: not symmetric")
@@ -182,7 +180,7 @@ class Ekf:
         torque = np.zeros(NU) if u is None else _vector(u, "u", NU)
         if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
             raise ValueError(f"dt: expected a finite number of seconds > 0, got {dt!r}")
-        _check(lib.sr_ekf_predict(self._ekf, self.model._model, METHODS[self.method], _ptr(torque), dt,
+        _check(lib.sr_ekf_predict(self._ekf, self.model._model, METHODS[self.method], pointer(torque), dt,
                                   self._process), "x")
 
     def _applied(self, kind, status, singular):
@@ -200,19 +198,19 @@ class Ekf:
         self._before = self._ekf.accepted[0] + self._ekf.recovered[0]
         m = self.mount
         if self.noise.torque_hold > 0:
-            status = lib.sr_ekf_update_imu_held(self._ekf, self.model._model, _ptr(y), _ptr(torque), BODIES[m.body],
-                                                _ptr(self._imu_mount), _ptr(self._imu_sigma), self._process,
+            status = lib.sr_ekf_update_imu_held(self._ekf, self.model._model, pointer(y), pointer(torque), BODIES[m.body],
+                                                pointer(self._imu_mount), pointer(self._imu_sigma), self._process,
                                                 self.noise.torque_hold, self.gate["imu"])
         else:
-            status = lib.sr_ekf_update_imu_axes(self._ekf, self.model._model, _ptr(y), _ptr(torque), BODIES[m.body],
-                                                _ptr(self._imu_mount), _ptr(self._imu_sigma), self.gate["imu"])
+            status = lib.sr_ekf_update_imu_axes(self._ekf, self.model._model, pointer(y), pointer(torque), BODIES[m.body],
+                                                pointer(self._imu_mount), pointer(self._imu_sigma), self.gate["imu"])
         return self._applied("imu", status, "the innovation covariance or the inertia is not positive definite")
 
     def update_encoders(self, y):
         """One encoder sample (θ_Y, θ_P) [rad]."""
         y = _vector(y, "y", 2)
         self._before = self._ekf.accepted[1] + self._ekf.recovered[1]
-        status = lib.sr_ekf_update_encoders(self._ekf, self.model._model, _ptr(y), self.noise.encoder,
+        status = lib.sr_ekf_update_encoders(self._ekf, self.model._model, pointer(y), self.noise.encoder,
                                             self.gate["encoders"])
         return self._applied("encoders", status, "the innovation covariance is not positive definite")
 
@@ -220,7 +218,7 @@ class Ekf:
         """One position fix (q_x, q_y) [m]."""
         y = _vector(y, "y", 2)
         self._before = self._ekf.accepted[2] + self._ekf.recovered[2]
-        status = lib.sr_ekf_update_position(self._ekf, self.model._model, _ptr(y), self.noise.position,
+        status = lib.sr_ekf_update_position(self._ekf, self.model._model, pointer(y), self.noise.position,
                                             self.gate["position"])
         return self._applied("position", status, "the innovation covariance is not positive definite")
 
@@ -237,7 +235,7 @@ class Ekf:
             raise ValueError(f"slot: {slot} waits for no fix (mark_position first)")
         y = _vector(y, "y", 2)
         self._before = self._ekf.accepted[2] + self._ekf.recovered[2]
-        status = lib.sr_ekf_update_position_delayed(self._ekf, self.model._model, slot, _ptr(y), self.noise.position,
+        status = lib.sr_ekf_update_position_delayed(self._ekf, self.model._model, slot, pointer(y), self.noise.position,
                                                     self.gate["position"])
         return self._applied("position", status, "the innovation covariance is not positive definite")
 
@@ -253,7 +251,7 @@ class Ekf:
         self._before = self._ekf.accepted[3] + self._ekf.recovered[3]
         m = self.heading_mount
         status = lib.sr_ekf_update_heading(self._ekf, self.model._model, value, BODIES[m.body],
-                                           _ptr(self._heading_mount), self.noise.heading, self.gate["heading"])
+                                           pointer(self._heading_mount), self.noise.heading, self.gate["heading"])
         return self._applied("heading", status, "the sensor's x axis is along the floor's normal or the "
                                                 "innovation covariance is not positive definite")
 

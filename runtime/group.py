@@ -7,14 +7,12 @@ the dynamics and of the steps are expressed.  `Model` inherits these methods; lo
 import numpy as np
 
 from bindings._sr import ffi, lib
+from bindings.buffers import pointer
 
 from .errors import KernelError
 from .state import NE, NX
 from .validation import check_finite, real_array
 
-
-def _ptr(arr):
-    return ffi.cast("double *", ffi.from_buffer(arr))
 
 
 class GroupMethods:
@@ -42,11 +40,11 @@ class GroupMethods:
         # an overflow of x's entries by `other`'s, and that is `other`'s fault.
         if x.ndim == 1:
             out = np.empty(width)
-            self._blame(name, result, single(self._model, _ptr(x), _ptr(other), _ptr(out)))
+            self._blame(name, result, single(self._model, pointer(x), pointer(other), pointer(out)))
             return out
         out = np.empty((x.shape[0], width))
         failed = ffi.new("long *")
-        status = batch(self._model, x.shape[0], _ptr(x), _ptr(other), _ptr(out), failed)
+        status = batch(self._model, x.shape[0], pointer(x), pointer(other), pointer(out), failed)
         self._blame(f"{name}[{failed[0]}]" if failed[0] >= 0 else name, result, status)
         return out
 

@@ -3,6 +3,7 @@ import numpy as np
 
 from bindings._fastcall import Kernels
 from bindings._sr import ffi, lib
+from bindings.buffers import pointer
 
 from .errors import KernelError, SimulationStopped
 from .derivatives import DerivativeMethods
@@ -61,9 +62,6 @@ def _double_array(value, field, shape_tail):
     return real_array(value, field, shape_tail)
 
 
-def _ptr(arr):
-    return ffi.cast("double *", ffi.from_buffer(arr))
-
 
 def _method(method, allowed=METHODS):
     """The C code of the integrator named `method`, one of `allowed` (ValueError naming `method`)."""
@@ -106,7 +104,7 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativ
             raise ValueError(f"params: expected a runtime.Params, got {type(self.params).__name__}")
         self._p = self.params.as_array()
         self._model = ffi.new("sr_model *")
-        status = lib.sr_model_init(self._model, _ptr(self._p))
+        status = lib.sr_model_init(self._model, pointer(self._p))
         if status != lib.SR_OK:
             raise KernelError("params", status,
                               message=_param_message(self.params, status) if status in _PARAM_MESSAGES else None)
@@ -153,15 +151,15 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativ
         if x.ndim == 1:
             x, u = self._state_and_input(x, u, batch=False)
             out = np.empty(NV)
-            self._check("x", lib.sr_accel(self._model, _ptr(x), _ptr(u), _ptr(out)))
+            self._check("x", lib.sr_accel(self._model, pointer(x), pointer(u), pointer(out)))
             return out
         # A batch: C checks every state in full and solves, both vectorised (sr_checked_accel_batch);
         # the state it stops at is checked again here, for the message that names what is wrong.
         u = None if u is None else self._input(u, x)
         out = np.empty((x.shape[0], NV))
         failed = ffi.new("long *")
-        status = lib.sr_checked_accel_batch(self._model, x.shape[0], _ptr(x), ffi.NULL if u is None else _ptr(u),
-                                            _ptr(out), failed)
+        status = lib.sr_checked_accel_batch(self._model, x.shape[0], pointer(x), ffi.NULL if u is None else pointer(u),
+                                            pointer(out), failed)
         self._check_batch(x, status, failed[0])
         return out
 
@@ -173,13 +171,13 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativ
         if x.ndim == 1:
             x, u = self._state_and_input(x, u, batch=False)
             out = np.empty(3)
-            self._check("x", lib.sr_contact_force(self._model, _ptr(x), _ptr(u), _ptr(out)))
+            self._check("x", lib.sr_contact_force(self._model, pointer(x), pointer(u), pointer(out)))
             return out
         u = None if u is None else self._input(u, x)
         out = np.empty((x.shape[0], 3))
         failed = ffi.new("long *")
-        status = lib.sr_contact_force_batch(self._model, x.shape[0], _ptr(x), ffi.NULL if u is None else _ptr(u),
-                                            _ptr(out), failed)
+        status = lib.sr_contact_force_batch(self._model, x.shape[0], pointer(x), ffi.NULL if u is None else pointer(u),
+                                            pointer(out), failed)
         self._check_batch(x, status, failed[0])
         return out
 
@@ -195,7 +193,7 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativ
     def _single(self, fn, x, n, field="x"):
         x = self._valid_states(x, field, batch=False)
         out = np.empty(n)
-        self._check(field, fn(self._model, _ptr(x), _ptr(out)))
+        self._check(field, fn(self._model, pointer(x), pointer(out)))
         return out
 
     def inertia(self, x):
@@ -208,7 +206,7 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativ
         out = np.empty((x.shape[0], NV, NV))
         failed = ffi.new("long *")
         # the binding's loop over sr_inertia (bindings/build_sr.py); the states are checked in full above
-        status = lib.sr_py_inertia_batch(self._model, x.shape[0], _ptr(x), _ptr(out), failed)
+        status = lib.sr_py_inertia_batch(self._model, x.shape[0], pointer(x), pointer(out), failed)
         self._check(f"x[{failed[0]}]", status)
         return out
 
@@ -216,7 +214,7 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativ
         """f (5,) with M ν̇ = f."""
         x, u = self._state_and_input(x, u, batch=False)
         out = np.empty(NV)
-        self._check("x", lib.sr_rhs(self._model, _ptr(x), _ptr(u), _ptr(out)))
+        self._check("x", lib.sr_rhs(self._model, pointer(x), pointer(u), pointer(out)))
         return out
 
     def energy(self, x):
@@ -247,7 +245,7 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativ
             x, u = self._state_and_input(x, u, batch=False)
             dt = self._dt(dt)
             out = np.empty(NX)
-            self._check("x", lib.sr_step(self._model, _method(method), _ptr(x), _ptr(u), dt, _ptr(out)),
+            self._check("x", lib.sr_step(self._model, _method(method), pointer(x), pointer(u), dt, pointer(out)),
                         ": the step's result overflowed (dt too large for this state?)")
             return out
         # A batch: C checks every state in full and steps (sr_step_batch); the state it stops at
@@ -257,8 +255,8 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativ
         code = _method(method)
         out = np.empty((x.shape[0], NX))
         failed = ffi.new("long *")
-        status = lib.sr_step_batch(self._model, code, x.shape[0], _ptr(x), ffi.NULL if u is None else _ptr(u), dt,
-                                   _ptr(out), failed)
+        status = lib.sr_step_batch(self._model, code, x.shape[0], pointer(x), ffi.NULL if u is None else pointer(u), dt,
+                                   pointer(out), failed)
         self._check_batch(x, status, failed[0], ": the step's result overflowed (dt too large for this state?)")
         return out
 
@@ -308,9 +306,9 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativ
     def _guarded_run(self, code, dt, n, u, guard, traj, first):
         """`n` steps from traj[first] into traj[first..first+n] by sr_simulate_guarded; raises SimulationStopped."""
         done = ffi.new("long *")
-        status = lib.sr_simulate_guarded(self._model, code, _ptr(traj[first]), dt, n,
-                                         ffi.NULL if u is None else _ptr(u), guard,
-                                         _ptr(traj[first:first + n + 1]), done)
+        status = lib.sr_simulate_guarded(self._model, code, pointer(traj[first]), dt, n,
+                                         ffi.NULL if u is None else pointer(u), guard,
+                                         pointer(traj[first:first + n + 1]), done)
         if status == lib.SR_ERR_MODEL:    # refused before any step: the model's fault, not the run's
             raise KernelError("model", status)
         if status != lib.SR_OK:
@@ -388,9 +386,9 @@ class Model(GroupMethods, DerivativeMethods, StepJacobianMethods, ParamDerivativ
         totals = {"accepted": 0, "rejected": 0, "evaluations": 0, "h_next": 0.0}
 
         def run(x_start, rows, u_rows, h_init, out, k0):
-            status = lib.sr_simulate_adaptive(self._model, code, _ptr(x_start), dt_out, rows,
-                                              ffi.NULL if u_rows is None else _ptr(u_rows),
-                                              float(rtol), float(atol), h_init, max_steps, _ptr(out), stats)
+            status = lib.sr_simulate_adaptive(self._model, code, pointer(x_start), dt_out, rows,
+                                              ffi.NULL if u_rows is None else pointer(u_rows),
+                                              float(rtol), float(atol), h_init, max_steps, pointer(out), stats)
             for key in ("accepted", "rejected", "evaluations"):
                 totals[key] += getattr(stats, key)
             totals["h_next"] = stats.h_next

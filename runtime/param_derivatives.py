@@ -17,15 +17,13 @@ import dataclasses
 import numpy as np
 
 from bindings._sr import ffi, lib
+from bindings.buffers import pointer
 
 from .params import FLAT_FIELDS, SHAPES, flat_names, parameter_order
 from .so3 import random_rotation
 from .state import NE, NV, NX, initial_state
 from .validation import choice, check_finite, real_array
 
-
-def _ptr(arr):
-    return ffi.cast("double *", ffi.from_buffer(arr))
 
 
 def _parameter_names():
@@ -83,10 +81,10 @@ class ParamDerivativeMethods:
 
     def _rows(self, single, batch, x, out, *arrays, field="x"):
         if x.ndim == 1:
-            self._check(field, single(self._model, *arrays, _ptr(out)))
+            self._check(field, single(self._model, *arrays, pointer(out)))
             return out
         failed = ffi.new("long *")
-        status = batch(self._model, x.shape[0], *arrays, _ptr(out), failed)
+        status = batch(self._model, x.shape[0], *arrays, pointer(out), failed)
         self._check(f"{field}[{failed[0]}]" if failed[0] >= 0 else field, status)
         return out
 
@@ -101,7 +99,7 @@ class ParamDerivativeMethods:
         if columns is not None:
             return self._columns(lib.sr_accel_param_jacobian_cols_batch, x, u, NV, columns)
         out = np.empty(x.shape[:-1] + (NV, NPARAM))
-        return self._rows(lib.sr_accel_param_jacobian, lib.sr_accel_param_jacobian_batch, x, out, _ptr(x), _ptr(u))
+        return self._rows(lib.sr_accel_param_jacobian, lib.sr_accel_param_jacobian_batch, x, out, pointer(x), pointer(u))
 
     def step_param_jacobian(self, x, u=None, dt=0.01, method="lie-euler", columns=None):
         """Jp (12, 31): step(x, u; p + δp) ⊖ step(x, u; p) = Jp δp + O(|δp|²), the exact derivative of
@@ -118,10 +116,10 @@ class ParamDerivativeMethods:
             return self._columns(lib.sr_step_param_jacobian_cols_batch, x, u, NE, columns, (code, dt))
         out = np.empty(x.shape[:-1] + (NE, NPARAM))
         if x.ndim == 1:
-            self._check("x", lib.sr_step_param_jacobian(self._model, code, _ptr(x), _ptr(u), dt, _ptr(out)))
+            self._check("x", lib.sr_step_param_jacobian(self._model, code, pointer(x), pointer(u), dt, pointer(out)))
             return out
         failed = ffi.new("long *")
-        status = lib.sr_step_param_jacobian_batch(self._model, code, x.shape[0], _ptr(x), _ptr(u), dt, _ptr(out), failed)
+        status = lib.sr_step_param_jacobian_batch(self._model, code, x.shape[0], pointer(x), pointer(u), dt, pointer(out), failed)
         self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
         return out
 
@@ -154,8 +152,8 @@ class ParamDerivativeMethods:
         first = np.empty((xb.shape[0], *first_shape))
         Jp = np.empty((xb.shape[0], NE, len(cols)))
         failed = ffi.new("long *")
-        status = batch(self._model, getattr(lib, STEP_METHODS[method]), xb.shape[0], _ptr(xb), _ptr(ub), dt, len(cols),
-                       ffi.new("int[]", [int(c) for c in cols]), _ptr(first), _ptr(Jp), failed)
+        status = batch(self._model, getattr(lib, STEP_METHODS[method]), xb.shape[0], pointer(xb), pointer(ub), dt, len(cols),
+                       ffi.new("int[]", [int(c) for c in cols]), pointer(first), pointer(Jp), failed)
         self._check(f"x[{failed[0]}]" if failed[0] >= 0 and x.ndim > 1 else "x", status)
         return (first, Jp) if x.ndim > 1 else (first[0], Jp[0])
 
@@ -167,8 +165,8 @@ class ParamDerivativeMethods:
         ub = np.ascontiguousarray(u.reshape(-1, u.shape[-1]))
         out = np.empty((xb.shape[0], rows, len(cols)))
         failed = ffi.new("long *")
-        status = batch(self._model, *step[:1], xb.shape[0], _ptr(xb), _ptr(ub), *step[1:], len(cols),
-                       ffi.new("int[]", [int(c) for c in cols]), _ptr(out), failed)
+        status = batch(self._model, *step[:1], xb.shape[0], pointer(xb), pointer(ub), *step[1:], len(cols),
+                       ffi.new("int[]", [int(c) for c in cols]), pointer(out), failed)
         self._check(f"x[{failed[0]}]" if failed[0] >= 0 and x.ndim > 1 else "x", status)
         return out if x.ndim > 1 else out[0]
 
@@ -190,7 +188,7 @@ class ParamDerivativeMethods:
         cint = ffi.new("int[]", [int(c) for c in cols])
         failed = ffi.new("long *")
         status = lib.sr_step_param_jacobian_fd_batch(self._model, getattr(lib, STEP_METHODS[method]), xb.shape[0],
-                                                     _ptr(xb), _ptr(ub), dt, len(cols), cint, _ptr(out), _ptr(work),
+                                                     pointer(xb), pointer(ub), dt, len(cols), cint, pointer(out), pointer(work),
                                                      failed)
         if status == lib.SR_ERR_PARAM:
             raise ValueError("columns: a parameter has no valid robot on either side of its value, no difference exists")
@@ -208,7 +206,7 @@ class ParamDerivativeMethods:
             raise ValueError(f"nudot: shape {nudot.shape} does not match x of shape {x.shape}")
         check_finite(nudot, "nudot")
         out = np.empty(x.shape[:-1] + (NV, NPI))
-        return self._rows(lib.sr_regressor, lib.sr_regressor_batch, x, out, _ptr(x), _ptr(nudot))
+        return self._rows(lib.sr_regressor, lib.sr_regressor_batch, x, out, pointer(x), pointer(nudot))
 
 
 def trajectory_sensitivities(model, x0, dt, steps, u=None, method="rkmk4"):

@@ -13,6 +13,7 @@ the reference (tests/runtime/test_sensor_sim_c.py holds them equal).
 import numpy as np
 
 from bindings._sr import ffi, lib
+from bindings.buffers import pointer
 
 from .errors import KernelError
 from .ekf import KINDS as FILTER_KINDS
@@ -25,9 +26,6 @@ from .state import NX
 _FILTER_KIND = dict(zip(KINDS, ("imu", "encoders", "position", "heading")))
 assert all(_FILTER_KIND[k] in FILTER_KINDS for k in KINDS)
 
-
-def _ptr(arr):
-    return ffi.cast("double *", ffi.from_buffer(arr))
 
 
 def imu_biases(sim):
@@ -59,7 +57,7 @@ class SensorRunC:
         def buf(arr):
             arr = np.ascontiguousarray(arr, dtype=np.float64)
             keep.append(arr)
-            return _ptr(arr)
+            return pointer(arr)
 
         c.steps, c.dt, c.method = self.steps, sim.dt, METHODS[sim.method]
         c.process = buf(sim.rng["process"].normal(0.0, 1.0, (self.steps, 5)))
@@ -85,7 +83,7 @@ class SensorRunC:
             st.time = buf(t)
             st.arrival = buf(np.array([sim.arrival(kind, i) for i in range(n)]) if kind == "fixes" else t)
             self.readings[kind] = np.empty((n, WIDTH[kind]))
-            st.reading = _ptr(self.readings[kind])
+            st.reading = pointer(self.readings[kind])
             width = WIDTH[kind]
             if kind == "imu":
                 st.draw = buf(sim.rng["imu"].normal(0.0, 1.0, (n, 6)))
@@ -128,8 +126,8 @@ class SensorRunC:
         u = np.ascontiguousarray(u, dtype=np.float64)
         self._c.filter_time = self.estimator.t
         status = lib.sr_sim_advance(self._c, self.plant._model, self.estimator.filter._ekf,
-                                    self.estimator.filter.model._model, step, count, _ptr(x), _ptr(u),
-                                    ffi.NULL if traj is None else _ptr(traj))
+                                    self.estimator.filter.model._model, step, count, pointer(x), pointer(u),
+                                    ffi.NULL if traj is None else pointer(traj))
         self.estimator.t = float(self._c.filter_time)
         if status != lib.SR_OK:
             raise KernelError("x", status, f" (the C sensor simulation, steps {step}..{step + count - 1})")

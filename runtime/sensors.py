@@ -19,6 +19,7 @@ import dataclasses
 import numpy as np
 
 from bindings._sr import ffi, lib
+from bindings.buffers import pointer
 
 from .errors import KernelError
 from .state import NV
@@ -37,9 +38,6 @@ IDX_EB_BA = slice(lib.SR_EB_b_a, lib.SR_EB_b_a + 3)
 HEADING_MIN_HORIZONTAL = float(lib.SR_HEADING_MIN_HORIZONTAL)
 
 
-def _ptr(arr):
-    return ffi.cast("double *", ffi.from_buffer(arr))
-
 
 @dataclasses.dataclass(frozen=True)
 class Mount:
@@ -57,7 +55,7 @@ class Mount:
         check_finite(lever, "mount.lever")
         check_finite(rotation, "mount.rotation")
         array = np.concatenate([lever, rotation.ravel()])
-        status = lib.sr_check_mount(BODIES[self.body], _ptr(array))
+        status = lib.sr_check_mount(BODIES[self.body], pointer(array))
         if status == lib.SR_ERR_NOT_ROTATION:
             raise ValueError("mount.rotation: not a rotation matrix (orthonormal with det +1 to "
                              f"{float(lib.SR_ROTATION_TOL):g})")
@@ -117,11 +115,11 @@ def imu(model, x, nu_dot=None, *, u=None, mount=None, bias=None):
         if u is not None:
             raise ValueError("u: give either nu_dot or u, not both")
         a = _vector(nu_dot, "nu_dot", NV)
-        status = lib.sr_imu_measure(model._model, _ptr(x), _ptr(a), BODIES[m.body], _ptr(m.as_array()), _ptr(b), _ptr(y))
+        status = lib.sr_imu_measure(model._model, pointer(x), pointer(a), BODIES[m.body], pointer(m.as_array()), pointer(b), pointer(y))
     else:
         torque = _vector(u, "u", 2, default_zero=True)
-        status = lib.sr_imu_measure_u(model._model, _ptr(x), _ptr(torque), BODIES[m.body], _ptr(m.as_array()),
-                                      _ptr(b), _ptr(y))
+        status = lib.sr_imu_measure_u(model._model, pointer(x), pointer(torque), BODIES[m.body], pointer(m.as_array()),
+                                      pointer(b), pointer(y))
     _call("x", status, "the generalized inertia is singular")
     return y
 
@@ -132,8 +130,8 @@ def imu_partials(model, x, nu_dot, *, mount=None, bias=None):
     m, b = _mount(mount), _vector(bias, "bias", NBIAS, default_zero=True)
     a = _vector(nu_dot, "nu_dot", NV)
     y, H, Hn = np.empty(NIMU), np.empty((NIMU, NEB)), np.empty((NIMU, NV))
-    _call("x", lib.sr_imu_partials(model._model, _ptr(x), _ptr(a), BODIES[m.body], _ptr(m.as_array()), _ptr(b),
-                                   _ptr(y), _ptr(H), _ptr(Hn)))
+    _call("x", lib.sr_imu_partials(model._model, pointer(x), pointer(a), BODIES[m.body], pointer(m.as_array()), pointer(b),
+                                   pointer(y), pointer(H), pointer(Hn)))
     return y, H, Hn
 
 
@@ -160,8 +158,8 @@ def imu_partials_batch(model, x, nu_dot, *, mount=None, bias=None):
     n = X.shape[0]
     y, H, Hn = np.empty((n, NIMU)), np.empty((n, NIMU, NEB)), np.empty((n, NIMU, NV))
     failed = ffi.new("long *")
-    status = lib.sr_imu_partials_batch(model._model, n, _ptr(X), _ptr(a), BODIES[m.body], _ptr(m.as_array()), _ptr(b),
-                                       _ptr(y), _ptr(H), _ptr(Hn), failed)
+    status = lib.sr_imu_partials_batch(model._model, n, pointer(X), pointer(a), BODIES[m.body], pointer(m.as_array()), pointer(b),
+                                       pointer(y), pointer(H), pointer(Hn), failed)
     _batch_call(model, X, status, failed[0])
     return y.reshape(lead + (NIMU,)), H.reshape(lead + (NIMU, NEB)), Hn.reshape(lead + (NIMU, NV))
 
@@ -171,7 +169,7 @@ def _pair_batch(model, x, function):
     n = X.shape[0]
     y, H = np.empty((n, 2)), np.empty((n, 2, NEB))
     failed = ffi.new("long *")
-    _batch_call(model, X, function(model._model, n, _ptr(X), _ptr(y), _ptr(H), failed), failed[0])
+    _batch_call(model, X, function(model._model, n, pointer(X), pointer(y), pointer(H), failed), failed[0])
     return y.reshape(lead + (2,)), H.reshape(lead + (2, NEB))
 
 
@@ -191,8 +189,8 @@ def imu_jacobian(model, x, u=None, *, mount=None, bias=None):
     m, b = _mount(mount), _vector(bias, "bias", NBIAS, default_zero=True)
     torque = _vector(u, "u", 2, default_zero=True)
     y, H = np.empty(NIMU), np.empty((NIMU, NEB))
-    _call("x", lib.sr_imu_jacobian(model._model, _ptr(x), _ptr(torque), BODIES[m.body], _ptr(m.as_array()), _ptr(b),
-                                   _ptr(y), _ptr(H)), "the generalized inertia is singular")
+    _call("x", lib.sr_imu_jacobian(model._model, pointer(x), pointer(torque), BODIES[m.body], pointer(m.as_array()), pointer(b),
+                                   pointer(y), pointer(H)), "the generalized inertia is singular")
     return y, H
 
 
@@ -200,10 +198,10 @@ def _pair(model, x, measure, jacobian):
     x = _state(model, x)
     y = np.empty(2)
     if not jacobian:
-        _call("x", measure(model._model, _ptr(x), _ptr(y)))
+        _call("x", measure(model._model, pointer(x), pointer(y)))
         return y
     H = np.empty((2, NEB))
-    _call("x", measure(model._model, _ptr(x), _ptr(y), _ptr(H)))
+    _call("x", measure(model._model, pointer(x), pointer(y), pointer(H)))
     return y, H
 
 
@@ -235,7 +233,7 @@ def heading(model, x, mount=None):
     h = R_B R_m e_x, counter-clockwise from the inertial x axis (up the slope)."""
     x, m = _state(model, x), _mount(mount)
     out = ffi.new("double *")
-    _call("x", lib.sr_heading_measure(model._model, _ptr(x), BODIES[m.body], _ptr(m.as_array()), out), _VERTICAL)
+    _call("x", lib.sr_heading_measure(model._model, pointer(x), BODIES[m.body], pointer(m.as_array()), out), _VERTICAL)
     return float(out[0])
 
 
@@ -243,6 +241,6 @@ def heading_jacobian(model, x, mount=None):
     """(heading, H (18,))."""
     x, m = _state(model, x), _mount(mount)
     out, H = ffi.new("double *"), np.empty(NEB)
-    _call("x", lib.sr_heading_jacobian(model._model, _ptr(x), BODIES[m.body], _ptr(m.as_array()), out, _ptr(H)),
+    _call("x", lib.sr_heading_jacobian(model._model, pointer(x), BODIES[m.body], pointer(m.as_array()), out, pointer(H)),
           _VERTICAL)
     return float(out[0]), H

@@ -102,17 +102,15 @@ class StepJacobianMethods:
 
     def _c_step_jacobian(self, x, u, dt, method):
         from bindings._sr import ffi, lib
-
-        def ptr(arr):
-            return ffi.cast("double *", ffi.from_buffer(arr))
+        from bindings.buffers import pointer
         code = {"lie-euler": lib.SR_LIE_EULER, "rkmk4": lib.SR_RKMK4, "cf4": lib.SR_CF4}[method]
         lead = x.shape[:-1]
         F, G = np.empty(lead + (NE, NE)), np.empty(lead + (NE, NU))
         if x.ndim == 1:
-            self._check("x", lib.sr_step_jacobian(self._model, code, ptr(x), ptr(u), dt, ptr(F), ptr(G)))
+            self._check("x", lib.sr_step_jacobian(self._model, code, pointer(x), pointer(u), dt, pointer(F), pointer(G)))
             return F, G
         failed = ffi.new("long *")
-        status = lib.sr_step_jacobian_batch(self._model, code, x.shape[0], ptr(x), ptr(u), dt, ptr(F), ptr(G), failed)
+        status = lib.sr_step_jacobian_batch(self._model, code, x.shape[0], pointer(x), pointer(u), dt, pointer(F), pointer(G), failed)
         self._check(f"x[{failed[0]}]" if failed[0] >= 0 else "x", status)
         return F, G
 

@@ -16,6 +16,7 @@ import time
 import numpy as np
 
 from bindings._sr import ffi, lib
+from bindings.buffers import pointer
 
 from ..errors import KernelError
 from ..sensor_sim_c import SensorRunC
@@ -43,7 +44,7 @@ def c_path(reference, keep):
     keep.extend(arrays)
     c = ffi.new("sr_path *")
     c.n = len(reference.s)
-    c.points, c.s, c.tangent, c.curvature = (ffi.cast("double *", ffi.from_buffer(a)) for a in arrays)
+    c.points, c.s, c.tangent, c.curvature = (pointer(a) for a in arrays)
     c.speed, c.search_back, c.search_ahead, c.hint = reference.speed, SEARCH_BACK_M, SEARCH_AHEAD_M, reference._hint
     status = lib.sr_path_check(c)
     if status != lib.SR_OK:
@@ -69,7 +70,7 @@ class PathTargets:
     def __call__(self, t, y):
         """The target at time t [s] for the estimate y (35,)."""
         y = np.ascontiguousarray(y, dtype=np.float64)
-        status = lib.sr_path_target(self._path, _ptr(y) + IDX_Q.start, self._target)
+        status = lib.sr_path_target(self._path, pointer(y) + IDX_Q.start, self._target)
         if status != lib.SR_OK:
             raise ValueError(f"reference: {ffi.string(lib.sr_status_string(status)).decode()} at t = {t:g} s")
         self.reference._hint = int(self._path.hint)
@@ -80,7 +81,7 @@ class PathTargets:
         distances = np.ascontiguousarray(self.controller.preview_distances(target), dtype=np.float64)
         if self._ahead is None or len(self._ahead) != len(distances):
             self._ahead = np.empty(len(distances))
-        lib.sr_path_curvature_ahead(self._path, _ptr(distances), len(distances), _ptr(self._ahead))
+        lib.sr_path_curvature_ahead(self._path, pointer(distances), len(distances), pointer(self._ahead))
         return dataclasses.replace(target, curvature_ahead=tuple(self._ahead.tolist()))
 
 
@@ -96,14 +97,11 @@ def track(reference, positions):
     path = c_path(reference, keep)
     path.hint = 0
     out, first = np.empty(len(positions)), ffi.new("long *")
-    status = lib.sr_path_cross_track(path, _ptr(positions), len(positions), positions.shape[1], _ptr(out), first)
+    status = lib.sr_path_cross_track(path, pointer(positions), len(positions), positions.shape[1], pointer(out), first)
     if status != lib.SR_OK:
         raise ValueError(f"positions: {ffi.string(lib.sr_status_string(status)).decode()}")
     return out, float(reference.s[path.hint] - reference.s[first[0]])
 
-
-def _ptr(arr):
-    return ffi.cast("double *", ffi.from_buffer(arr))
 
 
 def run(sim, controller, reference, x0, estimator, per, samples, record_samples, progress=False):
@@ -139,9 +137,9 @@ def run(sim, controller, reference, x0, estimator, per, samples, record_samples,
     for first in tqdm(range(0, samples, CHUNK), disable=not progress or None, unit="chunk", leave=False):
         count = min(CHUNK, samples - first)
         status = lib.sr_loop_lqr(sim_c._c, sim.plant._model, estimator.filter._ekf, controller._model._model,
-                                 controller._c, controller._memory, estimate, offsets, path, _ptr(preview), len(preview),
-                                 per, first, count, _ptr(x), _ptr(u), _ptr(traj[first * per + 1:]), _ptr(torques[first:]),
-                                 _ptr(estimates[first:]), ffi.cast("long *", ffi.from_buffer(applied[first:])),
+                                 controller._c, controller._memory, estimate, offsets, path, pointer(preview), len(preview),
+                                 per, first, count, pointer(x), pointer(u), pointer(traj[first * per + 1:]), pointer(torques[first:]),
+                                 pointer(estimates[first:]), ffi.cast("long *", ffi.from_buffer(applied[first:])),
                                  saturated, done, failed_in)
         estimator.t = float(sim_c._c.filter_time)
         reference._hint = int(path.hint)

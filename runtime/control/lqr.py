@@ -16,6 +16,7 @@ import typing
 import numpy as np
 
 from bindings._sr import ffi, lib
+from bindings.buffers import pointer
 
 from ..errors import KernelError
 from ..model import Model
@@ -320,10 +321,10 @@ class Lqr(SlopeFeedforward, Controller):
             self._estimator.update(x, self._applied)
         if target.cross_track is not None:
             target = dataclasses.replace(target, curvature=self.operating_curvature(target))
-        status = lib.sr_lqr_control_offsets(self._c, self._model._model, ffi.cast("double *", ffi.from_buffer(x)),
+        status = lib.sr_lqr_control_offsets(self._c, self._model._model, pointer(x),
                                             c_target(target), self.offsets(), self._memory,
-                                            ffi.cast("double *", ffi.from_buffer(self._u)),
-                                            ffi.cast("double *", ffi.from_buffer(self._raw)))
+                                            pointer(self._u),
+                                            pointer(self._raw))
         if status == lib.SR_ERR_MODEL:
             raise KernelError("model", status, f" (controller lqr at t = {t:g} s)")
         if status != lib.SR_OK:

@@ -543,6 +543,7 @@ class NmpcC(Nmpc):
 
     def compute(self, t, x, target):
         """The torques of one sample of `sr_nmpc_step` for state x and the target."""
+        from bindings.buffers import pointer
         from ..errors import KernelError
         ffi, lib, c = self._ffi, self._lib, self._target
         c.speed, c.heading = target.speed, target.heading
@@ -562,8 +563,8 @@ class NmpcC(Nmpc):
         x, feedforward = self._on_slope(x, target, kappa)
         x = np.ascontiguousarray(x, dtype=np.float64)
         self._memory.disturbance[0:2] = (self.disturbance - feedforward).tolist()
-        status = lib.sr_nmpc_step(self._c, self._memory, self._model._model, ffi.cast("double *", ffi.from_buffer(x)),
-                                  c, ffi.cast("double *", ffi.from_buffer(self._u)))
+        status = lib.sr_nmpc_step(self._c, self._memory, self._model._model, pointer(x),
+                                  c, pointer(self._u))
         if status == lib.SR_ERR_MODEL:
             raise KernelError("model", status, f" (controller {self.kind} at t = {t:g} s)")
         if status != lib.SR_OK:

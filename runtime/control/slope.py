@@ -46,6 +46,7 @@ import math
 import numpy as np
 
 from bindings._sr import ffi, lib
+from bindings.buffers import pointer
 
 from ..model import Model
 from ..so3 import rot_z
@@ -316,7 +317,7 @@ class SlopeEstimatorC:
         self.prior_scale = _prior_scale(prior_scale)
         self._c = ffi.new("sr_slope_estimator *")
         p = np.ascontiguousarray(params.replace(slope=0.0).as_array(), dtype=np.float64)
-        status = lib.sr_slope_init(self._c, ffi.cast("double *", ffi.from_buffer(p)), self.period, self.time_constant_s)
+        status = lib.sr_slope_init(self._c, pointer(p), self.period, self.time_constant_s)
         if status != lib.SR_OK:
             raise ValueError(f"slope_estimate_s: the C slope estimate refuses period {self.period!r} s and time "
                              f"constant {self.time_constant_s!r} s ({ffi.string(lib.sr_status_string(status)).decode()})")
@@ -358,8 +359,8 @@ class SlopeEstimatorC:
         u = np.ascontiguousarray(u_applied_before, dtype=np.float64)
         if u.shape != (2,) or not np.all(np.isfinite(u)):
             raise ValueError(f"u_applied_before: expected 2 finite torques, got {u_applied_before!r}")
-        status = lib.sr_slope_update(self._c, ffi.cast("double *", ffi.from_buffer(x)),
-                                     ffi.cast("double *", ffi.from_buffer(u)))
+        status = lib.sr_slope_update(self._c, pointer(x),
+                                     pointer(u))
         if status != lib.SR_OK:
             raise ValueError(f"x: the C slope estimate refuses the sample "
                              f"({ffi.string(lib.sr_status_string(status)).decode()})")

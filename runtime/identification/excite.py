@@ -260,16 +260,14 @@ def _imu_rows(model, mount):
     (the per-sample cost of runtime.sensors.imu_partials is its argument checks, done once by the
     caller on the first sample; the states are the simulator's own)."""
     from bindings._sr import ffi, lib
-
-    def ptr(a):
-        return ffi.cast("double *", ffi.from_buffer(a))
+    from bindings.buffers import pointer
     m = np.ascontiguousarray(mount.as_array())
     b, y, H, Hn = np.zeros(6), np.empty(NIMU), np.empty((NIMU, NEB)), np.empty((NIMU, 5))
-    fixed = (BODIES[mount.body], ptr(m), ptr(b), ptr(y), ptr(H), ptr(Hn))
+    fixed = (BODIES[mount.body], pointer(m), pointer(b), pointer(y), pointer(H), pointer(Hn))
 
     def rows(x, nudot, _keep=(m, b, y)):     # the buffers the pointers point into stay alive with rows
         x, nudot = np.ascontiguousarray(x), np.ascontiguousarray(nudot)
-        status = lib.sr_imu_partials(model._model, ptr(x), ptr(nudot), *fixed)
+        status = lib.sr_imu_partials(model._model, pointer(x), pointer(nudot), *fixed)
         if status != lib.SR_OK:
             raise ValueError(f"x: the IMU's Jacobian failed ({ffi.string(lib.sr_status_string(status)).decode()})")
         return H, Hn

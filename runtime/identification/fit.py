@@ -33,6 +33,7 @@ import scipy.optimize
 import scipy.sparse
 import scipy.stats
 from bindings._sr import lib as _lib
+from bindings.buffers import pointer
 
 from ..blas import one_thread
 from ..errors import KernelError
@@ -41,7 +42,7 @@ from ..param_derivatives import PARAMETER_NAMES, base_parameters, inertial_param
 from ..params import SHAPES, Params, flat_names
 from ..state import IDX_E_NU, IDX_E_XI_S, IDX_NU, IDX_RS, NE, NV
 from .first_guess import _dpi_of, regressor_guess
-from .segments import Rows, _ptr, buffer, dlocal_batch, dretract_batch, segment_blocks
+from .segments import Rows, buffer, dlocal_batch, dretract_batch, segment_blocks
 from .sensitivity import JACOBIANS, step_and_sensitivity
 
 #: Where the fit starts the parameters: the regressor's linear least-squares first guess, or the nominal robot.
@@ -538,10 +539,10 @@ class _Problem:
         width = np.array([w for _, w in Ms.shapes], dtype=np.int64)
         out = buffer(buffers, "W", Ms.data.size)
         work = np.empty((NE + 1) * int(width.max()))
-        status = _lib.sr_ident_whiten(len(n_rows), _ptr(n_rows, "long"), _ptr(width, "long"),
-                                      _ptr(stacked["n_steps"], "long"), _ptr(stacked["step_rows"], "long"),
-                                      _ptr(stacked["unit"]), _ptr(stacked["H"]), _ptr(stacked["L"]),
-                                      _ptr(stacked["K"]), _ptr(Ms.data), _ptr(out), _ptr(work))
+        status = _lib.sr_ident_whiten(len(n_rows), pointer(n_rows, "long"), pointer(width, "long"),
+                                      pointer(stacked["n_steps"], "long"), pointer(stacked["step_rows"], "long"),
+                                      pointer(stacked["unit"]), pointer(stacked["H"]), pointer(stacked["L"]),
+                                      pointer(stacked["K"]), pointer(Ms.data), pointer(out), pointer(work))
         if status != _lib.SR_OK:
             raise KernelError("whitening", status)
         return Rows(out, Ms.shapes)

@@ -13,6 +13,7 @@ would give, to rounding.
 import numpy as np
 
 from bindings._sr import ffi, lib
+from bindings.buffers import pointer
 
 from ..errors import KernelError
 from ..sensors import encoders_jacobian_batch, imu_partials_batch, position_jacobian_batch
@@ -65,9 +66,6 @@ def dlocal_batch(model, a, b):
     return _differenced(da), _differenced(db)
 
 
-def _ptr(arr, kind="double"):
-    return ffi.cast(f"{kind} *", ffi.from_buffer(arr))
-
 
 def _check(field, status):
     if status != lib.SR_OK:
@@ -94,8 +92,8 @@ def chain(steps, nf, F, Jp=None, buffers=None):
     F = np.ascontiguousarray(F, dtype=float)
     n = int(np.sum(steps + 1))
     G = buffer(buffers, "G", n * NE * (NE + nf)).reshape(n, NE, NE + nf)
-    jp = ffi.NULL if Jp is None else _ptr(np.ascontiguousarray(Jp, dtype=float))
-    _check("chain", lib.sr_ident_chain(len(steps), _ptr(steps, "long"), nf, _ptr(F), jp, _ptr(G)))
+    jp = ffi.NULL if Jp is None else pointer(np.ascontiguousarray(Jp, dtype=float))
+    _check("chain", lib.sr_ident_chain(len(steps), pointer(steps, "long"), nf, pointer(F), jp, pointer(G)))
     return G
 
 
@@ -251,10 +249,10 @@ def rows(steps, nf, n_read, has, at, node, Hx, Hn, Hb, r, sig, G, Jpa, D, A, B, 
     shapes = [(int(m) + NE * int(h), nf + NB + NE + NE * int(h) + 1) for m, h in zip(n_read, has)]
     out = buffer(buffers, "M", sum(m * w for m, w in shapes))
     node = np.ascontiguousarray(node, dtype=np.int64)
-    jpa = ffi.NULL if Jpa is None else _ptr(np.ascontiguousarray(Jpa, dtype=float))
+    jpa = ffi.NULL if Jpa is None else pointer(np.ascontiguousarray(Jpa, dtype=float))
     n_nodes = 0 if Jpa is None else len(Jpa)
-    _check("rows", lib.sr_ident_rows(len(steps), nf, _ptr(steps, "long"), _ptr(np.ascontiguousarray(n_read, dtype=np.int64), "long"),
-                                     _ptr(has, "int"), _ptr(at, "long"), _ptr(node, "long"), n_nodes, _ptr(Hx), _ptr(Hn),
-                                     _ptr(Hb), _ptr(r), _ptr(np.ascontiguousarray(sig, dtype=float)), _ptr(G), jpa, _ptr(D),
-                                     _ptr(A), _ptr(B), _ptr(Dn), _ptr(defects), _ptr(out)))
+    _check("rows", lib.sr_ident_rows(len(steps), nf, pointer(steps, "long"), pointer(np.ascontiguousarray(n_read, dtype=np.int64), "long"),
+                                     pointer(has, "int"), pointer(at, "long"), pointer(node, "long"), n_nodes, pointer(Hx), pointer(Hn),
+                                     pointer(Hb), pointer(r), pointer(np.ascontiguousarray(sig, dtype=float)), pointer(G), jpa, pointer(D),
+                                     pointer(A), pointer(B), pointer(Dn), pointer(defects), pointer(out)))
     return Rows(out, shapes)

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from bindings._sr import ffi, lib
+from bindings.buffers import pointer
 from runtime.control import lqr
 from runtime.params import Params
 from tests.runtime.control.test_lqr import random_state, random_target
@@ -17,10 +18,6 @@ GAINS = lqr.LqrGains(v_min=0.2, v_max=0.4, n_speeds=2, kappa_max=0.5, n_curvatur
 @pytest.fixture(scope="module")
 def controller():
     return lqr.Lqr(PARAMS, 50.0, 0.5, GAINS)
-
-
-def _ptr(a):
-    return ffi.cast("double *", ffi.from_buffer(a))
 
 
 def _random_offsets(controller, rng):
@@ -46,11 +43,11 @@ def _mismatch(controller, samples=40, seed=3, offsets=None):
         plain, fed = ffi.new("sr_lqr_memory *", memory[0]), ffi.new("sr_lqr_memory *", memory[0])
         u, raw, raw_fed = np.empty(2), np.empty(2), np.empty(2)
         c_target = lqr.c_target(target)
-        assert lib.sr_lqr_control(controller._c, controller._model._model, _ptr(x), c_target, plain, _ptr(u),
-                                  _ptr(raw)) == lib.SR_OK
+        assert lib.sr_lqr_control(controller._c, controller._model._model, pointer(x), c_target, plain, pointer(u),
+                                  pointer(raw)) == lib.SR_OK
         given = controller.offsets() if offsets is None else offsets
-        assert lib.sr_lqr_control_offsets(controller._c, controller._model._model, _ptr(x), c_target, given, fed,
-                                          _ptr(u), _ptr(raw_fed)) == lib.SR_OK
+        assert lib.sr_lqr_control_offsets(controller._c, controller._model._model, pointer(x), c_target, given, fed,
+                                          pointer(u), pointer(raw_fed)) == lib.SR_OK
         assert np.array_equal(u, np.clip(raw_fed, -0.5, 0.5))
         same_memory &= bytes(ffi.buffer(plain)) == bytes(ffi.buffer(fed))
         controller._memory.kappa = fed.kappa
@@ -93,10 +90,10 @@ def test_without_the_offsets_the_law_is_sr_lqr_control(controller):
     rng = np.random.default_rng(5)
     x, target = random_state(rng), random_target(rng, path=True)
     out = []
-    for call in (lambda m, u, r: lib.sr_lqr_control(controller._c, controller._model._model, _ptr(x),
-                                                    lqr.c_target(target), m, _ptr(u), _ptr(r)),
-                 lambda m, u, r: lib.sr_lqr_control_offsets(controller._c, controller._model._model, _ptr(x),
-                                                            lqr.c_target(target), ffi.NULL, m, _ptr(u), _ptr(r))):
+    for call in (lambda m, u, r: lib.sr_lqr_control(controller._c, controller._model._model, pointer(x),
+                                                    lqr.c_target(target), m, pointer(u), pointer(r)),
+                 lambda m, u, r: lib.sr_lqr_control_offsets(controller._c, controller._model._model, pointer(x),
+                                                            lqr.c_target(target), ffi.NULL, m, pointer(u), pointer(r))):
         u, r = np.empty(2), np.empty(2)
         assert call(ffi.new("sr_lqr_memory *"), u, r) == lib.SR_OK
         out.append(np.concatenate([u, r]))
@@ -127,6 +124,6 @@ def test_non_finite_offsets_are_refused_and_nothing_is_written(controller):
     offsets.pendulum[2] = float("inf")
     memory = ffi.new("sr_lqr_memory *")
     u = np.full(2, 7.0)
-    assert lib.sr_lqr_control_offsets(controller._c, controller._model._model, _ptr(x), lqr.c_target(target),
-                                      offsets, memory, _ptr(u), ffi.NULL) == lib.SR_ERR_NONFINITE
+    assert lib.sr_lqr_control_offsets(controller._c, controller._model._model, pointer(x), lqr.c_target(target),
+                                      offsets, memory, pointer(u), ffi.NULL) == lib.SR_ERR_NONFINITE
     assert np.all(u == 7.0) and memory.started == 0
