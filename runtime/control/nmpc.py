@@ -541,6 +541,28 @@ class NmpcC(Nmpc):
         """The C controller's memory (`sr_nmpc_memory`, cffi): the last solution and the last QP."""
         return self._memory
 
+    def hand_memory_to(self, other):
+        """Sets `other`, a Python `Nmpc` of the same design, to this controller's memory: the guess,
+        the last torques, the reference heading, the integral, the offsets, the last sample and the
+        sample count, so that `other.compute` solves the next sample from where this one does (the
+        two formulations compared sample by sample: runtime/control/nmpc_c.py, `lockstep_gaps`).
+        Flat models without the slope estimate only (the memory holds the offsets less the slope's share)."""
+        if self._slope_schedule is not None or other._slope_schedule is not None:
+            raise ValueError("hand_memory_to: the memory holds the torque offset less the slope's feedforward; "
+                             "only flat models without the slope estimate are handed over")
+        m, n = self._memory, self.n
+        if other.n != n or other.node_periods != self.node_periods:
+            raise ValueError(f"hand_memory_to: the other NMPC has {other.n} nodes of {other.node_periods} periods, "
+                             f"this one {n} of {self.node_periods}")
+        real = lambda field, size: np.array(list(getattr(m, field))[:size])     # noqa: E731
+        other.samples = m.samples
+        other._guess = ((real("Z", (n + 1) * NZ_N).reshape(n + 1, NZ_N), real("U", 2 * n).reshape(n, 2))
+                        if m.have_guess else None)
+        other._u_last = real("u_last", 2) if m.have_u_last else None
+        other._heading, other.integral = m.heading, m.integral
+        other.disturbance, other.shell_accel = real("disturbance", 2), real("shell_accel", 3)
+        other._last = (real("z_last", NZ_N), real("u_last", 2), m.v_last, m.kappa_last) if m.have_last else None
+
     def compute(self, t, x, target):
         """The torques of one sample of `sr_nmpc_step` for state x and the target."""
         from bindings.buffers import pointer

@@ -171,6 +171,36 @@ def recorded_qps(task, samples):
     return qps
 
 
+def lockstep_gaps(task, start, stop, **python_gains):
+    """The C NMPC's closed loop of `task` (its NMPC run as nmpc-c) up to `stop` s; at every sample from
+    `start` s on, the Python NMPC (the task's settings, `python_gains` changed), handed the C NMPC's
+    memory before the sample (`NmpcC.hand_memory_to`), solves the same sample.  Returns the
+    per-sample largest |u_Python − u_C| [N m] of those samples: how far the two formulations part on
+    one sample, without the drift of two closed loops apart (docs/control.md, "Equal to the Python NMPC")."""
+    import dataclasses
+    from .closed_loop import simulate_closed_loop
+    from .offsets import with_controller
+    task = with_controller(task, "nmpc-c")
+    spec = task.controllers[0]
+    controller = task.controller()
+    python = dataclasses.replace(task, controllers=(dataclasses.replace(
+        spec, kind="nmpc", gains=dataclasses.replace(spec.gains, **python_gains)),)).controller()
+    compute, gaps = controller.compute, []
+
+    def both(t, x, target):
+        if t < start - 1e-9:
+            return compute(t, x, target)
+        controller.hand_memory_to(python)
+        theirs = np.asarray(python.compute(t, x, target), dtype=float)
+        ours = np.asarray(compute(t, x, target), dtype=float)
+        gaps.append(float(np.max(np.abs(theirs - ours))))
+        return ours
+    controller.compute = both
+    simulate_closed_loop(task.plant_params, controller, task.reference(), task.scenario.x0, stop, task.scenario.dt,
+                         task.scenario.method)
+    return np.array(gaps)
+
+
 def daqp_solution(H, g, lb, ub):
     """DAQP's solution of min ½xᵀHx + gᵀx, lb ≤ x ≤ ub (its Python package), and its exit flag."""
     import ctypes

@@ -12,8 +12,9 @@ from runtime.casadi_model import parameter_vector
 from runtime.control import nmpc
 from runtime.control.benchmark import run_task
 from conftest import ROOT
-from runtime.control.nmpc_c import (FIRMWARE_HORIZON, FIRMWARE_NODE_PERIODS, daqp_solution, design_initializer, main,
-                                    ratio_line, recorded_qps, task_header)
+from runtime.control.nmpc_c import (FIRMWARE_HORIZON, FIRMWARE_NODE_PERIODS, daqp_solution, design_initializer,
+                                    lockstep_gaps, main, ratio_line, recorded_qps, task_header)
+from runtime.control.offsets import with_controller
 from runtime.control.task import load_task
 from runtime.params import Params
 
@@ -117,7 +118,6 @@ def _figure8_meeting_error(**gains):
     """The largest cross-track error [m] of the C NMPC on the nominal figure eight (the task file's
     settings, `gains` changed) from 40 s to 60 s: the lobes meet at about 42 s."""
     from runtime.control.closed_loop import simulate_closed_loop
-    from runtime.control.offsets import with_controller
     from runtime.state import IDX_Q
     task = with_controller(load_task("figure8"), "nmpc-c")
     spec = task.controllers[0]
@@ -139,6 +139,32 @@ def test_the_c_nmpc_holds_the_figure_eight_where_its_lobes_meet():
 def test_the_lobes_meeting_check_fails_with_the_cross_track_error_sized_as_elsewhere():
     # Sized 0.15 m (the default), the plan keeps to the operating points' jump of lean and drifts about 0.14 m.
     assert _figure8_meeting_error(cross_track_m=0.15) > 0.08
+
+
+def _meeting_lockstep_median(**python_gains):
+    """The median per-sample torque gap [N m] of the Python NMPC handed the C NMPC's memory, over the
+    figure eight's lobes meeting (40-46 s; runtime/control/nmpc_c.py, `lockstep_gaps`)."""
+    return float(np.median(lockstep_gaps(load_task("figure8"), 40.0, 46.0, **python_gains)))
+
+
+def test_the_python_nmpc_handed_the_c_memory_solves_the_figure_eights_meeting_as_the_c_nmpc():
+    # Sample by sample the two formulations agree (measured 2.9e-4 N m median, 9.4e-3 at worst) where
+    # their closed loops part (docs/control.md, "Equal to the Python NMPC").
+    assert _meeting_lockstep_median() < 1e-3
+
+
+def test_the_lockstep_check_fails_for_a_python_nmpc_with_its_cross_track_error_sized_5_percent_larger():
+    # cross_track_m 0.021 instead of 0.02 in the Python NMPC alone: 3.8e-3 N m median.
+    assert _meeting_lockstep_median(cross_track_m=0.021) > 1e-3
+
+
+def test_handing_the_memory_over_refuses_a_sloped_model():
+    task = load_task("circle").with_controller("nmpc")
+    sloped = dataclasses.replace(task, scenario=dataclasses.replace(
+        task.scenario, params=task.scenario.params.replace(slope=0.05)))
+    c_task_ = with_controller(sloped, "nmpc-c")
+    with pytest.raises(ValueError, match="slope"):
+        c_task_.controller().hand_memory_to(sloped.controller())
 
 
 def test_a_horizon_beyond_the_c_capacity_is_named():
