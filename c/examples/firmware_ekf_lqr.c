@@ -89,15 +89,6 @@ typedef struct tick_count {
     int n;
 } tick_count;
 
-static void report_ticks(tick_count *c, double per_tick)
-{
-    if (c->n < 2) return;
-    qsort(c->ticks + 1, (size_t)(c->n - 1), sizeof c->ticks[0], by_ticks);
-    fprintf(stderr, "instructions per tick (the slope estimate and the law): first %.0f; the other %d: p50 %.0f, "
-            "max %.0f\n", per_tick * (double)c->ticks[0], c->n - 1, per_tick * (double)c->ticks[c->n / 2],
-            per_tick * (double)c->ticks[c->n - 1]);
-}
-
 static tick_count law_counts;
 #endif
 #endif
@@ -240,7 +231,7 @@ int main(void)
 #ifdef HAVE_SYSTICK
     report(&counts, per_tick);
 #ifdef LQR_TASK_SLOPE_ESTIMATE_S
-    report_ticks(&law_counts, per_tick);
+    report_first_and_rest("tick", "the slope estimate and the law", law_counts.ticks, law_counts.n, per_tick);
 #endif
 #endif
     return 0;

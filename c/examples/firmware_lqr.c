@@ -24,7 +24,6 @@
  * Exit status 0 on success; on an error, a message on stderr and 1.
  */
 #include <stdio.h>
-#include <stdlib.h>
 
 /* -DLQR_TASK_FROM_INCLUDE_PATH -I<dir>: another task's header from <dir> (the tests do this, through
  * c/Makefile's CPPFLAGS, which come before the library's include directories). */
@@ -123,13 +122,8 @@ int main(void)
     }
     print_row(LQR_TASK_SAMPLES * PER, x, u);
 #if defined(LQR_TASK_SLOPE_ESTIMATE_S) && defined(HAVE_SYSTICK)
-    {
-        const double per_tick = instructions_per_tick();
-        qsort(sample_ticks + 1, LQR_TASK_SAMPLES - 1, sizeof sample_ticks[0], by_ticks);
-        fprintf(stderr, "instructions per sample (the slope estimate and the law): first %.0f; the other %ld: "
-                "p50 %.0f, max %.0f\n", per_tick * (double)sample_ticks[0], LQR_TASK_SAMPLES - 1,
-                per_tick * (double)sample_ticks[LQR_TASK_SAMPLES / 2], per_tick * (double)sample_ticks[LQR_TASK_SAMPLES - 1]);
-    }
+    report_first_and_rest("sample", "the slope estimate and the law", sample_ticks, LQR_TASK_SAMPLES,
+                          instructions_per_tick());
 #endif
     return 0;
 }

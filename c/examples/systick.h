@@ -10,6 +10,8 @@
 #if defined(__ARM_ARCH_7M__) || defined(__ARM_ARCH_7EM__)
 #define HAVE_SYSTICK 1
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 
 /* SysTick (Armv7-M): a 24-bit down-counter of the processor clock, free-running, no interrupt. */
 #define SYST_CSR (*(volatile uint32_t *)0xE000E010u)
@@ -39,6 +41,16 @@ static inline int by_ticks(const void *a, const void *b)
 {
     const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
     return (x > y) - (x < y);
+}
+
+/* One line on stderr, "instructions per <unit> (<what>): first F; the other N: p50 P, max M", for the
+ * tick counts of n samples (the first, a cold start, apart; ticks[1..n-1] sorted in place). */
+static inline void report_first_and_rest(const char *unit, const char *what, uint32_t *ticks, long n, double per_tick)
+{
+    if (n < 2) return;
+    qsort(ticks + 1, (size_t)(n - 1), sizeof ticks[0], by_ticks);
+    fprintf(stderr, "instructions per %s (%s): first %.0f; the other %ld: p50 %.0f, max %.0f\n", unit, what,
+            per_tick * (double)ticks[0], n - 1, per_tick * (double)ticks[n / 2], per_tick * (double)ticks[n - 1]);
 }
 #endif
 

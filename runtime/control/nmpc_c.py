@@ -12,6 +12,7 @@ initializer designed for the task's robot exactly as `NmpcC` builds it, the task
 the circle (centre, radius), dt and the rates.  Doubles are printed with %.17g.
 """
 import argparse
+import dataclasses
 import datetime
 import json
 import pathlib
@@ -68,7 +69,6 @@ def design_initializer(controller, name="NMPC_DESIGN"):
 def c_task(task_name, horizon=None, node_periods=None):
     """The task with its NMPC run by the C NMPC (kind nmpc-c, the same settings), on `horizon` nodes
     of `node_periods` controller periods where given (else the task's)."""
-    import dataclasses
     from .task import load_task
     task = load_task(task_name).with_controller("nmpc")
     spec = task.controllers[0]
@@ -129,7 +129,6 @@ def python_timing(task_name, seconds, kind="nmpc"):
     """(p50, p99) [ms] of one controller sample as called from Python (the closed loop's own timing,
     `solve_ms`), over the first `seconds` of the task's closed loop, for the controller `kind`
     (nmpc: the Python NMPC; nmpc-c: the C NMPC through cffi)."""
-    import dataclasses
     from .benchmark import run_task
     from .task import load_task
     task = load_task(task_name).with_controller("nmpc")
@@ -177,7 +176,6 @@ def lockstep_gaps(task, start, stop, **python_gains):
     memory before the sample (`NmpcC.hand_memory_to`), solves the same sample.  Returns the
     per-sample largest |u_Python − u_C| [N m] of those samples: how far the two formulations part on
     one sample, without the drift of two closed loops apart (docs/control.md, "Equal to the Python NMPC")."""
-    import dataclasses
     from .closed_loop import simulate_closed_loop
     from .offsets import with_controller
     task = with_controller(task, "nmpc-c")
